@@ -1,0 +1,240 @@
+"""Put a reduced link into an Exudyn system.
+
+The link is placed from its two eye centres: its frame origin sits at eye A,
+its x axis points at eye B, its z axis (the bore axis) is the requested
+``bore_axis`` made perpendicular. A flexible link becomes an
+``ObjectFFRFreducedOrder`` (C++ path; Euler-parameter frame node); a rigid
+link an ``ObjectRigidBody`` with the same mass properties. Either way the
+link gets one position marker per eye, on the master node only (markers on
+every bore node were measured 3-8 x slower).
+
+A link with ball joints at both eyes can spin freely about its own axis, and
+a static solve then fails or returns absurd forces. A soft torsional spring
+to ground about the link axis removes that motion; its stiffness is chosen
+from the link's spin inertia so that it adds one mode at
+``spin_frequency_hz``, far below the excitation band. Ball hinges pass no
+moment, so no hinge force depends on it.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .reduced import ReducedLink
+
+__all__ = ["ExudynLink", "add_link_to_exudyn", "link_rotation", "DEFAULT_SPIN_FREQUENCY_HZ"]
+
+#: Frequency of the spin mode the torsional restraint adds, Hz.
+DEFAULT_SPIN_FREQUENCY_HZ = 1.0
+#: A link whose eye distance differs more than this from its end points is rejected, m.
+LENGTH_TOLERANCE = 1e-6
+
+
+@dataclass(frozen=True)
+class ExudynLink:
+    """Item numbers of a link in an Exudyn system.
+
+    Attributes
+    ----------
+    name : str
+    flexible : bool
+    body : int
+        ``ObjectFFRFreducedOrder`` or ``ObjectRigidBody`` number.
+    nodes : tuple of int
+        Frame (rigid-body) node, then the modal node of a flexible link.
+    marker_a, marker_b : int
+        Position markers at the eye centres.
+    spin_restraint : int
+        ``ObjectConnectorTorsionalSpringDamper`` number.
+    spin_stiffness : float
+        Torsional stiffness of the restraint, N m/rad.
+    spin_frequency_hz : float
+        Frequency of the spin mode it adds, Hz.
+    dof : int
+        Degrees of freedom of the body (6 + modal coordinates).
+    mass : float
+        kg.
+    rotation : ndarray, shape (3, 3)
+        Link frame to global.
+    """
+
+    name: str
+    flexible: bool
+    body: int
+    nodes: tuple
+    marker_a: int
+    marker_b: int
+    spin_restraint: int
+    spin_stiffness: float
+    spin_frequency_hz: float
+    dof: int
+    mass: float
+    rotation: np.ndarray
+
+
+def link_rotation(end_a, end_b, bore_axis=None) -> np.ndarray:
+    """Rotation from the link frame to global coordinates.
+
+    Parameters
+    ----------
+    end_a, end_b : array_like, shape (3,)
+        Global positions of the eye centres, m.
+    bore_axis : array_like, shape (3,), optional
+        Wanted direction of the bore axis (link z). Default: global x
+        (heading), or global y when the link itself runs along x.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Columns are the link's x, y, z axes in global coordinates.
+    """
+    ex = np.asarray(end_b, dtype=float) - np.asarray(end_a, dtype=float)
+    ex /= np.linalg.norm(ex)
+    if bore_axis is None:
+        bore_axis = [1.0, 0.0, 0.0] if abs(ex[0]) < 0.9 else [0.0, 1.0, 0.0]
+    ez = np.asarray(bore_axis, dtype=float)
+    ez = ez - ex * (ez @ ex)
+    norm = np.linalg.norm(ez)
+    if norm < 1e-6:
+        raise ValueError(f"bore axis {list(bore_axis)} is parallel to the link axis {list(np.round(ex, 6))}")
+    ez /= norm
+    return np.column_stack([ex, np.cross(ez, ex), ez])
+
+
+def _homogeneous(rotation, translation) -> np.ndarray:
+    H = np.eye(4)
+    H[:3, :3] = rotation
+    H[:3, 3] = translation
+    return H
+
+
+#: Marker frame whose z axis is the link (node) x axis.
+_SPIN_AXIS_FRAME = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+
+
+def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping, mass_damping, name):
+    import exudyn as exu
+    from exudyn.FEM import ObjectFFRFreducedOrderInterface
+
+    from .reduced import FFRF_KEYS
+
+    cms = ObjectFFRFreducedOrderInterface()
+    n_modes = link.n_modes
+    data = {key: link.ffrf[key] for key in FFRF_KEYS}
+    data.update(
+        modeBasis=link.mode_basis,
+        trigList=link.surface_triangles.tolist(),
+        postProcessingModes={},
+        rigidBodyNodeType="NodeType.RotationEulerParameters",
+        infoList=np.array([n_modes, len(link.nodes), 3, 4, 7, 7 + n_modes]),
+    )
+    cms.SetWithDictionary(data)
+    items = cms.AddObjectFFRFreducedOrder(
+        mbs, positionRef=list(position), rotationMatrixRef=rotation,
+        stiffnessProportionalDamping=stiffness_damping, massProportionalDamping=mass_damping,
+        name=name,
+    )
+    body = items["oFFRFreducedOrder"]
+    markers = [
+        mbs.AddMarker(exu.itemInterface.MarkerSuperElementPosition(
+            bodyNumber=body, meshNodeNumbers=[int(i)], weightingFactors=[1.0]))
+        for i in link.master_nodes[:2]
+    ]
+    return body, (items["nRigidBody"], items["nGenericODE2"]), markers
+
+
+def _add_rigid(mbs, link: ReducedLink, position, rotation, name):
+    import exudyn as exu
+    from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters
+
+    eii = exu.itemInterface
+    node = mbs.AddNode(eii.NodeRigidBodyEP(
+        referenceCoordinates=list(position) + list(RotationMatrix2EulerParameters(rotation)),
+        name=f"NodeRigidBody:{name}" if name else "",
+    ))
+    inertia = link.inertia_at_origin
+    body = mbs.AddObject(eii.ObjectRigidBody(
+        name=name, nodeNumber=node, mass=link.mass, centerOfMass=list(link.centre_of_mass),
+        inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[1, 2], inertia[0, 2], inertia[0, 1]],
+    ))
+    markers = [
+        mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=body, localPosition=list(link.master_position(i))))
+        for i in range(2)
+    ]
+    return body, (node,), markers
+
+
+def add_link_to_exudyn(
+    mbs,
+    link: ReducedLink,
+    end_a,
+    end_b,
+    *,
+    flexible: bool = True,
+    bore_axis=None,
+    stiffness_damping: float = 0.0,
+    mass_damping: float = 0.0,
+    spin_frequency_hz: float = DEFAULT_SPIN_FREQUENCY_HZ,
+    name: str = "",
+) -> ExudynLink:
+    """Add a reduced link between two eye centres.
+
+    Parameters
+    ----------
+    mbs : exudyn.MainSystem
+    link : ReducedLink
+    end_a, end_b : array_like, shape (3,)
+        Global positions of the centres of eye A and eye B, m. Their distance
+        must equal the link's eye distance.
+    flexible : bool
+        Flexible (``ObjectFFRFreducedOrder``) or rigid body.
+    bore_axis : array_like, optional
+        Wanted bore-axis direction, see :func:`link_rotation`.
+    stiffness_damping : float
+        Rayleigh stiffness-proportional damping of the modal coordinates, s.
+    mass_damping : float
+        Rayleigh mass-proportional damping of the modal coordinates, 1/s.
+    spin_frequency_hz : float
+        Frequency of the spin mode the torsional restraint adds, Hz.
+    name : str
+        Name of the Exudyn items.
+
+    Returns
+    -------
+    ExudynLink
+    """
+    import exudyn as exu
+
+    eii = exu.itemInterface
+    end_a = np.asarray(end_a, dtype=float)
+    end_b = np.asarray(end_b, dtype=float)
+    distance = float(np.linalg.norm(end_b - end_a))
+    if abs(distance - link.length) > LENGTH_TOLERANCE:
+        raise ValueError(
+            f"link {name!r}: its eyes are {link.length * 1e3:.3f} mm apart but its end points "
+            f"are {distance * 1e3:.3f} mm apart"
+        )
+    if not spin_frequency_hz > 0:
+        raise ValueError(f"link {name!r}: spin_frequency_hz must be > 0, got {spin_frequency_hz}")
+    rotation = link_rotation(end_a, end_b, bore_axis)
+    if flexible:
+        body, nodes, markers = _add_flexible(mbs, link, end_a, rotation, stiffness_damping, mass_damping, name)
+    else:
+        body, nodes, markers = _add_rigid(mbs, link, end_a, rotation, name)
+
+    spin_inertia = float(link.inertia_at_origin[0, 0])
+    spin_stiffness = spin_inertia * (2 * np.pi * spin_frequency_hz) ** 2
+    ground = mbs.AddObject(eii.ObjectGround(referencePosition=list(end_a)))
+    m_link = mbs.AddMarker(eii.MarkerNodeRigid(nodeNumber=nodes[0], localHT=_homogeneous(_SPIN_AXIS_FRAME, np.zeros(3))))
+    m_ground = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=ground, localHT=_homogeneous(rotation @ _SPIN_AXIS_FRAME, np.zeros(3))))
+    spin = mbs.AddObject(eii.ObjectConnectorTorsionalSpringDamper(
+        markerNumbers=[m_link, m_ground], stiffness=spin_stiffness,
+        visualization=eii.VObjectConnectorTorsionalSpringDamper(show=False),
+    ))
+    return ExudynLink(
+        name=name, flexible=flexible, body=body, nodes=nodes,
+        marker_a=markers[0], marker_b=markers[1], spin_restraint=spin,
+        spin_stiffness=spin_stiffness, spin_frequency_hz=float(spin_frequency_hz),
+        dof=link.dof if flexible else 6, mass=link.mass, rotation=rotation,
+    )

@@ -1,0 +1,150 @@
+"""From an FE model of a link to a :class:`~flexbodies.reduced.ReducedLink`.
+
+Steps: tie the bores to master nodes (:mod:`~flexbodies.interfaces`),
+compute the reference frequencies of the coupled FE model
+(:mod:`~flexbodies.frequencies`), build the Craig-Bampton basis the mode
+decision asks for (:mod:`~flexbodies.craig_bampton`), orthonormalise it
+into elastic modes and let Exudyn compute the floating-frame invariants.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .craig_bampton import craig_bampton, elastic_modes
+from .frequencies import free_free_frequencies, mounted_frequencies
+from .interfaces import InterfaceCoupling, couple_interfaces
+from .reduced import FFRF_KEYS, ReducedLink
+from .selection import ModeDecision
+
+__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "ffrf_invariants"]
+
+
+@dataclass(frozen=True)
+class CoupledModel:
+    """An FE model with its bores tied to master nodes.
+
+    Attributes
+    ----------
+    fe_model : FEModel
+    coupling : InterfaceCoupling
+    stiffness, mass : scipy.sparse.csr_matrix
+        ``T^T K T`` and ``T^T M T`` in coupled coordinates.
+    """
+
+    fe_model: object
+    coupling: InterfaceCoupling
+    stiffness: sp.csr_matrix
+    mass: sp.csr_matrix
+
+
+def couple(fe_model, kind: str = "RBE2") -> CoupledModel:
+    """Tie the bores of ``fe_model`` to master nodes (``"RBE2"`` or ``"RBE3"``)."""
+    coupling = couple_interfaces(fe_model, kind)
+    return CoupledModel(fe_model, coupling, coupling.reduce(fe_model.stiffness), coupling.reduce(fe_model.mass))
+
+
+def reference_frequencies(coupled: CoupledModel, count: int = 6) -> dict:
+    """Free-free and as-mounted frequencies of the coupled FE model, Hz."""
+    return {
+        "free_free_hz": free_free_frequencies(coupled.stiffness, coupled.mass, count),
+        "mounted_hz": mounted_frequencies(coupled.stiffness, coupled.mass, coupled.coupling, count=3),
+    }
+
+
+def _padded(matrix: sp.spmatrix, extra: int) -> sp.csr_matrix:
+    """A square matrix with ``extra`` zero rows and columns appended."""
+    return sp.block_diag((matrix, sp.csr_matrix((extra, extra))), format="csr")
+
+
+def ffrf_invariants(nodes, mass, stiffness, mode_basis, triangles) -> dict:
+    """Floating-frame inertia invariants, computed by Exudyn.
+
+    Parameters
+    ----------
+    nodes : ndarray, shape (n, 3)
+        Node positions in the body frame, m.
+    mass, stiffness : scipy.sparse matrix, shape (3n, 3n)
+        Node-major mass (kg) and stiffness (N/m).
+    mode_basis : ndarray, shape (3n, m)
+        Elastic modes, no rigid-body motion.
+    triangles : ndarray of int, shape (k, 3)
+        Surface triangles for drawing.
+
+    Returns
+    -------
+    dict
+        The arrays of :data:`~flexbodies.reduced.FFRF_KEYS`.
+    """
+    from exudyn.FEM import FEMinterface, ObjectFFRFreducedOrderInterface
+
+    fem = FEMinterface()
+    fem.nodes = {"Position": np.asarray(nodes, dtype=float)}
+    # Exudyn needs scipy's csr_matrix, not csr_array.
+    fem.massMatrix = sp.csr_matrix(mass)
+    fem.stiffnessMatrix = sp.csr_matrix(stiffness)
+    fem.surface = [{"Name": "surface", "Trigs": np.asarray(triangles, dtype=int)}]
+    fem.modeBasis = {"matrix": np.asarray(mode_basis, dtype=float), "type": "HCBmodes"}
+    cms = ObjectFFRFreducedOrderInterface(fem)
+    data = cms.GetDictionary()
+    return {key: np.asarray(data[key], dtype=float) for key in FFRF_KEYS}
+
+
+def reduce_coupled(coupled: CoupledModel, decision: ModeDecision, frequencies: dict, info: dict) -> ReducedLink:
+    """Craig-Bampton reduction of a coupled link for a resolved mode decision.
+
+    Parameters
+    ----------
+    coupled : CoupledModel
+    decision : ModeDecision
+        Gives the count or cut-off of fixed-interface modes.
+    frequencies : dict
+        Reference frequencies of the coupled model (:func:`reference_frequencies`).
+    info : dict
+        JSON-able facts about the inputs, stored with the link; reduction
+        timings and sizes are added.
+
+    Returns
+    -------
+    ReducedLink
+    """
+    start = time.perf_counter()
+    coupling = coupled.coupling
+    cb = craig_bampton(
+        coupled.stiffness, coupled.mass, coupling.boundary,
+        count=decision.count, cutoff_hz=decision.cutoff_hz,
+    )
+    modes_q, reduced_hz = elastic_modes(cb, coupled.stiffness, coupled.mass)
+    fe = coupled.fe_model
+    n_fe = len(fe.nodes)
+    n_if = len(coupling.names)
+    masters_t = coupling.master_dofs[:, :3]
+    mode_basis = np.vstack([coupling.transform @ modes_q, modes_q[masters_t.ravel()]])
+    nodes = np.vstack([fe.nodes, coupling.centres])
+    invariants = ffrf_invariants(
+        nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if),
+        mode_basis, fe.surface_triangles,
+    )
+    info = dict(info)
+    info.update(
+        coupling=coupling.kind,
+        fe_dof=int(fe.ndof),
+        coupled_dof=int(coupling.n_q),
+        fe_description=fe.description,
+        reduction_seconds=time.perf_counter() - start,
+    )
+    return ReducedLink(
+        nodes=nodes,
+        master_nodes=n_fe + np.arange(n_if),
+        interface_names=coupling.names,
+        interface_nodes=tuple(np.asarray(b.nodes) for b in fe.bores),
+        surface_triangles=np.asarray(fe.surface_triangles, dtype=int),
+        mode_basis=mode_basis,
+        ffrf=invariants,
+        frequencies={**frequencies, "fixed_interface_hz": cb.fixed_interface_hz, "reduced_hz": reduced_hz},
+        decision=decision,
+        info=info,
+    )

@@ -1,0 +1,1 @@
+"""Engine mount vibration isolation: cases, Exudyn scenes, answers and workbooks."""
