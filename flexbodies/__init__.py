@@ -12,7 +12,7 @@ The pieces, in the order a link passes through them::
 from .assembly import FEModel, assemble
 from .craig_bampton import CraigBamptonBasis, craig_bampton, elastic_modes
 from .eigen import natural_frequencies
-from .exudyn_body import ExudynLink, add_link_to_exudyn, link_rotation
+from .exudyn_body import ExudynLink, add_link_to_exudyn, export_exudyn_file, link_rotation
 from .geometry import LinkGeometry
 from .interfaces import InterfaceCoupling, couple_interfaces
 from .link import LinkModel, MeshSource, build_fe_model, default_cache_dir, reduce_link
@@ -23,7 +23,7 @@ from .selection import ModeDecision, decide_modes
 
 __all__ = [
     "FEModel", "assemble", "CraigBamptonBasis", "craig_bampton", "elastic_modes",
-    "natural_frequencies", "ExudynLink", "add_link_to_exudyn", "link_rotation",
+    "natural_frequencies", "ExudynLink", "add_link_to_exudyn", "export_exudyn_file", "link_rotation",
     "LinkGeometry", "InterfaceCoupling", "couple_interfaces", "LinkModel", "MeshSource",
     "build_fe_model", "default_cache_dir", "reduce_link", "STEEL", "TITANIUM", "Material",
     "material", "Bore", "BoreSpec", "LinkMesh", "load_mesh", "mesh_link", "ReducedLink",

@@ -15,9 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from .eigen import factorize
+from .eigen import factorize, lowest_modes
 
 __all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes"]
 
@@ -64,14 +63,10 @@ def _fixed_interface_modes(K_ii, M_ii, factor, count=None, cutoff_hz=None):
     n = K_ii.shape[0]
     if count == 0:
         return np.zeros(0), np.zeros((n, 0))
-    operator = factor.as_operator()
     k = count if count is not None else 8
     while True:
         k_eff = min(k, n - 2)
-        lam, vec = spla.eigsh(K_ii, k=k_eff, M=M_ii, sigma=0.0, which="LM", OPinv=operator)
-        order = np.argsort(lam)
-        freqs = np.sqrt(np.clip(lam[order], 0.0, None)) / (2 * np.pi)
-        vec = vec[:, order]
+        freqs, vec = lowest_modes(K_ii, M_ii, k_eff, 0.0, factor)
         if count is not None:
             return freqs, vec
         reached = np.flatnonzero(freqs >= cutoff_hz)

@@ -10,7 +10,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["factorize", "natural_frequencies", "free_dofs"]
+__all__ = ["factorize", "natural_frequencies", "free_dofs", "lowest_modes"]
 
 
 class _Factor:
@@ -18,19 +18,26 @@ class _Factor:
 
     def __init__(self, matrix: sp.spmatrix):
         self.shape = matrix.shape
+        self._matrix = sp.csr_matrix(matrix)
         self._lu = spla.splu(
             sp.csc_matrix(matrix),
             permc_spec="MMD_AT_PLUS_A",
             options={"SymmetricMode": True},
         )
 
+    def _refined(self, rhs: np.ndarray) -> np.ndarray:
+        # One step of iterative refinement recovers the digits that the
+        # ill-conditioning of coupled (RBE3) matrices costs.
+        x = self._lu.solve(rhs)
+        return x + self._lu.solve(rhs - self._matrix @ x)
+
     def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """Solve for a vector or for each column of a matrix."""
+        """Solve for a vector or for each column of a matrix, with one refinement step."""
         rhs = np.asarray(rhs, dtype=float)
         if rhs.ndim == 1:
-            return self._lu.solve(rhs)
+            return self._refined(rhs)
         # SuperLU on a 2-D right-hand side is slower than a loop over columns.
-        return np.column_stack([self._lu.solve(np.ascontiguousarray(c)) for c in rhs.T])
+        return np.column_stack([self._refined(np.ascontiguousarray(c)) for c in rhs.T])
 
     def as_operator(self) -> spla.LinearOperator:
         return spla.LinearOperator(self.shape, matvec=self._lu.solve, dtype=float)
@@ -47,8 +54,9 @@ def factorize(matrix: sp.spmatrix) -> _Factor:
     Returns
     -------
     factor
-        Object with ``solve(rhs)`` for a vector or a matrix of columns and
-        ``as_operator()`` for ARPACK's ``OPinv``.
+        Object with ``solve(rhs)`` for a vector or a matrix of columns (with
+        one step of iterative refinement) and ``as_operator()`` for ARPACK's
+        ``OPinv`` (plain solves).
     """
     return _Factor(matrix)
 
@@ -58,6 +66,44 @@ def free_dofs(ndof: int, fixed) -> np.ndarray:
     mask = np.ones(ndof, dtype=bool)
     mask[np.asarray(fixed, dtype=int)] = False
     return np.flatnonzero(mask)
+
+
+def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None):
+    """Eigenpairs of ``K x = lambda M x`` nearest to ``sigma``, by shift-invert Lanczos.
+
+    Parameters
+    ----------
+    stiffness, mass : scipy.sparse matrix, shape (n, n)
+    count : int
+        Number of eigenpairs (at most n - 2).
+    sigma : float
+        Shift, (rad/s)^2.
+    factor : optional
+        A factorisation of ``K - sigma M`` from :func:`factorize`, to reuse.
+
+    Returns
+    -------
+    frequencies_hz : ndarray, shape (count,)
+        ``sqrt(lambda) / 2 pi``, ascending; round-off negatives count as 0.
+    modes : ndarray, shape (n, count)
+        Mass-normalised.
+    """
+    n = stiffness.shape[0]
+    if factor is None:
+        factor = factorize((stiffness - sigma * mass).tocsc())
+    # A fixed start vector makes the modes, and every file made from them, reproducible.
+    start = np.random.default_rng(0).standard_normal(n)
+    lam, vec = spla.eigsh(
+        stiffness, k=min(count, n - 2), M=mass, sigma=sigma, which="LM",
+        OPinv=factor.as_operator(), v0=start,
+    )
+    order = np.argsort(lam)
+    return np.sqrt(np.clip(lam[order], 0.0, None)) / (2 * np.pi), vec[:, order]
+
+
+#: Default shift for free or supported bodies, Hz: negative and small, so that
+#: ``K - sigma M`` is regular even with rigid-body modes and the lowest modes converge first.
+DEFAULT_SHIFT_HZ = -10.0
 
 
 def natural_frequencies(stiffness, mass, count: int, *, fixed=(), shift_hz: float | None = None):
@@ -72,8 +118,10 @@ def natural_frequencies(stiffness, mass, count: int, *, fixed=(), shift_hz: floa
     fixed : sequence of int, optional
         DOF held at zero; their rows and columns are removed.
     shift_hz : float, optional
-        Shift of the shift-invert transformation in Hz. The default is a small
-        negative shift, which works for free (singular) and supported bodies.
+        Shift of the shift-invert transformation in Hz; a negative value means
+        a negative shift ``-(2 pi |shift_hz|)^2``. Default
+        :data:`DEFAULT_SHIFT_HZ`, which works for free (singular) and
+        supported bodies.
 
     Returns
     -------
@@ -88,18 +136,9 @@ def natural_frequencies(stiffness, mass, count: int, *, fixed=(), shift_hz: floa
     keep = free_dofs(n, fixed)
     Kf = K[keep][:, keep]
     Mf = M[keep][:, keep]
-    if shift_hz is None:
-        # A shift of -1 % of a typical frequency keeps K - sigma M regular for
-        # free bodies without distorting the lower spectrum.
-        scale = Kf.diagonal().mean() / Mf.diagonal().mean()
-        sigma = -1e-4 * scale
-    else:
-        sigma = (2 * np.pi * shift_hz) ** 2
-    factor = factorize((Kf - sigma * Mf).tocsc())
-    count = min(count, Kf.shape[0] - 2)
-    lam, vec = spla.eigsh(Kf, k=count, M=Mf, sigma=sigma, which="LM", OPinv=factor.as_operator())
-    order = np.argsort(lam)
-    lam = np.clip(lam[order], 0.0, None)
-    modes = np.zeros((n, count))
-    modes[keep] = vec[:, order]
-    return np.sqrt(lam) / (2 * np.pi), modes
+    shift_hz = DEFAULT_SHIFT_HZ if shift_hz is None else shift_hz
+    sigma = np.sign(shift_hz) * (2 * np.pi * shift_hz) ** 2
+    freqs, vec = lowest_modes(Kf, Mf, count, sigma)
+    modes = np.zeros((n, vec.shape[1]))
+    modes[keep] = vec
+    return freqs, modes

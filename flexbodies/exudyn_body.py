@@ -9,11 +9,16 @@ link gets one position marker per eye, on the master node only (markers on
 every bore node were measured 3-8 x slower).
 
 A link with ball joints at both eyes can spin freely about its own axis, and
-a static solve then fails or returns absurd forces. A soft torsional spring
-to ground about the link axis removes that motion; its stiffness is chosen
+a static solve then fails or returns absurd forces. A torsional spring to
+ground about the link axis removes that motion; its stiffness is chosen
 from the link's spin inertia so that it adds one mode at
-``spin_frequency_hz``, far below the excitation band. Ball hinges pass no
-moment, so no hinge force depends on it.
+``spin_frequency_hz``. The default puts that mode at 2 kHz, well above the
+rotor excitations (59 and 248.5 Hz) and the mount's modes. A restraint soft
+enough to sit below the band (1-2 Hz, 0.02-0.07 N m/rad on the test link)
+made Exudyn's Newton iteration diverge along the spin direction in several
+of the placements tried; from 100 Hz up every one converged. Ball hinges pass no
+moment and the spin does not move the hinge points, so no hinge force
+depends on it.
 """
 from __future__ import annotations
 
@@ -23,10 +28,10 @@ import numpy as np
 
 from .reduced import ReducedLink
 
-__all__ = ["ExudynLink", "add_link_to_exudyn", "link_rotation", "DEFAULT_SPIN_FREQUENCY_HZ"]
+__all__ = ["ExudynLink", "add_link_to_exudyn", "exudyn_cms_interface", "export_exudyn_file", "link_rotation", "DEFAULT_SPIN_FREQUENCY_HZ"]
 
 #: Frequency of the spin mode the torsional restraint adds, Hz.
-DEFAULT_SPIN_FREQUENCY_HZ = 1.0
+DEFAULT_SPIN_FREQUENCY_HZ = 2000.0
 #: A link whose eye distance differs more than this from its end points is rejected, m.
 LENGTH_TOLERANCE = 1e-6
 
@@ -113,23 +118,42 @@ def _homogeneous(rotation, translation) -> np.ndarray:
 _SPIN_AXIS_FRAME = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
-def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping, mass_damping, name):
-    import exudyn as exu
+def exudyn_cms_interface(link: ReducedLink, node_type: str = "NodeType.RotationEulerParameters"):
+    """Exudyn's ``ObjectFFRFreducedOrderInterface`` filled from a reduced link.
+
+    Parameters
+    ----------
+    link : ReducedLink
+    node_type : str
+        Rotation parametrisation of the frame node (Euler parameters by default).
+
+    Returns
+    -------
+    exudyn.FEM.ObjectFFRFreducedOrderInterface
+        Ready for ``AddObjectFFRFreducedOrder`` or ``SaveToFile``.
+    """
     from exudyn.FEM import ObjectFFRFreducedOrderInterface
 
     from .reduced import FFRF_KEYS
 
+    n_rot = 4 if node_type.endswith("EulerParameters") else 3
     cms = ObjectFFRFreducedOrderInterface()
-    n_modes = link.n_modes
     data = {key: link.ffrf[key] for key in FFRF_KEYS}
     data.update(
         modeBasis=link.mode_basis,
         trigList=link.surface_triangles.tolist(),
         postProcessingModes={},
-        rigidBodyNodeType="NodeType.RotationEulerParameters",
-        infoList=np.array([n_modes, len(link.nodes), 3, 4, 7, 7 + n_modes]),
+        rigidBodyNodeType=node_type,
+        infoList=np.array([link.n_modes, len(link.nodes), 3, n_rot, 3 + n_rot, 3 + n_rot + link.n_modes]),
     )
     cms.SetWithDictionary(data)
+    return cms
+
+
+def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping, mass_damping, name):
+    import exudyn as exu
+
+    cms = exudyn_cms_interface(link)
     items = cms.AddObjectFFRFreducedOrder(
         mbs, positionRef=list(position), rotationMatrixRef=rotation,
         stiffnessProportionalDamping=stiffness_damping, massProportionalDamping=mass_damping,
@@ -238,3 +262,37 @@ def add_link_to_exudyn(
         spin_stiffness=spin_stiffness, spin_frequency_hz=float(spin_frequency_hz),
         dof=link.dof if flexible else 6, mass=link.mass, rotation=rotation,
     )
+
+
+def export_exudyn_file(link: ReducedLink, path) -> "Path":
+    """Write a reduced link in Exudyn's own reduced-body format.
+
+    A plain Exudyn script loads it without this package::
+
+        from exudyn.FEM import ObjectFFRFreducedOrderInterface
+        cms = ObjectFFRFreducedOrderInterface()
+        cms.LoadFromFile("link.npz")
+        cms.AddObjectFFRFreducedOrder(mbs, positionRef=..., rotationMatrixRef=...)
+
+    The last two nodes are the master nodes of eye A and eye B, for
+    ``MarkerSuperElementPosition`` markers.
+
+    Parameters
+    ----------
+    link : ReducedLink
+    path : str or Path
+        Target file; ``.npz`` is appended when missing.
+
+    Returns
+    -------
+    Path
+        The file written.
+    """
+    from pathlib import Path
+
+    path = Path(path)
+    if path.suffix != ".npz":
+        path = path.with_name(path.name + ".npz")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    exudyn_cms_interface(link).SaveToFile(str(path))
+    return path

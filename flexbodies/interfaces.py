@@ -118,6 +118,8 @@ def _rbe3_rows(bore, nodes):
     """
     offsets = nodes[bore.nodes] - bore.centre
     weights = np.asarray(bore.weights, dtype=float)
+    # Corner nodes of 6-node triangles carry zero weight, up to round-off.
+    weights = np.where(np.abs(weights) <= 1e-12 * np.abs(weights).max(initial=0.0), 0.0, weights)
     if np.any(weights < 0) or weights.sum() <= 0:
         raise ValueError(f"bore {bore.name}: RBE3 weights must be non-negative with a positive sum")
     G = rigid_motion_rows(offsets)

@@ -32,7 +32,7 @@ import numpy as np
 from .assembly import FEModel, assemble
 from .geometry import LinkGeometry
 from .materials import STEEL, Material
-from .meshing import BoreSpec, load_mesh, mesh_link
+from .meshing import default_element_size, load_mesh, mesh_link
 from .reduced import SCHEMA_VERSION, ReducedLink, ReducedLinkFileError, load_reduced_link, package_version, save_reduced_link, with_decision
 from .reduction import couple, reduce_coupled, reference_frequencies
 from .selection import decide_modes
@@ -96,7 +96,8 @@ class LinkModel:
     def fingerprint(self) -> dict:
         """JSON-able description of every input; a mesh file enters by its SHA-256."""
         if self.geometry is not None:
-            shape = {"geometry": dataclasses.asdict(self.geometry), "element_size": self.element_size}
+            size = self.element_size if self.element_size is not None else default_element_size(self.geometry)
+            shape = {"geometry": dataclasses.asdict(self.geometry), "element_size": size}
         else:
             path = Path(self.mesh.path)
             try:

@@ -1,0 +1,95 @@
+"""Linear elastic, isotropic materials for the flexible links (SI units)."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["Material", "STEEL", "TITANIUM", "material"]
+
+
+@dataclass(frozen=True)
+class Material:
+    """An isotropic linear elastic material.
+
+    Parameters
+    ----------
+    name : str
+        Name used in reports and for :func:`material` look-up.
+    youngs_modulus : float
+        Young's modulus E in Pa; must be positive.
+    poisson_ratio : float
+        Poisson's ratio nu (dimensionless); must satisfy -1 < nu < 0.5.
+    density : float
+        Mass density rho in kg/m^3; must be positive.
+
+    Raises
+    ------
+    ValueError
+        If a value is not finite or lies outside its physical range.
+    """
+
+    name: str
+    youngs_modulus: float
+    poisson_ratio: float
+    density: float
+
+    def __post_init__(self):
+        _check_positive(self.name, "Young's modulus", self.youngs_modulus, "Pa")
+        _check_positive(self.name, "density", self.density, "kg/m^3")
+        nu = self.poisson_ratio
+        if not (math.isfinite(nu) and -1.0 < nu < 0.5):
+            raise ValueError(
+                f"material {self.name!r}: Poisson's ratio must lie strictly between -1 and 0.5 "
+                f"(0.5 would be incompressible), got {nu!r}"
+            )
+
+    @property
+    def lame_lambda(self) -> float:
+        """First Lame parameter lambda = E nu / ((1 + nu)(1 - 2 nu)), in Pa."""
+        e, nu = self.youngs_modulus, self.poisson_ratio
+        return e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
+
+    @property
+    def shear_modulus(self) -> float:
+        """Shear modulus G = E / (2 (1 + nu)), in Pa."""
+        return self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+
+
+def _check_positive(name: str, what: str, value: float, unit: str) -> None:
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise ValueError(f"material {name!r}: {what} must be a positive number in {unit}, got {value!r}")
+
+
+STEEL = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
+"""Structural steel: E = 210 GPa, nu = 0.3, rho = 7850 kg/m^3."""
+
+TITANIUM = Material("titanium", youngs_modulus=114e9, poisson_ratio=0.34, density=4430.0)
+"""Titanium alloy Ti-6Al-4V: E = 114 GPa, nu = 0.34, rho = 4430 kg/m^3."""
+
+_PRESETS = {m.name: m for m in (STEEL, TITANIUM)}
+
+
+def material(name: str) -> Material:
+    """Look up a preset material by name (case-insensitive).
+
+    Parameters
+    ----------
+    name : str
+        Preset name, e.g. ``"steel"`` or ``"Titanium"``.
+
+    Returns
+    -------
+    Material
+        The preset.
+
+    Raises
+    ------
+    ValueError
+        If no preset has that name; the message lists the known names.
+    """
+    key = str(name).strip().lower()
+    try:
+        return _PRESETS[key]
+    except KeyError:
+        known = ", ".join(sorted(_PRESETS))
+        raise ValueError(f"unknown material {name!r}; known materials: {known}") from None
