@@ -1,0 +1,124 @@
+"""Link reduction cost against mesh size: a table of medians.
+
+Each mesh size runs in a fresh process (so peak memory is that of the size
+alone) and repeats every stage; the table shows the median wall time of the
+repeats, in s, and the process's peak resident memory, in MB.
+
+Stages: mesh (gmsh), assembly (K and M), coupling (RBE2 transformation),
+factorisation of the interior stiffness (fill-reducing ordering, and
+scipy's default ordering for comparison), the fixed-interface eigen-solve
+(12 modes, reusing that factorisation) and the whole Craig-Bampton
+reduction with 12 modes (static modes, eigen-solve, orthonormalisation,
+Exudyn's floating-frame invariants). ``--exudyn`` adds Exudyn's own
+``ComputeHurtyCraigBamptonModes`` (RBE2, 12 modes) on the same matrices.
+
+Run::
+
+    python benchmarks/bench_reduction.py                 # 14, 10 and 7 mm
+    python benchmarks/bench_reduction.py --sizes 10 5 --repeats 3 --exudyn
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+#: The test link of the measured-facts sheet: steel, eyes 0.30 m apart, 40x25 mm shank.
+TEST_LINK = dict(length=0.30, eye_outer_radius=0.030, bore_radius=0.015, thickness=0.025,
+                 shank_width=0.040, shank_thickness=0.025)
+
+
+def _timed(function, repeats):
+    times, result = [], None
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = function()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), result
+
+
+def measure(size_mm: float, repeats: int, with_exudyn: bool) -> dict:
+    """All stages for one mesh size, in this process."""
+    import numpy as np
+    import scipy.sparse.linalg as spla
+
+    from flexbodies import STEEL, LinkGeometry, assemble, mesh_link
+    from flexbodies.craig_bampton import craig_bampton, elastic_modes
+    from flexbodies.eigen import factorize, lowest_modes
+    from flexbodies.reduction import couple, ffrf_invariants
+
+    geometry = LinkGeometry(**TEST_LINK)
+    row = {"size [mm]": size_mm}
+    row["mesh [s]"], link_mesh = _timed(lambda: mesh_link(geometry, size_mm * 1e-3), repeats)
+    row["assembly [s]"], fe = _timed(lambda: assemble(link_mesh, STEEL), repeats)
+    row["DOF"] = fe.ndof
+    row["coupling [s]"], coupled = _timed(lambda: couple(fe, "RBE2"), repeats)
+    K, M = coupled.stiffness, coupled.mass
+    interior = np.setdiff1d(np.arange(K.shape[0]), coupled.coupling.boundary)
+    K_ii = K[interior][:, interior].tocsc()
+    M_ii = M[interior][:, interior].tocsc()
+    row["factorise [s]"], factor = _timed(lambda: factorize(K_ii), repeats)
+    row["factorise, scipy default [s]"], _ = _timed(lambda: spla.splu(K_ii), repeats)
+    row["12 modes [s]"], _ = _timed(lambda: lowest_modes(K_ii, M_ii, 12, 0.0, factor), repeats)
+
+    def reduce_12():
+        cb = craig_bampton(K, M, coupled.coupling.boundary, count=12)
+        modes_q, _ = elastic_modes(cb, K, M)
+        return modes_q
+
+    row["CB, 12 modes [s]"], _ = _timed(reduce_12, repeats)
+    if with_exudyn:
+        from exudyn.FEM import FEMinterface, HCBstaticModeSelection
+
+        fem = FEMinterface()
+        fem.nodes = {"Position": fe.nodes}
+        fem.massMatrix, fem.stiffnessMatrix = fe.mass, fe.stiffness
+        bores = [list(map(int, b.nodes)) for b in fe.bores]
+        row["Exudyn CB, 12 modes [s]"], _ = _timed(
+            lambda: fem.ComputeHurtyCraigBamptonModes(bores, 12, computationMode=HCBstaticModeSelection.RBE2),
+            repeats,
+        )
+    modes = reduce_12()
+    row["invariants [s]"], _ = _timed(
+        lambda: ffrf_invariants(fe.nodes, fe.mass, fe.stiffness, coupled.coupling.transform @ modes, fe.surface_triangles),
+        repeats,
+    )
+    row["peak memory [MB]"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return row
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=float, nargs="+", default=[14.0, 10.0, 7.0], help="element sizes, mm")
+    parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--exudyn", action="store_true", help="also time Exudyn's ComputeHurtyCraigBamptonModes")
+    parser.add_argument("--one", type=float, help=argparse.SUPPRESS)  # a single size, in this process
+    args = parser.parse_args(argv)
+    if args.one is not None:
+        print(json.dumps(measure(args.one, args.repeats, args.exudyn)))
+        return
+    import pandas as pd
+
+    rows = []
+    for size in args.sizes:
+        command = [sys.executable, __file__, "--one", str(size), "--repeats", str(args.repeats)]
+        if args.exudyn:
+            command.append("--exudyn")
+        output = subprocess.run(command, check=True, capture_output=True, text=True).stdout
+        rows.append(json.loads(output.strip().splitlines()[-1]))
+        print(f"  {size:g} mm done", file=sys.stderr)
+    table = pd.DataFrame(rows).set_index("size [mm]")
+    print(f"Reduction of the 0.30 m steel test link, median of {args.repeats} repeats, 1 BLAS thread")
+    print(table.T.to_string(float_format=lambda v: f"{v:.3g}"))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,300 @@
+"""Reading and checking case workbooks: units, formulas, and the bad-input suite (issue 4)."""
+from __future__ import annotations
+
+import dataclasses
+import io
+import re
+import zipfile
+
+import pytest
+from openpyxl import load_workbook
+
+from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference, set_cells, sha256
+from workbook.cli import main
+from workbook.codec import to_dict
+from workbook.excel.reader import WorkbookError, read_workbook
+from workbook.excel.template import reference_workbook, template_workbook, write_workbook
+from workbook.excel.units import UnitProblem, si_factor
+from workbook.reference import reference_case
+
+
+def _numbers(case):
+    """Everything that decides a case's numbers (sweeps as their frequencies), as plain data."""
+    return to_dict(dataclasses.replace(case, excitations=case.single_frequency_excitations()))
+
+
+# -- units ------------------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("text, si_unit, factor", [
+    ("mm", "m", 1e-3), ("kN/mm", "N/m", 1e6), ("t", "kg", 1e3), ("rpm", "Hz", 1 / 60), ("1/min", "Hz", 1 / 60),
+    ("g", "m/s^2", 9.80665), ("g*mm", "kg*m", 1e-6), ("g", "kg", 1e-3), ("GPa", "Pa", 1e9), ("kN", "N", 1e3),
+    ("%", "-", 0.01), ("-", "-", 1.0), ("kN*s/mm", "N*s/m", 1e6), ("lbf", "N", 4.4482216152605),
+])
+def test_unit_factors(text, si_unit, factor):
+    assert si_factor(text, si_unit) == pytest.approx(factor, rel=1e-12)
+
+
+@pytest.mark.parametrize("text, si_unit", [("kg", "N/m"), ("mmm", "m"), ("", "m"), ("g", "m"), ("Hz", "-")])
+def test_bad_units(text, si_unit):
+    with pytest.raises(UnitProblem):
+        si_factor(text, si_unit)
+
+
+# -- generated workbooks ---------------------------------------------------------------------------------------
+
+
+def _members(path):
+    """Zip members and contents, without the save-time stamp (docProps/core.xml)."""
+    with zipfile.ZipFile(path) as archive:
+        return {name: archive.read(name) for name in archive.namelist() if name != "docProps/core.xml"}
+
+
+@pytest.mark.parametrize("make, committed", [(template_workbook, TEMPLATE), (reference_workbook, REFERENCE)])
+def test_committed_workbooks_are_what_the_code_generates(tmp_path, make, committed):
+    generated = write_workbook(make(), tmp_path / committed.name)
+    assert _members(generated) == _members(committed), \
+        f"{committed.name} is stale: regenerate it with `mountwb template {committed} [--reference]`"
+
+
+def test_reference_workbook_is_the_python_default():
+    book = read_workbook(REFERENCE)
+    assert _numbers(book.case) == _numbers(reference_case(sweep=True))
+    assert [(r.name, r.excitation) for r in book.runs] == [("LP rotor", "LP rotor"), ("HP rotor", "HP rotor"),
+                                                           ("sweep", "sweep")]
+    lp, hp = (book.run_case(run).excitations[0] for run in book.runs[:2])
+    assert (lp.frequency, lp.force_amplitude, hp.frequency, hp.force_amplitude) == (59.0, 1000.0, 248.5, 1000.0)
+    loads = {load.name: load for load in book.case.static_loads}
+    assert loads["thrust"].force == (23_000.0, 0.0, 0.0)
+    assert book.case.engine.mass * -loads["gravity"].acceleration[2] == pytest.approx(35_000, rel=1e-3)
+
+
+def test_template_has_units_drop_downs_and_instructions():
+    wb = load_workbook(TEMPLATE)
+    assert wb.sheetnames[0] == "Instructions"
+    links = wb["Links"]
+    assert links.cell(2, column_of(links, "eye outer radius")).value == "mm"
+    assert links.cell(2, column_of(links, "E")).value == "GPa"
+    lists = {str(dv.sqref): dv.formula1 for dv in links.data_validations.dataValidation}
+    letter = links.cell(1, column_of(links, "material")).column_letter
+    assert lists[f"{letter}3:{letter}500"] == '"steel,titanium"'
+    assert links.cell(3, column_of(links, "material")).value == "steel"
+    assert read_workbook(TEMPLATE).runs[3].fidelity == "rigid"
+
+
+def test_units_are_converted_on_reading(tmp_path):
+    path = copy_reference(tmp_path)
+    wb = load_workbook(path)
+    engine, hinges, excitations = wb["Engine"], wb["Hinges"], wb["Excitations"]
+    engine.cell(2, column_of(engine, "mass"), "t")
+    engine.cell(3, column_of(engine, "mass"), 3.568)
+    hinges.cell(2, column_of(hinges, "stiffness"), "kN/mm")
+    hinges.cell(3, column_of(hinges, "stiffness"), 20)
+    hinges.cell(2, column_of(hinges, "radial clearance"), "µm")
+    hinges.cell(3, column_of(hinges, "radial clearance"), 50)
+    excitations.cell(2, column_of(excitations, "frequency"), "rpm")
+    excitations.cell(3, column_of(excitations, "frequency"), 3540)
+    wb.save(path)
+    case = read_workbook(path).case
+    assert case.engine.mass == pytest.approx(3568.0, rel=1e-12)
+    assert case.hinges[0].stiffness == pytest.approx(2.0e7, rel=1e-12)
+    assert case.hinges[0].radial_clearance == pytest.approx(5e-5, rel=1e-12)
+    assert case.excitations[0].frequency == pytest.approx(59.0, rel=1e-12)
+
+
+def _with_cached_value(path, sheet_index, cell, value):
+    """Give the formula in *cell* of the *sheet_index*-th sheet a cached value, as Excel would."""
+    member = f"xl/worksheets/sheet{sheet_index}.xml"
+    with zipfile.ZipFile(path) as archive:
+        contents = {name: archive.read(name) for name in archive.namelist()}
+    xml = contents[member].decode()
+    xml, count = re.subn(rf'(<c r="{cell}"[^>]*>\s*<f>[^<]*</f>)\s*(<v\s*/>|<v></v>)?', rf"\1<v>{value}</v>", xml)
+    assert count == 1
+    contents[member] = xml.encode()
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in contents.items():
+            archive.writestr(name, data)
+
+
+def test_formula_cells_are_read_as_their_cached_values(tmp_path):
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Engine", "mass", 3): "=3000+568"})
+    _with_cached_value(path, 3, "A3", 3568)   # Instructions, Case, Engine
+    assert read_workbook(path).case.engine.mass == 3568.0
+
+
+# -- the bad-input suite ---------------------------------------------------------------------------------------
+
+
+def _edit(edits):
+    return lambda path: set_cells(path, edits)
+
+
+def _edit_wb(change):
+    def apply(path):
+        wb = load_workbook(path)
+        change(wb)
+        wb.save(path)
+    return apply
+
+
+def _hinge_row(wb, name):
+    ws = wb["Hinges"]
+    return next(r for r in range(3, ws.max_row + 1) if ws.cell(r, 1).value == name)
+
+
+def _move_hinge(wb):
+    ws = wb["Hinges"]
+    col = column_of(ws, "position x")
+    ws.cell(3, col, ws.cell(3, col).value + 0.005)
+
+
+def _write_bytes(data):
+    def apply(path):
+        path.write_bytes(data(path))
+    return apply
+
+
+def _zip_of_text(path):
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        archive.writestr("notes.txt", "not a workbook")
+    return buffer.getvalue()
+
+
+BAD_INPUTS = {
+    "missing sheet": (_edit_wb(lambda wb: wb.remove(wb["Hinges"])), ["sheet 'Hinges'"]),
+    "missing column": (_edit_wb(lambda wb: wb["Hinges"].delete_cols(column_of(wb["Hinges"], "stiffness"))),
+                       ["sheet 'Hinges'", "column 'stiffness'"]),
+    "text in a number cell": (_edit({("Hinges", "stiffness", 4): "stiff"}), ["sheet 'Hinges'", "cell G4", "'stiff'",
+                                                                             "a number"]),
+    "empty required cell": (_edit({("Links", "name", 4): None}), ["sheet 'Links'", "cell A4", "a value"]),
+    "zero mass": (_edit({("Engine", "mass", 3): 0}), ["sheet 'Engine'", "cell A3", "found 0"]),
+    "negative mass": (_edit({("Engine", "mass", 3): -5}), ["sheet 'Engine'", "cell A3", "found -5"]),
+    "negative stiffness": (_edit({("Hinges", "stiffness", 5): -2e7}), ["sheet 'Hinges'", "cell G5", "> 0"]),
+    "zero stiffness": (_edit({("Hinges", "stiffness", 6): 0}), ["sheet 'Hinges'", "cell G6"]),
+    "unknown unit": (_edit({("Links", "eye outer radius", 2): "mmm"}), ["sheet 'Links'", "cell M2", "'mmm'",
+                                                                        "a known unit"]),
+    "unit of the wrong dimension": (_edit({("Hinges", "stiffness", 2): "kg"}), ["cell G2", "'kg'", "stiffness"]),
+    "hinge naming an unknown body": (_edit({("Hinges", "body B", 3): "front-lefty"}),
+                                     ["sheet 'Hinges'", "cell C3", "'front-lefty'", "front-left"]),
+    "duplicate link names": (_edit({("Links", "name", 4): "front-left"}), ["sheet 'Links'", "cell A4",
+                                                                          "not used before (row 3)"]),
+    "duplicate hinge names": (_edit({("Hinges", "name", 9): "front-up-left"}), ["sheet 'Hinges'", "cell A9"]),
+    "hinge far from its link's eye": (_edit_wb(_move_hinge), ["sheet 'Hinges'", "cell D3:F3", "an eye centre",
+                                                              "5 mm away"]),
+    "missing mesh file": (_edit({("Links", "mesh file", 3): "meshes/front-left.msh"}),
+                          ["sheet 'Links'", "cell AB3", "'meshes/front-left.msh'", "mesh file"]),
+    "not an xlsx file": (_write_bytes(lambda p: b"name,mass\nengine,3568\n"), ["case.xlsx", "not a zip",
+                                                                              "Excel .xlsx workbook"]),
+    "corrupt zip": (_write_bytes(lambda p: p.read_bytes()[:3000]), ["case.xlsx", "Excel .xlsx"]),
+    "a zip that is not a workbook": (_write_bytes(_zip_of_text), ["case.xlsx", "readable Excel .xlsx"]),
+    "formula without a cached value": (_edit({("Engine", "mass", 3): "=3000+568"}),
+                                       ["sheet 'Engine'", "cell A3", "'=3000+568'", "calculated value"]),
+    "unknown material": (_edit({("Links", "material", 5): "unobtainium"}), ["cell I5", "steel, titanium"]),
+    "bad yes/no": (_edit({("Links", "flexible", 3): "maybe"}), ["sheet 'Links'", "cell U3", "yes or no"]),
+    "bad modes": (_edit({("Links", "modes", 3): "lots"}), ["sheet 'Links'", "cell T3", "mode count"]),
+    "length not matching the ends": (_edit({("Links", "length", 3): 0.3}), ["sheet 'Links'", "cell H3",
+                                                                            "distance between end A and end B"]),
+    "bore larger than the eye": (_edit({("Links", "bore radius", 3): 45}), ["sheet 'Links'", "cell M3:Q3",
+                                                                           "the bore radius (0.045 m)"]),
+    "too few steps per period": (_edit({("Case", "steps per period", 3): 4}), ["sheet 'Case'", "cell C3",
+                                                                               "at least 8"]),
+    "two rows in the Case sheet": (_edit({("Case", "name", 4): "second"}), ["sheet 'Case'", "row 4"]),
+    "misspelt column": (_edit({("Hinges", "damping", 1): "dampng"}), ["sheet 'Hinges'", "cell H1", "'dampng'"]),
+    "negative frequency": (_edit({("Excitations", "frequency", 3): -59}), ["sheet 'Excitations'", "cell F3"]),
+    "inertia not positive definite": (_edit({("Engine", "Ixy", 3): 5000}), ["sheet 'Engine'", "cell E3:J3",
+                                                                            "positive definite"]),
+    "sweep with a frequency": (_edit({("Excitations", "frequency", 5): 10}), ["sheet 'Excitations'", "cell F5",
+                                                                             "sweep"]),
+    "run of an unknown excitation": (_edit({("Runs", "excitation", 3): "IP rotor"}),
+                                     ["sheet 'Runs'", "cell B3", "'IP rotor'", "LP rotor"]),
+    "unknown fidelity": (_edit({("Runs", "fidelity", 4): "super"}), ["sheet 'Runs'", "cell E4", "rigid, static"]),
+    "frequency override on a sweep": (_edit({("Runs", "frequency", 5): 100}), ["sheet 'Runs'", "cell C5"]),
+    "negative gap": (_edit({("Runs", "gap", 3): -0.1}), ["sheet 'Runs'", "cell F3", ">= 0"]),
+    "test data of an unknown run": (_edit({("Test data", "run", 3): "IP rotor", ("Test data", "direction", 3): "y",
+                                           ("Test data", "amplitude", 3): 30}),
+                                    ["sheet 'Test data'", "cell A3", "'IP rotor'"]),
+    "no runs": (_edit_wb(lambda wb: wb["Runs"].delete_rows(3, 3)), ["sheet 'Runs'", "at least one run"]),
+}
+
+
+@pytest.mark.parametrize("name", list(BAD_INPUTS))
+def test_bad_input(tmp_path, capsys, name):
+    change, expected = BAD_INPUTS[name]
+    path = copy_reference(tmp_path)
+    change(path)
+    before, files = sha256(path), sorted(tmp_path.iterdir())
+    assert main(["check", str(path)]) == 2
+    message = capsys.readouterr().err
+    for text in expected:
+        assert text in message, f"{name}: {text!r} not in\n{message}"
+    assert main(["run", str(path), "--no-progress"]) == 2
+    assert sha256(path) == before, "the input was changed"
+    assert sorted(tmp_path.iterdir()) == files, "a file was written"
+
+
+def test_every_problem_is_reported_at_once(tmp_path):
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Engine", "mass", 3): "heavy", ("Hinges", "stiffness", 2): "kg",
+                     ("Links", "name", 5): "front-left", ("Runs", "fidelity", 3): "super"})
+    with pytest.raises(WorkbookError) as error:
+        read_workbook(path)
+    cells = {(p.sheet, p.cell) for p in error.value.problems}
+    assert {("Engine", "A3"), ("Hinges", "G2"), ("Links", "A5")} <= cells
+    # the run sheet is checked against the case once the case is valid
+    set_cells(path, {("Engine", "mass", 3): 3568, ("Hinges", "stiffness", 2): "N/m", ("Links", "name", 5): "rear-left"})
+    with pytest.raises(WorkbookError) as error:
+        read_workbook(path)
+    assert [(p.sheet, p.cell) for p in error.value.problems] == [("Runs", "E3")]
+
+
+def test_check_passes_the_shipped_workbooks(capsys):
+    for path in (REFERENCE, TEMPLATE):
+        assert main(["check", str(path)]) == 0
+    assert "OK - case 'reference mount': 8 links, 16 hinges" in capsys.readouterr().out
+
+
+def test_run_overrides(tmp_path):
+    path = tmp_path / "template.xlsx"
+    path.write_bytes(TEMPLATE.read_bytes())
+    set_cells(path, {("Runs", "hinge stiffness", 2): "kN/mm", ("Runs", "hinge stiffness", 5): 35,
+                     ("Runs", "amplitude", 5): 1.5, ("Runs", "amplitude", 2): "kN"})
+    book = read_workbook(path)
+    case = {run.name: book.run_case(run) for run in book.runs}
+    rigid = case["LP rotor, rigid links"]
+    assert not rigid.effects.flexible_links and [e.name for e in rigid.excitations] == ["LP rotor"]
+    assert {link.modes for link in case["HP rotor, 20 modes"].links} == {20}
+    assert case["HP rotor, 20 modes"].effects.flexible_links
+    assert [h.radial_clearance for h in case["LP rotor, 0.05 mm gap"].hinges] == pytest.approx([5e-5] * 16, rel=1e-12)
+    assert case["LP rotor at 4000 rpm"].excitations[0].frequency == pytest.approx(4000 / 60, rel=1e-12)
+    sweep = case["sweep"].excitations[0]
+    assert len(sweep.frequencies_hz) == 25 and sweep.frequencies_hz[0] == pytest.approx(5.0)
+    overridden = case["sweep"]
+    assert {h.stiffness for h in overridden.hinges} == {3.5e7}
+    assert {e.force_amplitude for e in overridden.single_frequency_excitations()} == {1500.0}
+    assert {h.stiffness for h in case["LP rotor"].hinges} == {2.0e7}
+
+
+def test_mesh_link_and_missing_geometry_column(tmp_path):
+    path = copy_reference(tmp_path)
+    (tmp_path / "meshes").mkdir()
+    (tmp_path / "meshes" / "front-left.inp").write_text("*NODE\n")
+    set_cells(path, {("Links", "mesh file", 3): "meshes/front-left.inp", ("Links", "mesh unit", 3): "mm",
+                     ("Links", "bore A node set", 3): "BORE_A", ("Links", "bore B node set", 3): "BORE_B",
+                     ("Hinges", "body A", 3): "Pylon"})
+    case = read_workbook(path).case
+    mesh = case.links[0].model.mesh
+    assert case.links[0].model.geometry is None and case.hinges[0].body_a == "pylon"
+    assert mesh.path == str(tmp_path / "meshes" / "front-left.inp") and mesh.scale == pytest.approx(1e-3)
+    assert [b.node_set for b in mesh.bores] == ["BORE_A", "BORE_B"]
+    # a geometric bore needs its centre, axis and radius; the parametric links need their sizes
+    set_cells(path, {("Links", "bore B node set", 3): None})
+    wb = load_workbook(path)
+    wb["Links"].delete_cols(column_of(wb["Links"], "eye thickness"))
+    wb.save(path)
+    with pytest.raises(WorkbookError) as error:
+        read_workbook(path)
+    messages = [str(p) for p in error.value.problems]
+    assert sum("column 'eye thickness'" in m for m in messages) == 1
+    assert any("cell AH3, column 'mesh bore B x'" in m and "bore B of a mesh link" in m for m in messages)

@@ -1,0 +1,168 @@
+"""Amplitude at a known frequency from sampled force histories.
+
+Used on simulated hinge forces and on measured rig data alike, so it knows
+nothing about Exudyn: a history is a time vector and one or more signal
+columns. The amplitude at frequency f is the single-bin DFT of the
+mean-removed signal over a window of an integer number of periods,
+``A = 2/N |sum (x_k - mean) exp(-i 2 pi f t_k)|``, which is exact for a
+uniformly sampled sinusoid plus a constant.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["period_window", "harmonic_amplitude", "steady_amplitude", "SteadyAmplitude",
+           "amplitude_spectrum"]
+
+
+def period_window(time: np.ndarray, frequency_hz: float, periods: int, *, end: int | None = None) -> slice:
+    """Index range of the last *periods* whole periods ending at sample *end*.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Uniformly sampled times, s.
+    frequency_hz : float
+        Frequency whose periods count, Hz.
+    periods : int
+        Whole periods in the window.
+    end : int, optional
+        Index one past the window's last sample (default: the end).
+
+    Returns
+    -------
+    slice
+        ``time[window]`` spans ``periods / frequency_hz`` to within one sample.
+
+    Raises
+    ------
+    ValueError
+        If the history is shorter than the window or not uniformly sampled.
+    """
+    time = np.asarray(time, dtype=float)
+    end = len(time) if end is None else end
+    step = _uniform_step(time)
+    samples = int(round(periods / (frequency_hz * step)))
+    if samples < 2 or samples > end:
+        raise ValueError(f"a window of {periods} periods at {frequency_hz:g} Hz needs {samples} samples; "
+                         f"{end} available")
+    return slice(end - samples, end)
+
+
+def _uniform_step(time: np.ndarray) -> float:
+    steps = np.diff(time)
+    if len(steps) == 0 or steps.min() <= 0:
+        raise ValueError("time must increase")
+    step = float(np.median(steps))
+    if np.abs(steps - step).max() > 1e-6 * step + 1e-12:
+        raise ValueError("time must be uniformly sampled")
+    return step
+
+
+def harmonic_amplitude(time: np.ndarray, signals: np.ndarray, frequency_hz: float) -> np.ndarray:
+    """Complex amplitude of each signal column at *frequency_hz*.
+
+    The mean is removed first; the window should span whole periods.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Uniformly sampled times of the window, s.
+    signals : ndarray, shape (n,) or (n, k)
+        The sampled signals.
+    frequency_hz : float
+        Frequency of interest, Hz.
+
+    Returns
+    -------
+    ndarray, complex, shape () or (k,)
+        ``X`` with ``x(t) ~ mean + Re(X exp(i 2 pi f t))``; ``abs(X)`` is the
+        amplitude in the signals' unit.
+    """
+    time = np.asarray(time, dtype=float)
+    values = np.asarray(signals, dtype=float)
+    centred = values - values.mean(axis=0)
+    phasor = np.exp(-2j * np.pi * frequency_hz * time)
+    return 2.0 / len(time) * np.tensordot(phasor, centred, axes=(0, 0))
+
+
+@dataclass(frozen=True)
+class SteadyAmplitude:
+    """Amplitudes from the last window, checked against the window before.
+
+    Attributes
+    ----------
+    amplitude : ndarray, shape (k,)
+        Amplitude of each signal in the last window.
+    previous : ndarray, shape (k,)
+        Amplitude of each signal in the window before.
+    relative_change : float
+        Largest amplitude change between the windows relative to the largest
+        amplitude.
+    tolerance : float
+        The allowed relative change.
+    window : slice
+        Samples of the last window.
+    """
+
+    amplitude: np.ndarray
+    previous: np.ndarray
+    relative_change: float
+    tolerance: float
+    window: slice
+
+    @property
+    def steady(self) -> bool:
+        """True if the two windows agree within the tolerance."""
+        return self.relative_change <= self.tolerance
+
+
+def steady_amplitude(time: np.ndarray, signals: np.ndarray, frequency_hz: float, periods: int,
+                     tolerance: float = 0.005) -> SteadyAmplitude:
+    """Amplitude at *frequency_hz* over the last *periods* periods, with a steady-state check.
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Uniformly sampled times, s.
+    signals : ndarray, shape (n,) or (n, k)
+        The sampled signals.
+    frequency_hz : float
+        Frequency of interest, Hz.
+    periods : int
+        Periods per window; the history must hold two windows.
+    tolerance : float
+        Allowed relative change between the two windows.
+
+    Returns
+    -------
+    SteadyAmplitude
+    """
+    values = np.asarray(signals, dtype=float)
+    values = values[:, None] if values.ndim == 1 else values
+    last = period_window(time, frequency_hz, periods)
+    before = period_window(time, frequency_hz, periods, end=last.start)
+    amplitude = np.abs(harmonic_amplitude(time[last], values[last], frequency_hz))
+    previous = np.abs(harmonic_amplitude(time[before], values[before], frequency_hz))
+    scale = max(amplitude.max(), previous.max())
+    change = float(np.abs(amplitude - previous).max() / scale) if scale > 0 else 0.0
+    return SteadyAmplitude(amplitude, previous, change, tolerance, last)
+
+
+def amplitude_spectrum(time: np.ndarray, signal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided amplitude spectrum of a mean-removed, uniformly sampled signal.
+
+    Returns
+    -------
+    frequencies : ndarray
+        Hz.
+    amplitudes : ndarray
+        Amplitude of a sinusoid at each frequency, in the signal's unit.
+    """
+    step = _uniform_step(np.asarray(time, dtype=float))
+    values = np.asarray(signal, dtype=float)
+    values = values - values.mean(axis=0)
+    spectrum = np.abs(np.fft.rfft(values, axis=0)) * 2.0 / len(values)
+    return np.fft.rfftfreq(len(values), step), spectrum

@@ -1,0 +1,272 @@
+"""The sheets of a case workbook: one source of truth for template, reader and writer.
+
+Every input sheet is a table with the same layout:
+
+- row 1 (:data:`HEADER_ROW`): column headers;
+- row 2 (:data:`UNIT_ROW`): the unit of each column (``-`` for numbers
+  without dimension, empty for text and choices);
+- rows 3 on (:data:`FIRST_DATA_ROW`): one item per row; empty rows are
+  skipped. The Case and Engine sheets hold exactly one row.
+
+A vector (position, force, direction) takes three columns ``<name> x``,
+``<name> y``, ``<name> z``, each with its own unit cell. Axes (DESIGN.md
+section 1): x heading, y lateral, z vertical (up). Columns whose header
+starts with ``#`` are the user's notes and are ignored.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .units import DIMENSIONLESS
+
+__all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
+           "EXCITATIONS", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW", "FIRST_DATA_ROW",
+           "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO"]
+
+HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
+INSTRUCTIONS_SHEET = "Instructions"
+#: Result sheets written back by a run start with this prefix.
+RESULT_PREFIX = "Result "
+YES, NO = "yes", "no"
+
+#: Column kinds: how a cell is read.
+KINDS = ("number", "integer", "text", "choice", "yesno", "modes", "fidelity", "unit")
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of an input table.
+
+    Attributes
+    ----------
+    key : str
+        Name the reader uses, e.g. ``"end_a_x"``.
+    header : str
+        Text of the header cell, e.g. ``"end A x"``.
+    kind : str
+        One of :data:`KINDS`: ``number``, ``integer``, ``text``, ``choice``
+        (one of *choices*), ``yesno``, ``modes`` (auto, static, a count or a
+        cut-off such as ``500 Hz``), ``fidelity`` (rigid or a ``modes``
+        value), ``unit`` (a length unit as text, e.g. for a mesh file).
+    si_unit : str or None
+        SI unit of a number column (:data:`~workbook.excel.units.DIMENSIONLESS`
+        for no dimension); None for the other kinds.
+    unit : str or None
+        Unit shown in the template's unit cell (default: *si_unit*).
+    required : bool
+        The cell must not be empty.
+    choices : tuple of str
+        Allowed values of a ``choice`` column (a drop-down list in the template).
+    help : str
+        One line for the Instructions sheet.
+    """
+
+    key: str
+    header: str
+    kind: str = "number"
+    si_unit: str | None = None
+    unit: str | None = None
+    required: bool = False
+    choices: tuple = ()
+    help: str = ""
+
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"column {self.header!r}: kind {self.kind!r} is not one of {', '.join(KINDS)}")
+        if (self.kind == "choice") != bool(self.choices):
+            raise ValueError(f"column {self.header!r}: choices go with kind 'choice' only")
+
+    @property
+    def has_unit(self) -> bool:
+        """True if the unit cell is read (number columns)."""
+        return self.si_unit is not None
+
+    @property
+    def template_unit(self) -> str:
+        """Text of the template's unit cell."""
+        if not self.has_unit:
+            return ""
+        return self.unit or self.si_unit
+
+    @property
+    def drop_down(self) -> tuple:
+        """Values of the template's drop-down list (empty: none)."""
+        if self.kind == "yesno":
+            return (YES, NO)
+        return self.choices
+
+
+def _xyz(key: str, header: str, si_unit: str, *, unit: str | None = None, required: bool = False,
+         help: str = "") -> tuple[Column, ...]:
+    """Three columns ``<header> x/y/z`` of a vector."""
+    return tuple(Column(f"{key}_{axis}", f"{header} {axis}", "number", si_unit, unit, required,
+                        help=f"{help} ({axis})" if help else "")
+                 for axis in "xyz")
+
+
+def _num(key, header, si_unit=DIMENSIONLESS, *, unit=None, required=False, help=""):
+    return Column(key, header, "number", si_unit, unit, required, help=help)
+
+
+@dataclass(frozen=True)
+class Table:
+    """An input sheet.
+
+    Attributes
+    ----------
+    sheet : str
+        Sheet name.
+    columns : tuple of Column
+    single_row : bool
+        The sheet holds exactly one row (Case, Engine).
+    optional : bool
+        The sheet may be missing (Test data).
+    help : str
+        What the sheet is for (Instructions sheet).
+    """
+
+    sheet: str
+    columns: tuple
+    single_row: bool = False
+    optional: bool = False
+    help: str = ""
+
+    def column(self, key: str) -> Column:
+        """The column with *key*."""
+        for column in self.columns:
+            if column.key == key:
+                return column
+        raise KeyError(key)
+
+    def vector_keys(self, key: str) -> tuple[str, str, str]:
+        """Keys of the three columns of vector *key*."""
+        return tuple(f"{key}_{axis}" for axis in "xyz")
+
+
+CASE = Table("Case", single_row=True, help="case name, analysis settings and the physical effects asked for", columns=(
+    Column("name", "name", "text", required=True, help="case name"),
+    Column("description", "description", "text", help="free text"),
+    Column("steps_per_period", "steps per period", "integer", DIMENSIONLESS,
+           help="time steps per excitation period (at least 8; 40 recommended)"),
+    _num("ramp_periods", "ramp periods", help="periods over which the excitation rises"),
+    _num("settle_time_constants", "settle time constants",
+         help="settle time after the ramp in decay time constants of the least damped mounted mode"),
+    _num("settle_time", "settle time", "s", help="fixed settle time (empty: from the damping)"),
+    Column("measured_periods", "measured periods", "integer", DIMENSIONLESS,
+           help="periods per measured window"),
+    _num("steady_tolerance", "steady tolerance", help="largest change between the two last windows"),
+    _num("spectral_radius", "spectral radius", help="generalized-alpha spectral radius (0 to 1)"),
+    _num("newton_tolerance", "newton tolerance", help="Newton tolerance relative to the load scale"),
+    _num("equilibrium_tolerance", "equilibrium tolerance",
+         help="largest relative mismatch of the static equilibrium"),
+    Column("flexible_links", "flexible links", "yesno", help="no: every link rigid"),
+    Column("preload", "preload", "yesno", help="solve the static loads first"),
+    Column("hinge_damping", "hinge damping", "yesno", help="no: hinge damping set to zero"),
+    Column("link_damping", "link damping", "yesno", help="no: link Rayleigh damping set to zero"),
+    Column("clearance", "clearance", "yesno", help="no: hinge gaps ignored"),
+))
+
+ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(
+    _num("mass", "mass", "kg", required=True, help="engine mass (t accepted)"),
+    *_xyz("cg", "CG", "m", required=True, help="centre of gravity"),
+    *(_num(f"i{ij}", f"I{ij}", "kg*m^2", required=ij in ("xx", "yy", "zz"),
+           help=f"inertia tensor component {ij} about the CG (off-diagonal: empty = 0)")
+      for ij in ("xx", "yy", "zz", "xy", "xz", "yz")),
+))
+
+LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh file", columns=(
+    Column("name", "name", "text", required=True, help="unique link name"),
+    *_xyz("end_a", "end A", "m", required=True, help="centre of eye A"),
+    *_xyz("end_b", "end B", "m", required=True, help="centre of eye B"),
+    _num("length", "length", "m", help="eye distance; empty: from the ends, given: checked against them"),
+    Column("material", "material", "choice", choices=("steel", "titanium"), help="preset material"),
+    _num("youngs_modulus", "E", "Pa", unit="GPa", help="Young's modulus overriding the preset"),
+    _num("poisson_ratio", "nu", help="Poisson's ratio overriding the preset"),
+    _num("density", "density", "kg/m^3", help="density overriding the preset"),
+    _num("eye_outer_radius", "eye outer radius", "m", unit="mm", help="parametric link: eye outer radius"),
+    _num("bore_radius", "bore radius", "m", unit="mm", help="bore radius (parametric link or mesh bores)"),
+    _num("thickness", "eye thickness", "m", unit="mm", help="parametric link: eye thickness"),
+    _num("shank_width", "shank width", "m", unit="mm", help="parametric link: shank width"),
+    _num("shank_thickness", "shank thickness", "m", unit="mm", help="parametric link: shank thickness"),
+    _num("element_size", "element size", "m", unit="mm", help="mesh size (empty: default)"),
+    Column("interface", "interface", "choice", choices=("RBE2", "RBE3"), help="bore coupling"),
+    Column("modes", "modes", "modes", help="auto, static, a mode count or a cut-off such as '2000 Hz'"),
+    Column("flexible", "flexible", "yesno", help="no: rigid link"),
+    _num("stiffness_damping", "stiffness damping", "s", help="Rayleigh stiffness-proportional damping"),
+    _num("mass_damping", "mass damping", "1/s", help="Rayleigh mass-proportional damping"),
+    _num("spin_frequency_hz", "spin frequency", "Hz", help="torsional restraint about the link axis"),
+    *_xyz("bore_axis", "bore axis", DIMENSIONLESS, help="global direction of the bore axes (empty: default)"),
+    Column("mesh_file", "mesh file", "text", help="mesh file, relative to the workbook (instead of a geometry)"),
+    Column("mesh_unit", "mesh unit", "unit", help="length unit of the mesh file (e.g. mm)"),
+    Column("bore_a_set", "bore A node set", "text", help="mesh: node set of bore A"),
+    Column("bore_b_set", "bore B node set", "text", help="mesh: node set of bore B"),
+    *_xyz("mesh_bore_a", "mesh bore A", "m", unit="mm", help="mesh: a point on bore A's axis, mesh frame"),
+    *_xyz("mesh_bore_b", "mesh bore B", "m", unit="mm", help="mesh: a point on bore B's axis, mesh frame"),
+    *_xyz("mesh_bore_axis", "mesh bore axis", DIMENSIONLESS, help="mesh: bore axis direction, mesh frame"),
+))
+
+HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", columns=(
+    Column("name", "name", "text", required=True, help="unique hinge name"),
+    Column("body_a", "body A", "text", required=True, help="pylon, engine or a link name"),
+    Column("body_b", "body B", "text", required=True, help="pylon, engine or a link name"),
+    *_xyz("position", "position", "m", required=True, help="hinge centre: an eye centre of its links"),
+    _num("stiffness", "stiffness", "N/m", required=True, help="translational stiffness"),
+    _num("damping", "damping", "N*s/m", help="translational damping (empty: 0)"),
+    _num("radial_clearance", "radial clearance", "m", unit="mm", help="bearing gap (empty: 0)"),
+    _num("contact_stiffness", "contact stiffness", "N/m", help="stiffness once the gap closes"),
+))
+
+STATIC_LOADS = Table("Static loads", help="constant loads solved first (the preload)", columns=(
+    Column("name", "name", "text", required=True, help="unique load name"),
+    Column("type", "type", "choice", required=True, choices=("force", "moment", "gravity"),
+           help="force at a point, moment, or gravity on every body"),
+    *_xyz("force", "force", "N", help="force"),
+    *_xyz("point", "point", "m", help="point of the force"),
+    *_xyz("moment", "moment", "N*m", help="moment"),
+    *_xyz("acceleration", "acceleration", "m/s^2", help="gravitational acceleration ('g' = 9.80665 m/s^2)"),
+))
+
+EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a sweep runs one at many frequencies",
+                    columns=(
+    Column("name", "name", "text", required=True, help="unique excitation name"),
+    Column("type", "type", "choice", required=True, choices=("rotating", "harmonic"),
+           help="rotating imbalance force or fixed-direction harmonic force"),
+    *_xyz("point", "point", "m", required=True, help="point of application on the engine"),
+    _num("frequency", "frequency", "Hz", help="frequency (rpm accepted); empty for a sweep"),
+    _num("amplitude", "amplitude", "N", help="force amplitude"),
+    _num("unbalance", "unbalance", "kg*m", help="rotating: unbalance m e instead of the amplitude ('g' = gram)"),
+    *_xyz("axis", "axis", DIMENSIONLESS, help="rotating: spin axis (empty: x)"),
+    *_xyz("direction", "direction", DIMENSIONLESS, help="harmonic: force direction"),
+    _num("phase", "phase", "deg", help="phase at t = 0 (empty: 0)"),
+    _num("sweep_from", "sweep from", "Hz", help="sweep: first frequency"),
+    _num("sweep_to", "sweep to", "Hz", help="sweep: last frequency"),
+    Column("sweep_points", "sweep points", "integer", DIMENSIONLESS, help="sweep: number of frequencies"),
+    Column("sweep_spacing", "sweep spacing", "choice", choices=("log", "linear"), help="sweep: spacing"),
+))
+
+RUNS = Table("Runs", help="one run per row: an excitation and optional overrides", columns=(
+    Column("name", "run", "text", required=True, help="unique run name"),
+    Column("excitation", "excitation", "text", required=True, help="an excitation name"),
+    _num("frequency", "frequency", "Hz", help="override: frequency (not for sweeps)"),
+    _num("amplitude", "amplitude", "N", help="override: force amplitude"),
+    Column("fidelity", "fidelity", "fidelity",
+           help="override: rigid, static, auto, a mode count or a cut-off such as '2000 Hz'"),
+    _num("gap", "gap", "m", unit="mm", help="override: radial clearance of every hinge"),
+    _num("hinge_stiffness", "hinge stiffness", "N/m", help="override: stiffness of every hinge"),
+    _num("hinge_damping", "hinge damping", "N*s/m", help="override: damping of every hinge"),
+    Column("preload", "preload", "yesno", help="override: solve the static loads first"),
+    Column("steps_per_period", "steps per period", "integer", DIMENSIONLESS, help="override"),
+    _num("settle_time", "settle time", "s", help="override: fixed settle time"),
+    Column("measured_periods", "measured periods", "integer", DIMENSIONLESS, help="override"),
+))
+
+TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes to compare with", columns=(
+    Column("run", "run", "text", required=True, help="a run name"),
+    Column("location", "location", "text", help="'pylon sum' (empty) or a hinge name"),
+    Column("direction", "direction", "choice", required=True, choices=("x", "y", "z"), help="direction"),
+    _num("frequency", "frequency", "Hz", help="sweep runs: the frequency measured"),
+    _num("amplitude", "amplitude", "N", required=True, help="measured force amplitude"),
+))
+
+#: The input tables in sheet order.
+TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, RUNS, TEST_DATA)

@@ -1,0 +1,393 @@
+"""Read a case workbook into a :class:`~workbook.case.Case`, its runs and test data.
+
+Every problem found is collected and raised at once in one
+:class:`~workbook.excel.sheets.WorkbookError`. Nothing here runs a simulation
+or imports Exudyn: checking a workbook is fast.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import logging
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable, Union
+
+from .. import case as cm
+from ..results import PYLON_SUM
+from . import layout as L
+from .runs import RunSpec, TestPoint, case_for_run
+from .sheets import Problem, Record, SheetReader, WorkbookError, open_workbook
+
+__all__ = ["Problem", "WorkbookError", "CaseBook", "read_workbook"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class CaseBook:
+    """What a case workbook holds.
+
+    Attributes
+    ----------
+    path : Path
+    case : Case
+    runs : tuple of RunSpec
+    tests : tuple of TestPoint
+    sha256 : str
+        Hash of the file's bytes.
+    """
+
+    path: Path
+    case: cm.Case
+    runs: tuple
+    tests: tuple
+    sha256: str
+
+    def run_case(self, run: RunSpec) -> cm.Case:
+        """The case of one run (see :func:`~workbook.excel.runs.case_for_run`)."""
+        return case_for_run(self.case, run)
+
+
+# -- items ----------------------------------------------------------------------------------------------------
+
+_GEOMETRY_KEYS = ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")
+_MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density")
+#: Case-model field -> columns, where the names differ.
+_FIELD_COLUMNS = {
+    "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
+               "inertia": ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")},
+    "Excitations": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "phase_deg": ("phase",),
+                    "frequencies_hz": ("sweep_from", "sweep_to"), "spacing": ("sweep_spacing",)},
+    "Runs": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "radial_clearance": ("gap",),
+             "stiffness": ("hinge_stiffness",), "damping": ("hinge_damping",), "modes": ("fidelity",)},
+}
+_ITEM = re.compile(r"^(link|hinge|static load|excitation) '(.*)'$")
+_ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS}
+
+
+def _field_keys(table: L.Table, field: str) -> tuple:
+    """Columns holding case-model *field* in *table*."""
+    aliases = _FIELD_COLUMNS.get(table.sheet, {})
+    if field in aliases:
+        return aliases[field]
+    keys = {c.key for c in table.columns}
+    if field in keys:
+        return (field,)
+    vector = table.vector_keys(field)
+    return vector if vector[0] in keys else ()
+
+
+class _CaseReader(SheetReader):
+    """Builds the case, the runs and the test data from the tables."""
+
+    def build(self, record: Record, make: Callable, fallback: tuple = ()) -> Any:
+        """Call *make*; report its CaseError (at the field's cells) or ValueError (at *fallback*)."""
+        try:
+            return make()
+        except cm.CaseError as exc:
+            keys = _field_keys(record.table, exc.field) or fallback
+            self.record_problem(record, keys, record.typed(keys, exc.value), exc.expected)
+        except (ValueError, TypeError) as exc:
+            self.record_problem(record, fallback, record.typed(fallback, None), str(exc))
+        return None
+
+    def require(self, record: Record, keys: tuple, why: str) -> bool:
+        """Report each of *keys* that is empty; True if all are given."""
+        ok = True
+        for key in keys:
+            if key in record.cells and record.values.get(key) is None:
+                self.record_problem(record, (key,), None, f"a value ({why})")
+                ok = False
+            elif key not in record.cells:
+                self.problem(record.table.sheet, f"row {L.HEADER_ROW}", record.table.column(key).header, None,
+                             f"a column headed '{record.table.column(key).header}' ({why})")
+                ok = False
+        return ok
+
+    def unique(self, records: list[Record], key: str = "name") -> None:
+        seen = {}
+        for record in records:
+            name = record.values.get(key)
+            if name is None:
+                continue
+            if name in seen:
+                self.record_problem(record, (key,), name, f"a name not used before (row {seen[name]})")
+            else:
+                seen[name] = record.row
+
+    # -- one item per row --------------------------------------------------------------------------------
+
+    def engine(self, record: Record) -> Union[cm.Engine, None]:
+        get = record.get
+        inertia = ((get("ixx"), get("ixy", 0.0), get("ixz", 0.0)),
+                   (get("ixy", 0.0), get("iyy"), get("iyz", 0.0)),
+                   (get("ixz", 0.0), get("iyz", 0.0), get("izz")))
+        return self.build(record, lambda: cm.Engine(get("mass"), record.vector("cg"), inertia))
+
+    def material(self, record: Record):
+        import flexbodies
+
+        base = flexbodies.material(record.get("material", "steel"))
+        overrides = {key: record.get(key) for key in _MATERIAL_KEYS if record.get(key) is not None}
+        if not overrides:
+            return base
+        return self.build(record, lambda: dataclasses.replace(base, name=f"{base.name} (modified)", **overrides),
+                          _MATERIAL_KEYS)
+
+    def link_model(self, record: Record):
+        import flexbodies
+
+        material = self.material(record)
+        if material is None:
+            return None
+        common = dict(material=material, element_size=record.get("element_size"),
+                      interface=record.get("interface", "RBE2"))
+        if record.get("mesh_file") is not None:
+            mesh = self.mesh(record)
+            return None if mesh is None else flexbodies.LinkModel(mesh=mesh, **common)
+        if not self.require(record, _GEOMETRY_KEYS, "a parametric link without a mesh file"):
+            return None
+        distance = math.dist(record.vector("end_a"), record.vector("end_b"))
+        length = record.get("length", distance)
+        if abs(length - distance) > 1e-6 * max(1.0, distance):
+            self.record_problem(record, ("length",), record.typed(("length",), length),
+                                f"the distance between end A and end B, {distance:.6g} m ({distance * 1e3:.6g} mm)")
+            return None
+        geometry = self.build(record, lambda: flexbodies.LinkGeometry(
+            distance, *(record.get(key) for key in _GEOMETRY_KEYS)), _GEOMETRY_KEYS)
+        return None if geometry is None else flexbodies.LinkModel(geometry=geometry, **common)
+
+    def mesh(self, record: Record):
+        import flexbodies
+
+        path = self.path.parent / record.get("mesh_file")
+        if not path.is_file():
+            self.record_problem(record, ("mesh_file",), record.get("mesh_file"),
+                                f"a mesh file (relative to the workbook's folder; {path} does not exist)")
+            return None
+        bores = []
+        for eye in ("a", "b"):
+            node_set = record.get(f"bore_{eye}_set")
+            if node_set is not None:
+                bores.append(flexbodies.BoreSpec(f"bore {eye.upper()}", node_set=node_set))
+                continue
+            keys = (*L.LINKS.vector_keys(f"mesh_bore_{eye}"), *L.LINKS.vector_keys("mesh_bore_axis"), "bore_radius")
+            if not self.require(record, keys, f"bore {eye.upper()} of a mesh link without a node set"):
+                return None
+            bores.append(self.build(record, lambda: flexbodies.BoreSpec(
+                f"bore {eye.upper()}", centre=record.vector(f"mesh_bore_{eye}"),
+                axis=record.vector("mesh_bore_axis"), radius=record.get("bore_radius")), keys))
+        if None in bores:
+            return None
+        return flexbodies.MeshSource(str(path), tuple(bores), record.get("mesh_unit", 1.0))
+
+    def link(self, record: Record) -> Union[cm.Link, None]:
+        model = self.link_model(record)
+        if model is None:
+            return None
+        get = record.get
+        return self.build(record, lambda: cm.Link(
+            get("name"), record.vector("end_a"), record.vector("end_b"), model, modes=get("modes", "auto"),
+            flexible=get("flexible", True), stiffness_damping=get("stiffness_damping", 0.0),
+            mass_damping=get("mass_damping", 0.0), spin_frequency_hz=get("spin_frequency_hz"),
+            bore_axis=record.vector("bore_axis")))
+
+    def hinge(self, record: Record) -> Union[cm.Hinge, None]:
+        get = record.get
+
+        def body(key: str) -> str:
+            name = get(key)
+            return name.lower() if name.lower() in (cm.PYLON, cm.ENGINE) else name
+
+        return self.build(record, lambda: cm.Hinge(
+            get("name"), body("body_a"), body("body_b"), record.vector("position"), get("stiffness"),
+            get("damping", 0.0), get("radial_clearance", 0.0), get("contact_stiffness")))
+
+    def static_load(self, record: Record):
+        kind, name, vector = record.get("type"), record.get("name"), record.vector
+        needs = {"force": ("force", "point"), "moment": ("moment",), "gravity": ("acceleration",)}[kind]
+        keys = tuple(k for vector_key in needs for k in L.STATIC_LOADS.vector_keys(vector_key))
+        if not self.require(record, keys, f"a {kind} load"):
+            return None
+        make = {"force": lambda: cm.PointForce(name, vector("force"), vector("point")),
+                "moment": lambda: cm.PointMoment(name, vector("moment")),
+                "gravity": lambda: cm.Gravity(name, vector("acceleration"))}[kind]
+        return self.build(record, make)
+
+    def excitation(self, record: Record):
+        get, vector = record.get, record.vector
+        sweep = get("sweep_from") is not None or get("sweep_to") is not None
+        if sweep and not self.require(record, ("sweep_from", "sweep_to", "sweep_points"), "a sweep"):
+            return None
+        if sweep and get("frequency") is not None:
+            self.record_problem(record, ("frequency",), record.typed(("frequency",), None),
+                                "an empty cell (a sweep takes its frequencies from 'sweep from' and 'sweep to')")
+            return None
+        frequency = get("sweep_from") if sweep else get("frequency")
+        if get("type") == "rotating":
+            template = self.build(record, lambda: cm.RotatingForce(
+                get("name"), vector("point"), frequency_hz=frequency, amplitude=get("amplitude"),
+                unbalance=get("unbalance"), axis=vector("axis", (1.0, 0.0, 0.0)), phase_deg=get("phase", 0.0)))
+        else:
+            template = self.build(record, lambda: cm.HarmonicForce(
+                get("name"), vector("point"), vector("direction"), get("amplitude"), frequency_hz=frequency,
+                phase_deg=get("phase", 0.0)))
+        if template is None or not sweep:
+            return template
+        return self.build(record, lambda: cm.Sweep.band(get("name"), template, get("sweep_from"), get("sweep_to"),
+                                                        get("sweep_points"), get("sweep_spacing", "log")),
+                          ("sweep_from", "sweep_to", "sweep_points"))
+
+    def settings(self, record: Record):
+        def given(cls):
+            return {f.name: record.get(f.name) for f in dataclasses.fields(cls) if record.get(f.name) is not None}
+
+        analysis = self.build(record, lambda: cm.AnalysisSettings(**given(cm.AnalysisSettings)))
+        effects = self.build(record, lambda: cm.Effects(**given(cm.Effects)))
+        return analysis, effects
+
+    # -- the case ----------------------------------------------------------------------------------------
+
+    def case(self, tables: dict) -> Union[cm.Case, None]:
+        for key in ("Links", "Hinges", "Static loads", "Excitations"):
+            self.unique(tables[key])
+        engine = [self.engine(r) for r in tables["Engine"] if r.ok]
+        settings = [self.settings(r) for r in tables["Case"] if r.ok]
+        items = {key: [(r, make(r) if r.ok else None) for r in tables[key]] for key, make in
+                 (("Links", self.link), ("Hinges", self.hinge), ("Static loads", self.static_load),
+                  ("Excitations", self.excitation))}
+        first_links = {}
+        for record, link in items["Links"]:
+            first_links.setdefault(record.get("name"), link)
+        self.hinge_bodies(items["Hinges"], tables["Links"], first_links)
+        if self.problems or not engine or None in engine or not settings or None in settings[0]:
+            return None
+        (analysis, effects), record = settings[0], tables["Case"][0]
+        try:
+            return cm.Case(record.get("name"), engine[0], *(tuple(i for _, i in items[key]) for key in
+                                                            ("Links", "Hinges", "Static loads", "Excitations")),
+                           analysis=analysis, effects=effects, description=record.get("description", ""))
+        except cm.CaseError as exc:
+            self.case_error(exc, items)
+        return None
+
+    def hinge_bodies(self, hinges: list, link_records: list, links: dict) -> None:
+        """Report hinges naming an unknown body or placed away from their link's eyes."""
+        names = list(dict.fromkeys(r.get("name") for r in link_records if r.get("name") is not None))
+        for record, hinge in hinges:
+            if hinge is None:
+                continue
+            for key in ("body_a", "body_b"):
+                body = getattr(hinge, key)
+                if body in (cm.PYLON, cm.ENGINE):
+                    continue
+                if body not in names:
+                    self.record_problem(record, (key,), body, f"pylon, engine or a link name ({', '.join(names)})")
+                elif links.get(body) is not None and links[body].eye_at(hinge.position) is None:
+                    link = links[body]
+                    gap = min(math.dist(hinge.position, link.end_a), math.dist(hinge.position, link.end_b))
+                    self.record_problem(record, L.HINGES.vector_keys("position"),
+                                        record.typed(L.HINGES.vector_keys("position"), None),
+                                        f"an eye centre of link '{body}' (the nearest is {gap * 1e3:.4g} mm away)")
+
+    def case_error(self, exc: cm.CaseError, items: dict) -> None:
+        """Report a CaseError of the Case constructor at the row of the item it names."""
+        match = _ITEM.match(exc.item)
+        if match:
+            table = _ITEM_TABLES[match.group(1)]
+            for record, _ in items[table.sheet]:
+                if record.get("name") == match.group(2):
+                    keys = _field_keys(table, exc.field)
+                    self.record_problem(record, keys, record.typed(keys, exc.value), exc.expected)
+                    return
+        self.problem(None, None, exc.field, exc.value, f"{exc.expected} ({exc.item})")
+
+    # -- runs and test data ------------------------------------------------------------------------------
+
+    def runs(self, case: cm.Case, records: list[Record]) -> list[RunSpec]:
+        self.unique(records)
+        if not records:
+            self.problem(L.RUNS.sheet, f"row {L.FIRST_DATA_ROW}", None, None, "at least one run")
+        excitations = {e.name: e for e in case.excitations}
+        runs = []
+        fields = {f.name for f in dataclasses.fields(RunSpec)}
+        for record in records:
+            if not record.ok:
+                continue
+            excitation = excitations.get(record.get("excitation"))
+            if excitation is None:
+                self.record_problem(record, ("excitation",), record.get("excitation"),
+                                    f"an excitation name ({', '.join(excitations)})")
+                continue
+            if isinstance(excitation, cm.Sweep) and record.get("frequency") is not None:
+                self.record_problem(record, ("frequency",), record.typed(("frequency",), None),
+                                    f"an empty cell ('{excitation.name}' is a sweep)")
+                continue
+            run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
+            if self.build(record, lambda: case_for_run(case, run)) is not None:
+                runs.append((record, run))
+        return runs
+
+    def tests(self, runs: list, records: list[Record], case: cm.Case) -> list[TestPoint]:
+        by_name = {run.name: (record, run) for record, run in runs}
+        locations = [PYLON_SUM] + [h.name for h in case.hinges]
+        points = []
+        for record in records:
+            if not record.ok:
+                continue
+            name = record.get("run")
+            if name not in by_name:
+                self.record_problem(record, ("run",), name, f"a run name ({', '.join(by_name)})")
+                continue
+            location = record.get("location", PYLON_SUM)
+            if location not in locations:
+                self.record_problem(record, ("location",), location, "'pylon sum' or a hinge name")
+                continue
+            frequencies = [e.frequency for e in case_for_run(case, by_name[name][1]).single_frequency_excitations()]
+            frequency = record.get("frequency")
+            if frequency is None and len(frequencies) > 1:
+                self.record_problem(record, ("frequency",), None, f"the frequency measured (run '{name}' is a sweep)")
+                continue
+            if frequency is not None and not any(abs(frequency - f) <= 1e-3 * f for f in frequencies):
+                self.record_problem(record, ("frequency",), record.typed(("frequency",), frequency),
+                                    "a frequency of the run: " + ", ".join(f"{f:.6g} Hz" for f in frequencies))
+                continue
+            points.append(TestPoint(name, location, record.get("direction"), frequency, record.get("amplitude")))
+        return points
+
+
+def read_workbook(path: Union[str, Path]) -> CaseBook:
+    """Read and check a case workbook.
+
+    Parameters
+    ----------
+    path : str or Path
+        The .xlsx file.
+
+    Returns
+    -------
+    CaseBook
+
+    Raises
+    ------
+    WorkbookError
+        With every problem found.
+    """
+    path = Path(path)
+    formulas, values = open_workbook(path)
+    reader = _CaseReader(path, formulas, values)
+    tables = {table.sheet: reader.table(table) for table in L.TABLES}
+    case = reader.case(tables)
+    if case is None:
+        reader.unique(tables["Runs"])
+        raise WorkbookError(reader.problems)
+    runs = reader.runs(case, tables["Runs"])
+    tests = reader.tests(runs, tables["Test data"], case)
+    if reader.problems:
+        raise WorkbookError(reader.problems)
+    log.info("read %s: %d links, %d hinges, %d runs", path.name, len(case.links), len(case.hinges), len(runs))
+    return CaseBook(path, case, tuple(run for _, run in runs), tuple(tests),
+                    hashlib.sha256(path.read_bytes()).hexdigest())

@@ -1,0 +1,267 @@
+"""Write case workbooks: the template (templates/) and ready cases (cases/).
+
+Both are generated from a :class:`~workbook.case.Case` and its runs with the
+sheet layout of :mod:`workbook.excel.layout`; the committed files are what
+this module writes (a test keeps them equal). Each quantity is written in
+the column's display unit (mm for link sizes, GPa for moduli) when that
+reads back to the identical number, else in SI.
+"""
+from __future__ import annotations
+
+import dataclasses
+import datetime
+from pathlib import Path
+from typing import Iterable, Union
+
+import numpy as np
+from openpyxl import Workbook
+from openpyxl.styles import Alignment, Font, PatternFill
+from openpyxl.utils import get_column_letter
+from openpyxl.worksheet.datavalidation import DataValidation
+
+from .. import case as cm
+from . import layout as L
+from .files import save_atomic
+from .runs import RunSpec, TestPoint
+from .units import si_factor
+
+__all__ = ["case_rows", "case_workbook", "template_workbook", "reference_workbook", "write_workbook",
+           "TEMPLATE_RUNS", "REFERENCE_RUNS"]
+
+#: Fixed creation date: generated files depend on the code only.
+_CREATED = datetime.datetime(2026, 1, 1)
+_HEADER_FILL = PatternFill("solid", fgColor="DDEBF7")
+_UNIT_FILL = PatternFill("solid", fgColor="F2F2F2")
+#: Rows of the template that get the drop-down lists.
+_VALIDATED_ROWS = 500
+
+#: The seed study's runs (cases/reference.xlsx).
+REFERENCE_RUNS = (RunSpec("LP rotor", "LP rotor"), RunSpec("HP rotor", "HP rotor"), RunSpec("sweep", "sweep"))
+#: Example runs of the template: the seed runs and some overrides.
+TEMPLATE_RUNS = REFERENCE_RUNS + (
+    RunSpec("LP rotor, rigid links", "LP rotor", fidelity="rigid"),
+    RunSpec("HP rotor, 20 modes", "HP rotor", fidelity=20),
+    RunSpec("LP rotor, 0.05 mm gap", "LP rotor", gap=5e-5),
+    RunSpec("LP rotor at 4000 rpm", "LP rotor", frequency=4000 / 60),
+)
+
+#: The Instructions sheet, one cell per line.
+_INSTRUCTIONS = (
+    "Engine Mount Workbook: case workbook",
+    "One sheet per input table. Row 1: column headers. Row 2: the unit of each column. "
+    "Rows 3 on: one item per row.",
+    "Units: write any unit of the right kind in row 2 (mm, m, kN, t, kN/mm, rpm, GPa, ...); "
+    "values are converted to SI on reading.",
+    "'g' is standard gravity (9.80665 m/s^2) in an acceleration column and gram everywhere else "
+    "(e.g. an unbalance in g*mm).",
+    "Frequencies count cycles: 1 rpm = 1/60 Hz. A column without dimension takes '-' (or '%').",
+    "Axes: x heading (along the engine axis, forward), y lateral, z vertical (up). "
+    "Bodies: 'pylon' (ground), 'engine' or a link name.",
+    "A hinge joins two bodies at a point; on a link that point must be one of the link's eye centres.",
+    "Vectors take three columns (x, y, z). Empty optional cells take the default. "
+    "Columns headed '#...' are your notes.",
+    "A link is parametric (eye and shank sizes) or a mesh file (path relative to this workbook) "
+    "with its two bores: node sets or centre, axis and bore radius.",
+    "Formulas are allowed: the values Excel last calculated are read (save the file from Excel).",
+    "Runs: each row runs one excitation; the other columns override the case for that run "
+    "(frequency, amplitude, fidelity, gap, stiffness, ...).",
+    "Fidelity: rigid (every link rigid), static (static modes only), auto (the low-frequency rule), "
+    "a mode count, or a cut-off such as '2000 Hz'.",
+    "Test data: measured force amplitudes (pylon sum or a hinge, per direction); "
+    "the results show error = (sim - test) / test x 100 %.",
+    "Check a workbook:  mountwb check CASE.xlsx     "
+    "Run it:  mountwb run CASE.xlsx [--run NAME] [--report REPORT.xlsx]",
+    "A run writes sheets named 'Result ...' back into the workbook and never changes the input sheets.",
+    "The rows below list every column.",
+)
+
+
+def _display(value: float, factor: float) -> float:
+    return value / factor
+
+
+def _row_for_link(link: cm.Link) -> dict:
+    model = link.model
+    if model.geometry is None:
+        raise ValueError(f"link {link.name!r}: only parametric links can be written (a mesh link is written by hand)")
+    import flexbodies
+
+    row = {"name": link.name, **_vector("end_a", link.end_a), **_vector("end_b", link.end_b),
+           "element_size": model.element_size, "interface": model.interface, "modes": link.modes,
+           "flexible": link.flexible, "stiffness_damping": link.stiffness_damping,
+           "mass_damping": link.mass_damping, "spin_frequency_hz": link.spin_frequency_hz}
+    row.update({key: getattr(model.geometry, key) for key in
+                ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")})
+    base = flexbodies.material(model.material.name.split(" ")[0])
+    row["material"] = base.name
+    row.update({key: getattr(model.material, key) for key in ("youngs_modulus", "poisson_ratio", "density")
+                if getattr(model.material, key) != getattr(base, key)})
+    if link.bore_axis is not None:
+        row.update(_vector("bore_axis", link.bore_axis))
+    return row
+
+
+def _vector(key: str, values) -> dict:
+    return {f"{key}_{axis}": value for axis, value in zip("xyz", values)}
+
+
+def _row_for_excitation(excitation: cm.Excitation) -> dict:
+    row = {}
+    if isinstance(excitation, cm.Sweep):
+        f = excitation.frequencies_hz
+        spacing = next((name for name, space in (("log", np.geomspace), ("linear", np.linspace))
+                        if np.allclose(space(f[0], f[-1], len(f)), f, rtol=1e-12)), None)
+        if spacing is None:
+            raise ValueError(f"excitation {excitation.name!r}: only log or linear sweeps can be written")
+        row.update(sweep_from=f[0], sweep_to=f[-1], sweep_points=len(f), sweep_spacing=spacing)
+        template = excitation.template
+    else:
+        template = excitation
+        row["frequency"] = excitation.frequency
+    row.update(name=excitation.name, **_vector("point", template.point), phase=template.phase_deg or None)
+    if isinstance(template, cm.RotatingForce):
+        row.update(type="rotating", amplitude=template.amplitude, unbalance=template.unbalance)
+        if template.axis != (1.0, 0.0, 0.0):
+            row.update(_vector("axis", template.axis))
+    else:
+        row.update(type="harmonic", amplitude=template.amplitude, **_vector("direction", template.direction))
+    return row
+
+
+def _row_for_load(load: cm.StaticLoad) -> dict:
+    if isinstance(load, cm.PointForce):
+        return {"name": load.name, "type": "force", **_vector("force", load.force), **_vector("point", load.point)}
+    if isinstance(load, cm.PointMoment):
+        return {"name": load.name, "type": "moment", **_vector("moment", load.moment)}
+    return {"name": load.name, "type": "gravity", **_vector("acceleration", load.acceleration)}
+
+
+def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> dict[str, list[dict]]:
+    """The rows of every input sheet (values in SI, by column key) for *case*."""
+    inertia = case.engine.inertia
+    settings = {"name": case.name, "description": case.description or None,
+                **dataclasses.asdict(case.analysis), **dataclasses.asdict(case.effects)}
+    engine = {"mass": case.engine.mass, **_vector("cg", case.engine.center_of_mass),
+              **{f"i{a}{b}": inertia[i][j] for (a, i), (b, j) in
+                 ((("x", 0), ("x", 0)), (("y", 1), ("y", 1)), (("z", 2), ("z", 2)),
+                  (("x", 0), ("y", 1)), (("x", 0), ("z", 2)), (("y", 1), ("z", 2)))}}
+    hinges = [{"name": h.name, "body_a": h.body_a, "body_b": h.body_b, **_vector("position", h.position),
+               "stiffness": h.stiffness, "damping": h.damping, "radial_clearance": h.radial_clearance or None,
+               "contact_stiffness": h.contact_stiffness} for h in case.hinges]
+    return {
+        L.CASE.sheet: [settings], L.ENGINE.sheet: [engine],
+        L.LINKS.sheet: [_row_for_link(link) for link in case.links],
+        L.HINGES.sheet: hinges,
+        L.STATIC_LOADS.sheet: [_row_for_load(load) for load in case.static_loads],
+        L.EXCITATIONS.sheet: [_row_for_excitation(e) for e in case.excitations],
+        L.RUNS.sheet: [dataclasses.asdict(run) for run in runs],
+        L.TEST_DATA.sheet: [dataclasses.asdict(point) for point in tests],
+    }
+
+
+def _column_unit(column: L.Column, values: list) -> tuple[str, float]:
+    """Unit text and factor of a column: the display unit if every value reads back identically."""
+    if not column.has_unit or column.kind != "number":
+        return column.template_unit, 1.0
+    factor = si_factor(column.template_unit, column.si_unit)
+    if all(_display(v, factor) * factor == v for v in values if v is not None):
+        return column.template_unit, factor
+    return column.si_unit, 1.0
+
+
+def _cell_value(column: L.Column, value, factor: float):
+    if value is None:
+        return None
+    if column.kind == "yesno":
+        return L.YES if value else L.NO
+    if column.kind in ("modes", "fidelity") and isinstance(value, float):
+        return f"{value:g} Hz"
+    if column.kind == "number":
+        return _display(value, factor)
+    return value
+
+
+def _write_table(ws, table: L.Table, rows: list[dict]) -> None:
+    for col, column in enumerate(table.columns, start=1):
+        values = [row.get(column.key) for row in rows]
+        unit, factor = _column_unit(column, values)
+        header = ws.cell(L.HEADER_ROW, col, column.header)
+        header.font, header.fill = Font(bold=True), _HEADER_FILL
+        unit_cell = ws.cell(L.UNIT_ROW, col, unit or None)
+        unit_cell.font, unit_cell.fill = Font(italic=True, color="595959"), _UNIT_FILL
+        for row, value in enumerate(values, start=L.FIRST_DATA_ROW):
+            ws.cell(row, col, _cell_value(column, value, factor))
+        ws.column_dimensions[get_column_letter(col)].width = max(10, len(column.header) + 3)
+        if column.drop_down:
+            letter = get_column_letter(col)
+            validation = DataValidation(type="list", formula1='"' + ",".join(column.drop_down) + '"',
+                                        allow_blank=True, showErrorMessage=True,
+                                        errorTitle=column.header, error="Choose from the list")
+            validation.add(f"{letter}{L.FIRST_DATA_ROW}:{letter}{_VALIDATED_ROWS}")
+            ws.add_data_validation(validation)
+    ws.freeze_panes = ws.cell(L.FIRST_DATA_ROW, 2)
+
+
+def _write_instructions(ws) -> None:
+    for row, line in enumerate(_INSTRUCTIONS, start=1):
+        ws.cell(row, 1, line).font = Font(bold=row == 1, size=14 if row == 1 else 11)
+    row = len(_INSTRUCTIONS) + 2
+    for col, text in enumerate(("sheet", "column", "unit", "kind", "required", "meaning"), start=1):
+        ws.cell(row, col, text).font = Font(bold=True)
+    for table in L.TABLES:
+        row += 1
+        ws.cell(row, 1, table.sheet).font = Font(bold=True)
+        ws.cell(row, 6, table.help + (" (optional sheet)" if table.optional else ""))
+        for column in table.columns:
+            row += 1
+            kind = "/".join(column.drop_down) if column.drop_down else column.kind
+            for col, text in enumerate((table.sheet, column.header, column.template_unit, kind,
+                                        "yes" if column.required else "", column.help), start=1):
+                ws.cell(row, col, text or None)
+    for letter, width in zip("ABCDEF", (14, 22, 10, 22, 9, 90)):
+        ws.column_dimensions[letter].width = width
+    ws.cell(1, 1).alignment = Alignment(vertical="top")
+
+
+def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> Workbook:
+    """A case workbook: Instructions plus one sheet per input table holding *case*.
+
+    Parameters
+    ----------
+    case : Case
+        Parametric links only.
+    runs : iterable of RunSpec
+    tests : iterable of TestPoint
+
+    Returns
+    -------
+    openpyxl.Workbook
+    """
+    rows = case_rows(case, runs, tests)
+    workbook = Workbook()
+    workbook.properties.created = _CREATED
+    workbook.properties.creator = "mountwb"
+    _write_instructions(workbook.active)
+    workbook.active.title = L.INSTRUCTIONS_SHEET
+    for table in L.TABLES:
+        _write_table(workbook.create_sheet(table.sheet), table, rows[table.sheet])
+    return workbook
+
+
+def template_workbook() -> Workbook:
+    """The case template: the reference mount as example rows, with example runs."""
+    from ..reference import reference_case
+
+    return case_workbook(reference_case(sweep=True), TEMPLATE_RUNS)
+
+
+def reference_workbook() -> Workbook:
+    """cases/reference.xlsx: the reference mount with the seed study's runs."""
+    from ..reference import reference_case
+
+    return case_workbook(reference_case(sweep=True), REFERENCE_RUNS)
+
+
+def write_workbook(workbook: Workbook, path: Union[str, Path]) -> Path:
+    """Save a generated workbook (atomically)."""
+    return save_atomic(workbook, path)

@@ -1,0 +1,288 @@
+"""Write run results back into the case workbook, safely.
+
+Result sheets are named ``Result ...`` and carry a marker in a hidden cell,
+so a later run replaces them and never a sheet of the user's that happens to
+share a name. The input sheets are left as openpyxl read them (values,
+styles, drop-downs, comments).
+
+The case workbook is not overwritten (the results go to a separate, new
+workbook beside it, and the reason is given) when:
+
+- it is open in Excel (the lock file ``~$<name>`` is present);
+- it holds content openpyxl would drop (charts, images, pivot tables,
+  macros, external links, data-validation extensions, ...);
+- a sheet named like a result sheet exists that is not ours;
+- it changed on disk while the runs were computed.
+
+Every save is atomic (temporary file in the same folder, then rename).
+"""
+from __future__ import annotations
+
+import datetime
+import hashlib
+import logging
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Union
+
+import pandas as pd
+from openpyxl import Workbook, load_workbook
+from openpyxl.styles import Font, PatternFill
+from openpyxl.utils import get_column_letter
+
+from ..case import DIRECTIONS
+from ..results import PYLON_SUM
+from . import layout as L
+from .files import lock_file, restore_formula_values, save_atomic, unsupported_content
+from .runs import RunSpec, TestPoint
+
+__all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
+           "MARKER", "MARKER_CELL"]
+
+log = logging.getLogger(__name__)
+
+#: Text of the hidden marker cell of every result sheet.
+MARKER = "mountwb result sheet"
+#: Marker cell (its column is hidden).
+MARKER_CELL = "Z1"
+_HEADER_FILL = PatternFill("solid", fgColor="E2EFDA")
+
+
+@dataclass
+class RunResult:
+    """One row of the Runs sheet and its answers.
+
+    Attributes
+    ----------
+    spec : RunSpec
+    result : workbook.results.MountResult
+        One excitation result per frequency (several for a sweep).
+    """
+
+    spec: RunSpec
+    result: object
+
+
+@dataclass(frozen=True)
+class WriteOutcome:
+    """Where the results went.
+
+    Attributes
+    ----------
+    path : Path
+        The workbook written.
+    reason : str or None
+        Why the case workbook was not overwritten (None: it was).
+    """
+
+    path: Path
+    reason: Union[str, None]
+
+
+def _match_test(tests: list[TestPoint], frequency: float):
+    for test in tests:
+        if test.frequency is None or abs(test.frequency - frequency) <= 1e-3 * frequency:
+            return test
+    return None
+
+
+def _long_frame(runs: list[RunResult], tests: tuple) -> pd.DataFrame:
+    """Every answer, one row per run, point, location and direction, with the test comparison."""
+    frames = []
+    for run in runs:
+        frame = run.result.to_frame().rename(columns={"run": "point"})
+        frame.insert(0, "run", run.spec.name)
+        frames.append(frame)
+    frame = pd.concat(frames, ignore_index=True)
+    test_amplitude, test_error = [], []
+    by_key = {}
+    for test in tests:
+        by_key.setdefault((test.run, test.location, test.direction), []).append(test)
+    for row in frame.to_dict("records"):
+        test = _match_test(by_key.get((row["run"], row["location"], row["direction"]), []), row["frequency Hz"])
+        test_amplitude.append(None if test is None else test.amplitude)
+        test_error.append(None if test is None else (row["amplitude N"] - test.amplitude) / test.amplitude * 100)
+    frame["test amplitude N"] = test_amplitude
+    frame["error %"] = test_error
+    return frame
+
+
+def result_frames(runs: list[RunResult], tests: tuple = ()) -> dict[str, pd.DataFrame]:
+    """The result tables, by sheet name (without the ``Result`` prefix).
+
+    - ``efficiency``: pylon force per run, point and direction: amplitude,
+      T, eta %, dB, the test amplitude and the error (sim - test)/test %;
+    - ``hinges``: the same for every hinge;
+    - ``sweep``: T and eta per direction against frequency, for sweep runs.
+    """
+    frame = _long_frame(runs, tests)
+    pylon = frame[frame["location"] == PYLON_SUM].drop(columns=["location", "pylon side"])
+    hinges = frame[frame["location"] != PYLON_SUM]
+    frames = {"efficiency": pylon.reset_index(drop=True), "hinges": hinges.reset_index(drop=True)}
+    sweeps = [run for run in runs if len(run.result.runs) > 1]
+    if sweeps:
+        rows = []
+        for run in sweeps:
+            for point in run.result.runs:
+                t = point.transmissibility
+                rows.append([run.spec.name, point.frequency_hz, *t, *((1 - t) * 100)])
+        frames["sweep"] = pd.DataFrame(rows, columns=["run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS),
+                                                      *(f"eta % {d}" for d in DIRECTIONS)])
+    return frames
+
+
+def card_lines(runs: list[RunResult]) -> list[str]:
+    lines = []
+    for run in runs:
+        for card in run.result.model_cards.values():
+            lines += [f"Run '{run.spec.name}'", *card.to_text().splitlines(), ""]
+    return lines
+
+
+def _sheet_title(name: str) -> str:
+    return f"{L.RESULT_PREFIX}{name}"
+
+
+def _mark(ws) -> None:
+    ws[MARKER_CELL] = MARKER
+    ws.column_dimensions[MARKER_CELL.rstrip("0123456789")].hidden = True
+
+
+def is_result_sheet(ws) -> bool:
+    """True if *ws* is a result sheet written by this module."""
+    return ws[MARKER_CELL].value == MARKER
+
+
+def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
+    ws.cell(1, 1, note).font = Font(italic=True)
+    for col, name in enumerate(frame.columns, start=1):
+        cell = ws.cell(2, col, name)
+        cell.font, cell.fill = Font(bold=True), _HEADER_FILL
+        ws.column_dimensions[get_column_letter(col)].width = max(10, len(str(name)) + 2)
+    for row, values in enumerate(frame.itertuples(index=False), start=3):
+        for col, value in enumerate(values, start=1):
+            if isinstance(value, float) and not pd.notna(value):
+                value = None
+            elif hasattr(value, "item"):
+                value = value.item()
+            ws.cell(row, col, value)
+    ws.freeze_panes = "A3"
+    _mark(ws)
+
+
+_NOTES = {
+    "efficiency": "Pylon force (sum of the pylon-side hinges): T = |F_pylon| / |F_exc|, eta = (1 - T) x 100 %, "
+                  "dB = 20 log10 T; error = (sim - test) / test x 100 %",
+    "hinges": "Hinge forces: T = |F_hinge| / |F_exc| per direction",
+    "sweep": "Pylon transmissibility and isolation efficiency against frequency",
+}
+
+
+def result_sheet_names(frames: dict) -> list[str]:
+    """Titles of the result sheets a write creates."""
+    return [_sheet_title(name) for name in frames] + [_sheet_title("model card")]
+
+
+def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str) -> list[str]:
+    """Add the result sheets to an openpyxl *workbook* (our old ones are removed first).
+
+    Returns
+    -------
+    list of str
+        The sheet titles written.
+    """
+    for ws in list(workbook.worksheets):
+        if ws.title.startswith(L.RESULT_PREFIX) and is_result_sheet(ws):
+            workbook.remove(ws)
+    frames = result_frames(runs, tests)
+    for name, frame in frames.items():
+        _write_frame(workbook.create_sheet(_sheet_title(name)), frame, f"{_NOTES[name]}. {stamp}")
+    ws = workbook.create_sheet(_sheet_title("model card"))
+    for row, line in enumerate(card_lines(runs), start=2):
+        ws.cell(row, 1, line).font = Font(name="Consolas", bold=line.startswith("Run '"))
+    ws.cell(1, 1, stamp).font = Font(italic=True)
+    _mark(ws)
+    return result_sheet_names(frames)
+
+
+def _conflicts(workbook, titles: list[str]) -> list[str]:
+    return [title for title in titles if title in workbook.sheetnames and not is_result_sheet(workbook[title])]
+
+
+def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
+    """(reason or None, the loaded workbook or None)."""
+    lock = lock_file(path)
+    if lock is not None:
+        return f"it is open in Excel (lock file {lock.name} present); close it and run again to write into it", None
+    if hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
+        return "it changed on disk while the runs were computed", None
+    dropped = unsupported_content(path)
+    if dropped:
+        return f"it holds content this program cannot keep ({', '.join(dropped)})", None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        workbook = load_workbook(path)
+    conflicts = _conflicts(workbook, titles)
+    if conflicts:
+        return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
+                "rename them to write the results into the workbook"), None
+    return None, workbook
+
+
+def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]:
+    """The values Excel cached for the formula cells of *workbook* (read from *path*), by sheet number."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        values = load_workbook(path, data_only=True)
+    cached = {}
+    for number, ws in enumerate(workbook.worksheets, start=1):
+        if ws.title not in values.sheetnames:
+            continue
+        for row in ws.iter_rows():
+            for cell in row:
+                if cell.data_type == "f" and values[ws.title][cell.coordinate].value is not None:
+                    cached.setdefault(number, {})[cell.coordinate] = values[ws.title][cell.coordinate].value
+    return cached
+
+
+def _separate_path(path: Path) -> Path:
+    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    candidate = path.with_name(f"{path.stem}-results-{stamp}.xlsx")
+    number = 1
+    while candidate.exists():
+        number += 1
+        candidate = path.with_name(f"{path.stem}-results-{stamp}-{number}.xlsx")
+    return candidate
+
+
+def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], tests: tuple = ()) -> WriteOutcome:
+    """Write the result sheets into the case workbook at *path*, or beside it.
+
+    Parameters
+    ----------
+    path : str or Path
+        The case workbook that was read.
+    sha256 : str
+        Its hash when it was read (a changed file is not overwritten).
+    runs : list of RunResult
+    tests : tuple of TestPoint
+
+    Returns
+    -------
+    WriteOutcome
+    """
+    path = Path(path)
+    stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
+    titles = result_sheet_names(result_frames(runs, tests))
+    reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
+    if reason is None:
+        add_result_sheets(workbook, runs, tests, stamp)
+        cached = _cached_formula_values(path, workbook)
+        return WriteOutcome(save_atomic(workbook, path, lambda saved: restore_formula_values(saved, cached)), None)
+    separate = Workbook()
+    separate.remove(separate.active)
+    add_result_sheets(separate, runs, tests, stamp)
+    target = save_atomic(separate, _separate_path(path))
+    log.warning("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
+    return WriteOutcome(target, reason)

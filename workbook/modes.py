@@ -1,0 +1,193 @@
+"""Linearised modes of a scene: free motions (mechanisms) and mounted modes.
+
+Exudyn linearises the system at its initial state (``ComputeLinearizedSystem``:
+M, K, D, geometric stiffness included). Euler-parameter nodes of the links add
+one algebraic constraint each; the matrices are projected onto the null
+space of the constraint Jacobian. Then
+
+- a *free motion* is an eigenvector of ``K x = w^2 M x`` with w close to zero:
+  the scene is a mechanism; it is described by the engine's motion (heading,
+  lateral, vertical translation; roll, pitch, yaw) or, when the engine does
+  not move, by the links that do;
+- a *mounted mode* is a mode in which most of the kinetic energy is in the
+  engine: the engine's rigid-body modes on its mount. Their modal decay
+  rates ``sigma = phi^T D phi / (2 phi^T M phi)`` set the settle time.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from .case import ENGINE
+from .scene import Scene
+
+__all__ = ["Linearization", "Mode", "linearize", "modes_of", "free_motions", "mounted_modes",
+           "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
+
+#: Modes below this frequency count as free motions (mechanisms), Hz. The
+#: links' spin restraints add modes at about 1 Hz and more.
+FREE_FREQUENCY_HZ = 0.05
+#: Names of the engine's six motions, in the order of its node coordinates.
+ENGINE_MOTIONS = ("heading translation (x)", "lateral translation (y)", "vertical translation (z)",
+                  "roll (rotation about x)", "pitch (rotation about y)", "yaw (rotation about z)")
+#: A mode is a mounted mode when at least this share of its kinetic energy is in the engine.
+ENGINE_SHARE = 0.5
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """Linearised equations ``M x'' + D x' + K x = f`` in independent coordinates.
+
+    Attributes
+    ----------
+    mass, stiffness, damping : ndarray, shape (n, n)
+        Projected matrices (kg, N/m, N s/m in the coordinates' units).
+    basis : ndarray, shape (N, n)
+        Full ODE2 coordinates from independent ones: ``q = basis @ x``.
+    full_mass : ndarray, shape (N, N)
+        Unprojected mass matrix.
+    body_coordinates : dict of str to ndarray of int
+        Full ODE2 coordinate indices of each body.
+    """
+
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    basis: np.ndarray
+    full_mass: np.ndarray
+    body_coordinates: dict
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One linearised mode.
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Undamped natural frequency, Hz.
+    decay_rate : float
+        Modal decay rate sigma, 1/s (free vibration decays as exp(-sigma t)).
+    engine_share : float
+        Share of the modal kinetic energy in the engine, 0 to 1.
+    engine_shape : ndarray, shape (6,)
+        The engine's motion (x, y, z in m; rotations about x, y, z in rad),
+        largest component 1 in magnitude.
+    body_shares : dict of str to float
+        Share of the modal kinetic energy per body.
+    """
+
+    frequency_hz: float
+    decay_rate: float
+    engine_share: float
+    engine_shape: np.ndarray
+    body_shares: dict
+
+    @property
+    def damping_ratio(self) -> float:
+        """Modal damping ratio zeta = sigma / w."""
+        omega = 2 * np.pi * self.frequency_hz
+        return self.decay_rate / omega if omega > 0 else float("inf")
+
+    @property
+    def description(self) -> str:
+        """The engine's dominant motions, or the moving links when the engine is still."""
+        if self.engine_share >= 0.1:
+            return describe_engine_motion(self.engine_shape)
+        moving = sorted(self.body_shares.items(), key=lambda item: -item[1])
+        names = [name for name, share in moving if share >= 0.1 * moving[0][1]][:3]
+        return "motion of link " + ", ".join(repr(name) for name in names) + " with the engine still"
+
+
+def _body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
+    import exudyn as exu
+
+    mbs = scene.mbs
+    indices = {}
+    for body, nodes in scene.body_nodes().items():
+        coordinates = []
+        for node in nodes:
+            start = mbs.GetNodeODE2Index(node)
+            size = len(mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates))
+            coordinates.extend(range(start, start + size))
+        indices[body] = np.array(coordinates, dtype=int)
+    return indices
+
+
+def linearize(scene: Scene) -> Linearization:
+    """Linearise *scene* at its initial state (after a static solve with
+    ``updateInitialValues=True``: the preloaded state)."""
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    mbs = scene.mbs
+    matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
+                                           returnConstraintJacobian=True)
+    mass, stiffness, damping = (np.asarray(m) for m in matrices[:3])
+    size = mass.shape[0]
+    if mbs.systemData.AEsize() > 0:
+        jacobian = np.asarray(matrices[3])
+        left, singular, _ = sla.svd(jacobian)
+        rank = int((singular > 1e-12 * max(singular.max(), 1.0)).sum())
+        basis = left[:, rank:]
+    else:
+        basis = np.eye(size)
+    project = lambda matrix: basis.T @ matrix @ basis  # noqa: E731
+    return Linearization(project(mass), project(stiffness), project(damping), basis, mass,
+                         _body_coordinates(scene))
+
+
+def modes_of(linearization: Linearization) -> list[Mode]:
+    """All modes of a linearisation, by ascending frequency."""
+    lin = linearization
+    eigenvalues, vectors = sla.eig(lin.stiffness, lin.mass)
+    order = np.argsort(eigenvalues.real)
+    modes = []
+    for index in order:
+        vector = vectors[:, index]
+        full = lin.basis @ vector
+        kinetic = float(np.real(np.conj(vector) @ lin.mass @ vector))
+        shares = {}
+        for body, coordinates in lin.body_coordinates.items():
+            part = full[coordinates]
+            shares[body] = float(np.real(np.conj(part) @ lin.full_mass[np.ix_(coordinates, coordinates)] @ part)
+                                 / kinetic)
+        engine = _real_shape(full[lin.body_coordinates[ENGINE]])
+        omega_squared = float(eigenvalues[index].real)
+        decay = float(np.real(np.conj(vector) @ lin.damping @ vector)) / (2 * kinetic)
+        modes.append(Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), decay, shares[ENGINE],
+                          engine, {b: s for b, s in shares.items() if b != ENGINE}))
+    return modes
+
+
+def _real_shape(part: np.ndarray) -> np.ndarray:
+    """A (possibly complex) mode-shape part turned real, largest component 1."""
+    peak = part[np.argmax(np.abs(part))]
+    return np.real(part / peak) if abs(peak) > 0 else np.zeros(len(part))
+
+
+def describe_engine_motion(shape: np.ndarray, length_scale: float = 1.0) -> str:
+    """Name the dominant engine motions of a 6-component shape.
+
+    Rotations are weighed by *length_scale* (m) against translations.
+    """
+    weights = np.abs(np.asarray(shape, dtype=float)) * np.r_[1, 1, 1, [length_scale] * 3]
+    if weights.max() == 0:
+        return "no engine motion"
+    order = np.argsort(-weights)
+    parts = [f"{ENGINE_MOTIONS[i]}" + ("" if k == 0 else f" ({weights[i] / weights[order[0]]:.2f})")
+             for k, i in enumerate(order) if weights[i] >= 0.3 * weights[order[0]]]
+    return "engine " + " with ".join(parts)
+
+
+def free_motions(modes: list[Mode]) -> list[Mode]:
+    """The modes below :data:`FREE_FREQUENCY_HZ`: free motions of a mechanism."""
+    return [mode for mode in modes if mode.frequency_hz < FREE_FREQUENCY_HZ]
+
+
+def mounted_modes(modes: list[Mode]) -> list[Mode]:
+    """The engine's modes on its mount (most kinetic energy in the engine)."""
+    return [mode for mode in modes if mode.engine_share >= ENGINE_SHARE and mode.frequency_hz >= FREE_FREQUENCY_HZ]

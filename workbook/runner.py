@@ -1,0 +1,110 @@
+"""Run a case: every excitation through reduction, scene, preload, modes,
+time integration and amplitude extraction, each stage timed."""
+from __future__ import annotations
+
+import logging
+import time
+from contextlib import contextmanager
+from typing import Callable, Union
+
+from .case import Case, SingleFrequencyExcitation, Sweep
+from .modelcard import model_card
+from .modes import linearize, modes_of, mounted_modes
+from .preload import solve_preload
+from .results import MountResult
+from .scene import build_scene, reduce_links
+from .timedomain import extract, integrate, plan_run
+
+__all__ = ["run_excitation", "run_case", "ProgressFactory"]
+
+log = logging.getLogger(__name__)
+
+#: Makes a progress reporter for a long stage: ``factory(description, total)``
+#: returns ``(update, close)``; ``update(done)`` reports the amount done so
+#: far (links reduced, or simulated seconds), ``close()`` ends the stage.
+ProgressFactory = Callable[[str, float], tuple]
+
+
+@contextmanager
+def _timed(timings: dict, stage: str):
+    start = time.perf_counter()
+    yield
+    timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
+
+
+def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
+                   reduce_for: Union[SingleFrequencyExcitation, None] = None,
+                   progress: Union[ProgressFactory, None] = None):
+    """Run one single-frequency excitation of *case*.
+
+    Parameters
+    ----------
+    case : Case
+    excitation : RotatingForce or HarmonicForce
+    reduce_for : RotatingForce or HarmonicForce, optional
+        The excitation whose frequency the link reductions must serve
+        (default: *excitation*; a sweep passes its highest frequency so that
+        every point uses the same link models).
+    progress : callable, optional
+        Progress factory for the long stages (see :data:`ProgressFactory`).
+
+    Returns
+    -------
+    result : ExcitationResult
+    card : ModelCard
+    preload : Preload
+
+    Raises
+    ------
+    MechanismError, EquilibriumError
+        From the preload stage.
+    """
+    timings = {}
+    with _timed(timings, "reduce links"):
+        reduction = reduce_for or excitation
+        if progress is None or not case.links:
+            reduced = reduce_links(case, reduction)
+        else:
+            update, close = progress(f"{excitation.name}: reducing links", len(case.links))
+            try:
+                reduced = reduce_links(case, reduction, update)
+            finally:
+                close()
+    with _timed(timings, "build scene"):
+        scene = build_scene(case, excitation, reduced=reduced)
+    with _timed(timings, "static preload"):
+        preload = solve_preload(scene)
+    with _timed(timings, "mounted modes"):
+        mounted = mounted_modes(modes_of(linearize(scene)))
+    plan = plan_run(case.analysis, scene.excitation.signal, mounted)
+    log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
+    with _timed(timings, "time integration"):
+        if progress is None:
+            histories = integrate(scene, plan)
+        else:
+            update, close = progress(f"{excitation.name} ({excitation.frequency:g} Hz)", plan.end_time)
+            try:
+                histories = integrate(scene, plan, update)
+            finally:
+                close()
+    with _timed(timings, "amplitude extraction"):
+        result = extract(scene, plan, histories)
+    return result, model_card(scene, preload, mounted, plan, timings), preload
+
+
+def run_case(case: Case, *, progress: Union[ProgressFactory, None] = None) -> MountResult:
+    """Run every excitation of *case* (sweeps frequency by frequency).
+
+    Returns
+    -------
+    MountResult
+    """
+    runs, cards, preloads = [], {}, {}
+    for item in case.excitations:
+        points = item.expand() if isinstance(item, Sweep) else (item,)
+        for excitation in points:
+            result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress)
+            runs.append(result)
+            cards[result.name] = card
+            preloads[result.name] = preload
+    return MountResult(case.name, runs, cards, preloads)
