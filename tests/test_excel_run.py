@@ -264,3 +264,11 @@ def test_unknown_run_name_is_bad_input(cheap, capsys):
     assert main(["run", str(cheap), "--no-progress", "--run", "IP rotor"]) == 2
     assert "'IP rotor'" in capsys.readouterr().err
     assert sha256(cheap) == digest
+
+
+def test_report_cannot_overwrite_the_case(cheap, tmp_path, capsys):
+    path = tmp_path / "case.xlsx"
+    shutil.copyfile(cheap, path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(path)]) == 1
+    assert "cannot overwrite the case workbook" in capsys.readouterr().err
+    assert "Result efficiency" in load_workbook(path).sheetnames       # the results were written first

@@ -117,7 +117,12 @@ def run_workbook(args) -> int:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
     _print_summary(runs)
-    outcome = write_results(book.path, book.sha256, runs, book.tests)
+    try:
+        outcome = write_results(book.path, book.sha256, runs, book.tests)
+    except OSError as error:
+        print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
+              file=sys.stderr)
+        return EXIT_TROUBLE
     if outcome.reason is None:
         print(f"results written into {outcome.path}")
     else:
@@ -125,7 +130,7 @@ def run_workbook(args) -> int:
     if args.report:
         try:
             print(f"report written to {write_report(args.report, book, runs)}")
-        except (ValueError, PermissionError) as error:
+        except (ValueError, OSError) as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE
     return EXIT_OK
