@@ -9,9 +9,9 @@ from threadpoolctl import threadpool_limits
 _blas_limit = threadpool_limits(limits=1)
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="session", autouse=True)
 def cache_dir(tmp_path_factory):
-    """A reduction cache shared by all tests of one session."""
+    """A reduction cache shared by all tests of one session (never the user's own cache)."""
     path = tmp_path_factory.mktemp("reduction-cache")
     os.environ["MOUNTWB_CACHE"] = str(path)
     return path

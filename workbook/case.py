@@ -34,6 +34,8 @@ __all__ = [
 PYLON = "pylon"
 ENGINE = "engine"
 DIRECTIONS = ("x", "y", "z")
+#: Analysis methods a case may ask for (AnalysisSettings.method).
+ANALYSIS_METHODS = ("time", "frequency", "auto")
 _RESERVED = (PYLON, ENGINE)
 # Two points closer than this (m) are the same point (a hinge on a link eye).
 POINT_TOLERANCE = 1e-6
@@ -572,6 +574,11 @@ class AnalysisSettings:
     equilibrium_tolerance : float
         Largest relative mismatch between the pylon-side hinge forces and the
         applied static loads.
+    method : {"time", "frequency", "auto"}
+        The analysis answering the case: time domain, frequency domain
+        (harmonic solution of the scene linearised about the preload), or
+        ``"auto"`` (frequency domain when no clearance law makes the scene
+        nonlinear, see :mod:`workbook.method`).
     """
 
     steps_per_period: int = 40
@@ -583,9 +590,12 @@ class AnalysisSettings:
     spectral_radius: float = 0.9
     newton_tolerance: float = 1e-6
     equilibrium_tolerance: float = 1e-6
+    method: str = "time"
 
     def __post_init__(self):
         item = "analysis settings"
+        if self.method not in ANALYSIS_METHODS:
+            raise CaseError(item, "method", self.method, " or ".join(repr(m) for m in ANALYSIS_METHODS))
         for name in ("steps_per_period", "measured_periods"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:

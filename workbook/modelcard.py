@@ -108,7 +108,7 @@ class ModelCard:
         return "\n".join(lines)
 
 
-def model_card(scene, preload, mounted, plan, timings: dict) -> ModelCard:
+def model_card(scene, preload, mounted, plan, timings: dict, method=None, solver: dict | None = None) -> ModelCard:
     """Fill the model card of a run.
 
     Parameters
@@ -116,8 +116,13 @@ def model_card(scene, preload, mounted, plan, timings: dict) -> ModelCard:
     scene : workbook.scene.Scene
     preload : workbook.preload.Preload
     mounted : list of workbook.modes.Mode
-    plan : workbook.timedomain.TimePlan
+    plan : workbook.timedomain.TimePlan or None
+        The time-domain plan (None for a frequency-domain run).
     timings : dict of str to float
+    method : workbook.method.MethodChoice, optional
+        The analysis method and why (default: the time domain, no reason recorded).
+    solver : dict, optional
+        Solver settings to record instead of those of *plan*.
     """
     from .case import ENGINE
     from .scene import link_is_flexible
@@ -133,12 +138,13 @@ def model_card(scene, preload, mounted, plan, timings: dict) -> ModelCard:
             why = ("all links rigid (effects.flexible_links off)" if not case.effects.flexible_links
                    else "link asked to be rigid (flexible = False)")
             bodies.append(BodyEntry(link.name, "rigid link", item.dof, 0, item.mass, why))
-    card = ModelCard(case.name, scene.excitation.name, bodies, _effects(scene, preload), _solver(scene, plan),
+    card = ModelCard(case.name, scene.excitation.name, bodies, _effects(scene, preload, method),
+                     _solver(scene, plan) if solver is None else dict(solver),
                      [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings))
     return card
 
 
-def _effects(scene, preload) -> list[EffectEntry]:
+def _effects(scene, preload, method=None) -> list[EffectEntry]:
     from .scene import link_is_flexible
 
     case, effects = scene.case, scene.case.effects
@@ -167,8 +173,17 @@ def _effects(scene, preload) -> list[EffectEntry]:
                     ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")),
         EffectEntry("gyroscopic rotor", False, "not modelled: rotor inertia is lumped into the rigid engine"),
         EffectEntry("test-rig force-sensor compliance", False, "not modelled: the pylon fittings are rigid"),
-        EffectEntry("time domain", True, "implicit generalized-alpha; amplitude by DFT of the last window"),
     ]
+    time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
+    if method is None:
+        entries.append(EffectEntry("time domain", True, time_detail))
+    else:
+        frequency_detail = "harmonic solution of the scene linearised about the preload"
+        entries += [EffectEntry("time domain", method.method == "time",
+                                f"{time_detail}: {method.reason}" if method.method == "time" else "not used"),
+                    EffectEntry("frequency domain", method.method == "frequency",
+                                f"{frequency_detail}: {method.reason}" if method.method == "frequency"
+                                else "not used")]
     return entries
 
 

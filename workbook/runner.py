@@ -8,6 +8,7 @@ from contextlib import contextmanager
 from typing import Callable, Union
 
 from .case import Case, SingleFrequencyExcitation, Sweep
+from .method import FREQUENCY, MethodChoice, choose_method
 from .modelcard import model_card
 from .modes import linearize, modes_of, mounted_modes
 from .preload import solve_preload
@@ -34,8 +35,9 @@ def _timed(timings: dict, stage: str):
 
 def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                    reduce_for: Union[SingleFrequencyExcitation, None] = None,
-                   progress: Union[ProgressFactory, None] = None):
-    """Run one single-frequency excitation of *case*.
+                   progress: Union[ProgressFactory, None] = None,
+                   method: Union[MethodChoice, None] = None):
+    """Run one single-frequency excitation of *case* in the time domain.
 
     Parameters
     ----------
@@ -47,6 +49,8 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         every point uses the same link models).
     progress : callable, optional
         Progress factory for the long stages (see :data:`ProgressFactory`).
+    method : MethodChoice, optional
+        Why the time domain answers this run, for the model card.
 
     Returns
     -------
@@ -89,21 +93,28 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 close()
     with _timed(timings, "amplitude extraction"):
         result = extract(scene, plan, histories)
-    return result, model_card(scene, preload, mounted, plan, timings), preload
+    return result, model_card(scene, preload, mounted, plan, timings, method), preload
 
 
 def run_case(case: Case, *, progress: Union[ProgressFactory, None] = None) -> MountResult:
-    """Run every excitation of *case* (sweeps frequency by frequency).
+    """Run every excitation of *case* (sweeps frequency by frequency) by the
+    method the case asks for (:func:`workbook.method.choose_method`).
 
     Returns
     -------
     MountResult
     """
+    method = choose_method(case)
+    if method.method == FREQUENCY:
+        from .frequency_runner import run_case_frequency
+
+        return run_case_frequency(case, method, progress=progress)
     runs, cards, preloads = [], {}, {}
     for item in case.excitations:
         points = item.expand() if isinstance(item, Sweep) else (item,)
         for excitation in points:
-            result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress)
+            result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress,
+                                                   method=method)
             runs.append(result)
             cards[result.name] = card
             preloads[result.name] = preload
