@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from .assembly import FEModel, assemble
+from .atomic import replacing
 from .geometry import LinkGeometry
 from .materials import STEEL, Material
 from .meshing import default_element_size, load_mesh, mesh_link
@@ -185,10 +186,8 @@ def _read_summary(path: Path) -> dict | None:
 
 
 def _write_summary(path: Path, frequencies: dict) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps({key: np.asarray(v).tolist() for key, v in frequencies.items()}))
-    os.replace(tmp, path)
+    with replacing(path) as temporary:
+        temporary.write_text(json.dumps({key: np.asarray(v).tolist() for key, v in frequencies.items()}))
 
 
 def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = None, *, cache_dir=None, use_cache: bool = True) -> ReducedLink:

@@ -16,14 +16,13 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import os
-import tempfile
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .atomic import replacing
 from .selection import ModeDecision
 
 __all__ = ["ReducedLink", "ReducedLinkFileError", "save_reduced_link", "load_reduced_link", "SCHEMA", "SCHEMA_VERSION"]
@@ -186,7 +185,6 @@ def save_reduced_link(link: ReducedLink, path) -> Path:
     Path
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     arrays = _arrays_of(link)
     meta = {
         "schema": SCHEMA,
@@ -200,14 +198,8 @@ def save_reduced_link(link: ReducedLink, path) -> Path:
         "info": link.info,
         "checksum": _checksum(arrays),
     }
-    fd, tmp = tempfile.mkstemp(prefix=path.stem, suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            np.savez_compressed(handle, meta=np.array(json.dumps(meta)), **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with replacing(path) as temporary, open(temporary, "wb") as handle:
+        np.savez_compressed(handle, meta=np.array(json.dumps(meta)), **arrays)
     return path
 
 

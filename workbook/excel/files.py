@@ -8,13 +8,13 @@ overwrite the file and write its results elsewhere instead.
 from __future__ import annotations
 
 import logging
-import os
 import re
-import tempfile
 import zipfile
 from pathlib import Path
 from typing import Callable, Union
 from xml.sax.saxutils import escape
+
+from flexbodies.atomic import replacing
 
 __all__ = ["save_atomic", "lock_file", "unsupported_content", "restore_formula_values"]
 
@@ -140,7 +140,8 @@ def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[Path],
     """Save an openpyxl workbook to *path* atomically.
 
     The workbook is written to a temporary file in the same folder and then
-    renamed over *path* (``os.replace``), so *path* is never half-written.
+    renamed over *path*, so *path* is never half-written; it keeps the
+    permissions of the workbook it replaces.
 
     Parameters
     ----------
@@ -154,15 +155,9 @@ def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[Path],
     Path
     """
     path = Path(path)
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.stem}-", suffix=".xlsx.tmp", dir=path.parent)
-    os.close(handle)
-    try:
+    with replacing(path, suffix=".xlsx.tmp") as temporary:
         workbook.save(temporary)
         if finish is not None:
-            finish(Path(temporary))
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
+            finish(temporary)
     log.info("saved %s", path)
     return path
