@@ -200,6 +200,7 @@ BAD_INPUTS = {
                                                                            "the bore radius (0.045 m)"]),
     "too few steps per period": (_edit({("Case", "steps per period", 3): 4}), ["sheet 'Case'", "cell C3",
                                                                                "at least 8"]),
+    "unknown analysis method": (_edit({("Case", "method", 3): "fast"}), ["sheet 'Case'", "cell L3", "'fast'"]),
     "two rows in the Case sheet": (_edit({("Case", "name", 4): "second"}), ["sheet 'Case'", "row 4"]),
     "misspelt column": (_edit({("Hinges", "damping", 1): "dampng"}), ["sheet 'Hinges'", "cell H1", "'dampng'"]),
     "negative frequency": (_edit({("Excitations", "frequency", 3): -59}), ["sheet 'Excitations'", "cell F3"]),
@@ -298,3 +299,12 @@ def test_mesh_link_and_missing_geometry_column(tmp_path):
     messages = [str(p) for p in error.value.problems]
     assert sum("column 'eye thickness'" in m for m in messages) == 1
     assert any("cell AH3, column 'mesh bore B x'" in m and "bore B of a mesh link" in m for m in messages)
+
+
+def test_the_case_sheet_chooses_the_analysis_method(tmp_path):
+    from workbook.excel.reader import read_workbook
+
+    path = copy_reference(tmp_path)
+    assert read_workbook(path).case.analysis.method == "time"
+    set_cells(path, {("Case", "method", 3): "auto"})
+    assert read_workbook(path).case.analysis.method == "auto"

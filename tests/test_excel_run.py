@@ -134,7 +134,12 @@ def test_test_data_error(ran):
 def test_report_workbook(ran):
     path, _, digest, report = ran
     wb = load_workbook(report)
-    assert wb.sheetnames == ["Summary", "Transmissibility", "Plots", "Model card", "Metadata"]
+    assert wb.sheetnames == ["Summary", "Validation", "Transmissibility", "Plots", "Model card", "Metadata"]
+    validation = _sheet_rows(wb["Validation"], header_row=3)   # the pylon-sum test point only
+    assert [(r["run"], r["direction"]) for r in validation] == [("LP rotor", "y")]
+    lp_y = validation[0]
+    assert lp_y["T test"] == pytest.approx(TEST_LP_Y / 1000.0, rel=1e-12)
+    assert lp_y["error %"] == pytest.approx((lp_y["T sim"] - lp_y["T test"]) / lp_y["T test"] * 100, rel=1e-9)
     assert len(wb["Summary"]._charts) == 1 and len(wb["Transmissibility"]._charts) == 1
     chart = wb["Transmissibility"]._charts[0]
     assert len(chart.series) == 6 and chart.x_axis.delete is False      # sweep and single runs, x y z each

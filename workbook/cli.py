@@ -6,6 +6,12 @@ Subcommands:
   reference mount, LP and HP rotors); print the three-way isolation-efficiency
   table and the model card of each run, or the answers as JSON.
 - ``mountwb layout [CASE.json] [-o FILE.png]``: draw a case's layout.
+- ``mountwb study accuracy [CASE] [--run R] [--repeats N] [--output DIR]``:
+  the accuracy-against-time ladder (:mod:`workbook.study_cli`).
+- ``mountwb study params [CASE] --vary NAME=SPEC ... [--lhs N] [--workers N |
+  --dask ADDRESS]``: a parameter study (:mod:`workbook.parametric_cli`).
+- ``mountwb rig measure|compare|synthesize ...``: rig records against
+  simulation (:mod:`workbook.rig_cli`).
 - ``mountwb run CASE.xlsx [--run NAME] [--report OUT.xlsx]``, ``mountwb check
   CASE.xlsx``, ``mountwb template OUT.xlsx [--reference]``: case workbooks
   (:mod:`workbook.excel.commands`).
@@ -22,6 +28,8 @@ from pathlib import Path
 from typing import Callable
 
 from .excel import commands as excel_commands
+from .rig_cli import rig_arguments
+from .study_cli import study_arguments
 
 __all__ = ["main", "SUBCOMMANDS"]
 
@@ -143,6 +151,11 @@ SUBCOMMANDS = {
               excel_commands.check_arguments),
     "template": ("write the case template workbook (or, with --reference, the reference case)",
                  excel_commands.template_arguments),
+    "study": ("accuracy against time: run a case through the ladder of link fidelities and methods; "
+              "or a parameter study (params)",
+              study_arguments),
+    "rig": ("measured rig records: measured T and eta, the validation table against simulation, "
+            "synthetic records", rig_arguments),
 }
 
 

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
@@ -90,7 +91,7 @@ class HarmonicModel:
     pylon_hinges: list
     stiffness_output: np.ndarray
     damping_output: np.ndarray
-    engine_point_jacobian: object = field(repr=False)
+    engine_point_jacobian: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     _inputs: dict = field(default_factory=dict, repr=False)
 
     @property

@@ -65,4 +65,4 @@ def choose_method(case: Case) -> MethodChoice:
     if gaps:
         return MethodChoice(TIME, f"auto: {nonlinear}; the time domain resolves the contact")
     return MethodChoice(FREQUENCY, "auto: the scene is linear (no hinge clearance), so the harmonic solution "
-                        "of the linearised scene about the preload is exact")
+                        "is exact")

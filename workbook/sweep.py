@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .case import DIRECTIONS, Case, Sweep
-from .method import MethodChoice
+from .method import FREQUENCY, MethodChoice
 from .modes import ENGINE_SHARE, FREE_FREQUENCY_HZ, Mode
 from .results import PYLON_SUM, MountResult
 
@@ -150,7 +150,7 @@ def run_sweep(case: Case, sweep: Sweep, *, reduced=None) -> SweepAnswer:
 
     points = sweep.expand()
     prepared = prepare(case, points[0], reduce_for=points[-1], reduced=reduced)
-    method = MethodChoice("frequency", "a sweep runs in the frequency domain: one linearisation serves "
+    method = MethodChoice(FREQUENCY, "a sweep runs in the frequency domain: one linearisation serves "
                                        "every frequency")
     runs, cards, preloads = results_of(case, prepared, points, method)
     return SweepAnswer(sweep, MountResult(case.name, runs, cards, preloads),

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..case import ANALYSIS_METHODS
 from .units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -159,6 +160,9 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
     _num("newton_tolerance", "newton tolerance", help="Newton tolerance relative to the load scale"),
     _num("equilibrium_tolerance", "equilibrium tolerance",
          help="largest relative mismatch of the static equilibrium"),
+    Column("method", "method", "choice", choices=ANALYSIS_METHODS,
+           help="time: time domain; frequency: frequency domain about the preload; auto: frequency domain "
+                "unless a clearance makes the scene nonlinear"),
     Column("flexible_links", "flexible links", "yesno", help="no: every link rigid"),
     Column("preload", "preload", "yesno", help="solve the static loads first"),
     Column("hinge_damping", "hinge damping", "yesno", help="no: hinge damping set to zero"),
@@ -260,12 +264,18 @@ RUNS = Table("Runs", help="one run per row: an excitation and optional overrides
     Column("measured_periods", "measured periods", "integer", DIMENSIONLESS, help="override"),
 ))
 
-TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes to compare with", columns=(
+TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes, or rig records, to compare with",
+                  columns=(
     Column("run", "run", "text", required=True, help="a run name"),
     Column("location", "location", "text", help="'pylon sum' (empty) or a hinge name"),
-    Column("direction", "direction", "choice", required=True, choices=("x", "y", "z"), help="direction"),
+    Column("direction", "direction", "choice", choices=("x", "y", "z"), help="direction (not with a rig record)"),
     _num("frequency", "frequency", "Hz", help="sweep runs: the frequency measured"),
-    _num("amplitude", "amplitude", "N", required=True, help="measured force amplitude"),
+    _num("amplitude", "amplitude", "N", help="measured force amplitude (not with a rig record)"),
+    Column("record", "rig record", "text",
+           help="instead of direction and amplitude: a rig record (CSV, relative to the workbook); its measured "
+                "pylon T per direction times the run's excitation amplitude"),
+    Column("periods", "record periods", "integer", DIMENSIONLESS,
+           help="rig record: whole periods per window (empty: the run's measured periods)"),
 ))
 
 #: The input tables in sheet order.

@@ -342,6 +342,13 @@ class _CaseReader(SheetReader):
             if name not in by_name:
                 self.record_problem(record, ("run",), name, f"a run name ({', '.join(by_name)})")
                 continue
+            if record.get("record") is not None:
+                points.extend(self.record_points(record, by_name[name][1], case))
+                continue
+            missing = [key for key in ("direction", "amplitude") if record.get(key) is None]
+            if missing:
+                self.record_problem(record, (missing[0],), None, f"a {missing[0]} (or a rig record)")
+                continue
             location = record.get("location", PYLON_SUM)
             if location not in locations:
                 self.record_problem(record, ("location",), location, "'pylon sum' or a hinge name")
@@ -357,6 +364,30 @@ class _CaseReader(SheetReader):
                 continue
             points.append(TestPoint(name, location, record.get("direction"), frequency, record.get("amplitude")))
         return points
+
+    def record_points(self, record: Record, run: RunSpec, case: cm.Case) -> list[TestPoint]:
+        """The pylon-sum test points of a Test data row naming a rig record."""
+        from ..rig import RecordError
+        from .rig_points import record_test_points
+
+        extra = [key for key in ("location", "direction", "amplitude", "frequency") if record.get(key) is not None]
+        if extra:
+            self.record_problem(record, (extra[0],), record.typed((extra[0],), None),
+                                "an empty cell (a rig record gives the pylon sum in every direction)")
+            return []
+        run_case = case_for_run(case, run)
+        if record.get("periods") is not None:
+            try:
+                analysis = dataclasses.replace(run_case.analysis, measured_periods=record.get("periods"))
+            except cm.CaseError as error:
+                self.record_problem(record, ("periods",), record.typed(("periods",), None), error.expected)
+                return []
+            run_case = dataclasses.replace(run_case, analysis=analysis)
+        try:
+            return record_test_points(self.path.parent / record.get("record"), run.name, run_case)
+        except RecordError as error:
+            self.record_problem(record, ("record",), record.get("record"), f"a usable rig record: {error}")
+            return []
 
 
 def read_workbook(path: Union[str, Path]) -> CaseBook:

@@ -4,6 +4,9 @@ Sheets:
 
 - ``Summary``: pylon isolation efficiency per run and direction (single
   frequencies) with a native bar chart;
+- ``Validation`` (with test data): the seed study's validation table, pylon
+  T and eta simulated and measured per run and direction, error =
+  (sim - test) / test x 100 %;
 - ``Transmissibility``: pylon T per direction against frequency with a
   native scatter chart (one curve per sweep run and direction; the single
   frequency runs as points);
@@ -29,7 +32,7 @@ from openpyxl.styles import Font
 from ..case import DIRECTIONS
 from .files import lock_file, save_atomic
 from .reader import CaseBook
-from .writer import RunResult, card_lines
+from .writer import RunResult, card_lines, result_frames
 
 __all__ = ["write_report", "PACKAGES"]
 
@@ -69,6 +72,18 @@ def _summary(ws, case_name: str, runs: list[RunResult]) -> None:
     chart.width, chart.height = 18, 9
     _show_axes(chart)
     ws.add_chart(chart, "J3")
+
+
+def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
+    ws["A1"] = "Validation: pylon transmissibility, simulation against test; error = (sim - test) / test x 100 %"
+    ws["A1"].font = Font(bold=True, size=13)
+    frame = result_frames(runs, tests)["efficiency"]
+    frame = frame[frame["test amplitude N"].notna()]
+    t_test = frame["T"] * frame["test amplitude N"] / frame["amplitude N"]
+    rows = [[row["run"], row["frequency Hz"], row["direction"], row["T"], t, row["error %"], row["eta %"],
+             (1 - t) * 100] for (_, row), t in zip(frame.iterrows(), t_test)]
+    _rows(ws, ["run", "frequency Hz", "direction", "T sim", "T test", "error %", "eta sim %", "eta test %"], rows,
+          start=3)
 
 
 def _transmissibility(ws, runs: list[RunResult]) -> None:
@@ -172,6 +187,8 @@ def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult]) 
     workbook = Workbook()
     workbook.active.title = "Summary"
     _summary(workbook.active, book.case.name, runs)
+    if book.tests:
+        _validation(workbook.create_sheet("Validation"), runs, book.tests)
     _transmissibility(workbook.create_sheet("Transmissibility"), runs)
     _plots(workbook.create_sheet("Plots"), runs)
     cards = workbook.create_sheet("Model card")

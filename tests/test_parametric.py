@@ -1,0 +1,122 @@
+"""Parameter studies: rows, row cases, and runs serial = processes = Dask, failures per row (issue 7)."""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from workbook.case import AnalysisSettings, CaseError
+from workbook.cli import main
+from workbook.codec import to_json
+from workbook.parallel import run_rows
+from workbook.parametric import grid, latin_hypercube, linear_range, row_case, study_cases
+from workbook.parametric_cli import parse_vary
+from workbook.reference import HINGE_STIFFNESS, LP_ROTOR, reference_case
+from workbook.runner import run_case
+from workbook.sensitivity import study_frame
+
+#: Short, steady runs on rigid links, LP rotor only.
+SHORT = AnalysisSettings(settle_time=0.2, measured_periods=10)
+STIFFNESS = [1e7, HINGE_STIFFNESS, 4e7, 0.0]
+REMOVED = ["none", "rear-left"]
+
+
+@pytest.fixture(scope="module")
+def base():
+    case = reference_case(analysis=SHORT).with_rigid_links()
+    return dataclasses.replace(case, excitations=(LP_ROTOR,))
+
+
+@pytest.fixture(scope="module")
+def rows():
+    return grid({"hinge_stiffness": STIFFNESS, "removed_link": REMOVED})
+
+
+@pytest.fixture(scope="module")
+def serial(base, rows, cache_dir):
+    return study_frame(rows, run_rows(study_cases(base, rows), workers=1))
+
+
+def _answers(frame):
+    return frame.drop(columns="wall time s").reset_index(drop=True)
+
+
+def test_grid_range_and_latin_hypercube_rows():
+    assert grid({"hinge_stiffness": [1, 2], "material": ["steel", "titanium"]}) == (
+        {"hinge_stiffness": 1, "material": "steel"}, {"hinge_stiffness": 1, "material": "titanium"},
+        {"hinge_stiffness": 2, "material": "steel"}, {"hinge_stiffness": 2, "material": "titanium"})
+    assert linear_range(1e7, 4e7, 4) == [1e7, 2e7, 3e7, 4e7]
+    samples = latin_hypercube({"hinge_stiffness": (1e7, 3e7), "frequency": (50.0, 70.0)}, 10, seed=3)
+    for name, (low, high) in (("hinge_stiffness", (1e7, 3e7)), ("frequency", (50.0, 70.0))):
+        strata = sorted(int((row[name] - low) / (high - low) * 10) for row in samples)
+        assert strata == list(range(10))  # one sample in each tenth of every range
+    assert parse_vary(["hinge_damping=1e3:3e3:3", "material=steel,titanium"], None) == grid(
+        {"hinge_damping": [1e3, 2e3, 3e3], "material": ["steel", "titanium"]})
+    with pytest.raises(ValueError, match="with --lhs give bounds"):
+        parse_vary(["frequency=50,60"], lhs=5)
+    with pytest.raises(ValueError, match="unknown study parameter"):
+        grid({"stiffness": [1.0]})
+
+
+def test_row_case_sets_every_parameter(base):
+    row = {"hinge_stiffness": 3e7, "hinge_damping": 500.0, "clearance": 1e-4, "section_scale": 1.2,
+           "material": "titanium", "frequency": 61.0, "removed_link": "rear-lateral"}
+    case = row_case(base, row, 7)
+    assert case.name.endswith("/ row 7") and "rear-lateral" not in case.link_map
+    assert {(h.stiffness, h.damping, h.radial_clearance) for h in case.hinges} == {(3e7, 500.0, 1e-4)}
+    front = case.link_map["front-left"].model
+    assert front.material.name == "titanium"
+    assert front.geometry.shank_width == pytest.approx(1.2 * base.link_map["front-left"].model.geometry.shank_width)
+    assert [e.frequency for e in case.excitations] == [61.0]
+    with pytest.raises(CaseError, match="stiffness"):
+        row_case(base, {"hinge_stiffness": 0.0}, 0)
+
+
+def test_processes_equal_serial_and_failing_rows_are_reported(base, rows, serial):
+    processes = study_frame(rows, run_rows(study_cases(base, rows), workers=2))
+    pd.testing.assert_frame_equal(_answers(processes), _answers(serial), check_exact=True)
+    by_row = serial.set_index("row")
+    for index, row in enumerate(rows):
+        status, error = by_row.loc[index, "status"], by_row.loc[index, "error"]
+        if row["hinge_stiffness"] == 0.0:
+            assert status == "failed" and error.startswith("CaseError: hinge") and "stiffness" in error
+        elif row["removed_link"] == "rear-left":
+            assert status == "failed" and error.startswith("MechanismError:") and "thrust-left" in error
+        else:
+            assert status == "ok" and error == "" and by_row.loc[index, "steady"]
+    ok = serial[serial["status"] == "ok"]
+    assert list(ok["hinge_stiffness"]) == [1e7, HINGE_STIFFNESS, 4e7]
+    # the row with the reference values is the reference case's own answer
+    direct = run_case(base).runs[0].transmissibility
+    reference_row = ok[ok["hinge_stiffness"] == HINGE_STIFFNESS]
+    np.testing.assert_array_equal(reference_row[["T x", "T y", "T z"]].to_numpy()[0], direct)
+    # stiffer hinges pass more heading force to the pylon at 59 Hz
+    assert np.all(np.diff(ok["T x"].to_numpy()) > 0)
+
+
+def test_dask_cluster_equals_local(base, rows, serial, tmp_path):
+    from distributed import LocalCluster
+
+    case_file = tmp_path / "case.json"
+    case_file.write_text(to_json(base))
+    argv = ["study", "params", str(case_file), "--output", str(tmp_path / "out")]
+    argv += [f"--vary=hinge_stiffness={','.join(map(str, STIFFNESS))}", f"--vary=removed_link={','.join(REMOVED)}"]
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        assert main(argv + ["--dask", cluster.scheduler_address]) == 0
+    table = pd.read_csv(tmp_path / "out" / "parameter-study.csv")
+    expected = _answers(serial)
+    for column in expected:
+        if expected[column].dtype.kind == "f":
+            np.testing.assert_array_equal(table[column].to_numpy(float), expected[column].to_numpy(float))
+        else:
+            assert list(table[column].fillna("").astype(str)) == list(expected[column].fillna("").astype(str))
+    assert (tmp_path / "out" / "parameter-study.png").stat().st_size > 10_000
+    assert pd.read_excel(tmp_path / "out" / "parameter-study.xlsx").shape[0] == len(serial)
+
+
+def test_a_section_too_wide_for_the_eyes_is_a_case_error_of_its_row(base):
+    cases = study_cases(base, ({"section_scale": 1.0}, {"section_scale": 2.0}))
+    assert cases[0].links[0].model == base.links[0].model
+    assert isinstance(cases[1], CaseError) and "shank width" in str(cases[1])

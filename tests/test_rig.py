@@ -1,0 +1,206 @@
+"""Measured rig records: the synthetic record's known T is recovered; bad records are refused (issue 7)."""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from workbook.case import AnalysisSettings
+from workbook.cli import main
+from workbook.correlation import comparison_frame, force_amplitude, measure
+from workbook.reference import LP_ROTOR, reference_case
+from workbook.rig import RecordError, read_record, write_record
+from workbook.runner import run_excitation
+from workbook.synthetic_rig import REFERENCE_TRANSDUCERS, synthetic_record
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+#: Short, steady runs on rigid links.
+SHORT = AnalysisSettings(settle_time=0.2, measured_periods=10)
+
+
+@pytest.fixture(scope="module")
+def lp_run(cache_dir):
+    case = reference_case(analysis=SHORT).with_rigid_links()
+    return run_excitation(case, LP_ROTOR)[0]
+
+
+def test_clean_record_gives_the_simulated_transmissibility(lp_run, tmp_path):
+    record = synthetic_record(lp_run, REFERENCE_TRANSDUCERS, noise=0.0, drift=0.0)
+    measurement = measure(read_record(write_record(tmp_path / "clean.csv", record)), periods=20)
+    assert measurement.frequency_hz == pytest.approx(59.0, rel=1e-6)
+    # the window spans 20 periods to within one sample (34.7 samples per period): 1e-3
+    assert measurement.excitation_amplitude == pytest.approx(1000.0, rel=1e-3)
+    # the transducers' sum is the pylon force, whatever the grouping
+    np.testing.assert_allclose(measurement.transmissibility, lp_run.transmissibility, rtol=1e-3)
+    front = measurement.transducer_amplitudes["front-left"]
+    np.testing.assert_allclose(front, lp_run.hinge_amplitudes["front-up-left"], rtol=1e-3, atol=1e-3)
+
+
+def test_noisy_drifting_record_recovers_t_where_the_pylon_force_is_not_a_cancellation(lp_run, tmp_path):
+    record = synthetic_record(lp_run, REFERENCE_TRANSDUCERS, duration=2.0, noise=0.03, drift=0.002, seed=1)
+    periods = 50
+    measurement = measure(read_record(write_record(tmp_path / "rig.csv", record)), periods=periods)
+    # the rotor speed found: the mean speed over the two measured windows at the record's end
+    duration, start = 2.0, 2.0 - 2 * periods / 59.0
+    expected = 59.0 * (1 + 0.002 * ((start + duration) / (2 * duration) - 0.5))
+    assert measurement.frequency_hz == pytest.approx(expected, abs=0.005)
+    error = (measurement.transmissibility - lp_run.transmissibility) / lp_run.transmissibility
+    # x (heading) and z (vertical): T of 0.037 and 0.019, within 1 %
+    assert abs(error[0]) < 0.01 and abs(error[2]) < 0.01, error
+    # y (lateral) nearly cancels at the pylon (T 0.0012, 1.2 N against 40 N per front transducer):
+    # 3 % transducer noise leaves several % there
+    assert abs(error[1]) < 0.15, error
+    table = comparison_frame(measurement, lp_run)
+    assert table.loc["z", "error %"] == pytest.approx(-100 * error[2] / (1 + error[2]), rel=1e-9)
+    # the DFT at the nominal 59 Hz, 0.009 Hz below the mean speed of the windows: T (a ratio) hardly moves
+    nominal = measure(record, periods=periods, search=0.0)
+    assert nominal.frequency_hz == 59.0
+    np.testing.assert_allclose(nominal.transmissibility[[0, 2]], measurement.transmissibility[[0, 2]], rtol=2e-3)
+
+
+def test_the_synthetic_record_recovers_t_within_one_percent(lp_run, tmp_path):
+    # the default record: 4 s at 2048 Hz, 0.5 % transducer noise, 0.2 % speed drift
+    record = synthetic_record(lp_run, REFERENCE_TRANSDUCERS)
+    measurement = measure(read_record(write_record(tmp_path / "rig.csv", record)), periods=100)
+    error = (measurement.transmissibility - lp_run.transmissibility) / lp_run.transmissibility
+    assert np.all(np.abs(error) < 0.01), error
+
+
+def test_force_amplitude_is_the_largest_magnitude_over_a_period():
+    rotating = np.array([0.0, 3.0, -3.0j])
+    harmonic = 5.0 * np.exp(0.3j) * np.array([0.6, 0.8, 0.0])
+    assert force_amplitude(rotating) == pytest.approx(3.0)
+    assert force_amplitude(harmonic) == pytest.approx(5.0)
+
+
+def test_committed_record_is_what_the_code_generates(tmp_path, cache_dir):
+    assert main(["rig", "synthesize", str(tmp_path / "rig.csv"), "--rigid"]) == 0
+    committed, made = read_record(CASES / "reference-lp-rig.csv"), read_record(tmp_path / "rig.csv")
+    assert committed.hinges == made.hinges and committed.notes == made.notes
+    np.testing.assert_allclose(committed.excitation, made.excitation, atol=2e-4)
+    for name, forces in made.transducers.items():
+        np.testing.assert_allclose(committed.transducers[name], forces, atol=2e-4)
+
+
+def _edit(path: Path, tmp_path: Path, change) -> Path:
+    lines = path.read_text().splitlines()
+    out = tmp_path / "edited.csv"
+    out.write_text("\n".join(change(lines)) + "\n")
+    return out
+
+
+def _header_line(lines):
+    return next(i for i, line in enumerate(lines) if not line.startswith("#"))
+
+
+@pytest.fixture(scope="module")
+def record_file(lp_run, tmp_path_factory):
+    record = synthetic_record(lp_run, REFERENCE_TRANSDUCERS, duration=0.5)
+    return write_record(tmp_path_factory.mktemp("rig") / "rig.csv", record)
+
+
+def test_wrong_sample_rate_is_refused(record_file, tmp_path):
+    path = _edit(record_file, tmp_path,
+                 lambda lines: [l.replace("sample rate [Hz]: 2048", "sample rate [Hz]: 2000") for l in lines])
+    with pytest.raises(RecordError, match=r"edited.csv, column 'time \[s\]': wrong sample rate: .*2000 Hz.*2048 Hz"):
+        read_record(path)
+
+
+def test_irregular_time_names_the_line(record_file, tmp_path):
+    def change(lines):
+        row = _header_line(lines) + 6
+        cells = lines[row].split(",")
+        cells[0] = f"{float(cells[0]) + 2e-4:.9f}"
+        lines[row] = ",".join(cells)
+        return lines
+
+    with pytest.raises(RecordError) as error:
+        read_record(_edit(record_file, tmp_path, change))
+    header = _header_line(record_file.read_text().splitlines()) + 1
+    assert error.value.line == header + 6 and error.value.column == "time [s]"
+    assert "not uniformly sampled" in str(error.value)
+
+
+def test_too_short_record_is_refused(record_file):
+    with pytest.raises(RecordError, match=r"too short: 0\.5 s recorded, two windows of 20 periods at 59 Hz need"):
+        measure(read_record(record_file), periods=20)
+
+
+def test_missing_channel_and_bad_cell_name_the_column(record_file, tmp_path):
+    def drop(lines):
+        header = _header_line(lines)
+        index = lines[header].split(",").index("rear-left z [N]")
+        return lines[:header] + [",".join(c for j, c in enumerate(l.split(",")) if j != index)
+                                 for l in lines[header:]]
+
+    with pytest.raises(RecordError, match="missing channel 'rear-left z") as error:
+        read_record(_edit(record_file, tmp_path, drop))
+    assert error.value.column == "rear-left z"
+
+    def garble(lines):
+        row = _header_line(lines) + 3
+        cells = lines[row].split(",")
+        cells[2] = "n/a"
+        lines[row] = ",".join(cells)
+        return lines
+
+    with pytest.raises(RecordError, match=r"line \d+, column 'front-left y \[N\]': 'n/a' is not a number"):
+        read_record(_edit(record_file, tmp_path, garble))
+
+
+def test_transducers_must_carry_every_pylon_hinge_once(record_file):
+    record = read_record(record_file)
+    case = reference_case()
+    record.check_hinges([h.name for h in case.pylon_hinges])
+    wrong = dataclasses.replace(record, hinges={**record.hinges, "rear-right": ("rear-up-right",)})
+    with pytest.raises(RecordError, match="carried by no transducer: rear-up-lateral"):
+        wrong.check_hinges([h.name for h in case.pylon_hinges])
+
+
+def test_cli_exits_2_on_a_bad_record(record_file, capsys):
+    assert main(["rig", "measure", str(record_file), "--periods", "20"]) == 2
+    assert "too short" in capsys.readouterr().err
+
+
+def _workbook_with_record(folder: Path, run_row: int, periods=50) -> Path:
+    """The reference workbook with short rigid runs and a Test data row naming the committed record."""
+    import shutil
+
+    from excel_helpers import copy_reference, set_cells
+
+    path = copy_reference(folder)
+    shutil.copyfile(CASES / "reference-lp-rig.csv", folder / "rig.csv")
+    set_cells(path, {("Case", "settle time", 3): SHORT.settle_time, ("Case", "measured periods", 3): 10,
+                     ("Runs", "fidelity", 3): "rigid", ("Test data", "run", 3): ["LP rotor", "HP rotor"][run_row],
+                     ("Test data", "rig record", 3): "rig.csv", ("Test data", "record periods", 3): periods})
+    return path
+
+
+def test_workbook_compares_a_rig_record_in_the_result_sheets(lp_run, tmp_path):
+    from openpyxl import load_workbook
+
+    from workbook.excel.reader import read_workbook
+
+    path = _workbook_with_record(tmp_path, 0)
+    measured = measure(read_record(CASES / "reference-lp-rig.csv"), periods=50).transmissibility
+    points = read_workbook(path).tests
+    assert [(p.run, p.location, p.direction) for p in points] == [("LP rotor", "pylon sum", d) for d in "xyz"]
+    np.testing.assert_allclose([p.amplitude for p in points], measured * 1000.0, rtol=1e-12)
+    assert main(["run", str(path), "--run", "LP rotor", "--no-progress"]) == 0
+    sheet = load_workbook(path)["Result efficiency"]
+    header = [c.value for c in sheet[2]]
+    rows = [dict(zip(header, r)) for r in sheet.iter_rows(min_row=3, values_only=True)]
+    for row, t_test in zip(rows, measured):
+        assert row["test amplitude N"] == pytest.approx(t_test * 1000.0, rel=1e-9)
+        assert row["error %"] == pytest.approx((row["T"] - t_test) / t_test * 100, rel=1e-6)
+    # the same answers as the record's own simulation: x and z within 1 % of the test
+    assert abs(rows[0]["error %"]) < 1 and abs(rows[2]["error %"]) < 1
+
+
+def test_workbook_names_the_cell_of_a_record_of_another_run(tmp_path, capsys):
+    path = _workbook_with_record(tmp_path, 1)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "Test data" in err and "rig record" in err and "nominal frequency 59 Hz is not run 'HP rotor'" in err

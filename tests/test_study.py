@@ -1,0 +1,90 @@
+"""``mountwb study accuracy``: the ladder on the reference mount (HP rotor, coarse link meshes)."""
+import dataclasses
+
+import numpy as np
+import pandas as pd
+import pytest
+from openpyxl import load_workbook
+
+from workbook.case import AnalysisSettings
+from workbook.cli import main
+from workbook.codec import to_json
+from workbook.reference import reference_case
+from workbook.study import REFERENCE_RUNG
+
+SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
+
+
+@pytest.fixture(scope="module")
+def study(cache_dir, tmp_path_factory):
+    """Run the CLI once into a folder that already holds a user's accuracy-study.md."""
+    folder = tmp_path_factory.mktemp("study")
+    case = reference_case(element_size=0.03, analysis=SHORT)
+    case = dataclasses.replace(case, excitations=(case.excitations[1],))
+    path = folder / "hp.json"
+    path.write_text(to_json(case))
+    (folder / "accuracy-study.md").write_text("a user's notes\n")
+    assert main(["study", "accuracy", str(path), "--repeats", "1", "--output", str(folder)]) == 0
+    return folder
+
+
+@pytest.fixture(scope="module")
+def table(study):
+    return pd.read_excel(study / "accuracy-study-2.xlsx", index_col=0)
+
+
+def _t(table, rung, axis):
+    """T of a rung from its error against the reference, relative to the reference's T."""
+    return 1 + table.loc[rung, f"HP rotor T_{axis} error %"] / 100
+
+
+def test_files_are_written_without_overwriting(study):
+    assert (study / "accuracy-study.md").read_text() == "a user's notes\n"
+    for suffix in (".md", ".png", ".xlsx"):
+        assert (study / f"accuracy-study-2{suffix}").stat().st_size > 0
+    assert load_workbook(study / "accuracy-study-2.xlsx").sheetnames == ["accuracy study"]
+    markdown = (study / "accuracy-study-2.md").read_text()
+    assert markdown.count("\n|") == 1 + 11
+    assert "seed study's method" in markdown and f"'{REFERENCE_RUNG}'" in markdown
+
+
+def test_ladder_rungs_and_their_dof(table):
+    assert len(table) == 11
+    reference = f"{REFERENCE_RUNG} (reference)"
+    assert table.loc[reference, "worst |error| %"] == 0
+    fidelity = ["rigid links", "static modes only"] + [f"Craig-Bampton, {n} modes" for n in (2, 6, 12)] + [reference]
+    dof = table.loc[fidelity, "DOF"].to_numpy()
+    assert dof[0] == 6 + 8 * 6
+    # eight flexible links, each 6 rigid-frame DOF plus 6 static modes, plus n fixed-interface modes
+    np.testing.assert_array_equal(dof[1:], 6 + 8 * (12 + np.array([0, 2, 6, 12, 20])))
+
+
+def test_errors_converge(table):
+    # mode count: 12 fixed-interface modes are within 0.05 % of 20 in the lateral and vertical answers
+    for axis in "yz":
+        assert abs(_t(table, "Craig-Bampton, 12 modes", axis) - 1) < 5e-4
+    # rigid links miss the thrust rods' bending (100 Hz) and overstate the heading force at 248.5 Hz
+    assert table.loc["rigid links", "HP rotor T_x error %"] > 10
+    # time step: the time domain converges to the frequency domain of the same model
+    gaps = []
+    for steps in (20, 40, 80):
+        rung = f"time domain, {steps} steps/period"
+        gaps.append(max(abs(_t(table, rung, a) / _t(table, "frequency domain", a) - 1) for a in "yz"))
+    assert gaps[0] > gaps[1] > gaps[2]
+    assert gaps[2] < 0.003
+    assert (table["wall time s"] > 0).all()
+
+
+def test_a_workbook_run_row_is_the_studied_case():
+    from pathlib import Path
+
+    from workbook.excel.sheets import WorkbookError
+    from workbook.study_cli import load_study_case
+
+    book = Path(__file__).parents[1] / "cases" / "reference.xlsx"
+    case = load_study_case(str(book), "HP rotor")
+    assert [e.frequency for e in case.excitations] == [248.5]
+    with pytest.raises(WorkbookError):
+        load_study_case(str(book), "no such run")
+    with pytest.raises(ValueError):
+        load_study_case(None, "HP rotor")
