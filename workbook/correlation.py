@@ -27,7 +27,7 @@ from scipy.optimize import minimize_scalar
 
 from .amplitude import harmonic_amplitude, period_window, steady_amplitude
 from .case import DIRECTIONS
-from .results import ExcitationResult, efficiency
+from .results import ExcitationResult, PylonAnswers, efficiency
 from .rig import RecordError, RigRecord
 
 __all__ = ["Measurement", "measure", "peak_frequency", "force_amplitude", "comparison_frame",
@@ -42,7 +42,7 @@ PEAK_SEARCH = 0.02
 
 
 @dataclass(frozen=True)
-class Measurement:
+class Measurement(PylonAnswers):
     """Answers of one rig record.
 
     Attributes
@@ -72,16 +72,6 @@ class Measurement:
     pylon_amplitude: np.ndarray
     transducer_amplitudes: dict
     steady_change: float
-
-    @property
-    def transmissibility(self) -> np.ndarray:
-        """Measured pylon transmissibility per direction x, y, z."""
-        return self.pylon_amplitude / self.excitation_amplitude
-
-    @property
-    def efficiency(self) -> np.ndarray:
-        """Measured isolation efficiency per direction, %."""
-        return efficiency(self.transmissibility)
 
 
 def force_amplitude(phasors: np.ndarray) -> float:

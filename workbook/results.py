@@ -21,7 +21,7 @@ import numpy as np
 
 from .case import DIRECTIONS
 
-__all__ = ["ExcitationResult", "MountResult", "PYLON_SUM", "efficiency", "level_db"]
+__all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM", "efficiency", "level_db"]
 
 #: Row label of the pylon sum in the tables.
 PYLON_SUM = "pylon sum"
@@ -38,8 +38,26 @@ def level_db(transmissibility: np.ndarray) -> np.ndarray:
         return 20.0 * np.log10(np.asarray(transmissibility, dtype=float))
 
 
+class PylonAnswers:
+    """Transmissibility and isolation efficiency of a pylon force.
+
+    For any answer holding ``pylon_amplitude`` (N, per direction x, y, z)
+    and ``excitation_amplitude`` (N): a simulated run or a rig measurement.
+    """
+
+    @property
+    def transmissibility(self) -> np.ndarray:
+        """Pylon-force transmissibility per direction x, y, z."""
+        return self.pylon_amplitude / self.excitation_amplitude
+
+    @property
+    def efficiency(self) -> np.ndarray:
+        """Pylon isolation efficiency per direction, %."""
+        return efficiency(self.transmissibility)
+
+
 @dataclass
-class ExcitationResult:
+class ExcitationResult(PylonAnswers):
     """Answers and histories of one excitation run.
 
     Attributes
@@ -89,16 +107,6 @@ class ExcitationResult:
     @property
     def steady(self) -> bool:
         return self.steady_change <= self.steady_tolerance
-
-    @property
-    def transmissibility(self) -> np.ndarray:
-        """Pylon-force transmissibility per direction x, y, z."""
-        return self.pylon_amplitude / self.excitation_amplitude
-
-    @property
-    def efficiency(self) -> np.ndarray:
-        """Pylon isolation efficiency per direction, %."""
-        return efficiency(self.transmissibility)
 
     def amplitudes(self) -> dict[str, np.ndarray]:
         """Amplitudes of every hinge and of the pylon sum (last), N."""
