@@ -346,8 +346,25 @@ def _frequency(item: str, frequency_hz: Any, rpm: Any) -> float:
     return _number(rpm, item, "rpm", minimum=0.0, strictly=True) / 60.0
 
 
+def _direction(value: Any, item: str, name: str) -> Vector3:
+    """Return *value* as three finite floats, not all zero, or raise CaseError."""
+    vector = _vector3(value, item, name)
+    if np.linalg.norm(vector) == 0:
+        raise CaseError(item, name, value, "a non-zero direction")
+    return vector
+
+
+class _OneFrequency:
+    """The frequency of an excitation given as ``frequency_hz`` or ``rpm``."""
+
+    @property
+    def frequency(self) -> float:
+        """Excitation frequency, Hz."""
+        return _frequency("", self.frequency_hz, self.rpm)
+
+
 @dataclass(frozen=True)
-class RotatingForce:
+class RotatingForce(_OneFrequency):
     """A rotating imbalance force on the engine.
 
     The force of magnitude A turns in the plane normal to *axis*, right-handed
@@ -391,16 +408,8 @@ class RotatingForce:
         for name in ("amplitude", "unbalance"):
             if getattr(self, name) is not None:
                 _set(self, name, _number(getattr(self, name), item, name, minimum=0.0, strictly=True))
-        axis = _vector3(self.axis, item, "axis")
-        if np.linalg.norm(axis) == 0:
-            raise CaseError(item, "axis", self.axis, "a non-zero direction")
-        _set(self, "axis", axis)
+        _set(self, "axis", _direction(self.axis, item, "axis"))
         _set(self, "phase_deg", _number(self.phase_deg, item, "phase_deg"))
-
-    @property
-    def frequency(self) -> float:
-        """Excitation frequency, Hz."""
-        return _frequency("", self.frequency_hz, self.rpm)
 
     @property
     def force_amplitude(self) -> float:
@@ -426,7 +435,7 @@ class RotatingForce:
 
 
 @dataclass(frozen=True)
-class HarmonicForce:
+class HarmonicForce(_OneFrequency):
     """A fixed-direction harmonic force on the engine: ``F(t) = A d cos(wt + phase)``.
 
     Parameters
@@ -457,18 +466,10 @@ class HarmonicForce:
         item = f"excitation {self.name!r}"
         _name(self.name, "excitation")
         _set(self, "point", _vector3(self.point, item, "point"))
-        direction = _vector3(self.direction, item, "direction")
-        if np.linalg.norm(direction) == 0:
-            raise CaseError(item, "direction", self.direction, "a non-zero direction")
-        _set(self, "direction", direction)
+        _set(self, "direction", _direction(self.direction, item, "direction"))
         _set(self, "amplitude", _number(self.amplitude, item, "amplitude", minimum=0.0, strictly=True))
         _frequency(item, self.frequency_hz, self.rpm)
         _set(self, "phase_deg", _number(self.phase_deg, item, "phase_deg"))
-
-    @property
-    def frequency(self) -> float:
-        """Excitation frequency, Hz."""
-        return _frequency("", self.frequency_hz, self.rpm)
 
     @property
     def force_amplitude(self) -> float:

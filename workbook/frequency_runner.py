@@ -22,7 +22,7 @@ from .modelcard import model_card
 from .modes import modes_of, mounted_modes
 from .preload import solve_preload
 from .results import MountResult
-from .runner import ProgressFactory, _timed
+from .runner import ProgressFactory, timed
 from .scene import build_scene, reduce_links
 
 __all__ = ["prepare", "PreparedScene", "results_of", "run_case_frequency"]
@@ -66,16 +66,16 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *, reduce_for=Non
         Reduced links to use (skips the reduction).
     """
     timings = {}
-    with _timed(timings, "reduce links"):
+    with timed(timings, "reduce links"):
         if reduced is None:
             reduced = reduce_links(case, reduce_for or excitation)
-    with _timed(timings, "build scene"):
+    with timed(timings, "build scene"):
         scene = build_scene(case, excitation, reduced=reduced)
-    with _timed(timings, "static preload"):
+    with timed(timings, "static preload"):
         preload = solve_preload(scene)
-    with _timed(timings, "linearisation"):
+    with timed(timings, "linearisation"):
         model = harmonic_model(scene)
-    with _timed(timings, "mounted modes"):
+    with timed(timings, "mounted modes"):
         modes = modes_of(model.linearization)
     return PreparedScene(scene, preload, model, modes, timings)
 

@@ -16,7 +16,7 @@ from .results import MountResult
 from .scene import build_scene, reduce_links
 from .timedomain import extract, integrate, plan_run
 
-__all__ = ["run_excitation", "run_case", "ProgressFactory"]
+__all__ = ["run_excitation", "run_case", "ProgressFactory", "timed"]
 
 log = logging.getLogger(__name__)
 
@@ -27,7 +27,8 @@ ProgressFactory = Callable[[str, float], tuple]
 
 
 @contextmanager
-def _timed(timings: dict, stage: str):
+def timed(timings: dict, stage: str):
+    """Add the wall time of the ``with`` block to ``timings[stage]``, s."""
     start = time.perf_counter()
     yield
     timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
@@ -64,7 +65,7 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         From the preload stage.
     """
     timings = {}
-    with _timed(timings, "reduce links"):
+    with timed(timings, "reduce links"):
         reduction = reduce_for or excitation
         if progress is None or not case.links:
             reduced = reduce_links(case, reduction)
@@ -74,15 +75,15 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 reduced = reduce_links(case, reduction, update)
             finally:
                 close()
-    with _timed(timings, "build scene"):
+    with timed(timings, "build scene"):
         scene = build_scene(case, excitation, reduced=reduced)
-    with _timed(timings, "static preload"):
+    with timed(timings, "static preload"):
         preload = solve_preload(scene)
-    with _timed(timings, "mounted modes"):
+    with timed(timings, "mounted modes"):
         mounted = mounted_modes(modes_of(linearize(scene)))
     plan = plan_run(case.analysis, scene.excitation.signal, mounted)
     log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
-    with _timed(timings, "time integration"):
+    with timed(timings, "time integration"):
         if progress is None:
             histories = integrate(scene, plan)
         else:
@@ -91,7 +92,7 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 histories = integrate(scene, plan, update)
             finally:
                 close()
-    with _timed(timings, "amplitude extraction"):
+    with timed(timings, "amplitude extraction"):
         result = extract(scene, plan, histories)
     return result, model_card(scene, preload, mounted, plan, timings, method), preload
 
