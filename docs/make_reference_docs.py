@@ -10,13 +10,13 @@ code builds. Run from anywhere::
 """
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import matplotlib
 
 matplotlib.use("Agg")
 
+from generated_sections import replace_section  # noqa: E402
 from workbook.layout import hinge_table, link_table, markdown_table, plot_layout  # noqa: E402
 from workbook.modes import linearize, modes_of, mounted_modes  # noqa: E402
 from workbook.preload import solve_preload  # noqa: E402
@@ -24,13 +24,6 @@ from workbook.reference import reference_case  # noqa: E402
 from workbook.scene import build_scene, reduce_links  # noqa: E402
 
 DOCS = Path(__file__).resolve().parent
-
-
-def _replace(text: str, name: str, content: str) -> str:
-    pattern = re.compile(rf"(<!-- generated: {name} -->\n).*?(<!-- end: {name} -->)", re.S)
-    if not pattern.search(text):
-        raise ValueError(f"marker 'generated: {name}' missing in reference-mount.md")
-    return pattern.sub(lambda m: m.group(1) + content + "\n" + m.group(2), text)
 
 
 def main() -> None:
@@ -56,7 +49,7 @@ def main() -> None:
     for name, content in (("links", markdown_table(link_table(case, reduced))),
                           ("hinges", markdown_table(hinge_table(case))),
                           ("modes", modes), ("static forces", forces)):
-        text = _replace(text, name, content)
+        text = replace_section(text, name, content, "reference-mount.md")
     path.write_text(text)
     print(f"wrote {DOCS / 'reference-mount.png'} and the tables of {path}")
 

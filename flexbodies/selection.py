@@ -59,6 +59,23 @@ class ModeDecision:
         return self.excitation_hz / self.fundamental_hz
 
     @property
+    def warning(self) -> str | None:
+        """Why the selection is unsafe, or None.
+
+        Unsafe: no fixed-interface modes kept (``"static"`` or a count of 0
+        asked for) while the excitation is at or above
+        :data:`LOW_FREQUENCY_RATIO` of the mounted fundamental, where the
+        low-frequency approximation does not hold.
+        """
+        ratio = self.ratio
+        if self.count != 0 or ratio is None or ratio < LOW_FREQUENCY_RATIO:
+            return None
+        return (f"no fixed-interface modes ({self.request}) although the excitation {self.excitation_hz:g} Hz is "
+                f"{ratio:.2f} of the mounted fundamental {self.fundamental_hz:.0f} Hz (the low-frequency "
+                f"approximation needs < {LOW_FREQUENCY_RATIO}): the link's own dynamics are missing; "
+                f"use modes='auto'")
+
+    @property
     def key(self) -> str:
         """What the reduction depends on: the resolved count or cut-off."""
         return f"count={self.count}" if self.count is not None else f"cutoff={self.cutoff_hz:.6g}"

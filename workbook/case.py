@@ -28,7 +28,7 @@ __all__ = [
     "PYLON", "ENGINE", "DIRECTIONS", "CaseError", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
-    "SingleFrequencyExcitation",
+    "SingleFrequencyExcitation", "ForceTransducers", "Rotor",
 ]
 
 PYLON = "pylon"
@@ -337,6 +337,54 @@ class Gravity:
 StaticLoad = Union[PointForce, PointMoment, Gravity]
 
 
+@dataclass(frozen=True)
+class ForceTransducers:
+    """The test rig's three-way force transducers between the pylon pins and the rigid ground.
+
+    On the rig the pylon-side hinges do not sit on rigid ground: each pylon
+    pin is carried by a three-component force transducer bolted to the rig
+    floor, and that transducer is a stiff spring. The scene then gets one
+    transducer per pylon pin (pylon-side hinges at the same point share
+    one): a point mass at the pin on a spring-damper to ground, and the pin's
+    hinges attach to that mass. The transducer forces are what the rig
+    measures, so they make the pylon force.
+
+    Parameters
+    ----------
+    stiffness : 3 floats
+        Stiffness of each transducer with its fixture in the global x, y, z
+        directions, N/m (a three-component piezoelectric force link with its
+        mounting is of order 1e8 to 1e9 N/m).
+    mass : float
+        Moving half of each transducer plus the fitting bolted to it, kg. The
+        default 1 kg is a force link of this load range (a few hundred grams,
+        half of it moving) with the clevis block of the pin on it; the mass
+        only has to be there (a node between two springs needs one in
+        Exudyn): at 1e8 N/m it resonates at 1.6 kHz, far above the rotor
+        frequencies. It carries no weight in the scene: a rig zeroes its
+        transducers with the fitting mounted, before the engine is hung.
+    damping : 3 floats
+        Viscous damping of each transducer in x, y, z, N s/m (piezoelectric
+        force links are very lightly damped: default 0).
+    """
+
+    stiffness: Vector3
+    mass: float = 1.0
+    damping: Vector3 = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        item = "test-rig force transducers"
+        stiffness = _vector3(self.stiffness, item, "stiffness")
+        if min(stiffness) <= 0:
+            raise CaseError(item, "stiffness", self.stiffness, "three numbers > 0 (N/m in x, y, z)")
+        damping = _vector3(self.damping, item, "damping")
+        if min(damping) < 0:
+            raise CaseError(item, "damping", self.damping, "three numbers >= 0 (N s/m in x, y, z)")
+        _set(self, "stiffness", stiffness)
+        _set(self, "damping", damping)
+        _set(self, "mass", _number(self.mass, item, "mass", minimum=0.0, strictly=True))
+
+
 def _frequency(item: str, frequency_hz: Any, rpm: Any) -> float:
     """Validate that exactly one of frequency_hz and rpm is given; return Hz."""
     if (frequency_hz is None) == (rpm is None):
@@ -487,6 +535,52 @@ SingleFrequencyExcitation = Union[RotatingForce, HarmonicForce]
 
 
 @dataclass(frozen=True)
+class Rotor(_OneFrequency):
+    """A rotor spinning at constant speed in the engine: its gyroscopic moment.
+
+    A rotor of polar moment of inertia Ip spinning at the constant rate
+    Omega = 2 pi f about the engine-fixed unit axis a carries the angular
+    momentum ``h = Ip Omega a``. When the engine turns with angular velocity
+    omega (global), a turns with it and the rotor exerts on the engine the
+    moment ``M = -dh/dt = -Ip Omega (omega x a)``. The rotor's mass and
+    transverse inertia stay lumped in the rigid engine (``Case.engine``);
+    only this moment is added (``Effects.gyroscopics``).
+
+    Parameters
+    ----------
+    name : str
+        Unique name, e.g. ``"LP spool"``.
+    polar_inertia : float
+        Polar moment of inertia Ip about the spin axis, kg m^2 (> 0).
+    frequency_hz, rpm : float
+        Spin speed; give exactly one.
+    axis : 3 floats
+        Spin axis in engine coordinates (the global axes at the reference
+        state); normalised here. The rotor spins right-handed about it.
+    """
+
+    name: str
+    polar_inertia: float
+    frequency_hz: Union[float, None] = None
+    rpm: Union[float, None] = None
+    axis: Vector3 = (1.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        item = f"rotor {self.name!r}"
+        _name(self.name, "rotor")
+        _set(self, "polar_inertia", _number(self.polar_inertia, item, "polar_inertia", minimum=0.0,
+                                            strictly=True))
+        _frequency(item, self.frequency_hz, self.rpm)
+        axis = np.array(_direction(self.axis, item, "axis"))
+        _set(self, "axis", tuple(float(v) for v in axis / np.linalg.norm(axis)))
+
+    @property
+    def angular_momentum(self) -> np.ndarray:
+        """Spin angular momentum ``h = Ip Omega a`` in engine coordinates, kg m^2/s, shape (3,)."""
+        return self.polar_inertia * 2 * math.pi * self.frequency * np.asarray(self.axis)
+
+
+@dataclass(frozen=True)
 class Sweep:
     """A stepped sweep: one excitation template run at each of several frequencies.
 
@@ -580,6 +674,16 @@ class AnalysisSettings:
         (harmonic solution of the scene linearised about the preload), or
         ``"auto"`` (frequency domain when no clearance law makes the scene
         nonlinear, see :mod:`workbook.method`).
+    step_halvings : int
+        When Newton's method fails in a segment of the time integration, the
+        segment is run again with the step halved, at most this many times
+        (0: no retry) before the run stops with the time and the cause.
+    time_budget : float or None
+        Wall time one run (one excitation) may take, s; checked between
+        segments of the integration (None: no limit).
+    divergence_displacement : float
+        Engine centre-of-gravity displacement from the preloaded position
+        above which the run stops as diverging, m.
     """
 
     steps_per_period: int = 40
@@ -592,9 +696,19 @@ class AnalysisSettings:
     newton_tolerance: float = 1e-6
     equilibrium_tolerance: float = 1e-6
     method: str = "time"
+    step_halvings: int = 4
+    time_budget: Union[float, None] = None
+    divergence_displacement: float = 0.05
 
     def __post_init__(self):
         item = "analysis settings"
+        if isinstance(self.step_halvings, bool) or not isinstance(self.step_halvings, int) \
+                or not 0 <= self.step_halvings <= 20:
+            raise CaseError(item, "step_halvings", self.step_halvings, "a whole number from 0 to 20")
+        if self.time_budget is not None:
+            _set(self, "time_budget", _number(self.time_budget, item, "time_budget", minimum=0.0, strictly=True))
+        _set(self, "divergence_displacement", _number(self.divergence_displacement, item,
+                                                      "divergence_displacement", minimum=0.0, strictly=True))
         if self.method not in ANALYSIS_METHODS:
             raise CaseError(item, "method", self.method, " or ".join(repr(m) for m in ANALYSIS_METHODS))
         for name in ("steps_per_period", "measured_periods"):
@@ -633,6 +747,13 @@ class Effects:
         Rayleigh damping of the flexible links as given; False sets it to zero.
     clearance : bool
         Hinge clearance laws where a gap > 0 is given; False ignores the gaps.
+    rig_sensors : bool
+        The test rig's force transducers where the case gives them
+        (``Case.test_rig``); False mounts the pylon pins on rigid ground.
+    gyroscopics : bool
+        Build the rotors' gyroscopic moments when the case gives rotors
+        (``Case.rotors``); False leaves the rotors as inertia lumped in the
+        engine.
     """
 
     flexible_links: bool = True
@@ -640,6 +761,8 @@ class Effects:
     hinge_damping: bool = True
     link_damping: bool = True
     clearance: bool = True
+    rig_sensors: bool = True
+    gyroscopics: bool = True
 
     def __post_init__(self):
         for item in dataclasses.fields(self):
@@ -671,6 +794,12 @@ class Case:
         The physical effects asked for.
     description : str
         Free text.
+    test_rig : ForceTransducers or None
+        The rig's force transducers under the pylon pins (None: the pylon
+        pins sit on rigid ground).
+    rotors : tuple of Rotor
+        Spinning rotors whose gyroscopic moments act on the engine (their
+        mass and inertia are part of ``engine``).
     """
 
     name: str
@@ -682,6 +811,8 @@ class Case:
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     effects: Effects = field(default_factory=Effects)
     description: str = ""
+    test_rig: Union[ForceTransducers, None] = None
+    rotors: tuple[Rotor, ...] = ()
 
     def __post_init__(self):
         _name(self.name, "case")
@@ -689,9 +820,11 @@ class Case:
         for name, kind in checks:
             if not isinstance(getattr(self, name), kind):
                 raise CaseError("case", name, getattr(self, name), f"a {kind.__name__}")
+        if self.test_rig is not None and not isinstance(self.test_rig, ForceTransducers):
+            raise CaseError("case", "test_rig", self.test_rig, "a ForceTransducers or None")
         groups = (("links", (Link,)), ("hinges", (Hinge,)),
                   ("static_loads", (PointForce, PointMoment, Gravity)),
-                  ("excitations", (RotatingForce, HarmonicForce, Sweep)))
+                  ("excitations", (RotatingForce, HarmonicForce, Sweep)), ("rotors", (Rotor,)))
         for name, kinds in groups:
             items = tuple(getattr(self, name))
             for item in items:

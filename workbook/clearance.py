@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["RESIDUAL_STIFFNESS_RATIO", "clearance_force", "exudyn_clearance_function"]
+__all__ = ["RESIDUAL_STIFFNESS_RATIO", "clearance_force", "exudyn_clearance_function", "linearised_gap_warnings"]
 
 #: Stiffness inside the gap relative to the contact stiffness.
 RESIDUAL_STIFFNESS_RATIO = 1e-4
@@ -67,3 +67,43 @@ def exudyn_clearance_function(gap: float):
         return [factor * u[i] + damping[i] * velocity[i] for i in range(3)]
 
     return spring_force
+
+
+def linearised_gap_warnings(hinges, static_forces: dict, dynamic_amplitudes: dict) -> list[str]:
+    """Where a linearisation about the preload misrepresents a clearance.
+
+    The frequency domain freezes every gap as it is at the preload. That
+    holds for a hinge whose gap the preload closes and whose dynamic force
+    stays below its static force (the contact never lifts off); it fails
+    where the gap is open at the preload (the hinge is linearised with the
+    residual stiffness inside the gap) or where the dynamic force could
+    reverse the static one (impacts).
+
+    Parameters
+    ----------
+    hinges : iterable of workbook.case.Hinge
+        The hinges whose clearance law is built.
+    static_forces : dict of str to array_like, shape (3,)
+        Preloaded force of each hinge, N.
+    dynamic_amplitudes : dict of str to array_like, shape (3,)
+        Amplitude of each hinge force component at the excitation frequency, N.
+
+    Returns
+    -------
+    list of str
+        One warning per hinge concerned (empty when the linearisation holds).
+    """
+    warnings = []
+    for hinge in hinges:
+        static = float(np.linalg.norm(static_forces[hinge.name]))
+        inside = RESIDUAL_STIFFNESS_RATIO * hinge.gap_contact_stiffness * hinge.radial_clearance
+        dynamic = float(np.linalg.norm(dynamic_amplitudes[hinge.name]))
+        if static <= inside * (1 + 1e-9):
+            warnings.append(f"hinge {hinge.name!r}: the clearance is open at the preload (static force "
+                            f"{static:.3g} N); the frequency domain sees only the residual stiffness inside the "
+                            f"gap, so contact and impacts need the time domain")
+        elif dynamic >= static - inside:
+            warnings.append(f"hinge {hinge.name!r}: the dynamic force amplitude {dynamic:.4g} N reaches the static "
+                            f"force {static:.4g} N, so the contact can lift off and the gap open; the frequency "
+                            f"domain assumes it stays closed: use the time domain")
+    return warnings

@@ -172,7 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mountwb`` console script."""
     from .case import CaseError
-    from .preload import EquilibriumError, MechanismError
+    from .guards import SimulationError
 
     from threadpoolctl import threadpool_limits
 
@@ -183,7 +183,7 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.handler(args)
-    except (CaseError, MechanismError, EquilibriumError, ValueError, OSError) as error:
+    except (CaseError, SimulationError, ValueError, OSError) as error:
         print(f"mountwb {args.command}: {error}", file=sys.stderr)
         return 2
 

@@ -14,8 +14,9 @@ at any frequency, with no transient to wait for. The hinge damping is the
 case's viscous damping, exactly as in the time domain.
 
 B and C_k, C_d come from Exudyn itself: central differences of the
-engine's point position (``GetObjectOutputBody``) and of each hinge
-connector's ``Force`` output with respect to the full coordinates and
+engine's point position (``GetObjectOutputBody``) and of the ``Force``
+output of each force channel (hinges and, when built, the test-rig
+transducers whose sum is then the pylon force) with respect to the full coordinates and
 velocities, projected with the same basis as M, K and D. A rotating force
 ``C cos wt + S sin wt`` is the phasor ``f_hat = C - i S``: its two harmonic
 parts 90 degrees apart are superposed in one complex solve.
@@ -58,9 +59,10 @@ class FrequencyResponse:
     ----------
     frequency_hz : float
     hinge_forces : dict of str to ndarray, complex, shape (3,)
-        ``F_hat`` of each hinge (force on its marker-0 body), N.
+        ``F_hat`` of each force channel (hinge or transducer; force on its
+        marker-0 body), N.
     pylon_force : ndarray, complex, shape (3,)
-        Sum over the pylon-side hinges, N.
+        Sum over the pylon channels, N.
     """
 
     frequency_hz: float
@@ -70,17 +72,20 @@ class FrequencyResponse:
 
 @dataclass
 class HarmonicModel:
-    """The linearised scene with its excitation input and hinge-force outputs.
+    """The linearised scene with its excitation input and force-channel outputs.
 
     Attributes
     ----------
     linearization : Linearization
         M, K, D in independent coordinates (n of them) and the basis.
     hinge_names : list of str
+        The force channels (:attr:`Scene.force_channels`): hinges, then
+        test-rig transducers.
     pylon_hinges : list of str
+        The channels summed into the pylon force (:attr:`Scene.pylon_channels`).
     stiffness_output, damping_output : ndarray, shape (3 h, n)
-        Hinge force per coordinate (N/m ...) and per velocity (N s/m ...),
-        three rows per hinge in the order of *hinge_names*.
+        Channel force per coordinate (N/m ...) and per velocity (N s/m ...),
+        three rows per channel in the order of *hinge_names*.
     engine_point_jacobian : callable
         ``jacobian(point)``: d(position of a point of the engine)/dz,
         shape (3, n); *point* in global coordinates of the reference state, m.
@@ -166,8 +171,9 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
         lin = linearize(scene)
     q0 = np.array(data.GetODE2Coordinates(configuration=current))
     v0 = np.array(data.GetODE2Coordinates_t(configuration=current))
-    names = list(scene.hinges)
-    connectors = [scene.hinges[name].connector for name in names]
+    channels = scene.force_channels
+    names = list(channels)
+    connectors = [channels[name].connector for name in names]
 
     def forces() -> np.ndarray:
         return np.concatenate([mbs.GetObjectOutput(c, exu.OutputVariableType.Force) for c in connectors])
@@ -192,6 +198,6 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
         partial = _central_difference(position, set_q, q0, engine_coordinates, COORDINATE_STEP)
         return partial @ lin.basis[engine_coordinates]
 
-    log.info("harmonic model of %r: %d independent coordinates, %d hinges", scene.case.name,
+    log.info("harmonic model of %r: %d independent coordinates, %d force channels", scene.case.name,
              lin.mass.shape[0], len(names))
-    return HarmonicModel(lin, names, list(scene.pylon_hinges), stiffness, damping, point_jacobian)
+    return HarmonicModel(lin, names, list(scene.pylon_channels), stiffness, damping, point_jacobian)

@@ -16,18 +16,24 @@ import time
 from typing import Union
 
 from .case import Case, SingleFrequencyExcitation, Sweep
+from .clearance import linearised_gap_warnings
 from .frequency import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
+from .guards import check_undamped_resonance
 from .method import MethodChoice, choose_method
 from .modelcard import model_card
 from .modes import modes_of, mounted_modes
 from .preload import solve_preload
 from .results import MountResult
-from .runner import ProgressFactory, timed
+from .runner import ProgressFactory, link_warnings, timed
 from .scene import build_scene, reduce_links
 
 __all__ = ["prepare", "PreparedScene", "results_of", "run_case_frequency"]
 
 log = logging.getLogger(__name__)
+
+#: Relative distance from an undamped mounted mode at which the harmonic
+#: solution is refused (the dynamic matrix is singular on the mode).
+RESONANCE_BAND = 1e-6
 
 
 @dataclasses.dataclass
@@ -87,9 +93,10 @@ def _solver_entries(case: Case, model: HarmonicModel) -> dict:
         "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness included); "
                          "Euler-parameter constraints projected out (null space by SVD)",
         "independent coordinates": model.dof,
-        "input and outputs": f"central differences of Exudyn's engine-point position and hinge Force outputs "
-                             f"(coordinate step {COORDINATE_STEP:g}, velocity step {VELOCITY_STEP:g})",
-        "damping": "viscous: hinge damping and Rayleigh link damping exactly as in the time domain",
+        "input and outputs": f"central differences of Exudyn's engine-point position and the hinge (and "
+                             f"transducer) Force outputs (coordinate step {COORDINATE_STEP:g}, velocity step {VELOCITY_STEP:g})",
+        "damping": "viscous: hinge damping and Rayleigh link damping exactly as in the time domain, plus the "
+                   "rotors' gyroscopic coupling when built",
         "static equilibrium check": f"relative {case.analysis.equilibrium_tolerance:g}",
     }
 
@@ -108,12 +115,18 @@ def results_of(case: Case, prepared: PreparedScene, points: tuple, method: Metho
     """
     mounted = mounted_modes(prepared.modes)
     solver = _solver_entries(case, prepared.model)
+    gaps = [h for h in case.hinges if prepared.scene.hinges[h.name].clearance]
     update, close = progress(f"{points[0].name}: frequencies", len(points)) if progress else (None, None)
     runs, cards, preloads = [], {}, {}
     try:
         for done, excitation in enumerate(points, start=1):
+            check_undamped_resonance(f"case {case.name!r}, run {excitation.name!r}", excitation.frequency, mounted,
+                                     RESONANCE_BAND, "the response grows without bound: no steady state exists")
             start = time.perf_counter()
             result = prepared.model.result(excitation, case.analysis.steady_tolerance)
+            result.warnings.extend(link_warnings(case, prepared.scene.reduced))
+            result.warnings.extend(linearised_gap_warnings(gaps, prepared.preload.hinge_forces,
+                                                           result.hinge_amplitudes))
             timings = dict(prepared.timings, **{"harmonic solve": time.perf_counter() - start})
             card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method, solver)
             card.run_name = excitation.name

@@ -20,7 +20,8 @@ class BodyEntry:
     ----------
     name : str
     model : str
-        ``"rigid body"``, ``"rigid link"`` or ``"flexible link (Craig-Bampton)"``.
+        ``"rigid body"``, ``"rigid link"``, ``"flexible link (Craig-Bampton)"``
+        or ``"force transducer (point mass)"``.
     dof : int
         Degrees of freedom in the scene.
     modes : int
@@ -138,6 +139,9 @@ def model_card(scene, preload, mounted, plan, timings: dict, method=None, solver
             why = ("all links rigid (effects.flexible_links off)" if not case.effects.flexible_links
                    else "link asked to be rigid (flexible = False)")
             bodies.append(BodyEntry(link.name, "rigid link", item.dof, 0, item.mass, why))
+    for name in scene.transducers:
+        bodies.append(BodyEntry(name, "force transducer (point mass)", 3, 0, case.test_rig.mass,
+                                "test-rig transducer under a pylon pin: moving half on its spring to ground"))
     card = ModelCard(case.name, scene.excitation.name, bodies, _effects(scene, preload, method),
                      _solver(scene, plan) if solver is None else dict(solver),
                      [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings))
@@ -171,12 +175,18 @@ def _effects(scene, preload, method=None) -> list[EffectEntry]:
                     f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
                     if effects.clearance and gaps else
                     ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")),
-        EffectEntry("gyroscopic rotor", False, "not modelled: rotor inertia is lumped into the rigid engine"),
-        EffectEntry("test-rig force-sensor compliance", False, "not modelled: the pylon fittings are rigid"),
+        EffectEntry("gyroscopic rotor", scene.gyroscopics is not None,
+                    ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in case.rotors)
+                    + ": moment -Ip Omega (omega x a) on the engine (symbolic ObjectGenericODE2); their mass and "
+                      "transverse inertia lumped in the engine" if scene.gyroscopics is not None else
+                    ("switched off: rotor inertia lumped in the engine" if case.rotors
+                     else "no rotors given: rotor inertia lumped in the engine")),
+        _rig_sensors(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
     if method is None:
-        entries.append(EffectEntry("time domain", True, time_detail))
+        entries += [EffectEntry("time domain", True, time_detail),
+                    EffectEntry("frequency domain", False, "not used")]
     else:
         frequency_detail = "harmonic solution of the scene linearised about the preload"
         entries += [EffectEntry("time domain", method.method == "time",
@@ -185,6 +195,19 @@ def _effects(scene, preload, method=None) -> list[EffectEntry]:
                                 f"{frequency_detail}: {method.reason}" if method.method == "frequency"
                                 else "not used")]
     return entries
+
+
+def _rig_sensors(scene) -> EffectEntry:
+    """The test-rig force transducers: built or not, and why."""
+    name, rig = "test-rig force-sensor compliance", scene.case.test_rig
+    if not scene.transducers:
+        return EffectEntry(name, False, "switched off: the pylon fittings are rigid" if rig is not None
+                           else "no transducers given: the pylon fittings are rigid")
+    pins = "; ".join(" + ".join(items.hinges) for items in scene.transducers.values())
+    stiffness = ", ".join(f"{k:.3g}" for k in rig.stiffness)
+    damping = "" if not any(rig.damping) else f", d = ({', '.join(f'{d:.3g}' for d in rig.damping)}) N s/m"
+    return EffectEntry(name, True, f"{len(scene.transducers)} transducers, k = ({stiffness}) N/m in x, y, z"
+                       f"{damping}, m = {rig.mass:g} kg on pins {pins}; their forces make the pylon force")
 
 
 def _solver(scene, plan) -> dict[str, Any]:

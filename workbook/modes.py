@@ -12,6 +12,16 @@ space of the constraint Jacobian. Then
 - a *mounted mode* is a mode in which most of the kinetic energy is in the
   engine: the engine's rigid-body modes on its mount. Their modal decay
   rates ``sigma = phi^T D phi / (2 phi^T M phi)`` set the settle time.
+
+Spinning rotors (``Case.rotors``, built as an ``ObjectGenericODE2`` on the
+engine node, see :func:`workbook.scene.exudyn_gyroscopic_function`) make D
+skew-symmetric in the engine's rotation coordinates: Exudyn differentiates
+the rotor force with respect to the velocities, so its D already holds the
+gyroscopic matrix ``G`` (exactly, at the preloaded rotation; about the
+reference state ``G = -[h]x`` with h the rotors' spin angular momentum).
+The linearisation records G separately, and the modes are then those of the
+undamped gyroscopic system ``M x'' + G x' + K x = 0``: eigenvalues
+``+-i w``, split by the spin into forward and backward whirl.
 """
 from __future__ import annotations
 
@@ -50,6 +60,9 @@ class Linearization:
         Unprojected mass matrix.
     body_coordinates : dict of str to ndarray of int
         Full ODE2 coordinate indices of each body.
+    gyroscopic : ndarray, shape (n, n), or None
+        The rotors' gyroscopic matrix G (skew-symmetric, N m s), projected;
+        *damping* already contains it. None when no rotor is built.
     """
 
     mass: np.ndarray
@@ -58,6 +71,7 @@ class Linearization:
     basis: np.ndarray
     full_mass: np.ndarray
     body_coordinates: dict
+    gyroscopic: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -98,7 +112,7 @@ class Mode:
             return describe_engine_motion(self.engine_shape)
         moving = sorted(self.body_shares.items(), key=lambda item: -item[1])
         names = [name for name, share in moving if share >= 0.1 * moving[0][1]][:3]
-        return "motion of link " + ", ".join(repr(name) for name in names) + " with the engine still"
+        return "motion of " + ", ".join(repr(name) for name in names) + " with the engine still"
 
 
 def _body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
@@ -118,7 +132,13 @@ def _body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
 
 def linearize(scene: Scene) -> Linearization:
     """Linearise *scene* at its initial state (after a static solve with
-    ``updateInitialValues=True``: the preloaded state)."""
+    ``updateInitialValues=True``: the preloaded state).
+
+    With rotors built (``scene.gyroscopics``), the gyroscopic matrix is the
+    skew-symmetric part of Exudyn's D in the engine's rotation coordinates
+    (the only skew-symmetric damping of the scene: hinge and Rayleigh damping
+    are symmetric).
+    """
     import exudyn as exu
 
     settings = exu.SimulationSettings()
@@ -136,17 +156,49 @@ def linearize(scene: Scene) -> Linearization:
     else:
         basis = np.eye(size)
     project = lambda matrix: basis.T @ matrix @ basis  # noqa: E731
-    return Linearization(project(mass), project(stiffness), project(damping), basis, mass,
-                         _body_coordinates(scene))
+    coordinates = _body_coordinates(scene)
+    gyroscopic = None
+    if scene.gyroscopics is not None:
+        rotations = np.ix_(coordinates[ENGINE][3:], coordinates[ENGINE][3:])
+        gyroscopic = np.zeros_like(damping)
+        gyroscopic[rotations] = (damping[rotations] - damping[rotations].T) / 2
+        gyroscopic = project(gyroscopic)
+    return Linearization(project(mass), project(stiffness), project(damping), basis, mass, coordinates,
+                         gyroscopic)
+
+
+def _eigen(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
+    """Squared circular frequencies (rad^2/s^2) and mode vectors, by ascending frequency.
+
+    Without rotors: ``K x = w^2 M x``. With rotors: the undamped gyroscopic
+    system ``(lambda^2 M + lambda G + K) x = 0`` in first-order form; its
+    eigenvalues come in pairs ``+-i w`` and the one with ``Im lambda > 0``
+    of each pair is kept; of the real ones (free motions near zero, or a
+    negative-stiffness pair ``+-lambda`` counting as ``w^2 = -lambda^2``)
+    the larger half.
+    """
+    if lin.gyroscopic is None:
+        eigenvalues, vectors = sla.eig(lin.stiffness, lin.mass)
+        order = np.argsort(eigenvalues.real)
+        return eigenvalues.real[order], vectors[:, order]
+    size = lin.mass.shape[0]
+    identity, zero = np.eye(size), np.zeros((size, size))
+    eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]),
+                                   np.block([[identity, zero], [zero, lin.mass]]))
+    tolerance = 1e-9 * np.abs(eigenvalues).max()
+    half_plane = np.where(eigenvalues.imag > tolerance, 0, np.where(eigenvalues.imag < -tolerance, 2, 1))
+    keep = np.lexsort((-eigenvalues.real, half_plane))[:size]
+    squared = -(eigenvalues[keep] ** 2).real
+    order = np.argsort(squared)
+    return squared[order], vectors[:size, keep[order]]
 
 
 def modes_of(linearization: Linearization) -> list[Mode]:
     """All modes of a linearisation, by ascending frequency."""
     lin = linearization
-    eigenvalues, vectors = sla.eig(lin.stiffness, lin.mass)
-    order = np.argsort(eigenvalues.real)
+    squared_frequencies, vectors = _eigen(lin)
     modes = []
-    for index in order:
+    for index, omega_squared in enumerate(squared_frequencies):
         vector = vectors[:, index]
         full = lin.basis @ vector
         kinetic = float(np.real(np.conj(vector) @ lin.mass @ vector))
@@ -156,7 +208,6 @@ def modes_of(linearization: Linearization) -> list[Mode]:
             shares[body] = float(np.real(np.conj(part) @ lin.full_mass[np.ix_(coordinates, coordinates)] @ part)
                                  / kinetic)
         engine = _real_shape(full[lin.body_coordinates[ENGINE]])
-        omega_squared = float(eigenvalues[index].real)
         decay = float(np.real(np.conj(vector) @ lin.damping @ vector)) / (2 * kinetic)
         modes.append(Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), decay, shares[ENGINE],
                           engine, {b: s for b, s in shares.items() if b != ENGINE}))
@@ -164,9 +215,15 @@ def modes_of(linearization: Linearization) -> list[Mode]:
 
 
 def _real_shape(part: np.ndarray) -> np.ndarray:
-    """A (possibly complex) mode-shape part turned real, largest component 1."""
+    """A (possibly complex) mode-shape part turned real, largest component 1:
+    each component's magnitude relative to the largest, negative when it is
+    more than 90 degrees out of phase with it (a whirl mode's pitch and yaw,
+    90 degrees apart, both count)."""
     peak = part[np.argmax(np.abs(part))]
-    return np.real(part / peak) if abs(peak) > 0 else np.zeros(len(part))
+    if abs(peak) == 0:
+        return np.zeros(len(part))
+    ratio = part / peak
+    return np.where(ratio.real < -1e-9 * np.abs(ratio), -1.0, 1.0) * np.abs(ratio)
 
 
 def describe_engine_motion(shape: np.ndarray, length_scale: float = 1.0) -> str:

@@ -7,9 +7,12 @@
    forces).
 2. The static loads are solved for (Newton, tolerance scaled to the loads),
    and the solution becomes the initial state of the dynamic run.
-3. The vector sum of the pylon-side hinge forces must equal the applied
-   static loads (forces on the engine plus the weight of every body) to
-   ``equilibrium_tolerance``, or the run stops with :class:`EquilibriumError`.
+3. The pylon force - the vector sum of the pylon-side hinge forces, or of
+   the test-rig transducer forces when they are built - must equal the
+   applied static loads (forces on the engine plus the weight of every body;
+   the transducers carry no weight, see
+   :class:`~workbook.case.ForceTransducers`) to ``equilibrium_tolerance``,
+   or the run stops with :class:`EquilibriumError`.
 """
 from __future__ import annotations
 
@@ -18,16 +21,21 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .guards import SimulationError
 from .modes import Mode, free_motions, linearize, modes_of
 from .scene import Scene
 
 __all__ = ["MechanismError", "EquilibriumError", "Preload", "applied_static_force", "check_mechanism",
-           "check_equilibrium", "solve_preload"]
+           "check_equilibrium", "solve_preload", "spring_roundoff_force", "ROUNDOFF_MARGIN"]
 
 log = logging.getLogger(__name__)
 
+#: Newton tolerances stay this many times above the round-off of the stiffest
+#: spring's force (:func:`spring_roundoff_force`).
+ROUNDOFF_MARGIN = 10.0
 
-class MechanismError(RuntimeError):
+
+class MechanismError(SimulationError):
     """The mount is an unrestrained mechanism.
 
     Attributes
@@ -44,7 +52,7 @@ class MechanismError(RuntimeError):
                          f"stiffness: {listing}.{hint} Add or restore the link or hinge that restrains it.")
 
 
-class EquilibriumError(RuntimeError):
+class EquilibriumError(SimulationError):
     """The static solve failed or its hinge forces do not balance the loads."""
 
 
@@ -55,10 +63,12 @@ class Preload:
     Attributes
     ----------
     hinge_forces : dict of str to ndarray, shape (3,)
-        Static force of each hinge on the pylon (pylon-side hinges) or on the
-        hinge's first body, N.
+        Static force of each force channel (:attr:`Scene.force_channels`):
+        of each hinge on the pylon (pylon-side hinges) or on the hinge's
+        first body, and of each test-rig transducer on the ground, N.
     pylon_force : ndarray, shape (3,)
-        Vector sum over the pylon-side hinges: the force on the pylon, N.
+        Vector sum over the pylon channels (:attr:`Scene.pylon_channels`):
+        the force on the pylon, N.
     applied_force : ndarray, shape (3,)
         Sum of the applied static loads (forces and weights), N.
     relative_mismatch : float
@@ -107,6 +117,24 @@ def applied_static_force(scene: Scene) -> np.ndarray:
     return total
 
 
+def spring_roundoff_force(scene: Scene) -> float:
+    """Force the static Newton iteration can resolve on the stiffest spring, N.
+
+    A spring force ``k (p1 - p0)`` is computed from positions of size
+    ``|p|``, known to the machine epsilon ``eps``: its round-off is
+    ``k eps |p|``, which a Newton tolerance must not undercut (a 1e12 N/m
+    transducer 1.7 m from the origin: 4e-4 N, ten times the default
+    tolerance on the reference mount). Returned with a margin of
+    :data:`ROUNDOFF_MARGIN`.
+    """
+    case = scene.case
+    stiffness = [max(h.stiffness, h.gap_contact_stiffness) for h in case.hinges]
+    if scene.transducers:
+        stiffness += list(case.test_rig.stiffness)
+    reach = max((float(np.abs(h.position).max()) for h in case.hinges), default=0.0)
+    return ROUNDOFF_MARGIN * max(stiffness, default=0.0) * np.finfo(float).eps * max(reach, 1.0)
+
+
 def check_mechanism(scene: Scene) -> list[Mode]:
     """Linearise the scene as built and stop if it has free motions.
 
@@ -120,7 +148,9 @@ def check_mechanism(scene: Scene) -> list[Mode]:
     MechanismError
         Naming each free motion.
     """
-    modes = modes_of(linearize(scene))
+    # a clearance restrains once its gap closes: check with the gaps closed
+    with scene.gaps_closed():
+        modes = modes_of(linearize(scene))
     free = free_motions(modes)
     if free:
         case = scene.case
@@ -143,8 +173,9 @@ def solve_preload(scene: Scene) -> Preload:
     MechanismError
         The mount has a free motion.
     EquilibriumError
-        The static solve failed, or the pylon-side hinge forces differ from
-        the applied static loads by more than the case's tolerance.
+        The static solve failed, or the pylon force (pylon-side hinges or
+        rig transducers) differs from the applied static loads by more than
+        the case's tolerance.
     """
     import exudyn as exu
 
@@ -155,9 +186,11 @@ def solve_preload(scene: Scene) -> Preload:
         settings = exu.SimulationSettings()
         settings.solution.file.write = False
         settings.solution.sensors.writePeriod = 1.0
-        # Newton a thousand times tighter than the check (not below round-off)
+        # Newton a thousand times tighter than the check (not below round-off,
+        # neither of the loads nor of the stiffest spring's force)
         relative = max(1e-3 * tolerance, 1e-12)
-        settings.staticSolver.newton.absoluteTolerance = relative * scene.load_scale
+        settings.staticSolver.newton.absoluteTolerance = max(relative * scene.load_scale,
+                                                             spring_roundoff_force(scene))
         settings.staticSolver.newton.relativeTolerance = relative
         # keep the tolerance relative to the loads: a first Newton step that
         # overshoots (a closed clearance gap) must not loosen it
@@ -172,7 +205,7 @@ def solve_preload(scene: Scene) -> Preload:
             raise EquilibriumError(f"case {case.name!r}: the static solve did not converge "
                                    f"(load scale {scene.load_scale:.4g} N)")
     forces = scene.hinge_forces()
-    pylon = sum((forces[name] for name in scene.pylon_hinges), np.zeros(3))
+    pylon = sum((forces[name] for name in scene.pylon_channels), np.zeros(3))
     applied = applied_static_force(scene)
     mismatch = check_equilibrium(case.name, pylon, applied, tolerance, scene.load_scale)
     log.info("preload of %r: pylon force %s N, relative mismatch %.1e", case.name, np.round(pylon, 1), mismatch)

@@ -15,10 +15,10 @@ from __future__ import annotations
 import numpy as np
 
 from .case import (ENGINE, PYLON, AnalysisSettings, Case, Engine, Gravity, Hinge, Link, PointForce,
-                   RotatingForce, Sweep)
+                   RotatingForce, Rotor, Sweep)
 
 __all__ = ["reference_case", "reference_sweep", "HINGE_STIFFNESS", "HINGE_DAMPING_TIME",
-           "LP_ROTOR", "HP_ROTOR"]
+           "LP_ROTOR", "HP_ROTOR", "LP_SPOOL", "HP_SPOOL"]
 
 #: Engine weight 35 kN at g = 9.81 m/s^2, kg.
 ENGINE_MASS = 3568.0
@@ -39,6 +39,18 @@ FRONT_X, REAR_X, LATERAL_X, THRUST_FORWARD_X = 0.0, -1.60, -1.72, -0.55
 
 LP_ROTOR = RotatingForce("LP rotor", point=(0.35, 0.0, 0.0), frequency_hz=59.0, amplitude=1000.0)
 HP_ROTOR = RotatingForce("HP rotor", point=(-0.70, 0.0, 0.0), frequency_hz=248.5, amplitude=1000.0)
+
+# The spools as gyroscopic rotors (reference_case(rotors=True); off by default).
+# LP spool (fan, booster, LP turbine): 24 wide-chord fan blades of about 7 kg
+# with a radius of gyration of about 0.5 m (1.55 m fan) give about 42 kg m^2;
+# fan disk and spinner (about 100 kg at 0.25 m) 6, the 3-stage booster (about
+# 100 kg at 0.4 m) 16, the 4-stage LP turbine (about 250 kg at 0.38 m) 36:
+# about 100 kg m^2. HP spool (9-stage compressor and 1-stage turbine, about
+# 250 kg at 0.25 m): about 15 kg m^2. Both spools turn clockwise seen from
+# behind, i.e. right-handed about +x (heading), like the imbalance forces
+# above, at the reference rotor frequencies at once.
+LP_SPOOL = Rotor("LP spool", polar_inertia=100.0, frequency_hz=LP_ROTOR.frequency_hz)
+HP_SPOOL = Rotor("HP spool", polar_inertia=15.0, frequency_hz=HP_ROTOR.frequency_hz)
 
 
 def _short_link(length: float, element_size: float | None):
@@ -119,7 +131,7 @@ def reference_sweep(points: int = 25) -> Sweep:
 
 
 def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = None,
-                   element_size: float | None = None) -> Case:
+                   element_size: float | None = None, rotors: bool = False) -> Case:
     """The reference mount with the LP and HP rotor cases.
 
     Parameters
@@ -130,6 +142,10 @@ def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = N
         Settings other than the defaults.
     element_size : float, optional
         Mesh element size of the links, m (None: the flexbodies default).
+    rotors : bool
+        Add the LP and HP spools (:data:`LP_SPOOL`, :data:`HP_SPOOL`) as
+        gyroscopic rotors; off by default (their inertia is then only lumped
+        in the engine, as in the bundled case).
 
     Returns
     -------
@@ -143,6 +159,6 @@ def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = N
     return Case(
         name="reference mount", engine=engine, links=_links(element_size), hinges=_hinges(),
         static_loads=static_loads, excitations=excitations,
-        analysis=analysis or AnalysisSettings(),
+        analysis=analysis or AnalysisSettings(), rotors=(LP_SPOOL, HP_SPOOL) if rotors else (),
         description="CFM56-class engine on 8 links and 16 ball hinges (14 pins); see docs/reference-mount.md",
     )

@@ -7,7 +7,8 @@ Definitions (DESIGN.md section 5), per direction d in x, y, z:
 - isolation efficiency ``eta_d = (1 - T_d) * 100 %``;
 - level ``20 log10(T_d)`` dB.
 
-The pylon force is the vector sum of the pylon-side hinge forces.
+The pylon force is the vector sum of the pylon-side hinge forces, or of the test rig's
+transducer forces when the case has them (``Scene.pylon_channels``).
 :class:`MountResult` tabulates itself (pandas), plots itself (matplotlib)
 and converts to JSON-ready data.
 """
@@ -72,7 +73,8 @@ class ExcitationResult(PylonAnswers):
     hinge_amplitudes : dict of str to ndarray, shape (3,)
         Amplitude of each hinge force, N.
     pylon_hinges : list of str
-        The hinges summed into the pylon force.
+        The force channels summed into the pylon force: the pylon-side hinges,
+        or the test rig's transducers when the case has them.
     steady_change : float
         Relative change of the pylon amplitudes between the last two windows.
     steady_tolerance : float

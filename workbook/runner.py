@@ -13,10 +13,10 @@ from .modelcard import model_card
 from .modes import linearize, modes_of, mounted_modes
 from .preload import solve_preload
 from .results import MountResult
-from .scene import build_scene, reduce_links
+from .scene import build_scene, link_is_flexible, reduce_links
 from .timedomain import extract, integrate, plan_run
 
-__all__ = ["run_excitation", "run_case", "ProgressFactory", "timed"]
+__all__ = ["run_excitation", "run_case", "ProgressFactory", "timed", "link_warnings"]
 
 log = logging.getLogger(__name__)
 
@@ -32,6 +32,13 @@ def timed(timings: dict, stage: str):
     start = time.perf_counter()
     yield
     timings[stage] = timings.get(stage, 0.0) + time.perf_counter() - start
+
+
+def link_warnings(case: Case, reduced: dict) -> list[str]:
+    """Warnings of the flexible links whose mode selection is unsafe at the
+    run's excitation (``flexbodies.ModeDecision.warning``)."""
+    return [f"link {name!r}: {link.decision.warning}" for name, link in reduced.items()
+            if link_is_flexible(case, name) and link.decision.warning]
 
 
 def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
@@ -61,8 +68,10 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
 
     Raises
     ------
-    MechanismError, EquilibriumError
-        From the preload stage.
+    workbook.guards.SimulationError
+        A mechanism or a failed equilibrium (preload stage), an excitation on
+        an undamped mode, a failed or diverging integration, or an exhausted
+        time budget; the message says when and why.
     """
     timings = {}
     with timed(timings, "reduce links"):
@@ -81,7 +90,8 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         preload = solve_preload(scene)
     with timed(timings, "mounted modes"):
         mounted = mounted_modes(modes_of(linearize(scene)))
-    plan = plan_run(case.analysis, scene.excitation.signal, mounted)
+    plan = plan_run(case.analysis, scene.excitation.signal, mounted,
+                    where=f"case {case.name!r}, run {excitation.name!r}")
     log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
     with timed(timings, "time integration"):
         if progress is None:
@@ -94,7 +104,10 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 close()
     with timed(timings, "amplitude extraction"):
         result = extract(scene, plan, histories)
-    return result, model_card(scene, preload, mounted, plan, timings, method), preload
+    result.warnings.extend(link_warnings(case, reduced))
+    card = model_card(scene, preload, mounted, plan, timings, method)
+    card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
+    return result, card, preload
 
 
 def run_case(case: Case, *, progress: Union[ProgressFactory, None] = None) -> MountResult:

@@ -95,7 +95,7 @@ def _print_summary(runs) -> None:
 def run_workbook(args) -> int:
     """Run the runs of a case workbook, write the results back and optionally a report."""
     from ..cli import _progress_factory
-    from ..preload import EquilibriumError, MechanismError
+    from ..guards import SimulationError
     from .execute import run_book, select_runs
     from .reader import WorkbookError, read_workbook
     from .report import write_report
@@ -113,7 +113,7 @@ def run_workbook(args) -> int:
     progress = None if getattr(args, "no_progress", False) else _progress_factory()
     try:
         runs = run_book(book, selected, progress=progress)
-    except (MechanismError, EquilibriumError) as error:
+    except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
     _print_summary(runs)

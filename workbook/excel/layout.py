@@ -160,6 +160,11 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
     _num("newton_tolerance", "newton tolerance", help="Newton tolerance relative to the load scale"),
     _num("equilibrium_tolerance", "equilibrium tolerance",
          help="largest relative mismatch of the static equilibrium"),
+    Column("step_halvings", "step halvings", "integer", DIMENSIONLESS,
+           help="a segment whose Newton iteration fails is run again with the step halved, at most this often"),
+    _num("time_budget", "time budget", "s", help="wall time one run may take (empty: no limit)"),
+    _num("divergence_displacement", "divergence limit", "m", unit="mm",
+         help="engine displacement from the preloaded position that stops a run as diverging"),
     Column("method", "method", "choice", choices=ANALYSIS_METHODS,
            help="time: time domain; frequency: frequency domain about the preload; auto: frequency domain "
                 "unless a clearance makes the scene nonlinear"),

@@ -1,0 +1,104 @@
+"""Regenerate the transducer-stiffness study in docs/rig-sensors.md.
+
+The reference mount (flexible links as reduced by default) under the LP rotor
+(59 Hz), on the test rig's three-way force transducers of a range of
+stiffnesses (the same in x, y and z, 1 kg moving mass each), in the
+frequency domain; one stiffness is checked against the time domain. Writes
+``docs/rig-sensors.png`` and replaces the generated tables in
+``docs/rig-sensors.md`` (between the ``<!-- generated: ... -->`` markers).
+Run from anywhere (about a minute once the links are cached)::
+
+    OPENBLAS_NUM_THREADS=1 python docs/make_rig_sensor_docs.py
+"""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+
+from generated_sections import replace_section  # noqa: E402
+from workbook.case import AnalysisSettings, ForceTransducers  # noqa: E402
+from workbook.frequency_runner import prepare  # noqa: E402
+from workbook.modes import mounted_modes  # noqa: E402
+from workbook.reference import LP_ROTOR, reference_case  # noqa: E402
+from workbook.runner import run_excitation  # noqa: E402
+from workbook.scene import reduce_links  # noqa: E402
+
+DOCS = Path(__file__).resolve().parent
+#: Stiffnesses of the table, N/m per direction (None: the pylon pins on rigid ground).
+TABLE_STIFFNESS = (None, 1e10, 1e9, 3e8, 1e8, 3e7)
+#: Stiffness checked against the time domain, N/m.
+TIME_DOMAIN_STIFFNESS = 1e8
+
+
+def _with_rig(case, stiffness):
+    return case if stiffness is None else dataclasses.replace(case, test_rig=ForceTransducers((stiffness,) * 3))
+
+
+def _cells(t) -> str:
+    """T x, y, z as table cells."""
+    return f"{t[0]:.5f} | {t[1]:.6f} | {t[2]:.5f}"
+
+
+def main() -> None:
+    case = dataclasses.replace(reference_case(), excitations=(LP_ROTOR,))
+    reduced = reduce_links(case, LP_ROTOR)
+
+    def answer(stiffness):
+        prepared = prepare(_with_rig(case, stiffness), LP_ROTOR, reduced=reduced)
+        mounted = mounted_modes(prepared.modes)
+        return prepared.model.result(LP_ROTOR, case.analysis.steady_tolerance).transmissibility, mounted
+
+    rigid, rigid_modes = answer(None)
+    rows = ["| transducer k (N/m) | T x | T y | T z | change x (%) | change y (%) | change z (%) | "
+            "mounted modes (Hz) |", "|---|---|---|---|---|---|---|---|"]
+    for stiffness in TABLE_STIFFNESS:
+        t, mounted = answer(stiffness)
+        change = 100 * (t / rigid - 1)
+        label = "none (rigid ground)" if stiffness is None else f"{stiffness:.0e}"
+        rows.append(f"| {label} | {_cells(t)} | " + " | ".join(f"{c:+.2f}" for c in change)
+                    + f" | {mounted[0].frequency_hz:.2f} to {mounted[-1].frequency_hz:.2f} |")
+
+    curve = np.geomspace(1e7, 1e11, 33)
+    ratios = np.array([answer(k)[0] / rigid for k in curve])
+    figure, axes = plt.subplots(figsize=(7, 4.2))
+    for axis, name in enumerate("xyz"):
+        axes.semilogx(curve, ratios[:, axis], label=f"T {name}")
+    axes.axhline(1.0, color="grey", lw=0.8, ls="--")
+    axes.axvspan(1e8, 1e9, color="tab:green", alpha=0.1, label="piezo force link with fixture")
+    axes.set_xlabel("transducer stiffness per direction (N/m)")
+    axes.set_ylabel("T on the rig / T on rigid ground")
+    axes.set_title("Reference mount, LP rotor 59 Hz: force-transducer compliance")
+    axes.legend()
+    axes.grid(True, which="both", alpha=0.3)
+    figure.tight_layout()
+    figure.savefig(DOCS / "rig-sensors.png", dpi=110)
+
+    check = ["| transducers | method | T x | T y | T z |", "|---|---|---|---|---|"]
+    for stiffness in (None, TIME_DOMAIN_STIFFNESS):
+        label = "none (rigid ground)" if stiffness is None else f"k = {stiffness:.0e} N/m"
+        frequency_t, _ = answer(stiffness)
+        time_case = _with_rig(dataclasses.replace(case, analysis=AnalysisSettings(method="time")), stiffness)
+        run, card, _ = run_excitation(time_case, LP_ROTOR)
+        difference = 100 * (run.transmissibility / frequency_t - 1)
+        check += [f"| {label} | frequency domain | {_cells(frequency_t)} |",
+                  f"| {label} | time domain, step {card.solver['time step']} | {_cells(run.transmissibility)} |",
+                  f"| {label} | difference (%) | " + " | ".join(f"{d:+.2f}" for d in difference) + " |"]
+    check = "\n".join(check)
+
+    path = DOCS / "rig-sensors.md"
+    text = path.read_text()
+    for name, content in (("stiffness table", "\n".join(rows)), ("time-domain check", check)):
+        text = replace_section(text, name, content, "rig-sensors.md")
+    path.write_text(text)
+    print(f"wrote {DOCS / 'rig-sensors.png'} and the tables of {path}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,70 @@
+"""Guards of the solver path (workbook.guards): a Newton failure is retried
+with a smaller step and then reported with its time and cause; a run-away
+engine, an exhausted time budget and an absurdly long plan stop the run in
+plain words. Real Exudyn runs of the single-DOF mass of test_sdof."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from test_sdof import sdof_case
+from workbook.case import AnalysisSettings, CaseError, HarmonicForce
+from workbook.guards import DivergenceError, NewtonFailure, RunTooLong, SimulationError, TimeBudgetExceeded
+from workbook.runner import run_excitation
+
+SDOF = sdof_case((1.0,))
+SHAKE = HarmonicForce("shake", point=SDOF.engine.center_of_mass, direction=(0, 0, 1), amplitude=1e4,
+                      frequency_hz=20.0)
+
+
+def _impacting(**analysis):
+    """The mass inside 20 um gaps with a 1e12 N/m contact: the first impact
+    at 0.3 s defeats Newton at 40 steps per period, half the step does not."""
+    hinges = tuple(dataclasses.replace(h, radial_clearance=20e-6, contact_stiffness=1e12) for h in SDOF.hinges)
+    return dataclasses.replace(SDOF, hinges=hinges, analysis=AnalysisSettings(**analysis))
+
+
+def test_a_newton_failure_is_retried_with_half_the_step():
+    result, card, _ = run_excitation(_impacting(), SHAKE)
+    retries = card.solver["step retries"]
+    assert retries.startswith("0.3 to 0.35 s: step halved 1 time(s) to 0.000625 s after: ")
+    assert np.all(np.isfinite(result.transmissibility))
+    # sampling stays at the planned step through the retried segments
+    assert np.allclose(np.diff(result.time), 1 / (40 * 20.0))
+
+
+def test_without_retries_the_failure_names_the_time_and_the_cause():
+    with pytest.raises(NewtonFailure, match=r"between t = 0\.3 s and t = 0\.35 s: Newton's method did not "
+                                            r"converge .* halved 0 time\(s\), to 0\.00125 s\. Likely cause: "
+                                            r".*(stiff|impact)") as caught:
+        run_excitation(_impacting(step_halvings=0), SHAKE)
+    assert caught.value.time == pytest.approx(0.3) and isinstance(caught.value, SimulationError)
+
+
+def test_a_run_away_engine_stops_the_run():
+    """The shaken mass moves about 0.13 mm at resonance; a limit of 1 um is exceeded."""
+    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(divergence_displacement=1e-6))
+    with pytest.raises(DivergenceError, match=r"at t = [\d.]+ s the engine's centre of gravity is [\d.]+ mm from "
+                                              r"its preloaded position \(limit 0.001 mm"):
+        run_excitation(case, SHAKE)
+
+
+def test_the_time_budget_stops_a_long_run_with_an_estimate():
+    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(settle_time=2000.0, time_budget=0.5))
+    with pytest.raises(TimeBudgetExceeded, match=r"time budget 0.5 s\) at t = [\d.]+ s of 2\d{3}(\.\d+)? s "
+                                                 r"simulated; the whole run would need about \d+ s") as caught:
+        run_excitation(case, SHAKE)
+    assert 0 < caught.value.simulated < 2000.0 and caught.value.estimated_wall_time > 0.5
+
+
+def test_an_absurd_plan_is_refused_before_integrating():
+    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(settle_time=1e7))
+    with pytest.raises(RunTooLong, match="time steps .* Add damping, set a fixed settle time"):
+        run_excitation(case, SHAKE)
+
+
+@pytest.mark.parametrize("field, value", [("step_halvings", -1), ("step_halvings", 1.5),
+                                          ("time_budget", 0.0), ("divergence_displacement", -1.0)])
+def test_guard_settings_are_validated(field, value):
+    with pytest.raises(CaseError, match=field):
+        AnalysisSettings(**{field: value})
