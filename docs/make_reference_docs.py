@@ -40,9 +40,9 @@ def main() -> None:
         f"| {i + 1} | {m.frequency_hz:.2f} | {100 * m.damping_ratio:.2f} | {m.description} |"
         for i, m in enumerate(mounted)])
     forces = "\n".join(["| hinge | Fx (N) | Fy (N) | Fz (N) |", "|---|---|---|---|"] + [
-        f"| {name} | {f[0]:.0f} | {f[1]:.0f} | {f[2]:.0f} |" for name, f in preload.hinge_forces.items()] + [
-        f"| **pylon sum** | {preload.pylon_force[0]:.0f} | {preload.pylon_force[1]:.0f} | "
-        f"{preload.pylon_force[2]:.0f} |"])
+        f"| {name} | {round(f[0])} | {round(f[1])} | {round(f[2])} |" for name, f in preload.hinge_forces.items()] + [
+        f"| **pylon sum** | {round(preload.pylon_force[0])} | {round(preload.pylon_force[1])} | "
+        f"{round(preload.pylon_force[2])} |"])
 
     path = DOCS / "reference-mount.md"
     text = path.read_text()

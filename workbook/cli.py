@@ -36,11 +36,15 @@ __all__ = ["main", "SUBCOMMANDS"]
 log = logging.getLogger(__name__)
 
 
-def _load_case(path: str | None, rigid: bool = False):
+def _load_case(path: str | None, rigid: bool = False, time_budget: float | None = None):
+    import dataclasses
+
     from .codec import from_json
     from .reference import reference_case
 
     case = reference_case() if path is None else from_json(Path(path).read_text())
+    if time_budget is not None:
+        case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, time_budget=time_budget))
     return case.with_rigid_links() if rigid else case
 
 
@@ -65,6 +69,8 @@ def _run_arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--json", action="store_true", help="print the answers as JSON")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--time-budget", type=float, metavar="SECONDS",
+                        help="wall time one run may take before it stops with an estimate of the time it needs")
     excel_commands.add_run_arguments(parser)
 
     def run(args) -> int:
@@ -73,7 +79,7 @@ def _run_arguments(parser: argparse.ArgumentParser) -> Callable:
         if excel_commands.is_workbook(args.case):
             return excel_commands.run_workbook(args)
 
-        case = _load_case(args.case, args.rigid)
+        case = _load_case(args.case, args.rigid, args.time_budget)
         result = run_case(case, progress=None if args.no_progress else _progress_factory())
         if args.json:
             print(result.to_json(indent=2))
@@ -183,7 +189,10 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.handler(args)
-    except (CaseError, SimulationError, ValueError, OSError) as error:
+    except SimulationError as error:
+        print(f"mountwb {args.command}: numerical trouble: {error}", file=sys.stderr)
+        return 1
+    except (CaseError, ValueError, OSError) as error:
         print(f"mountwb {args.command}: {error}", file=sys.stderr)
         return 2
 

@@ -77,9 +77,9 @@ class TimeBudgetExceeded(SimulationError):
         self.simulated = simulated
         self.estimated_wall_time = elapsed * end_time / simulated if simulated > 0 else math.inf
         super().__init__(
-            f"{where}: stopped after {elapsed:.1f} s of wall time (time budget {budget:g} s) at t = "
+            f"{where}: stopped after {elapsed:.3g} s of wall time (time budget {budget:g} s) at t = "
             f"{simulated:.4g} s of {end_time:.4g} s simulated; the whole run would need about "
-            f"{self.estimated_wall_time:.0f} s. Raise the time budget, shorten the run (settle time, measured "
+            f"{self.estimated_wall_time:.3g} s. Raise the time budget, shorten the run (settle time, measured "
             f"periods, steps per period) or answer it in the frequency domain.")
 
 

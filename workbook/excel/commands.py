@@ -101,9 +101,9 @@ def run_workbook(args) -> int:
     from .report import write_report
     from .writer import write_results
 
-    if getattr(args, "json", False) or getattr(args, "rigid", False):
-        print("mountwb run: --json and --rigid are for JSON cases; a workbook sets its runs' fidelity in its "
-              "Runs sheet", file=sys.stderr)
+    if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None):
+        print("mountwb run: --json, --rigid and --time-budget are for JSON cases; a workbook sets its runs' "
+              "fidelity in its Runs sheet and its time budget in its Case sheet", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         book = read_workbook(args.case)
