@@ -10,12 +10,17 @@ import pytest
 from openpyxl import load_workbook
 
 from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference, set_cells, sha256
+from workbook.case import ForceTransducers
 from workbook.cli import main
 from workbook.codec import to_dict
 from workbook.excel.reader import WorkbookError, read_workbook
 from workbook.excel.template import reference_workbook, template_workbook, write_workbook
 from workbook.excel.units import UnitProblem, si_factor
-from workbook.reference import reference_case
+from workbook.reference import HP_SPOOL, LP_SPOOL, reference_case
+
+#: A Rotors row and a Test rig row, as ``set_cells`` edits.
+ROTOR_ROW = {("Rotors", "name", 3): "LP spool", ("Rotors", "polar inertia", 3): 100, ("Rotors", "speed", 3): 59}
+RIG_ROW = {("Test rig", f"stiffness {axis}", 3): 1e8 for axis in "xyz"}
 
 
 def _numbers(case):
@@ -95,11 +100,49 @@ def test_units_are_converted_on_reading(tmp_path):
     excitations.cell(2, column_of(excitations, "frequency"), "rpm")
     excitations.cell(3, column_of(excitations, "frequency"), 3540)
     wb.save(path)
+    set_cells(path, {**ROTOR_ROW, ("Rotors", "speed", 2): "rpm", ("Rotors", "speed", 3): 3540,
+                     ("Rotors", "polar inertia", 2): "t*mm^2", ("Rotors", "polar inertia", 3): 1e5,
+                     **RIG_ROW, ("Test rig", "stiffness z", 2): "kN/mm", ("Test rig", "stiffness z", 3): 300,
+                     ("Test rig", "mass", 2): "g", ("Test rig", "mass", 3): 800})
     case = read_workbook(path).case
     assert case.engine.mass == pytest.approx(3568.0, rel=1e-12)
     assert case.hinges[0].stiffness == pytest.approx(2.0e7, rel=1e-12)
     assert case.hinges[0].radial_clearance == pytest.approx(5e-5, rel=1e-12)
     assert case.excitations[0].frequency == pytest.approx(59.0, rel=1e-12)
+    assert case.rotors[0].frequency == pytest.approx(59.0, rel=1e-12)
+    assert case.rotors[0].polar_inertia == pytest.approx(100.0, rel=1e-12)
+    assert case.test_rig.stiffness == pytest.approx((1e8, 1e8, 3e8), rel=1e-12)
+    assert case.test_rig.mass == pytest.approx(0.8, rel=1e-12)
+
+
+def test_rotors_and_test_rig_are_read(tmp_path):
+    path = copy_reference(tmp_path)
+    set_cells(path, {**ROTOR_ROW, ("Rotors", "name", 4): "HP spool", ("Rotors", "polar inertia", 4): 15,
+                     ("Rotors", "speed", 4): 248.5, ("Rotors", "spin axis", 4): "z",
+                     **RIG_ROW, ("Test rig", "stiffness z", 3): 3e8, ("Test rig", "mass", 3): 0.5,
+                     **{("Test rig", f"damping {axis}", 3): 20 for axis in "xyz"}})
+    expected = dataclasses.replace(reference_case(sweep=True),
+                                   rotors=(LP_SPOOL, dataclasses.replace(HP_SPOOL, axis=(0, 0, 1))),
+                                   test_rig=ForceTransducers((1e8, 1e8, 3e8), mass=0.5, damping=(20, 20, 20)))
+    case = read_workbook(path).case
+    assert _numbers(case) == _numbers(expected)
+    assert case.effects.gyroscopics and case.effects.rig_sensors
+    set_cells(path, {("Case", "gyroscopics", 3): "no", ("Case", "rig sensors", 3): "no"})
+    effects = read_workbook(path).case.effects
+    assert (effects.gyroscopics, effects.rig_sensors) == (False, False)
+
+
+def test_rotors_and_test_rig_sheets_are_optional(tmp_path):
+    """A workbook made before the Rotors and Test rig sheets (and their effect columns) still reads."""
+    path = copy_reference(tmp_path)
+    wb = load_workbook(path)
+    for sheet in ("Rotors", "Test rig"):
+        wb.remove(wb[sheet])
+    wb["Case"].delete_cols(column_of(wb["Case"], "gyroscopics"), 2)
+    wb.save(path)
+    case = read_workbook(path).case
+    assert (case.rotors, case.test_rig) == ((), None)
+    assert _numbers(case) == _numbers(reference_case(sweep=True))
 
 
 def _with_cached_value(path, sheet_index, cell, value):
@@ -218,6 +261,26 @@ BAD_INPUTS = {
                                            ("Test data", "amplitude", 3): 30}),
                                     ["sheet 'Test data'", "cell A3", "'IP rotor'"]),
     "no runs": (_edit_wb(lambda wb: wb["Runs"].delete_rows(3, 3)), ["sheet 'Runs'", "at least one run"]),
+    "text in a polar-inertia cell": (_edit({**ROTOR_ROW, ("Rotors", "polar inertia", 3): "heavy"}),
+                                     ["sheet 'Rotors'", "cell B3", "column 'polar inertia'", "'heavy'", "a number"]),
+    "zero rotor speed": (_edit({**ROTOR_ROW, ("Rotors", "speed", 3): 0}), ["sheet 'Rotors'", "cell C3", "> 0"]),
+    "unknown spin axis": (_edit({**ROTOR_ROW, ("Rotors", "spin axis", 3): "w"}),
+                          ["sheet 'Rotors'", "cell D3", "'w'", "one of x, y, z"]),
+    "duplicate rotor names": (_edit({**ROTOR_ROW, **{(sheet, header, 4): value for (sheet, header, _), value
+                                                      in ROTOR_ROW.items()}}),
+                              ["sheet 'Rotors'", "cell A4", "not used before (row 3)"]),
+    "unknown unit of a rotor": (_edit({**ROTOR_ROW, ("Rotors", "polar inertia", 2): "kg*mmm"}),
+                                ["sheet 'Rotors'", "cell B2", "'kg*mmm'", "a known unit"]),
+    "negative transducer stiffness": (_edit({**RIG_ROW, ("Test rig", "stiffness y", 3): -1e8}),
+                                      ["sheet 'Test rig'", "cell A3:C3", "column 'stiffness'", "-100000000",
+                                       "three numbers > 0"]),
+    "transducer stiffness of the wrong dimension": (_edit({**RIG_ROW, ("Test rig", "stiffness x", 2): "kg"}),
+                                                    ["sheet 'Test rig'", "cell A2", "'kg'", "stiffness"]),
+    "two rows in the Test rig sheet": (_edit({**RIG_ROW, **{(sheet, header, 4): value for (sheet, header, _), value
+                                                             in RIG_ROW.items()}}),
+                                       ["sheet 'Test rig'", "row 4", "exactly one row"]),
+    "bad rig sensors switch": (_edit({("Case", "rig sensors", 3): "sometimes"}),
+                               ["sheet 'Case'", "cell V3", "yes or no"]),
 }
 
 

@@ -17,7 +17,7 @@ from openpyxl.comments import Comment
 from openpyxl.styles import Font, PatternFill
 
 from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, make_cheap, set_cells, sha256
-from workbook.case import AnalysisSettings
+from workbook.case import AnalysisSettings, ForceTransducers
 from workbook.cli import main
 from workbook.excel import layout as L
 from workbook.excel.files import save_atomic, unsupported_content
@@ -83,6 +83,12 @@ def ran(cheap, tmp_path_factory):
     return path, before, digest, report
 
 
+def _cheap_python_case():
+    """The case of the cheap workbook built in Python: reference mount, rigid links, cheap settings."""
+    analysis = AnalysisSettings(**{k.replace(" ", "_"): v for k, v in CHEAP_SETTINGS.items()})
+    return reference_case(analysis=analysis, element_size=0.030).with_rigid_links()
+
+
 def _sheet_rows(ws, header_row=2):
     header = [c.value for c in ws[header_row]]
     return [dict(zip(header, values)) for values in ws.iter_rows(min_row=header_row + 1, values_only=True)
@@ -104,9 +110,7 @@ def test_results_written_back_match_a_python_run(ran):
     rows = _sheet_rows(wb["Result efficiency"])
     assert len(rows) == 3 * (1 + 1 + 4)          # LP, HP, 4 sweep points x 3 directions
     # the same case built in Python (reference, rigid links, cheap settings) gives identical numbers
-    analysis = AnalysisSettings(**{k.replace(" ", "_"): v for k, v in CHEAP_SETTINGS.items()})
-    case = reference_case(analysis=analysis, element_size=0.030).with_rigid_links()
-    python = run_case(dataclasses.replace(case, excitations=(LP_ROTOR, HP_ROTOR)))
+    python = run_case(dataclasses.replace(_cheap_python_case(), excitations=(LP_ROTOR, HP_ROTOR)))
     for run in python.runs:
         sheet = {r["direction"]: r for r in rows if r["run"] == run.name}
         for i, d in enumerate("xyz"):
@@ -117,6 +121,24 @@ def test_results_written_back_match_a_python_run(ran):
     assert [r["frequency Hz"] for r in sweep] == pytest.approx(list(reference_sweep(4).frequencies_hz))
     # isolation at the rotor frequencies, amplification somewhere near the mounted modes at 5-20 Hz
     assert min(r["eta % y"] for r in sweep[:2]) < 0 < min(r["eta % y"] for r in sweep[2:])
+
+
+def test_run_on_the_test_rig(tmp_path):
+    """A Test rig row builds the transducers: the model card says so and T is the Python case's."""
+    path = copy_reference(tmp_path)
+    make_cheap(path)
+    set_cells(path, {("Test rig", f"stiffness {axis}", 3): 1e8 for axis in "xyz"})
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    wb = load_workbook(path)
+    card = [str(cell.value) for cell in wb["Result model card"]["A"]]
+    assert any(line.startswith("  [on ] test-rig force-sensor compliance: 6 transducers, k = (1e+08, 1e+08, 1e+08)")
+               for line in card)
+    assert sum("force transducer (point mass)" in line for line in card) == 6
+    case = dataclasses.replace(_cheap_python_case(), excitations=(LP_ROTOR,),
+                               test_rig=ForceTransducers((1e8, 1e8, 1e8)))
+    python = run_case(case).runs[0]
+    sheet = {r["direction"]: r for r in _sheet_rows(wb["Result efficiency"])}
+    assert [sheet[d]["T"] for d in "xyz"] == pytest.approx(list(python.transmissibility), rel=1e-9)
 
 
 def test_test_data_error(ran):

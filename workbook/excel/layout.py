@@ -6,7 +6,8 @@ Every input sheet is a table with the same layout:
 - row 2 (:data:`UNIT_ROW`): the unit of each column (``-`` for numbers
   without dimension, empty for text and choices);
 - rows 3 on (:data:`FIRST_DATA_ROW`): one item per row; empty rows are
-  skipped. The Case and Engine sheets hold exactly one row.
+  skipped. The Case and Engine sheets hold exactly one row, the Test rig
+  sheet at most one.
 
 A vector (position, force, direction) takes three columns ``<name> x``,
 ``<name> y``, ``<name> z``, each with its own unit cell. Axes (DESIGN.md
@@ -17,18 +18,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..case import ANALYSIS_METHODS
+from ..case import ANALYSIS_METHODS, DIRECTIONS
 from .units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
-           "EXCITATIONS", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW", "FIRST_DATA_ROW",
-           "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO"]
+           "EXCITATIONS", "ROTORS", "TEST_RIG", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
+           "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES"]
 
 HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
 INSTRUCTIONS_SHEET = "Instructions"
 #: Result sheets written back by a run start with this prefix.
 RESULT_PREFIX = "Result "
 YES, NO = "yes", "no"
+
+#: Unit vector of each axis letter (the Rotors sheet's spin axis).
+AXES = {axis: tuple(float(axis == other) for other in DIRECTIONS) for axis in DIRECTIONS}
 
 #: Column kinds: how a cell is read.
 KINDS = ("number", "integer", "text", "choice", "yesno", "modes", "fidelity", "unit")
@@ -119,9 +123,10 @@ class Table:
         Sheet name.
     columns : tuple of Column
     single_row : bool
-        The sheet holds exactly one row (Case, Engine).
+        The sheet holds exactly one row (Case, Engine); an optional one holds
+        at most one (Test rig).
     optional : bool
-        The sheet may be missing (Test data).
+        The sheet may be missing (Rotors, Test rig, Test data).
     help : str
         What the sheet is for (Instructions sheet).
     """
@@ -173,6 +178,10 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
     Column("hinge_damping", "hinge damping", "yesno", help="no: hinge damping set to zero"),
     Column("link_damping", "link damping", "yesno", help="no: link Rayleigh damping set to zero"),
     Column("clearance", "clearance", "yesno", help="no: hinge gaps ignored"),
+    Column("gyroscopics", "gyroscopics", "yesno",
+           help="no: the rotors' gyroscopic moments are not built (their inertia stays lumped in the engine)"),
+    Column("rig_sensors", "rig sensors", "yesno",
+           help="no: the pylon pins sit on rigid ground even when the Test rig sheet gives transducers"),
 ))
 
 ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(
@@ -253,6 +262,24 @@ EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a
     Column("sweep_spacing", "sweep spacing", "choice", choices=("log", "linear"), help="sweep: spacing"),
 ))
 
+ROTORS = Table("Rotors", optional=True,
+               help="spinning rotors whose gyroscopic moments act on the engine (their mass and inertia are "
+                    "in the Engine sheet)", columns=(
+    Column("name", "name", "text", required=True, help="unique rotor name"),
+    _num("polar_inertia", "polar inertia", "kg*m^2", required=True,
+         help="polar moment of inertia about the spin axis"),
+    _num("frequency_hz", "speed", "Hz", required=True, help="spin speed (rpm accepted)"),
+    Column("axis", "spin axis", "choice", choices=DIRECTIONS,
+           help="spin axis in engine coordinates, spinning right-handed about it (empty: x)"),
+))
+
+TEST_RIG = Table("Test rig", single_row=True, optional=True,
+                 help="the rig's three-way force transducers under the pylon pins (empty: rigid ground)", columns=(
+    *_xyz("stiffness", "stiffness", "N/m", required=True, help="stiffness of each transducer with its fixture"),
+    _num("mass", "mass", "kg", help="moving mass of each transducer with its fitting (empty: 1 kg)"),
+    *_xyz("damping", "damping", "N*s/m", help="damping of each transducer (empty: 0)"),
+))
+
 RUNS = Table("Runs", help="one run per row: an excitation and optional overrides", columns=(
     Column("name", "run", "text", required=True, help="unique run name"),
     Column("excitation", "excitation", "text", required=True, help="an excitation name"),
@@ -284,4 +311,4 @@ TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes, o
 ))
 
 #: The input tables in sheet order.
-TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, RUNS, TEST_DATA)
+TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, ROTORS, TEST_RIG, RUNS, TEST_DATA)

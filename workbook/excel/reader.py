@@ -64,8 +64,10 @@ _FIELD_COLUMNS = {
     "Runs": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "radial_clearance": ("gap",),
              "stiffness": ("hinge_stiffness",), "damping": ("hinge_damping",), "modes": ("fidelity",)},
 }
-_ITEM = re.compile(r"^(link|hinge|static load|excitation) '(.*)'$")
-_ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS}
+#: Item kind in a CaseError of the Case constructor -> its table.
+_ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS,
+                "rotor": L.ROTORS}
+_ITEM = re.compile(rf"^({'|'.join(_ITEM_TABLES)}) '(.*)'$")
 
 
 def _field_keys(table: L.Table, field: str) -> tuple:
@@ -241,6 +243,19 @@ class _CaseReader(SheetReader):
                                                         get("sweep_points"), get("sweep_spacing", "log")),
                           ("sweep_from", "sweep_to", "sweep_points"))
 
+    def rotor(self, record: Record) -> Union[cm.Rotor, None]:
+        """A Rotors row: spin axis x, y or z (empty: the Rotor default, x)."""
+        get = record.get
+        axis = {} if get("axis") is None else {"axis": L.AXES[get("axis")]}
+        return self.build(record, lambda: cm.Rotor(get("name"), get("polar_inertia"),
+                                                   frequency_hz=get("frequency_hz"), **axis))
+
+    def test_rig(self, record: Record) -> Union[cm.ForceTransducers, None]:
+        """The Test rig row; empty mass and damping take the ForceTransducers defaults."""
+        given = {key: value for key, value in (("mass", record.get("mass")), ("damping", record.vector("damping")))
+                 if value is not None}
+        return self.build(record, lambda: cm.ForceTransducers(record.vector("stiffness"), **given))
+
     def settings(self, record: Record):
         def given(cls):
             return {f.name: record.get(f.name) for f in dataclasses.fields(cls) if record.get(f.name) is not None}
@@ -252,13 +267,14 @@ class _CaseReader(SheetReader):
     # -- the case ----------------------------------------------------------------------------------------
 
     def case(self, tables: dict) -> Union[cm.Case, None]:
-        for key in ("Links", "Hinges", "Static loads", "Excitations"):
+        for key in ("Links", "Hinges", "Static loads", "Excitations", "Rotors"):
             self.unique(tables[key])
         engine = [self.engine(r) for r in tables["Engine"] if r.ok]
         settings = [self.settings(r) for r in tables["Case"] if r.ok]
+        test_rig = [self.test_rig(r) for r in tables["Test rig"] if r.ok]
         items = {key: [(r, make(r) if r.ok else None) for r in tables[key]] for key, make in
                  (("Links", self.link), ("Hinges", self.hinge), ("Static loads", self.static_load),
-                  ("Excitations", self.excitation))}
+                  ("Excitations", self.excitation), ("Rotors", self.rotor))}
         first_links = {}
         for record, link in items["Links"]:
             first_links.setdefault(record.get("name"), link)
@@ -266,10 +282,12 @@ class _CaseReader(SheetReader):
         if self.problems or not engine or None in engine or not settings or None in settings[0]:
             return None
         (analysis, effects), record = settings[0], tables["Case"][0]
+        built = {key: tuple(item for _, item in pairs) for key, pairs in items.items()}
         try:
-            return cm.Case(record.get("name"), engine[0], *(tuple(i for _, i in items[key]) for key in
-                                                            ("Links", "Hinges", "Static loads", "Excitations")),
-                           analysis=analysis, effects=effects, description=record.get("description", ""))
+            return cm.Case(record.get("name"), engine[0], built["Links"], built["Hinges"], built["Static loads"],
+                           built["Excitations"], analysis=analysis, effects=effects,
+                           description=record.get("description", ""), test_rig=test_rig[0] if test_rig else None,
+                           rotors=built["Rotors"])
         except cm.CaseError as exc:
             self.case_error(exc, items)
         return None

@@ -148,7 +148,7 @@ class SheetReader:
                 continue
             records.append(self._record(table, row, raw, positions, factors))
         if table.single_row:
-            if not records:
+            if not records and not table.optional:
                 self.problem(table.sheet, f"row {L.FIRST_DATA_ROW}", None, None, "one row of data")
             for extra in records[1:]:
                 self.problem(table.sheet, f"row {extra.row}", None, "a second row", "exactly one row of data")

@@ -67,6 +67,8 @@ _INSTRUCTIONS = (
     "(frequency, amplitude, fidelity, gap, stiffness, ...).",
     "Fidelity: rigid (every link rigid), static (static modes only), auto (the low-frequency rule), "
     "a mode count, or a cut-off such as '2000 Hz'.",
+    "Rotors and Test rig (optional, empty: none): spinning rotors whose gyroscopic moments act on the engine, "
+    "and the rig's force transducers under the pylon pins; 'gyroscopics' and 'rig sensors' in Case switch them off.",
     "Test data: measured force amplitudes (pylon sum or a hinge, per direction); "
     "the results show error = (sim - test) / test x 100 %.",
     "Check a workbook:  mountwb check CASE.xlsx     "
@@ -136,6 +138,19 @@ def _row_for_load(load: cm.StaticLoad) -> dict:
     return {"name": load.name, "type": "gravity", **_vector("acceleration", load.acceleration)}
 
 
+def _row_for_rotor(rotor: cm.Rotor) -> dict:
+    axis = {vector: letter for letter, vector in L.AXES.items()}.get(rotor.axis)
+    if axis is None:
+        raise ValueError(f"rotor {rotor.name!r}: only rotors spinning about +x, +y or +z can be written")
+    return {"name": rotor.name, "polar_inertia": rotor.polar_inertia, "frequency_hz": rotor.frequency, "axis": axis}
+
+
+def _rows_for_test_rig(rig: Union[cm.ForceTransducers, None]) -> list[dict]:
+    if rig is None:
+        return []
+    return [{**_vector("stiffness", rig.stiffness), "mass": rig.mass, **_vector("damping", rig.damping)}]
+
+
 def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> dict[str, list[dict]]:
     """The rows of every input sheet (values in SI, by column key) for *case*."""
     inertia = case.engine.inertia
@@ -154,6 +169,8 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.HINGES.sheet: hinges,
         L.STATIC_LOADS.sheet: [_row_for_load(load) for load in case.static_loads],
         L.EXCITATIONS.sheet: [_row_for_excitation(e) for e in case.excitations],
+        L.ROTORS.sheet: [_row_for_rotor(rotor) for rotor in case.rotors],
+        L.TEST_RIG.sheet: _rows_for_test_rig(case.test_rig),
         L.RUNS.sheet: [dataclasses.asdict(run) for run in runs],
         L.TEST_DATA.sheet: [dataclasses.asdict(point) for point in tests],
     }
