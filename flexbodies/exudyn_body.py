@@ -23,6 +23,7 @@ depends on it.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -264,7 +265,7 @@ def add_link_to_exudyn(
     )
 
 
-def export_exudyn_file(link: ReducedLink, path) -> "Path":
+def export_exudyn_file(link: ReducedLink, path) -> Path:
     """Write a reduced link in Exudyn's own reduced-body format.
 
     A plain Exudyn script loads it without this package::

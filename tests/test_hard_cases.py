@@ -25,7 +25,6 @@ from workbook.modes import mounted_modes
 from workbook.preload import MechanismError
 from workbook.reference import HINGE_DAMPING_TIME, LP_ROTOR, reference_case
 from workbook.runner import run_excitation
-from workbook.timedomain import TRANSIENT_SEGMENTS  # noqa: F401  (the segmenting the long run relies on)
 
 
 @pytest.fixture(scope="module")

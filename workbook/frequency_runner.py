@@ -18,7 +18,7 @@ from typing import Union
 from .case import Case, SingleFrequencyExcitation, Sweep
 from .clearance import linearised_gap_warnings
 from .frequency import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
-from .guards import check_undamped_resonance
+from .guards import check_undamped_resonance, run_label
 from .method import MethodChoice, choose_method
 from .modelcard import model_card
 from .modes import modes_of, mounted_modes
@@ -94,7 +94,8 @@ def _solver_entries(case: Case, model: HarmonicModel) -> dict:
                          "Euler-parameter constraints projected out (null space by SVD)",
         "independent coordinates": model.dof,
         "input and outputs": f"central differences of Exudyn's engine-point position and the hinge (and "
-                             f"transducer) Force outputs (coordinate step {COORDINATE_STEP:g}, velocity step {VELOCITY_STEP:g})",
+                             f"transducer) Force outputs (coordinate step {COORDINATE_STEP:g}, velocity step "
+                             f"{VELOCITY_STEP:g})",
         "damping": "viscous: hinge damping and Rayleigh link damping exactly as in the time domain, plus the "
                    "rotors' gyroscopic coupling when built",
         "static equilibrium check": f"relative {case.analysis.equilibrium_tolerance:g}",
@@ -120,7 +121,7 @@ def results_of(case: Case, prepared: PreparedScene, points: tuple, method: Metho
     runs, cards, preloads = [], {}, {}
     try:
         for done, excitation in enumerate(points, start=1):
-            check_undamped_resonance(f"case {case.name!r}, run {excitation.name!r}", excitation.frequency, mounted,
+            check_undamped_resonance(run_label(case.name, excitation.name), excitation.frequency, mounted,
                                      RESONANCE_BAND, "the response grows without bound: no steady state exists")
             start = time.perf_counter()
             result = prepared.model.result(excitation, case.analysis.steady_tolerance)

@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 
 __all__ = ["SimulationError", "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError",
-           "RunTooLong", "newton_cause", "check_undamped_resonance", "UNDAMPED_RATIO", "MAX_STEPS"]
+           "RunTooLong", "run_label", "newton_cause", "check_undamped_resonance", "UNDAMPED_RATIO", "MAX_STEPS"]
 
 #: A mounted mode with a damping ratio below this counts as undamped (the
 #: linearisation of a scene without damping gives ratios of about 1e-15).
@@ -89,6 +89,11 @@ class ResonanceError(SimulationError):
 
 class RunTooLong(SimulationError):
     """The planned run has more steps than any meant run (:data:`MAX_STEPS`)."""
+
+
+def run_label(case_name: str, run_name: str) -> str:
+    """How the messages name a run: ``case 'NAME', run 'NAME'``."""
+    return f"case {case_name!r}, run {run_name!r}"
 
 
 def newton_cause(convergence) -> str:

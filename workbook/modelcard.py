@@ -175,12 +175,7 @@ def _effects(scene, preload, method=None) -> list[EffectEntry]:
                     f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
                     if effects.clearance and gaps else
                     ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")),
-        EffectEntry("gyroscopic rotor", scene.gyroscopics is not None,
-                    ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in case.rotors)
-                    + ": moment -Ip Omega (omega x a) on the engine (symbolic ObjectGenericODE2); their mass and "
-                      "transverse inertia lumped in the engine" if scene.gyroscopics is not None else
-                    ("switched off: rotor inertia lumped in the engine" if case.rotors
-                     else "no rotors given: rotor inertia lumped in the engine")),
+        _gyroscopics(scene),
         _rig_sensors(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
@@ -195,6 +190,17 @@ def _effects(scene, preload, method=None) -> list[EffectEntry]:
                                 f"{frequency_detail}: {method.reason}" if method.method == "frequency"
                                 else "not used")]
     return entries
+
+
+def _gyroscopics(scene) -> EffectEntry:
+    """The rotors' gyroscopic moment: built or not, and why."""
+    name, rotors = "gyroscopic rotor", scene.case.rotors
+    if scene.gyroscopics is None:
+        return EffectEntry(name, False, "switched off: rotor inertia lumped in the engine" if rotors
+                           else "no rotors given: rotor inertia lumped in the engine")
+    listing = ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in rotors)
+    return EffectEntry(name, True, f"{listing}: moment -Ip Omega (omega x a) on the engine (symbolic "
+                                   f"ObjectGenericODE2); their mass and transverse inertia lumped in the engine")
 
 
 def _rig_sensors(scene) -> EffectEntry:

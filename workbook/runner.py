@@ -8,6 +8,7 @@ from contextlib import contextmanager
 from typing import Callable, Union
 
 from .case import Case, SingleFrequencyExcitation, Sweep
+from .guards import run_label
 from .method import FREQUENCY, MethodChoice, choose_method
 from .modelcard import model_card
 from .modes import linearize, modes_of, mounted_modes
@@ -91,7 +92,7 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
     with timed(timings, "mounted modes"):
         mounted = mounted_modes(modes_of(linearize(scene)))
     plan = plan_run(case.analysis, scene.excitation.signal, mounted,
-                    where=f"case {case.name!r}, run {excitation.name!r}")
+                    where=run_label(case.name, excitation.name))
     log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
     with timed(timings, "time integration"):
         if progress is None:
