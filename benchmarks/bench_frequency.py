@@ -20,12 +20,12 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 import numpy as np  # noqa: E402
 
-from workbook.frequency import excitation_phasor, harmonic_model  # noqa: E402
-from workbook.modes import linearize, modes_of, mounted_modes  # noqa: E402
-from workbook.preload import solve_preload  # noqa: E402
-from workbook.reference import reference_case  # noqa: E402
-from workbook.scene import build_scene, reduce_links  # noqa: E402
-from workbook.timedomain import extract, integrate, plan_run  # noqa: E402
+from workbook.model.reference import reference_case  # noqa: E402
+from workbook.scene.build import build_scene, reduce_links  # noqa: E402
+from workbook.solve.harmonic import excitation_phasor, harmonic_model  # noqa: E402
+from workbook.solve.modes import linearize, modes_of, mounted_modes  # noqa: E402
+from workbook.solve.preload import solve_preload  # noqa: E402
+from workbook.solve.time_domain import extract, integrate, plan_run  # noqa: E402
 
 SWEEP_POINTS = 1000
 

@@ -4,7 +4,7 @@ Each run is the reference mount's LP rotor case with rigid links and a fixed
 settle time, in a fresh process (so the peak resident memory belongs to that
 run alone); its wall time and peak memory are printed against the number of
 steps. The time integration stores the hinge forces of the two measured
-windows only (``workbook.timedomain``), so the peak memory should stay flat
+windows only (``workbook.solve.time_domain``), so the peak memory should stay flat
 while the wall time grows with the steps. Run::
 
     OPENBLAS_NUM_THREADS=1 python benchmarks/bench_long_run.py [--settle 1 10 100]
@@ -18,8 +18,8 @@ import sys
 
 CHILD = """
 import dataclasses, json, resource, sys, time
-from workbook.reference import LP_ROTOR, reference_case
-from workbook.runner import run_excitation
+from workbook.model.reference import LP_ROTOR, reference_case
+from workbook.solve.pipeline import run_excitation
 case = reference_case().with_rigid_links()
 case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, settle_time=float(sys.argv[1])))
 start = time.perf_counter()

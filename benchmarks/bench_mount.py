@@ -12,11 +12,11 @@ import argparse
 import statistics
 import time
 
-from workbook.modes import linearize, modes_of, mounted_modes
-from workbook.preload import solve_preload
-from workbook.reference import reference_case
-from workbook.scene import build_scene, reduce_links
-from workbook.timedomain import extract, integrate, plan_run
+from workbook.model.reference import reference_case
+from workbook.scene.build import build_scene, reduce_links
+from workbook.solve.modes import linearize, modes_of, mounted_modes
+from workbook.solve.preload import solve_preload
+from workbook.solve.time_domain import extract, integrate, plan_run
 
 
 def _time(function):

@@ -5,7 +5,7 @@ hinge damping 5e3 to 4e4 N s/m) of the reference mount, each run for the LP
 and HP rotors (100 runs), with rigid links unless ``--flexible``. Link
 reductions are made (or loaded from the disk cache) before timing, as the
 study runner does in its parent process; the timed part is
-:func:`workbook.parallel.run_rows`, serial and then with ``--workers``
+:func:`workbook.studies.parallel.run_rows`, serial and then with ``--workers``
 processes, whose answers must be identical. Parallel efficiency =
 serial time / (workers x parallel time). Run::
 
@@ -21,10 +21,10 @@ import time
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-from workbook.parallel import prepare, run_rows  # noqa: E402
-from workbook.parametric import latin_hypercube, study_cases  # noqa: E402
-from workbook.reference import reference_case  # noqa: E402
-from workbook.sensitivity import study_frame  # noqa: E402
+from workbook.model.reference import reference_case  # noqa: E402
+from workbook.studies.parallel import prepare, run_rows  # noqa: E402
+from workbook.studies.parametric import latin_hypercube, study_cases  # noqa: E402
+from workbook.studies.sensitivity import study_frame  # noqa: E402
 
 
 def main() -> None:

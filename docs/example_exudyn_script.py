@@ -1,6 +1,6 @@
 """For Exudyn users: build the reference mount, extend it, run it yourself.
 
-`workbook.scene.build_scene` returns the Exudyn system (`scene.mbs`) with
+`workbook.scene.build.build_scene` returns the Exudyn system (`scene.mbs`) with
 the item numbers of every body, marker, hinge connector and force sensor.
 This script adds its own items - a sensor on the engine's centre of gravity
 and a 2 kN lateral gust on the engine - solves the preload with the package's
@@ -13,10 +13,10 @@ import exudyn as exu
 import numpy as np
 from exudyn.itemInterface import LoadForceVector, MarkerBodyPosition, SensorNode
 
-from workbook.amplitude import harmonic_amplitude, period_window
-from workbook.preload import solve_preload
-from workbook.reference import HP_ROTOR, reference_case
-from workbook.scene import build_scene
+from workbook.answers.amplitude import harmonic_amplitude, period_window
+from workbook.model.reference import HP_ROTOR, reference_case
+from workbook.scene.build import build_scene
+from workbook.solve.preload import solve_preload
 
 case = reference_case()
 scene = build_scene(case, HP_ROTOR)        # flexible links, hinges, sensors, loads, HP excitation

@@ -3,7 +3,7 @@
 Writes ``docs/reference-mount.png`` (the layout in three views) and replaces
 the generated tables in ``docs/reference-mount.md`` (between the
 ``<!-- generated: ... -->`` markers) with tables made from
-``workbook.reference.reference_case()``, so the committed docs are what the
+``workbook.model.reference.reference_case()``, so the committed docs are what the
 code builds. Run from anywhere::
 
     python docs/make_reference_docs.py
@@ -17,11 +17,12 @@ import matplotlib
 matplotlib.use("Agg")
 
 from generated_sections import replace_section  # noqa: E402
-from workbook.layout import hinge_table, link_table, markdown_table, plot_layout  # noqa: E402
-from workbook.modes import linearize, modes_of, mounted_modes  # noqa: E402
-from workbook.preload import solve_preload  # noqa: E402
-from workbook.reference import reference_case  # noqa: E402
-from workbook.scene import build_scene, reduce_links  # noqa: E402
+
+from workbook.model.drawing import hinge_table, link_table, markdown_table, plot_layout  # noqa: E402
+from workbook.model.reference import reference_case  # noqa: E402
+from workbook.scene.build import build_scene, reduce_links  # noqa: E402
+from workbook.solve.modes import linearize, modes_of, mounted_modes  # noqa: E402
+from workbook.solve.preload import solve_preload  # noqa: E402
 
 DOCS = Path(__file__).resolve().parent
 

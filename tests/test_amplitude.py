@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from workbook.amplitude import amplitude_spectrum, harmonic_amplitude, period_window, steady_amplitude
+from workbook.answers.amplitude import amplitude_spectrum, harmonic_amplitude, period_window, steady_amplitude
 
 
 def sampled(frequency, periods, samples_per_period, start=0.0):

@@ -6,10 +6,11 @@ import pickle
 import numpy as np
 import pytest
 
-from workbook.case import (ENGINE, PYLON, CaseError, Engine, HarmonicForce, Hinge, Link, RotatingForce, Sweep)
-from workbook.codec import from_json, to_json
-from workbook.excitation import ExcitationSignal
-from workbook.reference import reference_case
+from workbook.errors import CaseError
+from workbook.model.case import ENGINE, PYLON, Engine, HarmonicForce, Hinge, Link, RotatingForce, Sweep
+from workbook.model.codec import from_json, to_json
+from workbook.model.reference import reference_case
+from workbook.scene.excitation import ExcitationSignal
 
 
 @pytest.fixture(scope="module")

@@ -2,10 +2,10 @@
 import numpy as np
 
 from flexbodies.selection import LOW_FREQUENCY_RATIO
-from workbook.cli import main
-from workbook.link_table import link_table
-from workbook.reference import reference_case
-from workbook.scene import reduce_links
+from workbook.answers.link_table import link_table
+from workbook.cli.main import main
+from workbook.model.reference import reference_case
+from workbook.scene.build import reduce_links
 
 
 def test_link_table_follows_the_low_frequency_rule(cache_dir):
@@ -30,5 +30,5 @@ def test_links_command_prints_every_link_and_reuses_the_cache(cache_dir, capsys,
         assert f"{link.name}: low-frequency rule" in output
         assert (tmp_path / f"{link.name}.npz").is_file()
     assert main(["links"]) == 0
-    rows = [line for line in capsys.readouterr().out.splitlines() if line.split()[:1] in ([l.name] for l in case.links)]
+    rows = [line for line in capsys.readouterr().out.splitlines() if line.split()[:1] in ([link.name] for link in case.links)]
     assert len(rows) == len(case.links) and all(row.rstrip().endswith("hit") for row in rows)

@@ -9,12 +9,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from workbook.preload import solve_preload
-from workbook.reference import LP_ROTOR, reference_case
-from workbook.runner import run_excitation
-from workbook.scene import build_scene
+from workbook.model.reference import LP_ROTOR, reference_case
+from workbook.scene.build import build_scene
+from workbook.solve.pipeline import run_excitation
+from workbook.solve.preload import solve_preload
 
-#: Every effect the model card accounts for (DESIGN.md section 4).
+#: Every effect the model card accounts for (docs/physics.md, section 4).
 EFFECTS = {"link flexibility", "static preload", "hinge damping", "link damping", "hinge clearance",
            "gyroscopic rotor", "test-rig force-sensor compliance", "time domain", "frequency domain"}
 

@@ -1,4 +1,4 @@
-"""Reading and checking case workbooks: units, formulas, and the bad-input suite (issue 4)."""
+"""Reading and checking case workbooks: units, formulas, and the bad-input suite."""
 from __future__ import annotations
 
 import dataclasses
@@ -7,16 +7,17 @@ import re
 import zipfile
 
 import pytest
+from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference, set_cells, sha256
 from openpyxl import load_workbook
 
-from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference, set_cells, sha256
-from workbook.case import ForceTransducers
-from workbook.cli import main
-from workbook.codec import to_dict
-from workbook.excel.reader import WorkbookError, read_workbook
+from workbook.cli.main import main
+from workbook.errors import UnitProblem, WorkbookError
+from workbook.excel.reader import read_workbook
 from workbook.excel.template import reference_workbook, template_workbook, write_workbook
-from workbook.excel.units import UnitProblem, si_factor
-from workbook.reference import HP_SPOOL, LP_SPOOL, reference_case
+from workbook.model.case import ForceTransducers
+from workbook.model.codec import to_dict
+from workbook.model.reference import HP_SPOOL, LP_SPOOL, reference_case
+from workbook.model.units import si_factor
 
 #: A Rotors row and a Test rig row, as ``set_cells`` edits.
 ROTOR_ROW = {("Rotors", "name", 3): "LP spool", ("Rotors", "polar inertia", 3): 100, ("Rotors", "speed", 3): 59}

@@ -1,4 +1,4 @@
-"""Runs of a case workbook: results written back safely, the report workbook (issue 4).
+"""Runs of a case workbook: results written back safely, the report workbook.
 
 Runs use the workbook's own settings sheet for short runs on coarse rigid
 links (see ``excel_helpers.make_cheap``).
@@ -11,19 +11,19 @@ import zipfile
 
 import numpy as np
 import pytest
+from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, make_cheap, set_cells, sha256
 from openpyxl import Workbook, load_workbook
 from openpyxl.chart import BarChart, Reference
 from openpyxl.comments import Comment
 from openpyxl.styles import Font, PatternFill
 
-from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, make_cheap, set_cells, sha256
-from workbook.case import AnalysisSettings, ForceTransducers
-from workbook.cli import main
+from workbook.cli.main import main
 from workbook.excel import layout as L
 from workbook.excel.files import save_atomic, unsupported_content
 from workbook.excel.writer import MARKER, MARKER_CELL
-from workbook.reference import HP_ROTOR, LP_ROTOR, reference_case, reference_sweep
-from workbook.runner import run_case
+from workbook.model.case import AnalysisSettings, ForceTransducers
+from workbook.model.reference import HP_ROTOR, LP_ROTOR, reference_case, reference_sweep
+from workbook.solve.pipeline import run_case
 
 INPUT_SHEETS = [L.INSTRUCTIONS_SHEET] + [table.sheet for table in L.TABLES]
 #: Measured amplitudes of the test-data rows added below, N.

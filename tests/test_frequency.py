@@ -4,19 +4,19 @@ import dataclasses
 import numpy as np
 import pytest
 import scipy.linalg as sla
-
 from test_sdof import NATURAL_HZ, closed_form, sdof_case
-from workbook.case import AnalysisSettings, Effects, Sweep
-from workbook.frequency_runner import prepare
-from workbook.method import choose_method
-from workbook.modes import mounted_modes
-from workbook.preload import solve_preload
-from workbook.reference import reference_case
-from workbook.results import PYLON_SUM
-from workbook.runner import run_case
-from workbook.scene import build_scene, reduce_links
-from workbook.sweep import run_sweep
-from workbook.timedomain import TimePlan, integrate
+
+from workbook.answers.results import PYLON_SUM
+from workbook.model.case import AnalysisSettings, Effects, Sweep
+from workbook.model.reference import reference_case
+from workbook.scene.build import build_scene, reduce_links
+from workbook.solve.frequency_pipeline import prepare
+from workbook.solve.method import choose_method
+from workbook.solve.modes import mounted_modes
+from workbook.solve.pipeline import run_case
+from workbook.solve.preload import solve_preload
+from workbook.solve.sweep import run_sweep
+from workbook.solve.time_domain import TimePlan, integrate
 
 # as in test_mount_time: coarse link meshes, short but steady time runs
 ELEMENT_SIZE = 0.03

@@ -1,4 +1,4 @@
-"""Guards of the solver path (workbook.guards): a Newton failure is retried
+"""Guards of the solver path (workbook.solve.guards): a Newton failure is retried
 with a smaller step and then reported with its time and cause; a run-away
 engine, an exhausted time budget and an absurdly long plan stop the run in
 plain words. Real Exudyn runs of the single-DOF mass of test_sdof."""
@@ -6,11 +6,11 @@ import dataclasses
 
 import numpy as np
 import pytest
-
 from test_sdof import sdof_case
-from workbook.case import AnalysisSettings, CaseError, HarmonicForce
-from workbook.guards import DivergenceError, NewtonFailure, RunTooLong, SimulationError, TimeBudgetExceeded
-from workbook.runner import run_excitation
+
+from workbook.errors import CaseError, DivergenceError, NewtonFailure, RunTooLong, SimulationError, TimeBudgetExceeded
+from workbook.model.case import AnalysisSettings, HarmonicForce
+from workbook.solve.pipeline import run_excitation
 
 SDOF = sdof_case((1.0,))
 SHAKE = HarmonicForce("shake", point=SDOF.engine.center_of_mass, direction=(0, 0, 1), amplitude=1e4,
@@ -71,7 +71,7 @@ def test_guard_settings_are_validated(field, value):
 
 
 def test_the_command_line_reports_an_exhausted_time_budget_as_numerical_trouble(cache_dir, capsys):
-    from workbook.cli import main
+    from workbook.cli.main import main
 
     assert main(["run", "--rigid", "--no-progress", "--time-budget", "0.01"]) == 1
     error = capsys.readouterr().err

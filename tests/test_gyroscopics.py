@@ -27,13 +27,13 @@ import pickle
 import numpy as np
 import pytest
 
-from workbook.case import (ENGINE, PYLON, AnalysisSettings, Case, CaseError, Effects, Engine, Hinge,
-                           RotatingForce, Rotor)
-from workbook.codec import from_json, to_json
-from workbook.modes import linearize, modes_of, mounted_modes
-from workbook.preload import solve_preload
-from workbook.runner import run_case
-from workbook.scene import build_scene
+from workbook.errors import CaseError
+from workbook.model.case import ENGINE, PYLON, AnalysisSettings, Case, Effects, Engine, Hinge, RotatingForce, Rotor
+from workbook.model.codec import from_json, to_json
+from workbook.scene.build import build_scene
+from workbook.solve.modes import linearize, modes_of, mounted_modes
+from workbook.solve.pipeline import run_case
+from workbook.solve.preload import solve_preload
 
 MASS, ROLL_INERTIA, TRANSVERSE_INERTIA = 1000.0, 200.0, 1000.0    # kg, kg m^2
 STIFFNESS, LENGTH, RADIUS = 1.0e6, 1.0, 0.5                        # N/m per hinge, m

@@ -18,13 +18,12 @@ from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
 from flexbodies.meshing import LinkMesh
-from workbook.case import HarmonicForce
-from workbook.frequency_runner import prepare, run_case_frequency
-from workbook.guards import ResonanceError, SimulationError
-from workbook.modes import mounted_modes
-from workbook.preload import MechanismError
-from workbook.reference import HINGE_DAMPING_TIME, LP_ROTOR, reference_case
-from workbook.runner import run_excitation
+from workbook.errors import MechanismError, ResonanceError, SimulationError
+from workbook.model.case import HarmonicForce
+from workbook.model.reference import HINGE_DAMPING_TIME, LP_ROTOR, reference_case
+from workbook.solve.frequency_pipeline import prepare, run_case_frequency
+from workbook.solve.modes import mounted_modes
+from workbook.solve.pipeline import run_excitation
 
 
 @pytest.fixture(scope="module")

@@ -3,13 +3,12 @@ import exudyn as exu
 import numpy as np
 import pytest
 import scipy.linalg as sla
+from test_reduction import TEST_LINK
 
 from flexbodies import STEEL, LinkModel, add_link_to_exudyn, export_exudyn_file, reduce_link
 from flexbodies.eigen import factorize, free_dofs
 from flexbodies.link import build_fe_model
 from flexbodies.reduction import couple
-
-from test_reduction import TEST_LINK
 
 eii = exu.itemInterface
 

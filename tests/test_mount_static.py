@@ -4,11 +4,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from workbook.case import Gravity, PointForce
-from workbook.modes import linearize, modes_of, mounted_modes
-from workbook.preload import EquilibriumError, MechanismError, check_equilibrium, solve_preload
-from workbook.reference import ENGINE_CG, reference_case
-from workbook.scene import build_scene
+from workbook.errors import EquilibriumError, MechanismError
+from workbook.model.case import Gravity, PointForce
+from workbook.model.reference import ENGINE_CG, reference_case
+from workbook.scene.build import build_scene
+from workbook.solve.modes import linearize, modes_of, mounted_modes
+from workbook.solve.preload import check_equilibrium, solve_preload
 
 # Coarse link meshes: statics need the links' stiffness, which Craig-Bampton
 # reproduces exactly for any mesh; 30 mm elements keep the reductions short.

@@ -6,11 +6,11 @@ import matplotlib
 import numpy as np
 import pytest
 
-from workbook.case import AnalysisSettings
-from workbook.reference import reference_case
-from workbook.results import PYLON_SUM
-from workbook.runner import run_case
-from workbook.scene import reduce_links
+from workbook.answers.results import PYLON_SUM
+from workbook.model.case import AnalysisSettings
+from workbook.model.reference import reference_case
+from workbook.scene.build import reduce_links
+from workbook.solve.pipeline import run_case
 
 matplotlib.use("Agg")
 

@@ -1,4 +1,4 @@
-"""Parameter studies: rows, row cases, and runs serial = processes = Dask, failures per row (issue 7)."""
+"""Parameter studies: rows, row cases, and runs serial = processes = Dask, failures per row."""
 from __future__ import annotations
 
 import dataclasses
@@ -7,15 +7,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from workbook.case import AnalysisSettings, CaseError
-from workbook.cli import main
-from workbook.codec import to_json
-from workbook.parallel import run_rows
-from workbook.parametric import grid, latin_hypercube, linear_range, row_case, study_cases
-from workbook.parametric_cli import parse_vary
-from workbook.reference import HINGE_STIFFNESS, LP_ROTOR, reference_case
-from workbook.runner import run_case
-from workbook.sensitivity import study_frame
+from workbook.cli.main import main
+from workbook.cli.params import parse_vary
+from workbook.errors import CaseError
+from workbook.model.case import AnalysisSettings
+from workbook.model.codec import to_json
+from workbook.model.reference import HINGE_STIFFNESS, LP_ROTOR, reference_case
+from workbook.solve.pipeline import run_case
+from workbook.studies.parallel import run_rows
+from workbook.studies.parametric import grid, latin_hypercube, linear_range, row_case, study_cases
+from workbook.studies.sensitivity import study_frame
 
 #: Short, steady runs on rigid links, LP rotor only.
 SHORT = AnalysisSettings(settle_time=0.2, measured_periods=10)

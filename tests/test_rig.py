@@ -1,4 +1,4 @@
-"""Measured rig records: the synthetic record's known T is recovered; bad records are refused (issue 7)."""
+"""Measured rig records: the synthetic record's known T is recovered; bad records are refused."""
 from __future__ import annotations
 
 import dataclasses
@@ -7,13 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from workbook.case import AnalysisSettings
-from workbook.cli import main
-from workbook.correlation import comparison_frame, force_amplitude, measure
-from workbook.reference import LP_ROTOR, reference_case
-from workbook.rig import RecordError, read_record, write_record
-from workbook.runner import run_excitation
-from workbook.synthetic_rig import REFERENCE_TRANSDUCERS, synthetic_record
+from workbook.cli.main import main
+from workbook.errors import RecordError
+from workbook.model.case import AnalysisSettings
+from workbook.model.reference import LP_ROTOR, reference_case
+from workbook.rig.correlation import comparison_frame, force_amplitude, measure
+from workbook.rig.records import read_record, write_record
+from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, synthetic_record
+from workbook.solve.pipeline import run_excitation
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 #: Short, steady runs on rigid links.
@@ -103,7 +104,7 @@ def record_file(lp_run, tmp_path_factory):
 
 def test_wrong_sample_rate_is_refused(record_file, tmp_path):
     path = _edit(record_file, tmp_path,
-                 lambda lines: [l.replace("sample rate [Hz]: 2048", "sample rate [Hz]: 2000") for l in lines])
+                 lambda lines: [line.replace("sample rate [Hz]: 2048", "sample rate [Hz]: 2000") for line in lines])
     with pytest.raises(RecordError, match=r"edited.csv, column 'time \[s\]': wrong sample rate: .*2000 Hz.*2048 Hz"):
         read_record(path)
 
@@ -132,8 +133,8 @@ def test_missing_channel_and_bad_cell_name_the_column(record_file, tmp_path):
     def drop(lines):
         header = _header_line(lines)
         index = lines[header].split(",").index("rear-left z [N]")
-        return lines[:header] + [",".join(c for j, c in enumerate(l.split(",")) if j != index)
-                                 for l in lines[header:]]
+        return lines[:header] + [",".join(c for j, c in enumerate(line.split(",")) if j != index)
+                                 for line in lines[header:]]
 
     with pytest.raises(RecordError, match="missing channel 'rear-left z") as error:
         read_record(_edit(record_file, tmp_path, drop))

@@ -24,14 +24,15 @@ import pickle
 import exudyn as exu
 import numpy as np
 import pytest
-
 from test_sdof import DAMPING, MASS, STIFFNESS, closed_form, sdof_case
-from workbook.case import AnalysisSettings, CaseError, Effects, ForceTransducers, Gravity
-from workbook.codec import from_json, to_json
-from workbook.preload import solve_preload
-from workbook.reference import reference_case
-from workbook.runner import run_case
-from workbook.scene import build_scene
+
+from workbook.errors import CaseError
+from workbook.model.case import AnalysisSettings, Effects, ForceTransducers, Gravity
+from workbook.model.codec import from_json, to_json
+from workbook.model.reference import reference_case
+from workbook.scene.build import build_scene
+from workbook.solve.pipeline import run_case
+from workbook.solve.preload import solve_preload
 
 SENSOR_STIFFNESS = 2 * STIFFNESS      # per transducer, N/m: the pin's compliance triples
 SENSOR_MASS = 1.0                     # kg

@@ -15,8 +15,8 @@ import math
 import numpy as np
 import pytest
 
-from workbook.case import ENGINE, PYLON, AnalysisSettings, Case, Engine, Hinge, RotatingForce
-from workbook.runner import run_case
+from workbook.model.case import ENGINE, PYLON, AnalysisSettings, Case, Engine, Hinge, RotatingForce
+from workbook.solve.pipeline import run_case
 
 MASS = 500.0              # kg
 NATURAL_HZ = 10.0
@@ -81,10 +81,10 @@ def test_clearance_gap_adds_to_the_static_sag():
     stiffness k_r acts: 4 (k_r u + k_c (u - g)) = W."""
     import exudyn as exu
 
-    from workbook.case import Gravity
-    from workbook.clearance import RESIDUAL_STIFFNESS_RATIO
-    from workbook.preload import solve_preload
-    from workbook.scene import build_scene
+    from workbook.model.case import Gravity
+    from workbook.scene.build import build_scene
+    from workbook.scene.hinge_law import RESIDUAL_STIFFNESS_RATIO
+    from workbook.solve.preload import solve_preload
 
     gap = 0.5e-3
     case = sdof_case(())

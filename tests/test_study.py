@@ -6,11 +6,11 @@ import pandas as pd
 import pytest
 from openpyxl import load_workbook
 
-from workbook.case import AnalysisSettings
-from workbook.cli import main
-from workbook.codec import to_json
-from workbook.reference import reference_case
-from workbook.study import REFERENCE_RUNG
+from workbook.cli.main import main
+from workbook.model.case import AnalysisSettings
+from workbook.model.codec import to_json
+from workbook.model.reference import reference_case
+from workbook.studies.accuracy import REFERENCE_RUNG
 
 SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
 
@@ -78,13 +78,13 @@ def test_errors_converge(table):
 def test_a_workbook_run_row_is_the_studied_case():
     from pathlib import Path
 
-    from workbook.excel.sheets import WorkbookError
-    from workbook.study_cli import load_study_case
+    from workbook.cli.loading import load_case
+    from workbook.errors import WorkbookError
 
     book = Path(__file__).parents[1] / "cases" / "reference.xlsx"
-    case = load_study_case(str(book), "HP rotor")
+    case = load_case(str(book), run="HP rotor")
     assert [e.frequency for e in case.excitations] == [248.5]
     with pytest.raises(WorkbookError):
-        load_study_case(str(book), "no such run")
+        load_case(str(book), run="no such run")
     with pytest.raises(ValueError):
-        load_study_case(None, "HP rotor")
+        load_case(None, run="HP rotor")

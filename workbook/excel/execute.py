@@ -4,9 +4,10 @@ from __future__ import annotations
 import logging
 from typing import Iterable, Union
 
-from .reader import CaseBook, Problem, WorkbookError
-from .runs import RunSpec
-from .writer import RunResult
+from workbook.errors import Problem, WorkbookError
+from workbook.excel.reader import CaseBook
+from workbook.excel.runs import RunSpec
+from workbook.excel.writer import RunResult
 
 __all__ = ["select_runs", "run_book"]
 
@@ -40,13 +41,13 @@ def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> list[RunR
     book : CaseBook
     runs : list of RunSpec
     progress : callable, optional
-        Progress factory of :func:`workbook.runner.run_case`.
+        Progress factory of :func:`workbook.solve.pipeline.run_case`.
 
     Returns
     -------
     list of RunResult
     """
-    from ..runner import run_case
+    from workbook.solve.pipeline import run_case
 
     results = []
     for spec in runs:

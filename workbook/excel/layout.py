@@ -10,7 +10,7 @@ Every input sheet is a table with the same layout:
   sheet at most one.
 
 A vector (position, force, direction) takes three columns ``<name> x``,
-``<name> y``, ``<name> z``, each with its own unit cell. Axes (DESIGN.md
+``<name> y``, ``<name> z``, each with its own unit cell. Axes (docs/physics.md,
 section 1): x heading, y lateral, z vertical (up). Columns whose header
 starts with ``#`` are the user's notes and are ignored.
 """
@@ -18,8 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..case import ANALYSIS_METHODS, DIRECTIONS
-from .units import DIMENSIONLESS
+from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
            "EXCITATIONS", "ROTORS", "TEST_RIG", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
@@ -54,7 +54,7 @@ class Column:
         cut-off such as ``500 Hz``), ``fidelity`` (rigid or a ``modes``
         value), ``unit`` (a length unit as text, e.g. for a mesh file).
     si_unit : str or None
-        SI unit of a number column (:data:`~workbook.excel.units.DIMENSIONLESS`
+        SI unit of a number column (:data:`~workbook.model.units.DIMENSIONLESS`
         for no dimension); None for the other kinds.
     unit : str or None
         Unit shown in the template's unit cell (default: *si_unit*).

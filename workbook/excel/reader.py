@@ -1,4 +1,4 @@
-"""Read a case workbook into a :class:`~workbook.case.Case`, its runs and test data.
+"""Read a case workbook into a :class:`~workbook.model.case.Case`, its runs and test data.
 
 Every problem found is collected and raised at once in one
 :class:`~workbook.excel.sheets.WorkbookError`. Nothing here runs a simulation
@@ -15,13 +15,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Union
 
-from .. import case as cm
-from ..results import PYLON_SUM
-from . import layout as L
-from .runs import RunSpec, TestPoint, case_for_run
-from .sheets import Problem, Record, SheetReader, WorkbookError, open_workbook
+import workbook.excel.layout as L
+from workbook.answers.results import PYLON_SUM
+from workbook.errors import WorkbookError
+from workbook.excel.runs import RunSpec, TestPoint, case_for_run
+from workbook.excel.sheets import Record, SheetReader, open_workbook
+from workbook.model import case as cm
 
-__all__ = ["Problem", "WorkbookError", "CaseBook", "read_workbook"]
+__all__ = ["CaseBook", "read_workbook"]
 
 log = logging.getLogger(__name__)
 
@@ -385,8 +386,8 @@ class _CaseReader(SheetReader):
 
     def record_points(self, record: Record, run: RunSpec, case: cm.Case) -> list[TestPoint]:
         """The pylon-sum test points of a Test data row naming a rig record."""
-        from ..rig import RecordError
-        from .rig_points import record_test_points
+        from workbook.errors import RecordError
+        from workbook.excel.rig_points import record_test_points
 
         extra = [key for key in ("location", "direction", "amplitude", "frequency") if record.get(key) is not None]
         if extra:

@@ -29,10 +29,10 @@ from openpyxl.chart import BarChart, Reference, ScatterChart, Series
 from openpyxl.drawing.image import Image
 from openpyxl.styles import Font
 
-from ..case import DIRECTIONS
-from .files import lock_file, save_atomic
-from .reader import CaseBook
-from .writer import RunResult, card_lines, result_frames
+from workbook.excel.files import lock_file, save_atomic
+from workbook.excel.reader import CaseBook
+from workbook.excel.writer import RunResult, card_lines, result_frames
+from workbook.model.case import DIRECTIONS
 
 __all__ = ["write_report", "PACKAGES"]
 

@@ -1,6 +1,6 @@
 """Test data from a rig record: a row of the Test data sheet naming a record file.
 
-The record is measured like a simulation (:func:`workbook.correlation.measure`,
+The record is measured like a simulation (:func:`workbook.rig.correlation.measure`,
 windows of the run's ``measured_periods`` periods) and becomes one test
 point per direction at the pylon sum, with the amplitude ``T_test,d x
 |F_exc|`` of the run's own excitation: the result sheets' error
@@ -11,11 +11,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..case import DIRECTIONS, Case, Sweep
-from ..correlation import measure
-from ..results import PYLON_SUM
-from ..rig import RecordError, read_record
-from .runs import TestPoint
+from workbook.answers.results import PYLON_SUM
+from workbook.errors import RecordError
+from workbook.excel.runs import TestPoint
+from workbook.model.case import DIRECTIONS, Case, Sweep
+from workbook.rig.correlation import measure
+from workbook.rig.records import read_record
 
 __all__ = ["record_test_points"]
 

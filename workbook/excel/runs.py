@@ -10,7 +10,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Union
 
-from ..case import Case, Sweep
+from workbook.model.case import Case, Sweep
 
 __all__ = ["RunSpec", "TestPoint", "case_for_run", "FIDELITY_RIGID"]
 

@@ -16,56 +16,12 @@ from typing import Any, Callable, Union
 
 from openpyxl.utils import get_column_letter
 
-from . import layout as L
-from .runs import FIDELITY_RIGID
-from .units import UnitProblem, si_factor
+import workbook.excel.layout as L
+from workbook.errors import Problem, UnitProblem, WorkbookError
+from workbook.excel.runs import FIDELITY_RIGID
+from workbook.model.units import si_factor
 
-__all__ = ["Problem", "WorkbookError", "Record", "SheetReader", "open_workbook"]
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One input problem.
-
-    Attributes
-    ----------
-    file : str
-    sheet : str or None
-    cell : str or None
-        Cell or range (``"C4"``, ``"B4:D4"``); None for a whole sheet or file.
-    column : str or None
-        Column header.
-    value : object
-        The value found.
-    expected : str
-        What was expected, in plain words.
-    """
-
-    file: str
-    sheet: Union[str, None]
-    cell: Union[str, None]
-    column: Union[str, None]
-    value: Any
-    expected: str
-
-    def __str__(self) -> str:
-        where = [self.file]
-        if self.sheet is not None:
-            where.append(f"sheet '{self.sheet}'")
-        if self.cell is not None:
-            where.append(self.cell if self.cell.startswith("row") else f"cell {self.cell}")
-        if self.column is not None:
-            where.append(f"column '{self.column}'")
-        found = "empty" if self.value is None or self.value == "" else repr(self.value)
-        return f"{', '.join(where)}: found {found}, expected {self.expected}"
-
-
-class WorkbookError(Exception):
-    """A workbook that cannot be used; :attr:`problems` lists every problem found."""
-
-    def __init__(self, problems: list[Problem]):
-        self.problems = list(problems)
-        super().__init__("\n".join(str(p) for p in self.problems))
+__all__ = ["Record", "SheetReader", "open_workbook"]
 
 
 @dataclass

@@ -1,6 +1,6 @@
 """Write case workbooks: the template (templates/) and ready cases (cases/).
 
-Both are generated from a :class:`~workbook.case.Case` and its runs with the
+Both are generated from a :class:`~workbook.model.case.Case` and its runs with the
 sheet layout of :mod:`workbook.excel.layout`; the committed files are what
 this module writes (a test keeps them equal). Each quantity is written in
 the column's display unit (mm for link sizes, GPa for moduli) when that
@@ -19,11 +19,11 @@ from openpyxl.styles import Alignment, Font, PatternFill
 from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.datavalidation import DataValidation
 
-from .. import case as cm
-from . import layout as L
-from .files import save_atomic
-from .runs import RunSpec, TestPoint
-from .units import si_factor
+import workbook.excel.layout as L
+from workbook.excel.files import save_atomic
+from workbook.excel.runs import RunSpec, TestPoint
+from workbook.model import case as cm
+from workbook.model.units import si_factor
 
 __all__ = ["case_rows", "case_workbook", "template_workbook", "reference_workbook", "write_workbook",
            "TEMPLATE_RUNS", "REFERENCE_RUNS"]
@@ -267,14 +267,14 @@ def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPo
 
 def template_workbook() -> Workbook:
     """The case template: the reference mount as example rows, with example runs."""
-    from ..reference import reference_case
+    from workbook.model.reference import reference_case
 
     return case_workbook(reference_case(sweep=True), TEMPLATE_RUNS)
 
 
 def reference_workbook() -> Workbook:
     """cases/reference.xlsx: the reference mount with the seed study's runs."""
-    from ..reference import reference_case
+    from workbook.model.reference import reference_case
 
     return case_workbook(reference_case(sweep=True), REFERENCE_RUNS)
 

@@ -31,11 +31,11 @@ from openpyxl import Workbook, load_workbook
 from openpyxl.styles import Font, PatternFill
 from openpyxl.utils import get_column_letter
 
-from ..case import DIRECTIONS
-from ..results import PYLON_SUM
-from . import layout as L
-from .files import lock_file, restore_formula_values, save_atomic, unsupported_content
-from .runs import RunSpec, TestPoint
+import workbook.excel.layout as L
+from workbook.answers.results import PYLON_SUM
+from workbook.excel.files import lock_file, restore_formula_values, save_atomic, unsupported_content
+from workbook.excel.runs import RunSpec, TestPoint
+from workbook.model.case import DIRECTIONS
 
 __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
            "MARKER", "MARKER_CELL"]
@@ -56,7 +56,7 @@ class RunResult:
     Attributes
     ----------
     spec : RunSpec
-    result : workbook.results.MountResult
+    result : workbook.answers.results.MountResult
         One excitation result per frequency (several for a sweep).
     """
 

@@ -1,0 +1,234 @@
+"""The model card of a run: what was modelled, how it was solved, what it cost.
+
+DOF per body, the modes kept and why, every physical effect on or off with
+the reason, the solver settings, the mounted modes and the wall time of each
+stage (docs/physics.md, section 4: "Simulate only the effects a scene calls for").
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+__all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
+
+
+@dataclass(frozen=True)
+class BodyEntry:
+    """One body of the scene.
+
+    Attributes
+    ----------
+    name : str
+    model : str
+        ``"rigid body"``, ``"rigid link"``, ``"flexible link (Craig-Bampton)"``
+        or ``"force transducer (point mass)"``.
+    dof : int
+        Degrees of freedom in the scene.
+    modes : int
+        Fixed-interface normal modes kept (flexible links), else 0.
+    mass : float
+        kg.
+    reason : str
+        Why these modes (or why rigid).
+    """
+
+    name: str
+    model: str
+    dof: int
+    modes: int
+    mass: float
+    reason: str
+
+
+@dataclass(frozen=True)
+class EffectEntry:
+    """One physical effect: on or off, and why."""
+
+    name: str
+    on: bool
+    detail: str
+
+
+@dataclass
+class ModelCard:
+    """Model card of one run.
+
+    Attributes
+    ----------
+    case_name, run_name : str
+    bodies : list of BodyEntry
+    effects : list of EffectEntry
+    solver : dict of str to value
+        Integrator and Newton settings, step, durations.
+    mounted_modes : list of (float, float, str)
+        Frequency (Hz), damping ratio and description of each mounted mode.
+    timings : dict of str to float
+        Wall time per stage, s.
+    """
+
+    case_name: str
+    run_name: str
+    bodies: list
+    effects: list
+    solver: dict
+    mounted_modes: list
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def total_dof(self) -> int:
+        return sum(body.dof for body in self.bodies)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready data."""
+        return {"case": self.case_name, "run": self.run_name, "total_dof": self.total_dof,
+                "bodies": [asdict(b) for b in self.bodies], "effects": [asdict(e) for e in self.effects],
+                "solver": dict(self.solver),
+                "mounted_modes": [{"frequency_hz": f, "damping_ratio": z, "description": d}
+                                  for f, z, d in self.mounted_modes],
+                "timings_s": dict(self.timings)}
+
+    def to_text(self) -> str:
+        """A plain-text card for the console."""
+        lines = [f"Model card: {self.case_name} / {self.run_name}", "",
+                 f"Bodies ({self.total_dof} DOF):"]
+        width = max(len(b.name) for b in self.bodies)
+        for b in self.bodies:
+            lines.append(f"  {b.name:<{width}}  {b.model:<29} {b.dof:4d} DOF  {b.modes:3d} modes  "
+                         f"{b.mass:8.2f} kg  {b.reason}")
+        lines += ["", "Effects:"]
+        for e in self.effects:
+            lines.append(f"  [{'on ' if e.on else 'off'}] {e.name}: {e.detail}")
+        lines += ["", "Mounted modes (engine on its mount):"]
+        for frequency, zeta, description in self.mounted_modes:
+            lines.append(f"  {frequency:7.2f} Hz  zeta {100 * zeta:5.2f} %  {description}")
+        lines += ["", "Solver:"]
+        lines += [f"  {key}: {value}" for key, value in self.solver.items()]
+        lines += ["", "Wall time:"]
+        lines += [f"  {stage:<22} {seconds:8.3f} s" for stage, seconds in self.timings.items()]
+        lines.append(f"  {'total':<22} {sum(self.timings.values()):8.3f} s")
+        return "\n".join(lines)
+
+
+def model_card(scene, preload, mounted, plan, timings: dict, method=None, solver: dict | None = None) -> ModelCard:
+    """Fill the model card of a run.
+
+    Parameters
+    ----------
+    scene : workbook.scene.build.Scene
+    preload : workbook.solve.preload.Preload
+    mounted : list of workbook.solve.modes.Mode
+    plan : workbook.solve.time_domain.TimePlan or None
+        The time-domain plan (None for a frequency-domain run).
+    timings : dict of str to float
+    method : workbook.solve.method.MethodChoice, optional
+        The analysis method and why (default: the time domain, no reason recorded).
+    solver : dict, optional
+        Solver settings to record instead of those of *plan*.
+    """
+    from workbook.model.case import ENGINE
+    from workbook.scene.build import link_is_flexible
+
+    case = scene.case
+    bodies = [BodyEntry(ENGINE, "rigid body", 6, 0, case.engine.mass, "one rigid body: mass, CG and inertia from the case")]
+    for link in case.links:
+        reduced, item = scene.reduced[link.name], scene.links[link.name]
+        if link_is_flexible(case, link.name):
+            bodies.append(BodyEntry(link.name, "flexible link (Craig-Bampton)", item.dof,
+                                    reduced.n_fixed_interface, item.mass, reduced.decision.reason))
+        else:
+            why = ("all links rigid (effects.flexible_links off)" if not case.effects.flexible_links
+                   else "link asked to be rigid (flexible = False)")
+            bodies.append(BodyEntry(link.name, "rigid link", item.dof, 0, item.mass, why))
+    for name in scene.transducers:
+        bodies.append(BodyEntry(name, "force transducer (point mass)", 3, 0, case.test_rig.mass,
+                                "test-rig transducer under a pylon pin: moving half on its spring to ground"))
+    card = ModelCard(case.name, scene.excitation.name, bodies, _effects(scene, preload, method),
+                     _solver(scene, plan) if solver is None else dict(solver),
+                     [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings))
+    return card
+
+
+def _effects(scene, preload, method=None) -> list[EffectEntry]:
+    from workbook.scene.build import link_is_flexible
+
+    case, effects = scene.case, scene.case.effects
+    flexible = [link.name for link in case.links if link_is_flexible(case, link.name)]
+    damped_links = [link.name for link in case.links
+                    if link.name in flexible and (link.stiffness_damping > 0 or link.mass_damping > 0)]
+    gaps = [h for h in case.hinges if h.radial_clearance > 0]
+    hinge_damping = [h for h in case.hinges if h.damping > 0]
+    loads = ", ".join(load.name for load in case.static_loads)
+    entries = [
+        EffectEntry("link flexibility", bool(flexible),
+                    f"{len(flexible)} of {len(case.links)} links flexible" if flexible else
+                    ("switched off: all links rigid" if not effects.flexible_links else "every link asked to be rigid")),
+        EffectEntry("static preload", preload.solved,
+                    f"{loads} solved first; dynamics start from that equilibrium" if preload.solved else
+                    ("switched off" if not effects.preload else "no static loads given")),
+        EffectEntry("hinge damping", effects.hinge_damping and bool(hinge_damping),
+                    f"{len(hinge_damping)} hinges with damping" if effects.hinge_damping and hinge_damping else
+                    ("switched off" if not effects.hinge_damping else "no hinge has damping")),
+        EffectEntry("link damping", effects.link_damping and bool(damped_links),
+                    f"Rayleigh damping on {', '.join(damped_links)}" if effects.link_damping and damped_links else
+                    ("switched off" if not effects.link_damping else "no flexible link has Rayleigh damping")),
+        EffectEntry("hinge clearance", effects.clearance and bool(gaps),
+                    f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
+                    if effects.clearance and gaps else
+                    ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")),
+        _gyroscopics(scene),
+        _rig_sensors(scene),
+    ]
+    time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
+    if method is None:
+        entries += [EffectEntry("time domain", True, time_detail),
+                    EffectEntry("frequency domain", False, "not used")]
+    else:
+        frequency_detail = "harmonic solution of the scene linearised about the preload"
+        entries += [EffectEntry("time domain", method.method == "time",
+                                f"{time_detail}: {method.reason}" if method.method == "time" else "not used"),
+                    EffectEntry("frequency domain", method.method == "frequency",
+                                f"{frequency_detail}: {method.reason}" if method.method == "frequency"
+                                else "not used")]
+    return entries
+
+
+def _gyroscopics(scene) -> EffectEntry:
+    """The rotors' gyroscopic moment: built or not, and why."""
+    name, rotors = "gyroscopic rotor", scene.case.rotors
+    if scene.gyroscopics is None:
+        return EffectEntry(name, False, "switched off: rotor inertia lumped in the engine" if rotors
+                           else "no rotors given: rotor inertia lumped in the engine")
+    listing = ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in rotors)
+    return EffectEntry(name, True, f"{listing}: moment -Ip Omega (omega x a) on the engine (symbolic "
+                                   f"ObjectGenericODE2); their mass and transverse inertia lumped in the engine")
+
+
+def _rig_sensors(scene) -> EffectEntry:
+    """The test-rig force transducers: built or not, and why."""
+    name, rig = "test-rig force-sensor compliance", scene.case.test_rig
+    if not scene.transducers:
+        return EffectEntry(name, False, "switched off: the pylon fittings are rigid" if rig is not None
+                           else "no transducers given: the pylon fittings are rigid")
+    pins = "; ".join(" + ".join(items.hinges) for items in scene.transducers.values())
+    stiffness = ", ".join(f"{k:.3g}" for k in rig.stiffness)
+    damping = "" if not any(rig.damping) else f", d = ({', '.join(f'{d:.3g}' for d in rig.damping)}) N s/m"
+    return EffectEntry(name, True, f"{len(scene.transducers)} transducers, k = ({stiffness}) N/m in x, y, z"
+                       f"{damping}, m = {rig.mass:g} kg on pins {pins}; their forces make the pylon force")
+
+
+def _solver(scene, plan) -> dict[str, Any]:
+    analysis = scene.case.analysis
+    return {
+        "integrator": f"generalized-alpha, spectral radius {analysis.spectral_radius:g}, modified Newton",
+        "time step": f"{plan.step:.4g} s ({plan.steps_per_period} steps per period of {plan.frequency_hz:g} Hz)",
+        "ramp": f"{plan.ramp_periods} periods ({plan.ramp_periods / plan.frequency_hz:.3g} s), raised cosine",
+        "settle": f"{plan.settle_periods} periods ({plan.settle_periods / plan.frequency_hz:.3g} s): "
+                  f"{plan.settle_reason}",
+        "measured": f"2 windows of {plan.measured_periods} periods, steady if within "
+                    f"{100 * analysis.steady_tolerance:g} %",
+        "steps": plan.steps,
+        "end time": f"{plan.end_time:.4g} s",
+        "Newton absolute tolerance": f"{analysis.newton_tolerance * scene.load_scale:.3g} "
+                                     f"({analysis.newton_tolerance:g} x load scale {scene.load_scale:.4g} N)",
+        "static equilibrium check": f"relative {analysis.equilibrium_tolerance:g}",
+    }

@@ -1,0 +1,308 @@
+"""Answers of a mount run: amplitudes, transmissibility, isolation efficiency.
+
+Definitions (docs/physics.md, section 5), per direction d in x, y, z:
+
+- transmissibility ``T_d = |F_d(f)| / |F_exc(f)|`` with ``|F_exc|`` the
+  amplitude of the excitation force;
+- isolation efficiency ``eta_d = (1 - T_d) * 100 %``;
+- level ``20 log10(T_d)`` dB.
+
+The pylon force is the vector sum of the pylon-side hinge forces, or of the test rig's
+transducer forces when the case has them (``Scene.pylon_channels``).
+:class:`MountResult` tabulates itself (pandas), plots itself (matplotlib)
+and converts to JSON-ready data.
+"""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from workbook.model.case import DIRECTIONS
+
+__all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM", "efficiency", "level_db"]
+
+#: Row label of the pylon sum in the tables.
+PYLON_SUM = "pylon sum"
+
+
+def efficiency(transmissibility: np.ndarray) -> np.ndarray:
+    """Isolation efficiency (1 - T) * 100, %."""
+    return (1.0 - np.asarray(transmissibility)) * 100.0
+
+
+def level_db(transmissibility: np.ndarray) -> np.ndarray:
+    """20 log10(T), dB (-inf for T = 0)."""
+    with np.errstate(divide="ignore"):
+        return 20.0 * np.log10(np.asarray(transmissibility, dtype=float))
+
+
+class PylonAnswers:
+    """Transmissibility and isolation efficiency of a pylon force.
+
+    For any answer holding ``pylon_amplitude`` (N, per direction x, y, z)
+    and ``excitation_amplitude`` (N): a simulated run or a rig measurement.
+    """
+
+    @property
+    def transmissibility(self) -> np.ndarray:
+        """Pylon-force transmissibility per direction x, y, z."""
+        return self.pylon_amplitude / self.excitation_amplitude
+
+    @property
+    def efficiency(self) -> np.ndarray:
+        """Pylon isolation efficiency per direction, %."""
+        return efficiency(self.transmissibility)
+
+
+@dataclass
+class ExcitationResult(PylonAnswers):
+    """Answers and histories of one excitation run.
+
+    Attributes
+    ----------
+    name : str
+        Excitation name.
+    frequency_hz : float
+    excitation_amplitude : float
+        ``|F_exc|``, N.
+    pylon_amplitude : ndarray, shape (3,)
+        Amplitude of the pylon force at the excitation frequency, N.
+    hinge_amplitudes : dict of str to ndarray, shape (3,)
+        Amplitude of each hinge force, N.
+    pylon_hinges : list of str
+        The force channels summed into the pylon force: the pylon-side hinges,
+        or the test rig's transducers when the case has them.
+    steady_change : float
+        Relative change of the pylon amplitudes between the last two windows.
+    steady_tolerance : float
+    warnings : list of str
+    time : ndarray, shape (n,)
+        s.
+    hinge_histories : dict of str to ndarray, shape (n, 3)
+        N.
+    pylon_history : ndarray, shape (n, 3)
+        N.
+    excitation_history : ndarray, shape (n, 3)
+        N.
+    window : slice
+        Samples of the measured (last) window.
+    """
+
+    name: str
+    frequency_hz: float
+    excitation_amplitude: float
+    pylon_amplitude: np.ndarray
+    hinge_amplitudes: dict
+    pylon_hinges: list
+    steady_change: float
+    steady_tolerance: float
+    warnings: list
+    time: np.ndarray = field(repr=False)
+    hinge_histories: dict = field(repr=False)
+    pylon_history: np.ndarray = field(repr=False)
+    excitation_history: np.ndarray = field(repr=False)
+    window: slice = field(repr=False)
+
+    @property
+    def steady(self) -> bool:
+        return self.steady_change <= self.steady_tolerance
+
+    def amplitudes(self) -> dict[str, np.ndarray]:
+        """Amplitudes of every hinge and of the pylon sum (last), N."""
+        return {**self.hinge_amplitudes, PYLON_SUM: self.pylon_amplitude}
+
+
+@dataclass
+class MountResult:
+    """All runs of a case, with their model cards and preloads.
+
+    Attributes
+    ----------
+    case_name : str
+    runs : list of ExcitationResult
+    model_cards : dict of str to ModelCard
+        Per run (excitation name).
+    preloads : dict of str to Preload
+        Per run.
+    """
+
+    case_name: str
+    runs: list
+    model_cards: dict
+    preloads: dict
+
+    def run(self, name: str | None = None) -> ExcitationResult:
+        """The run named *name* (default: the first)."""
+        if name is None:
+            return self.runs[0]
+        for run in self.runs:
+            if run.name == name:
+                return run
+        raise KeyError(f"no run {name!r}; runs: {', '.join(r.name for r in self.runs)}")
+
+    def table(self, quantity: str = "efficiency"):
+        """The three-way table of the pylon force, one row per run.
+
+        Parameters
+        ----------
+        quantity : {"efficiency", "transmissibility", "db", "amplitude"}
+            Isolation efficiency (%), T, 20 log10 T (dB) or amplitude (N).
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: run name; columns: frequency (Hz) and x, y, z.
+        """
+        import pandas as pd
+
+        values = {"efficiency": lambda r: r.efficiency, "transmissibility": lambda r: r.transmissibility,
+                  "db": lambda r: level_db(r.transmissibility), "amplitude": lambda r: r.pylon_amplitude}
+        if quantity not in values:
+            raise ValueError(f"quantity must be one of {', '.join(values)}, got {quantity!r}")
+        units = {"efficiency": "eta %", "transmissibility": "T", "db": "dB", "amplitude": "N"}
+        rows = {run.name: [run.frequency_hz, *values[quantity](run)] for run in self.runs}
+        columns = ["frequency Hz"] + [f"{units[quantity]} {d}" for d in DIRECTIONS]
+        return pd.DataFrame.from_dict(rows, orient="index", columns=columns).rename_axis("run")
+
+    def to_frame(self):
+        """Every answer in long form: one row per run, location (hinge or
+        pylon sum) and direction, with amplitude (N), T, eta (%) and dB."""
+        import pandas as pd
+
+        rows = []
+        for run in self.runs:
+            for location, amplitude in run.amplitudes().items():
+                for axis, value in zip(DIRECTIONS, amplitude):
+                    t = value / run.excitation_amplitude
+                    rows.append((run.name, run.frequency_hz, location, location == PYLON_SUM
+                                 or location in run.pylon_hinges, axis, value, t,
+                                 float(efficiency(t)), float(level_db(t))))
+        return pd.DataFrame(rows, columns=["run", "frequency Hz", "location", "pylon side", "direction",
+                                           "amplitude N", "T", "eta %", "dB"])
+
+    def static_frame(self, run: str | None = None):
+        """Static (preload) hinge forces of a run, N; pylon sum last."""
+        import pandas as pd
+
+        preload = self.preloads[self.run(run).name]
+        forces = {**preload.hinge_forces, PYLON_SUM: preload.pylon_force}
+        return pd.DataFrame.from_dict({k: list(v) for k, v in forces.items()}, orient="index",
+                                      columns=[f"F{d} N" for d in DIRECTIONS]).rename_axis("hinge")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The answers as JSON-ready data (no time histories)."""
+        runs = []
+        for run in self.runs:
+            runs.append({
+                "name": run.name, "frequency_hz": run.frequency_hz,
+                "excitation_amplitude_n": run.excitation_amplitude,
+                "pylon": _direction_answers(run.pylon_amplitude, run.excitation_amplitude),
+                "hinges": {name: _direction_answers(a, run.excitation_amplitude)
+                           for name, a in run.hinge_amplitudes.items()},
+                "pylon_hinges": list(run.pylon_hinges),
+                "steady": run.steady, "steady_change": run.steady_change, "warnings": list(run.warnings),
+                "static_hinge_forces_n": {name: list(map(float, f))
+                                          for name, f in self.preloads[run.name].hinge_forces.items()},
+                "model_card": self.model_cards[run.name].to_dict(),
+            })
+        return {"case": self.case_name, "runs": runs}
+
+    def to_json(self, **kwargs) -> str:
+        """:meth:`to_dict` as JSON text (keyword arguments go to json.dumps)."""
+        return json.dumps(self.to_dict(), **kwargs)
+
+    def plot_time_histories(self, run: str | None = None, locations=(PYLON_SUM,)):
+        """Force histories of a run per direction, with the measured window shaded.
+
+        Parameters
+        ----------
+        run : str, optional
+            Run name (default: the first).
+        locations : sequence of str
+            Hinge names and/or ``"pylon sum"``.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        result = self.run(run)
+        histories = {**result.hinge_histories, PYLON_SUM: result.pylon_history}
+        fig, axes = plt.subplots(4, 1, sharex=True, figsize=(9, 8), constrained_layout=True)
+        t = result.time
+        for i, axis in enumerate(DIRECTIONS):
+            for location in locations:
+                axes[i].plot(t, histories[location][:, i], lw=0.7, label=location)
+            axes[i].axvspan(t[result.window][0], t[result.window][-1], color="0.9")
+            axes[i].set_ylabel(f"F{axis} N")
+        for i, axis in enumerate(DIRECTIONS):
+            axes[3].plot(t, result.excitation_history[:, i], lw=0.7, label=f"excitation {axis}")
+        axes[3].set_ylabel("excitation N")
+        axes[3].set_xlabel("time s")
+        axes[0].legend(loc="upper right", fontsize="small")
+        axes[3].legend(loc="upper right", fontsize="small")
+        fig.suptitle(f"{self.case_name}: {result.name} ({result.frequency_hz:g} Hz); measured window shaded")
+        return fig
+
+    def plot_spectra(self, run: str | None = None, locations=(PYLON_SUM,)):
+        """Amplitude spectra of the measured window per direction (log scale).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        from workbook.answers.amplitude import amplitude_spectrum
+
+        result = self.run(run)
+        histories = {**result.hinge_histories, PYLON_SUM: result.pylon_history}
+        window = result.window
+        fig, axes = plt.subplots(3, 1, sharex=True, figsize=(9, 7), constrained_layout=True)
+        for i, axis in enumerate(DIRECTIONS):
+            for location in locations:
+                frequencies, amplitudes = amplitude_spectrum(result.time[window], histories[location][window, i])
+                axes[i].semilogy(frequencies, np.maximum(amplitudes, 1e-12), lw=0.8, label=location)
+            axes[i].axvline(result.frequency_hz, color="0.6", ls="--", lw=0.8)
+            axes[i].set_ylabel(f"|F{axis}| N")
+            axes[i].set_xlim(0, 4 * result.frequency_hz)
+        axes[-1].set_xlabel("frequency Hz")
+        axes[0].legend(loc="upper right", fontsize="small")
+        fig.suptitle(f"{self.case_name}: {result.name}, spectrum of the measured window")
+        return fig
+
+    def plot_efficiency(self):
+        """Bar chart of the pylon isolation efficiency per run and direction.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        table = self.table("efficiency")
+        fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
+        width = 0.8 / len(DIRECTIONS)
+        positions = np.arange(len(table))
+        for i, axis in enumerate(DIRECTIONS):
+            bars = ax.bar(positions + (i - 1) * width, table[f"eta % {axis}"], width, label=axis)
+            ax.bar_label(bars, fmt="%.1f", fontsize="small")
+        ax.set_xticks(positions, [f"{name}\n{f:g} Hz" for name, f in zip(table.index, table["frequency Hz"])])
+        ax.set_ylabel("isolation efficiency %")
+        ax.legend(title="direction")
+        ax.set_title(f"{self.case_name}: pylon isolation efficiency")
+        return fig
+
+
+def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float]]:
+    t = np.asarray(amplitude) / reference
+    answers = {}
+    for axis, a, ti in zip(DIRECTIONS, amplitude, t):
+        db = float(level_db(ti))
+        answers[axis] = {"amplitude_n": float(a), "transmissibility": float(ti),
+                         "efficiency_pct": float(efficiency(ti)), "db": db if np.isfinite(db) else None}
+    return answers

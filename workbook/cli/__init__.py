@@ -1,0 +1,1 @@
+"""The ``mountwb`` command line: one module per command."""

@@ -1,0 +1,95 @@
+"""The one case loader of every command, and progress bars on stderr.
+
+A command's CASE argument is a case workbook (``.xlsx``/``.xlsm``), a JSON
+case (written by :func:`workbook.model.codec.to_json`), or nothing (the
+bundled reference mount).
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import sys
+from pathlib import Path
+from typing import Union
+
+from workbook.errors import CaseError, UsageError
+from workbook.model.case import Case
+from workbook.model.codec import from_json
+from workbook.model.reference import reference_case
+from workbook.solve.stages import ProgressFactory
+
+__all__ = ["WORKBOOK_SUFFIXES", "is_workbook", "load_case", "progress_factory"]
+
+#: File name endings read as case workbooks.
+WORKBOOK_SUFFIXES = (".xlsx", ".xlsm")
+
+
+def is_workbook(name: Union[str, None]) -> bool:
+    """True if *name* names a case workbook (by its ending)."""
+    return name is not None and Path(name).suffix.lower() in WORKBOOK_SUFFIXES
+
+
+def _json_case(path: str) -> Case:
+    try:
+        case = from_json(Path(path).read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        raise UsageError(f"{path}: not a JSON case (not UTF-8 text); give a case workbook (.xlsx/.xlsm) "
+                         f"or a JSON case") from None
+    except json.JSONDecodeError as error:
+        raise UsageError(f"{path}: not a JSON case: {error}") from None
+    if not isinstance(case, Case):
+        raise CaseError(path, "type", type(case).__name__, "a JSON case (type 'Case')")
+    return case
+
+
+def load_case(path: Union[str, None] = None, *, run: Union[str, None] = None, rigid: bool = False,
+              time_budget: Union[float, None] = None) -> Case:
+    """The case a command works on.
+
+    Parameters
+    ----------
+    path : str or None
+        A case workbook, a JSON case, or None for the reference mount.
+    run : str or None
+        A case workbook's Runs row whose case to take (default: the
+        workbook's case as it stands).
+    rigid : bool
+        Make every link rigid.
+    time_budget : float or None
+        Wall-time budget of one run, s (None: as the case says).
+
+    Raises
+    ------
+    workbook.errors.WorkbookError, CaseError, UsageError, OSError
+        A bad workbook, case or file, or a run name given for a case that is
+        not a workbook.
+    """
+    if is_workbook(path):
+        from workbook.excel.execute import select_runs
+        from workbook.excel.reader import read_workbook
+
+        book = read_workbook(path)
+        case = book.case if run is None else book.run_case(select_runs(book, [run])[0])
+    elif run is not None:
+        raise UsageError("--run names a row of a case workbook's Runs sheet; give a .xlsx case")
+    else:
+        case = reference_case() if path is None else _json_case(path)
+    if time_budget is not None:
+        case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, time_budget=time_budget))
+    return case.with_rigid_links() if rigid else case
+
+
+def progress_factory() -> ProgressFactory:
+    """Progress bars on stderr (tqdm hides them when stderr is not a terminal)."""
+    from tqdm import tqdm
+
+    def factory(description: str, total: float):
+        bar = tqdm(total=total, desc=description, file=sys.stderr, disable=None, leave=False,
+                   bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}<{remaining}")
+
+        def update(done: float):
+            bar.update(done - bar.n)
+
+        return update, bar.close
+
+    return factory

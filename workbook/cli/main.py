@@ -1,0 +1,67 @@
+"""The ``mountwb`` command line: the parser, and every error mapped to its exit code once.
+
+One module per command (``workbook.cli.<command>``); each has a function
+that adds the command's arguments to its parser and returns the handler.
+Exit codes (:mod:`workbook.errors`): 0 done, 1 numerical trouble, 2 bad
+input (nothing written), 130 interrupted (Ctrl-C).
+"""
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+
+from threadpoolctl import threadpool_limits
+
+from workbook.cli import layout, links, rig, run, study, workbooks
+from workbook.errors import EXIT_INTERRUPTED, SimulationError, exit_code
+
+__all__ = ["main", "COMMANDS", "build_parser"]
+
+#: name -> (help, function adding the arguments and returning the handler)
+COMMANDS = {
+    "run": ("run a case and print the isolation-efficiency table and the model card", run.arguments),
+    "links": ("per link: FE size, frequencies free-free and as mounted, modes kept and why, cost, cache hit",
+              links.arguments),
+    "layout": ("draw a case's layout (side, front and top views) as a PNG", layout.arguments),
+    "check": ("check a case workbook (.xlsx) and list every problem; nothing is run or written",
+              workbooks.check_arguments),
+    "template": ("write the case template workbook (or, with --reference, the reference case)",
+                 workbooks.template_arguments),
+    "study": ("studies of a case: 'accuracy' (accuracy against time) or 'params' (a parameter study)",
+              study.arguments),
+    "rig": ("measured rig records: measured T and eta, the validation table against simulation, "
+            "synthetic records", rig.arguments),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="mountwb", description="Engine mount vibration isolation workbook")
+    parser.add_argument("-v", "--verbose", action="count", default=0, help="more log output (-v, -vv)")
+    commands = parser.add_subparsers(dest="command", required=True)
+    for name, (help_text, configure) in COMMANDS.items():
+        command = commands.add_parser(name, help=help_text, description=help_text)
+        command.set_defaults(handler=configure(command))
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``mountwb`` console script; returns the exit code."""
+    # Multithreaded BLAS made the small dense solves of a run many times slower on 2 cores.
+    threadpool_limits(limits=1)
+    args = build_parser().parse_args(argv)
+    level = {0: logging.WARNING, 1: logging.INFO}.get(args.verbose, logging.DEBUG)
+    logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
+    try:
+        return args.handler(args)
+    except KeyboardInterrupt:
+        print(f"mountwb {args.command}: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except (SimulationError, ValueError, OSError) as error:
+        trouble = "numerical trouble: " if isinstance(error, SimulationError) else ""
+        print(f"mountwb {args.command}: {trouble}{error}", file=sys.stderr)
+        return exit_code(error)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,106 @@
+"""``mountwb study params [CASE] --vary NAME=SPEC ... [--lhs N] [--workers N | --dask ADDRESS]``.
+
+A parameter study of a case (:mod:`workbook.studies.parametric`): ``--vary`` names a
+parameter and its values, as a list ``a,b,c`` (numbers in SI units, or
+text for ``material`` and ``removed_link``) or a range ``low:high:points``;
+the rows are every combination. With ``--lhs N`` every ``--vary`` gives
+bounds ``low:high`` and the rows are N samples of a Latin hypercube. Runs go
+to local processes (``--workers``, default: every core) or to the Dask
+scheduler at ``--dask ADDRESS``; the table (CSV or Parquet, and a sheet) and
+the sensitivity plot go to ``--output``.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from workbook.cli.loading import load_case
+from workbook.errors import UsageError
+
+__all__ = ["add_arguments", "run_parameter_study", "parse_vary"]
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add the options of ``study params`` to its parser."""
+    from workbook.studies.parametric import PARAMETERS
+    from workbook.studies.sensitivity import TABLE_FORMATS
+
+    parser.add_argument("--vary", action="append", default=[], metavar="NAME=SPEC",
+                       help=f"parameter ({', '.join(PARAMETERS)}) and its values: a,b,c or low:high:points "
+                            "(with --lhs: low:high); SI units")
+    parser.add_argument("--lhs", type=int, metavar="N", help="N Latin-hypercube samples over the --vary bounds")
+    parser.add_argument("--seed", type=int, default=0, help="Latin-hypercube seed (0)")
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+                       help="local processes (default: every core; 1: serial)")
+    parser.add_argument("--dask", metavar="ADDRESS", help="run on the Dask scheduler at ADDRESS instead")
+    parser.add_argument("--format", choices=TABLE_FORMATS, default="csv", help="table file format (csv)")
+    parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+
+
+def _value(text: str, numeric: bool):
+    return float(text) if numeric else text.strip()
+
+
+def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, ...]:
+    """The study rows of the ``--vary`` options.
+
+    Raises
+    ------
+    ValueError
+        A malformed option, naming it.
+    """
+    from workbook.studies.parametric import PARAMETERS, grid, latin_hypercube, linear_range
+
+    if not specs:
+        raise UsageError("a parameter study needs at least one --vary NAME=SPEC")
+    values, bounds = {}, {}
+    for spec in specs:
+        name, sep, text = spec.partition("=")
+        name = name.strip()
+        if not sep or name not in PARAMETERS:
+            raise UsageError(f"--vary {spec!r}: expected NAME=SPEC with NAME one of {', '.join(PARAMETERS)}")
+        numeric = PARAMETERS[name].numeric
+        try:
+            parts = text.split(":")
+            if lhs is not None:
+                if len(parts) != 2:
+                    raise UsageError("with --lhs give bounds low:high")
+                bounds[name] = (float(parts[0]), float(parts[1]))
+            elif len(parts) == 3 and numeric:
+                values[name] = linear_range(float(parts[0]), float(parts[1]), int(parts[2]))
+            elif len(parts) == 1:
+                values[name] = [_value(v, numeric) for v in text.split(",")]
+            else:
+                raise UsageError("expected a,b,c or low:high:points")
+        except ValueError as error:
+            raise UsageError(f"--vary {spec!r}: {error}") from None
+    return latin_hypercube(bounds, lhs, seed) if lhs is not None else grid(values)
+
+
+def run_parameter_study(args) -> int:
+    """Run ``study params``; print the table and the files written."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from tqdm import tqdm
+
+    from workbook.studies.parallel import run_rows
+    from workbook.studies.parametric import study_cases
+    from workbook.studies.sensitivity import study_frame, write_study
+
+    rows = parse_vary(args.vary, args.lhs, args.seed)
+    case = load_case(args.case, run=args.run, rigid=args.rigid)
+    where = f"Dask scheduler {args.dask}" if args.dask else f"{args.workers} local process(es)"
+    print(f"{case.name}: {len(rows)} study rows on {where}", file=sys.stderr)
+    with tqdm(total=len(rows), desc="study rows", file=sys.stderr, disable=None) as bar:
+        outcomes = run_rows(study_cases(case, rows), workers=args.workers, dask=args.dask,
+                            progress=lambda done, total: bar.update(done - bar.n))
+    frame = study_frame(rows, outcomes)
+    print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}"))
+    for outcome in outcomes:
+        if outcome.status != "ok":
+            print(f"row {outcome.index} failed: {outcome.error}")
+    for path in write_study(frame, list(rows[0]) if rows else [], args.output, args.format):
+        print(path)
+    return 0

@@ -1,0 +1,128 @@
+"""``mountwb rig``: measured rig records against simulation.
+
+- ``mountwb rig measure RECORD.csv [--periods N] [--at-nominal]``: measured T
+  and eta per direction of a rig record (DFT at the spectral peak next to
+  the nominal rotor frequency, or at the nominal one);
+- ``mountwb rig compare RECORD.csv [CASE] [--rigid] [--periods N] [--csv OUT.csv]``:
+  simulate the record's run of the case (default: the reference mount) and
+  print the validation table, error = (sim - test) / test x 100 %;
+- ``mountwb rig synthesize OUT.csv [CASE] [--run NAME] [--rigid] [--noise F]
+  [--drift F] [--seed N] [--rate HZ] [--duration S]``: a synthetic record
+  made from a simulation (:mod:`workbook.rig.synthetic`).
+
+A bad record exits with code 2 and a message naming file, line and column.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from typing import Callable
+
+from workbook.answers.results import ExcitationResult
+from workbook.cli.loading import load_case
+from workbook.errors import UsageError
+from workbook.model.case import AnalysisSettings, Case
+
+__all__ = ["arguments", "simulate_run"]
+
+_DEFAULT_PERIODS = AnalysisSettings().measured_periods
+
+
+def simulate_run(case: Case, run: str, *, histories: bool = False) -> ExcitationResult:
+    """Simulate the excitation named *run* of *case*.
+
+    Parameters
+    ----------
+    case : Case
+    run : str
+        Name of a single-frequency excitation of *case* (a sweep point
+        included).
+    histories : bool
+        True: in the time domain, with force histories (for a synthetic
+        record); False: by the method the case asks for.
+
+    Returns
+    -------
+    ExcitationResult
+
+    Raises
+    ------
+    UsageError
+        No excitation of that name.
+    """
+    from workbook.solve.pipeline import run_case, run_excitation
+
+    excitations = {e.name: e for e in case.single_frequency_excitations()}
+    if run not in excitations:
+        raise UsageError(f"case {case.name!r} has no excitation {run!r}; it has {', '.join(excitations)}")
+    if histories:
+        return run_excitation(case, excitations[run])[0]
+    return run_case(dataclasses.replace(case, excitations=(excitations[run],))).runs[0]
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    modes = parser.add_subparsers(dest="mode", required=True)
+    measure = modes.add_parser("measure", help="measured T and eta per direction of a rig record")
+    compare = modes.add_parser("compare", help="simulate the record's run and print the validation table")
+    for sub in (measure, compare):
+        sub.add_argument("record", help="rig record (CSV)")
+        sub.add_argument("--periods", type=int, default=_DEFAULT_PERIODS,
+                         help=f"whole rotor periods per window (default {_DEFAULT_PERIODS})")
+        sub.add_argument("--at-nominal", action="store_true",
+                         help="DFT at the nominal rotor frequency, not at the spectral peak next to it")
+    compare.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    compare.add_argument("--rigid", action="store_true", help="make every link rigid")
+    compare.add_argument("--csv", metavar="OUT.csv", help="also write the validation table")
+    synthesize = modes.add_parser("synthesize", help="write a synthetic rig record made from a simulation")
+    synthesize.add_argument("output", help="record to write (CSV)")
+    synthesize.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    synthesize.add_argument("--run", default="LP rotor", help="excitation to simulate (default 'LP rotor')")
+    synthesize.add_argument("--rigid", action="store_true", help="make every link rigid")
+    synthesize.add_argument("--noise", type=float, default=0.005, help="noise / transducer amplitude (0.005)")
+    synthesize.add_argument("--drift", type=float, default=0.002, help="relative speed drift (0.002)")
+    synthesize.add_argument("--seed", type=int, default=0, help="noise seed (0)")
+    synthesize.add_argument("--rate", type=float, default=2048.0, help="sample rate, Hz (2048)")
+    synthesize.add_argument("--duration", type=float, default=4.0, help="record length, s (4)")
+
+    def rig(args) -> int:
+        if args.mode == "synthesize":
+            return _synthesize(args)
+        from workbook.rig.correlation import PEAK_SEARCH, comparison_frame, measure
+        from workbook.rig.records import read_record
+
+        record = read_record(args.record)
+        if args.mode == "compare":
+            case = load_case(args.case, rigid=args.rigid)
+            record.check_hinges([h.name for h in case.pylon_hinges])
+        measurement = measure(record, args.periods, search=0.0 if args.at_nominal else PEAK_SEARCH)
+        print(f"{record.path}: run {record.run!r}, rotor at {measurement.frequency_hz:.4f} Hz (nominal "
+              f"{measurement.nominal_hz:g} Hz), |F_exc| {measurement.excitation_amplitude:.1f} N, "
+              f"{args.periods}-period windows differ by {100 * measurement.steady_change:.2f} %\n")
+        if args.mode == "measure":
+            for axis, t, eta in zip("xyz", measurement.transmissibility, measurement.efficiency):
+                print(f"{axis}: T {t:.5f}  eta {eta:7.3f} %")
+            return 0
+        table = comparison_frame(measurement, simulate_run(case, record.run))
+        print(table.to_string(float_format=lambda v: f"{v:10.5g}"))
+        if args.csv:
+            table.to_csv(args.csv)
+            print(args.csv)
+        return 0
+
+    return rig
+
+
+def _synthesize(args) -> int:
+    from workbook.rig.records import write_record
+    from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, synthetic_record
+
+    case = load_case(args.case, rigid=args.rigid)
+    result = simulate_run(case, args.run, histories=True)
+    pylon = sorted(h.name for h in case.pylon_hinges)
+    reference = sorted(h for hinges in REFERENCE_TRANSDUCERS.values() for h in hinges)
+    # the seed study's rig on the reference mount, else one transducer per pylon-side hinge
+    transducers = REFERENCE_TRANSDUCERS if pylon == reference else {name: (name,) for name in pylon}
+    record = synthetic_record(result, transducers, sample_rate_hz=args.rate, duration=args.duration,
+                              noise=args.noise, drift=args.drift, seed=args.seed)
+    print(write_record(args.output, record))
+    return 0

@@ -1,0 +1,50 @@
+"""``mountwb run [CASE] [--json] [--rigid] [--time-budget S]``: run a case.
+
+Prints the three-way isolation-efficiency table, the dB table and the model
+card of each run, or the answers as JSON. A case workbook runs the rows of
+its Runs sheet and gets its results written back (:mod:`workbook.cli.workbooks`).
+"""
+from __future__ import annotations
+
+import argparse
+from typing import Callable
+
+from workbook.cli import workbooks
+from workbook.cli.loading import is_workbook, load_case, progress_factory
+
+__all__ = ["arguments"]
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    parser.add_argument("--json", action="store_true", help="print the answers as JSON")
+    parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--time-budget", type=float, metavar="SECONDS",
+                        help="wall time one run may take before it stops with an estimate of the time it needs")
+    workbooks.add_run_arguments(parser)
+    return run
+
+
+def run(args) -> int:
+    from workbook.solve.pipeline import run_case
+
+    if is_workbook(args.case):
+        return workbooks.run_workbook(args)
+    case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget)
+    result = run_case(case, progress=None if args.no_progress else progress_factory())
+    if args.json:
+        print(result.to_json(indent=2))
+        return 0
+    table = result.table("efficiency")
+    levels = result.table("db")
+    print(f"{case.name}: pylon isolation efficiency eta = (1 - T) x 100 % (T: pylon force / excitation)\n")
+    print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
+    print("\n20 log10 T (dB):")
+    print(levels.drop(columns="frequency Hz").to_string(float_format=lambda v: f"{v:8.2f}"))
+    for run_result in result.runs:
+        for warning in run_result.warnings:
+            print(f"\nWARNING {run_result.name}: {warning}")
+    for card in result.model_cards.values():
+        print("\n" + card.to_text())
+    return 0

@@ -1,0 +1,128 @@
+"""The Excel subcommands of ``mountwb``: ``check``, ``template`` and ``run CASE.xlsx``.
+
+Exit codes (:mod:`workbook.errors`): 0 done, 2 bad input (nothing
+written), 1 numerical trouble or a file that could not be saved. Messages are plain words on stdout (results) and stderr
+(problems).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Callable
+
+from workbook.cli.loading import progress_factory
+from workbook.errors import EXIT_BAD_INPUT, EXIT_OK, EXIT_TROUBLE
+
+__all__ = ["check_arguments", "template_arguments", "add_run_arguments", "run_workbook"]
+
+
+def _report_problems(error) -> int:
+    problems = error.problems
+    print(f"{len(problems)} problem{'s' if len(problems) != 1 else ''} found; nothing was written:", file=sys.stderr)
+    for problem in problems:
+        print(f"  {problem}", file=sys.stderr)
+    return EXIT_BAD_INPUT
+
+
+def check_arguments(parser: argparse.ArgumentParser) -> Callable:
+    """``mountwb check CASE.xlsx``: validate a case workbook; nothing is run or written."""
+    parser.add_argument("workbook", help="case workbook (.xlsx)")
+
+    def check(args) -> int:
+        from workbook.errors import WorkbookError
+        from workbook.excel.reader import read_workbook
+
+        try:
+            book = read_workbook(args.workbook)
+        except WorkbookError as error:
+            return _report_problems(error)
+        case = book.case
+        print(f"{book.path.name}: OK - case '{case.name}': {len(case.links)} links, {len(case.hinges)} hinges, "
+              f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values")
+        return EXIT_OK
+
+    return check
+
+
+def template_arguments(parser: argparse.ArgumentParser) -> Callable:
+    """``mountwb template OUT.xlsx [--reference]``: write the case template (or the reference case)."""
+    parser.add_argument("output", help="workbook to write, e.g. templates/case-template.xlsx")
+    parser.add_argument("--reference", action="store_true",
+                        help="write the reference case with the seed study's runs (cases/reference.xlsx)")
+
+    def template(args) -> int:
+        from workbook.excel.files import lock_file
+        from workbook.excel.template import reference_workbook, template_workbook, write_workbook
+
+        if lock_file(args.output) is not None:
+            print(f"{args.output} is open in Excel; close it and run again", file=sys.stderr)
+            return EXIT_TROUBLE
+        print(write_workbook(reference_workbook() if args.reference else template_workbook(), args.output))
+        return EXIT_OK
+
+    return template
+
+
+def add_run_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options of ``mountwb run`` for a case workbook."""
+    parser.add_argument("--run", action="append", dest="runs", metavar="NAME",
+                        help="case workbook: run only this row of Runs (repeat for several)")
+    parser.add_argument("--report", metavar="OUT.xlsx", help="case workbook: also write a report workbook")
+
+
+def _print_summary(runs) -> None:
+    from workbook.excel.writer import result_frames
+
+    frame = result_frames(runs)["efficiency"]
+    frame["frequency Hz"] = frame["frequency Hz"].map("{:.6g}".format)
+    table = frame.pivot_table(index=["run", "point", "frequency Hz"], columns="direction", values="eta %",
+                              sort=False)
+    print("Pylon isolation efficiency eta = (1 - T) x 100 %:")
+    print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
+    for run in runs:
+        for point in run.result.runs:
+            for warning in point.warnings:
+                print(f"WARNING {run.spec.name} / {point.name}: {warning}")
+
+
+def run_workbook(args) -> int:
+    """Run the runs of a case workbook, write the results back and optionally a report."""
+    from workbook.errors import SimulationError, WorkbookError
+    from workbook.excel.execute import run_book, select_runs
+    from workbook.excel.reader import read_workbook
+    from workbook.excel.report import write_report
+    from workbook.excel.writer import write_results
+
+    if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None):
+        print("mountwb run: --json, --rigid and --time-budget are for JSON cases; a workbook sets its runs' "
+              "fidelity in its Runs sheet and its time budget in its Case sheet", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    try:
+        book = read_workbook(args.case)
+        selected = select_runs(book, args.runs)
+    except WorkbookError as error:
+        return _report_problems(error)
+    progress = None if getattr(args, "no_progress", False) else progress_factory()
+    try:
+        runs = run_book(book, selected, progress=progress)
+    except SimulationError as error:
+        print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
+        return EXIT_TROUBLE
+    _print_summary(runs)
+    try:
+        outcome = write_results(book.path, book.sha256, runs, book.tests)
+    except OSError as error:
+        print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
+              file=sys.stderr)
+        return EXIT_TROUBLE
+    if outcome.reason is None:
+        print(f"results written into {outcome.path}")
+    else:
+        print(f"{book.path.name} was not overwritten: {outcome.reason}.\nresults written to {outcome.path}")
+    if args.report:
+        try:
+            print(f"report written to {write_report(args.report, book, runs)}")
+        except (ValueError, OSError) as error:
+            print(f"mountwb run: no report: {error}", file=sys.stderr)
+            return EXIT_TROUBLE
+    return EXIT_OK

@@ -1,0 +1,233 @@
+"""Every error the package raises on purpose, and the exit code of each.
+
+Two kinds, each with its command-line exit code (:func:`exit_code`):
+
+- **bad input** (exit 2): the case, a workbook, a rig record or a unit
+  cannot be used. The message names the file, sheet, cell, row or field,
+  what was found and what was expected. Nothing was written.
+- **numerical trouble** (exit 1, :class:`SimulationError` and its
+  subclasses): a mechanism, a failed equilibrium, a resonance without
+  damping, a failed or diverging integration, an exhausted time budget. The
+  message says when and why, in plain words.
+
+An interrupt (Ctrl-C) exits with 130.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Union
+
+__all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
+           "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
+           "MechanismError", "EquilibriumError", "UsageError", "BAD_INPUT", "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
+           "EXIT_INTERRUPTED", "exit_code"]
+
+#: Exit codes of the command line.
+EXIT_OK, EXIT_TROUBLE, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+
+
+class CaseError(ValueError):
+    """An invalid case.
+
+    Attributes
+    ----------
+    item : str
+        Name (or kind) of the item at fault, e.g. ``"hinge 'front-up-left'"``.
+    field : str
+        Field of that item, e.g. ``"stiffness"``.
+    value : object
+        The value found.
+    expected : str
+        What was expected instead.
+    """
+
+    def __init__(self, item: str, field: str, value: Any, expected: str):
+        self.item, self.field, self.value, self.expected = item, field, value, expected
+        super().__init__(f"{item}, field '{field}': found {value!r}, expected {expected}")
+
+
+class UnitProblem(ValueError):
+    """A unit text that cannot be used in its column.
+
+    Attributes
+    ----------
+    expected : str
+        Plain words: what the column takes.
+    """
+
+    def __init__(self, expected: str):
+        self.expected = expected
+        super().__init__(expected)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One input problem.
+
+    Attributes
+    ----------
+    file : str
+    sheet : str or None
+    cell : str or None
+        Cell or range (``"C4"``, ``"B4:D4"``); None for a whole sheet or file.
+    column : str or None
+        Column header.
+    value : object
+        The value found.
+    expected : str
+        What was expected, in plain words.
+    """
+
+    file: str
+    sheet: Union[str, None]
+    cell: Union[str, None]
+    column: Union[str, None]
+    value: Any
+    expected: str
+
+    def __str__(self) -> str:
+        where = [self.file]
+        if self.sheet is not None:
+            where.append(f"sheet '{self.sheet}'")
+        if self.cell is not None:
+            where.append(self.cell if self.cell.startswith("row") else f"cell {self.cell}")
+        if self.column is not None:
+            where.append(f"column '{self.column}'")
+        found = "empty" if self.value is None or self.value == "" else repr(self.value)
+        return f"{', '.join(where)}: found {found}, expected {self.expected}"
+
+
+class WorkbookError(ValueError):
+    """A workbook that cannot be used; :attr:`problems` lists every problem found."""
+
+    def __init__(self, problems: list[Problem]):
+        self.problems = list(problems)
+        super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class RecordError(ValueError):
+    """A rig record that cannot be used.
+
+    Attributes
+    ----------
+    path : str
+        The file.
+    line : int or None
+        1-based line of the file (None: the file as a whole).
+    column : str or None
+        Column header at fault.
+    """
+
+    def __init__(self, path, message: str, *, line: Union[int, None] = None, column: Union[str, None] = None):
+        self.path, self.line, self.column = str(path), line, column
+        where = "".join((f", line {line}" if line is not None else "",
+                         f", column {column!r}" if column is not None else ""))
+        super().__init__(f"{path}{where}: {message}")
+
+
+class SimulationError(RuntimeError):
+    """A run stopped for a numerical or physical reason given in the message."""
+
+
+class NewtonFailure(SimulationError):
+    """Newton's method did not converge at the smallest step allowed.
+
+    Attributes
+    ----------
+    time : float
+        Simulated time at which the failing segment started, s.
+    step : float
+        Smallest step tried, s.
+    cause : str
+        The likely cause, in plain words.
+    """
+
+    def __init__(self, where: str, time: float, end_time: float, step: float, halvings: int, cause: str):
+        self.time, self.step, self.cause = time, step, cause
+        super().__init__(
+            f"{where}: the time integration failed between t = {time:.6g} s and t = {end_time:.6g} s: Newton's "
+            f"method did not converge even with the step halved {halvings} time(s), to {step:.3g} s. "
+            f"Likely cause: {cause}.")
+
+
+class DivergenceError(SimulationError):
+    """The solution diverged: the engine moved too far, or a value became NaN or infinite."""
+
+
+class TimeBudgetExceeded(SimulationError):
+    """A run used up its wall-time budget.
+
+    Attributes
+    ----------
+    simulated : float
+        Simulated time reached, s.
+    estimated_wall_time : float
+        Wall time the whole run would have needed at the rate so far, s.
+    """
+
+    def __init__(self, where: str, budget: float, elapsed: float, simulated: float, end_time: float):
+        self.simulated = simulated
+        self.estimated_wall_time = elapsed * end_time / simulated if simulated > 0 else math.inf
+        super().__init__(
+            f"{where}: stopped after {elapsed:.3g} s of wall time (time budget {budget:g} s) at t = "
+            f"{simulated:.4g} s of {end_time:.4g} s simulated; the whole run would need about "
+            f"{self.estimated_wall_time:.3g} s. Raise the time budget, shorten the run (settle time, measured "
+            f"periods, steps per period) or answer it in the frequency domain.")
+
+
+class ResonanceError(SimulationError):
+    """The excitation frequency coincides with an undamped mounted mode."""
+
+
+class RunTooLong(SimulationError):
+    """The planned run has more steps than any meant run (:data:`MAX_STEPS`)."""
+
+
+class MechanismError(SimulationError):
+    """The mount is an unrestrained mechanism.
+
+    Attributes
+    ----------
+    motions : list of str
+        Description of each free motion.
+    """
+
+    def __init__(self, case_name: str, motions: list[str], loose_eyes: list[str] = ()):
+        self.motions = motions
+        listing = "; ".join(f"({i + 1}) {m}" for i, m in enumerate(motions))
+        hint = f" Eyes without a hinge: {', '.join(loose_eyes)}." if loose_eyes else ""
+        super().__init__(f"case {case_name!r} is a mechanism: {len(motions)} free motion(s) without "
+                         f"stiffness: {listing}.{hint} Add or restore the link or hinge that restrains it.")
+
+
+class EquilibriumError(SimulationError):
+    """The static solve failed or its hinge forces do not balance the loads."""
+
+
+
+class UsageError(ValueError):
+    """A command-line option or argument that cannot be used, with what it takes."""
+
+
+#: The errors that are the user's input, not the solution (exit 2).
+BAD_INPUT = (CaseError, UnitProblem, WorkbookError, RecordError, UsageError)
+
+
+def exit_code(error: BaseException) -> int:
+    """The command-line exit code of *error*: 1 numerical trouble, 2 bad input
+    (also a file that cannot be read, :class:`OSError`, and a link model
+    that :mod:`flexbodies` refuses, :class:`ValueError`), 130 interrupted.
+
+    Raises
+    ------
+    TypeError
+        *error* is none of these: a defect of the package, not of the input.
+    """
+    if isinstance(error, KeyboardInterrupt):
+        return EXIT_INTERRUPTED
+    if isinstance(error, SimulationError):
+        return EXIT_TROUBLE
+    if isinstance(error, BAD_INPUT + (ValueError, OSError)):
+        return EXIT_BAD_INPUT
+    raise TypeError(f"no exit code for {type(error).__name__}")

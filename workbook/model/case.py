@@ -1,0 +1,862 @@
+"""The case model: everything one mount study case needs, as plain frozen data.
+
+A :class:`Case` holds the engine, the connecting links, the hinges between
+bodies, the static loads, the excitations, the analysis settings and the
+physical effects asked for. Every class is a frozen dataclass that validates
+its fields on construction and raises :class:`CaseError` naming the item and
+field at fault, so that a workbook reader can point at the offending cell.
+Cases pickle (parameter studies send them to worker processes) and convert
+to and from JSON-ready dictionaries (:mod:`workbook.model.codec`).
+
+Units are SI throughout: m, kg, s, N, Hz. Axes (docs/physics.md, section 1): x
+heading (along the engine axis), y lateral, z vertical (up).
+
+Bodies are named: ``"pylon"`` (ground), ``"engine"`` (the rigid engine) or
+the name of a link. A hinge joins two named bodies at one point; on a link
+that point must be one of the link's two eye centres.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any, Union
+
+import numpy as np
+
+from workbook.errors import CaseError
+
+__all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
+    "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
+    "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
+    "SingleFrequencyExcitation", "ForceTransducers", "Rotor"]
+
+PYLON = "pylon"
+ENGINE = "engine"
+DIRECTIONS = ("x", "y", "z")
+#: Analysis methods a case may ask for (AnalysisSettings.method).
+ANALYSIS_METHODS = ("time", "frequency", "auto")
+_RESERVED = (PYLON, ENGINE)
+# Two points closer than this (m) are the same point (a hinge on a link eye).
+POINT_TOLERANCE = 1e-6
+
+Vector3 = tuple[float, float, float]
+
+
+def _vector3(value: Any, item: str, name: str) -> Vector3:
+    """Return *value* as a tuple of three finite floats or raise CaseError."""
+    try:
+        vector = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        raise CaseError(item, name, value, "three numbers") from None
+    if len(vector) != 3 or not all(math.isfinite(v) for v in vector):
+        raise CaseError(item, name, value, "three finite numbers")
+    return vector
+
+
+def _number(value: Any, item: str, name: str, *, minimum: float = -math.inf,
+            strictly: bool = False) -> float:
+    """Return *value* as a finite float above *minimum* or raise CaseError."""
+    if isinstance(value, bool):
+        raise CaseError(item, name, value, "a number")
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise CaseError(item, name, value, "a number") from None
+    too_small = number <= minimum if strictly else number < minimum
+    if not math.isfinite(number) or too_small:
+        bound = f"{'>' if strictly else '>='} {minimum:g}" if minimum > -math.inf else "finite"
+        raise CaseError(item, name, value, f"a number {bound}")
+    return number
+
+
+def _name(value: Any, item: str) -> str:
+    if not isinstance(value, str) or not value.strip():
+        raise CaseError(item, "name", value, "a non-empty text")
+    return value
+
+
+def _set(obj: Any, name: str, value: Any) -> None:
+    """Normalise a field of a frozen dataclass in ``__post_init__``."""
+    object.__setattr__(obj, name, value)
+
+
+@dataclass(frozen=True)
+class Engine:
+    """The engine: one rigid body.
+
+    Parameters
+    ----------
+    mass : float
+        Mass in kg.
+    center_of_mass : 3 floats
+        Centre of gravity in the global frame, m.
+    inertia : 3x3 floats
+        Inertia tensor about the centre of gravity, global axes, kg m^2.
+    """
+
+    mass: float
+    center_of_mass: Vector3
+    inertia: tuple[Vector3, Vector3, Vector3]
+
+    def __post_init__(self):
+        item = "engine"
+        _set(self, "mass", _number(self.mass, item, "mass", minimum=0.0, strictly=True))
+        _set(self, "center_of_mass", _vector3(self.center_of_mass, item, "center_of_mass"))
+        try:
+            rows = tuple(_vector3(row, item, "inertia") for row in self.inertia)
+        except TypeError:
+            raise CaseError(item, "inertia", self.inertia, "a 3x3 tensor") from None
+        if len(rows) != 3:
+            raise CaseError(item, "inertia", self.inertia, "a 3x3 tensor")
+        tensor = np.array(rows)
+        if not np.allclose(tensor, tensor.T, rtol=1e-9, atol=1e-9 * np.abs(tensor).max()):
+            raise CaseError(item, "inertia", self.inertia, "a symmetric tensor")
+        principal = np.linalg.eigvalsh(tensor)
+        if principal[0] <= 0 or 2 * principal.max() > principal.sum() * (1 + 1e-9):
+            raise CaseError(item, "inertia", self.inertia,
+                            "a positive definite tensor whose principal moments obey the "
+                            "triangle inequality")
+        _set(self, "inertia", rows)
+
+    @property
+    def inertia_matrix(self) -> np.ndarray:
+        """Inertia tensor about the centre of gravity as a 3x3 array, kg m^2."""
+        return np.array(self.inertia)
+
+
+@dataclass(frozen=True)
+class Link:
+    """A connecting link with a ball hinge eye at each end.
+
+    Parameters
+    ----------
+    name : str
+        Unique name, e.g. ``"front-left"``.
+    end_a, end_b : 3 floats
+        Global positions of the centres of eye A and eye B, m. Their distance
+        must equal the link model's eye distance.
+    model : flexbodies.LinkModel
+        Geometry or mesh, material, meshing and interface choices.
+    modes : {"auto", "static"} or int or float
+        Craig-Bampton fixed-interface modes kept: the low-frequency rule, none,
+        a count, or a cut-off frequency in Hz.
+    flexible : bool
+        False models the link as a rigid body with the same mass properties.
+    stiffness_damping : float
+        Rayleigh stiffness-proportional damping of the link, s.
+    mass_damping : float
+        Rayleigh mass-proportional damping of the link, 1/s.
+    spin_frequency_hz : float or None
+        Frequency of the torsional restraint of the free spin about the link
+        axis (None: the flexbodies default).
+    bore_axis : 3 floats or None
+        Global direction of the bore axes (None: the flexbodies default).
+    """
+
+    name: str
+    end_a: Vector3
+    end_b: Vector3
+    model: Any
+    modes: Union[str, int, float] = "auto"
+    flexible: bool = True
+    stiffness_damping: float = 0.0
+    mass_damping: float = 0.0
+    spin_frequency_hz: Union[float, None] = None
+    bore_axis: Union[Vector3, None] = None
+
+    def __post_init__(self):
+        item = f"link {self.name!r}"
+        _name(self.name, "link")
+        if self.name in _RESERVED:
+            raise CaseError(item, "name", self.name, f"a name other than {_RESERVED}")
+        _set(self, "end_a", _vector3(self.end_a, item, "end_a"))
+        _set(self, "end_b", _vector3(self.end_b, item, "end_b"))
+        if self.length <= POINT_TOLERANCE:
+            raise CaseError(item, "end_b", self.end_b, "a point apart from end_a")
+        geometry = getattr(self.model, "geometry", None)
+        if geometry is not None and abs(geometry.length - self.length) > 1e-6 * max(1.0, self.length):
+            raise CaseError(item, "end_b", self.end_b,
+                            f"a point {geometry.length:g} m from end_a (the link's eye distance); "
+                            f"the ends are {self.length:g} m apart")
+        modes = self.modes
+        valid_modes = (modes in ("auto", "static") if isinstance(modes, str)
+                       else (not isinstance(modes, bool) and isinstance(modes, (int, float))
+                             and modes >= 0 and math.isfinite(modes)))
+        if not valid_modes:
+            raise CaseError(item, "modes", modes,
+                            "'auto', 'static', a mode count or a cut-off frequency in Hz")
+        if not isinstance(self.flexible, bool):
+            raise CaseError(item, "flexible", self.flexible, "True or False")
+        _set(self, "stiffness_damping",
+             _number(self.stiffness_damping, item, "stiffness_damping", minimum=0.0))
+        _set(self, "mass_damping", _number(self.mass_damping, item, "mass_damping", minimum=0.0))
+        if self.spin_frequency_hz is not None:
+            _set(self, "spin_frequency_hz", _number(self.spin_frequency_hz, item,
+                                                    "spin_frequency_hz", minimum=0.0, strictly=True))
+        if self.bore_axis is not None:
+            _set(self, "bore_axis", _vector3(self.bore_axis, item, "bore_axis"))
+
+    @property
+    def length(self) -> float:
+        """Distance between the eye centres, m."""
+        return float(np.linalg.norm(np.subtract(self.end_b, self.end_a)))
+
+    def eye_at(self, point: Vector3) -> Union[str, None]:
+        """Return ``"a"`` or ``"b"`` if *point* is that eye's centre, else None."""
+        for eye, end in (("a", self.end_a), ("b", self.end_b)):
+            if np.linalg.norm(np.subtract(point, end)) <= POINT_TOLERANCE:
+                return eye
+        return None
+
+
+@dataclass(frozen=True)
+class Hinge:
+    """A ball hinge: an isotropic translational spring-damper between two bodies.
+
+    Parameters
+    ----------
+    name : str
+        Unique name, e.g. ``"front-up-left"``.
+    body_a, body_b : str
+        The two bodies joined: ``"pylon"``, ``"engine"`` or a link name.
+    position : 3 floats
+        Hinge centre, m; on a link it must be one of the link's eye centres.
+    stiffness : float
+        Translational stiffness in every direction, N/m.
+    damping : float
+        Translational damping in every direction, N s/m.
+    radial_clearance : float
+        Gap of the spherical bearing, m (0: no clearance law is built).
+    contact_stiffness : float or None
+        Stiffness once the gap is closed, N/m (None: *stiffness*).
+    """
+
+    name: str
+    body_a: str
+    body_b: str
+    position: Vector3
+    stiffness: float
+    damping: float = 0.0
+    radial_clearance: float = 0.0
+    contact_stiffness: Union[float, None] = None
+
+    def __post_init__(self):
+        item = f"hinge {self.name!r}"
+        _name(self.name, "hinge")
+        for name in ("body_a", "body_b"):
+            if not isinstance(getattr(self, name), str) or not getattr(self, name):
+                raise CaseError(item, name, getattr(self, name), "a body name")
+        if self.body_a == self.body_b:
+            raise CaseError(item, "body_b", self.body_b, "a body other than body_a")
+        _set(self, "position", _vector3(self.position, item, "position"))
+        _set(self, "stiffness", _number(self.stiffness, item, "stiffness", minimum=0.0, strictly=True))
+        _set(self, "damping", _number(self.damping, item, "damping", minimum=0.0))
+        _set(self, "radial_clearance",
+             _number(self.radial_clearance, item, "radial_clearance", minimum=0.0))
+        if self.contact_stiffness is not None:
+            _set(self, "contact_stiffness", _number(self.contact_stiffness, item,
+                                                    "contact_stiffness", minimum=0.0, strictly=True))
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        return self.body_a, self.body_b
+
+    @property
+    def on_pylon(self) -> bool:
+        """True for a pylon-side hinge (one of its bodies is the pylon)."""
+        return PYLON in self.bodies
+
+    @property
+    def gap_contact_stiffness(self) -> float:
+        """Stiffness beyond the gap, N/m."""
+        return self.stiffness if self.contact_stiffness is None else self.contact_stiffness
+
+
+@dataclass(frozen=True)
+class PointForce:
+    """A constant force on the engine at a point (thrust, a static load), N and m."""
+
+    name: str
+    force: Vector3
+    point: Vector3
+
+    def __post_init__(self):
+        item = f"static load {self.name!r}"
+        _name(self.name, "static load")
+        _set(self, "force", _vector3(self.force, item, "force"))
+        _set(self, "point", _vector3(self.point, item, "point"))
+
+
+@dataclass(frozen=True)
+class PointMoment:
+    """A constant moment on the engine, N m."""
+
+    name: str
+    moment: Vector3
+
+    def __post_init__(self):
+        item = f"static load {self.name!r}"
+        _name(self.name, "static load")
+        _set(self, "moment", _vector3(self.moment, item, "moment"))
+
+
+@dataclass(frozen=True)
+class Gravity:
+    """Gravitational acceleration acting on every body (engine and links), m/s^2."""
+
+    name: str = "gravity"
+    acceleration: Vector3 = (0.0, 0.0, -9.81)
+
+    def __post_init__(self):
+        _name(self.name, "static load")
+        _set(self, "acceleration", _vector3(self.acceleration, f"static load {self.name!r}",
+                                            "acceleration"))
+
+
+StaticLoad = Union[PointForce, PointMoment, Gravity]
+
+
+@dataclass(frozen=True)
+class ForceTransducers:
+    """The test rig's three-way force transducers between the pylon pins and the rigid ground.
+
+    On the rig the pylon-side hinges do not sit on rigid ground: each pylon
+    pin is carried by a three-component force transducer bolted to the rig
+    floor, and that transducer is a stiff spring. The scene then gets one
+    transducer per pylon pin (pylon-side hinges at the same point share
+    one): a point mass at the pin on a spring-damper to ground, and the pin's
+    hinges attach to that mass. The transducer forces are what the rig
+    measures, so they make the pylon force.
+
+    Parameters
+    ----------
+    stiffness : 3 floats
+        Stiffness of each transducer with its fixture in the global x, y, z
+        directions, N/m (a three-component piezoelectric force link with its
+        mounting is of order 1e8 to 1e9 N/m).
+    mass : float
+        Moving half of each transducer plus the fitting bolted to it, kg. The
+        default 1 kg is a force link of this load range (a few hundred grams,
+        half of it moving) with the clevis block of the pin on it; the mass
+        only has to be there (a node between two springs needs one in
+        Exudyn): at 1e8 N/m it resonates at 1.6 kHz, far above the rotor
+        frequencies. It carries no weight in the scene: a rig zeroes its
+        transducers with the fitting mounted, before the engine is hung.
+    damping : 3 floats
+        Viscous damping of each transducer in x, y, z, N s/m (piezoelectric
+        force links are very lightly damped: default 0).
+    """
+
+    stiffness: Vector3
+    mass: float = 1.0
+    damping: Vector3 = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        item = "test-rig force transducers"
+        stiffness = _vector3(self.stiffness, item, "stiffness")
+        if min(stiffness) <= 0:
+            raise CaseError(item, "stiffness", self.stiffness, "three numbers > 0 (N/m in x, y, z)")
+        damping = _vector3(self.damping, item, "damping")
+        if min(damping) < 0:
+            raise CaseError(item, "damping", self.damping, "three numbers >= 0 (N s/m in x, y, z)")
+        _set(self, "stiffness", stiffness)
+        _set(self, "damping", damping)
+        _set(self, "mass", _number(self.mass, item, "mass", minimum=0.0, strictly=True))
+
+
+def _frequency(item: str, frequency_hz: Any, rpm: Any) -> float:
+    """Validate that exactly one of frequency_hz and rpm is given; return Hz."""
+    if (frequency_hz is None) == (rpm is None):
+        raise CaseError(item, "frequency_hz", frequency_hz, "either frequency_hz or rpm, not both")
+    if frequency_hz is not None:
+        return _number(frequency_hz, item, "frequency_hz", minimum=0.0, strictly=True)
+    return _number(rpm, item, "rpm", minimum=0.0, strictly=True) / 60.0
+
+
+def _direction(value: Any, item: str, name: str) -> Vector3:
+    """Return *value* as three finite floats, not all zero, or raise CaseError."""
+    vector = _vector3(value, item, name)
+    if np.linalg.norm(vector) == 0:
+        raise CaseError(item, name, value, "a non-zero direction")
+    return vector
+
+
+class _OneFrequency:
+    """The frequency of an excitation given as ``frequency_hz`` or ``rpm``."""
+
+    @property
+    def frequency(self) -> float:
+        """Excitation frequency, Hz."""
+        return _frequency("", self.frequency_hz, self.rpm)
+
+
+@dataclass(frozen=True)
+class RotatingForce(_OneFrequency):
+    """A rotating imbalance force on the engine.
+
+    The force of magnitude A turns in the plane normal to *axis*, right-handed
+    about it: ``F(t) = A (u cos(wt + phase) + v sin(wt + phase))`` with
+    ``(u, v, axis)`` a right-handed orthonormal triad (for axis x: u = y,
+    v = z, i.e. lateral plus vertical).
+
+    Parameters
+    ----------
+    name : str
+        Unique name, e.g. ``"LP rotor"``.
+    point : 3 floats
+        The rotor's imbalance plane on the engine axis, m.
+    frequency_hz, rpm : float
+        Rotor speed; give exactly one.
+    amplitude, unbalance : float
+        Force amplitude A in N, or the unbalance m*e in kg m (then
+        A = m e w^2); give exactly one.
+    axis : 3 floats
+        Spin axis (not necessarily unit length).
+    phase_deg : float
+        Phase at t = 0, degrees.
+    """
+
+    name: str
+    point: Vector3
+    frequency_hz: Union[float, None] = None
+    rpm: Union[float, None] = None
+    amplitude: Union[float, None] = None
+    unbalance: Union[float, None] = None
+    axis: Vector3 = (1.0, 0.0, 0.0)
+    phase_deg: float = 0.0
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        _set(self, "point", _vector3(self.point, item, "point"))
+        _frequency(item, self.frequency_hz, self.rpm)
+        if (self.amplitude is None) == (self.unbalance is None):
+            raise CaseError(item, "amplitude", self.amplitude, "either amplitude or unbalance, not both")
+        for name in ("amplitude", "unbalance"):
+            if getattr(self, name) is not None:
+                _set(self, name, _number(getattr(self, name), item, name, minimum=0.0, strictly=True))
+        _set(self, "axis", _direction(self.axis, item, "axis"))
+        _set(self, "phase_deg", _number(self.phase_deg, item, "phase_deg"))
+
+    @property
+    def force_amplitude(self) -> float:
+        """Force amplitude, N."""
+        if self.amplitude is not None:
+            return self.amplitude
+        return self.unbalance * (2 * math.pi * self.frequency) ** 2
+
+    def force_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return (C, S) with ``F(t) = C cos(wt) + S sin(wt)``, N."""
+        axis = np.asarray(self.axis) / np.linalg.norm(self.axis)
+        # u: the global axis least aligned with the spin axis, made normal to
+        # it (for an x spin axis u = y and v = +-z).
+        helper = np.eye(3)[np.argmin(np.abs(axis))]
+        u = helper - axis * (helper @ axis)
+        u /= np.linalg.norm(u)
+        v = np.cross(axis, u)
+        phase = math.radians(self.phase_deg)
+        amplitude = self.force_amplitude
+        cos_part = amplitude * (u * math.cos(phase) + v * math.sin(phase))
+        sin_part = amplitude * (v * math.cos(phase) - u * math.sin(phase))
+        return cos_part, sin_part
+
+
+@dataclass(frozen=True)
+class HarmonicForce(_OneFrequency):
+    """A fixed-direction harmonic force on the engine: ``F(t) = A d cos(wt + phase)``.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    point : 3 floats
+        Point of application on the engine, m.
+    direction : 3 floats
+        Direction d (normalised here).
+    frequency_hz, rpm : float
+        Frequency; give exactly one.
+    amplitude : float
+        Force amplitude A, N.
+    phase_deg : float
+        Phase at t = 0, degrees.
+    """
+
+    name: str
+    point: Vector3
+    direction: Vector3
+    amplitude: float
+    frequency_hz: Union[float, None] = None
+    rpm: Union[float, None] = None
+    phase_deg: float = 0.0
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        _set(self, "point", _vector3(self.point, item, "point"))
+        _set(self, "direction", _direction(self.direction, item, "direction"))
+        _set(self, "amplitude", _number(self.amplitude, item, "amplitude", minimum=0.0, strictly=True))
+        _frequency(item, self.frequency_hz, self.rpm)
+        _set(self, "phase_deg", _number(self.phase_deg, item, "phase_deg"))
+
+    @property
+    def force_amplitude(self) -> float:
+        """Force amplitude, N."""
+        return self.amplitude
+
+    def force_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
+        """Return (C, S) with ``F(t) = C cos(wt) + S sin(wt)``, N."""
+        d = np.asarray(self.direction) / np.linalg.norm(self.direction)
+        phase = math.radians(self.phase_deg)
+        return self.amplitude * math.cos(phase) * d, -self.amplitude * math.sin(phase) * d
+
+
+SingleFrequencyExcitation = Union[RotatingForce, HarmonicForce]
+
+
+@dataclass(frozen=True)
+class Rotor(_OneFrequency):
+    """A rotor spinning at constant speed in the engine: its gyroscopic moment.
+
+    A rotor of polar moment of inertia Ip spinning at the constant rate
+    Omega = 2 pi f about the engine-fixed unit axis a carries the angular
+    momentum ``h = Ip Omega a``. When the engine turns with angular velocity
+    omega (global), a turns with it and the rotor exerts on the engine the
+    moment ``M = -dh/dt = -Ip Omega (omega x a)``. The rotor's mass and
+    transverse inertia stay lumped in the rigid engine (``Case.engine``);
+    only this moment is added (``Effects.gyroscopics``).
+
+    Parameters
+    ----------
+    name : str
+        Unique name, e.g. ``"LP spool"``.
+    polar_inertia : float
+        Polar moment of inertia Ip about the spin axis, kg m^2 (> 0).
+    frequency_hz, rpm : float
+        Spin speed; give exactly one.
+    axis : 3 floats
+        Spin axis in engine coordinates (the global axes at the reference
+        state); normalised here. The rotor spins right-handed about it.
+    """
+
+    name: str
+    polar_inertia: float
+    frequency_hz: Union[float, None] = None
+    rpm: Union[float, None] = None
+    axis: Vector3 = (1.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        item = f"rotor {self.name!r}"
+        _name(self.name, "rotor")
+        _set(self, "polar_inertia", _number(self.polar_inertia, item, "polar_inertia", minimum=0.0,
+                                            strictly=True))
+        _frequency(item, self.frequency_hz, self.rpm)
+        axis = np.array(_direction(self.axis, item, "axis"))
+        _set(self, "axis", tuple(float(v) for v in axis / np.linalg.norm(axis)))
+
+    @property
+    def angular_momentum(self) -> np.ndarray:
+        """Spin angular momentum ``h = Ip Omega a`` in engine coordinates, kg m^2/s, shape (3,)."""
+        return self.polar_inertia * 2 * math.pi * self.frequency * np.asarray(self.axis)
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """A stepped sweep: one excitation template run at each of several frequencies.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    template : RotatingForce or HarmonicForce
+        The excitation; its own frequency is replaced by each sweep frequency
+        (an unbalance given as m*e gives a force growing with frequency^2).
+    frequencies_hz : floats
+        The frequencies, Hz, ascending.
+    """
+
+    name: str
+    template: SingleFrequencyExcitation
+    frequencies_hz: tuple[float, ...]
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        if not isinstance(self.template, (RotatingForce, HarmonicForce)):
+            raise CaseError(item, "template", self.template, "a RotatingForce or HarmonicForce")
+        try:
+            frequencies = tuple(_number(f, item, "frequencies_hz", minimum=0.0, strictly=True)
+                                for f in self.frequencies_hz)
+        except TypeError:
+            raise CaseError(item, "frequencies_hz", self.frequencies_hz, "a list of frequencies") from None
+        if not frequencies or any(b <= a for a, b in zip(frequencies, frequencies[1:])):
+            raise CaseError(item, "frequencies_hz", self.frequencies_hz, "ascending frequencies")
+        _set(self, "frequencies_hz", frequencies)
+
+    @classmethod
+    def band(cls, name: str, template: SingleFrequencyExcitation, start_hz: float, stop_hz: float,
+             points: int, spacing: str = "log") -> "Sweep":
+        """A sweep of *points* frequencies from *start_hz* to *stop_hz* (``"log"`` or ``"linear"``)."""
+        if spacing not in ("log", "linear"):
+            raise CaseError(f"excitation {name!r}", "spacing", spacing, "'log' or 'linear'")
+        space = np.geomspace if spacing == "log" else np.linspace
+        return cls(name, template, tuple(float(f) for f in space(start_hz, stop_hz, int(points))))
+
+    @property
+    def frequency(self) -> float:
+        """Highest frequency of the sweep, Hz."""
+        return self.frequencies_hz[-1]
+
+    def expand(self) -> tuple[SingleFrequencyExcitation, ...]:
+        """The single-frequency excitations of the sweep, named ``"<name> @ <f> Hz"``."""
+        return tuple(dataclasses.replace(self.template, name=f"{self.name} @ {f:.6g} Hz",
+                                         frequency_hz=f, rpm=None)
+                     for f in self.frequencies_hz)
+
+
+Excitation = Union[RotatingForce, HarmonicForce, Sweep]
+
+
+@dataclass(frozen=True)
+class AnalysisSettings:
+    """How a time-domain run is set up and checked.
+
+    Parameters
+    ----------
+    steps_per_period : int
+        Time steps per period of the excitation (at least 40: 20 gave
+        amplitudes about 1 % low; the error is about (2 pi / n)^2 / 6).
+    ramp_periods : float
+        The excitation rises smoothly (raised cosine) over this many periods,
+        which keeps the mounted modes from being excited by the start.
+    settle_time_constants : float
+        Settle time after the ramp, in decay time constants 1/(zeta w) of the
+        least damped mounted mode (one is ample after the smooth start: on the
+        reference mount even none changed T by less than 0.05 %).
+    settle_time : float or None
+        Fixed settle time after the ramp, s (None: from the damping).
+    measured_periods : int
+        Periods per measured window; two consecutive windows are compared.
+    steady_tolerance : float
+        Largest relative change of the pylon-force amplitudes between the two
+        windows for the run to count as steady.
+    spectral_radius : float
+        Generalized-alpha spectral radius at infinite frequency (1: no
+        numerical damping).
+    newton_tolerance : float
+        Newton absolute tolerance relative to the load scale (largest of the
+        static load and the excitation amplitude).
+    equilibrium_tolerance : float
+        Largest relative mismatch between the pylon-side hinge forces and the
+        applied static loads.
+    method : {"time", "frequency", "auto"}
+        The analysis answering the case: time domain, frequency domain
+        (harmonic solution of the scene linearised about the preload), or
+        ``"auto"`` (frequency domain when no clearance law makes the scene
+        nonlinear, see :mod:`workbook.solve.method`).
+    step_halvings : int
+        When Newton's method fails in a segment of the time integration, the
+        segment is run again with the step halved, at most this many times
+        (0: no retry) before the run stops with the time and the cause.
+    time_budget : float or None
+        Wall time one run (one excitation) may take, s; checked between
+        segments of the integration (None: no limit).
+    divergence_displacement : float
+        Engine centre-of-gravity displacement from the preloaded position
+        above which the run stops as diverging, m.
+    """
+
+    steps_per_period: int = 40
+    ramp_periods: float = 10.0
+    settle_time_constants: float = 1.0
+    settle_time: Union[float, None] = None
+    measured_periods: int = 20
+    steady_tolerance: float = 0.005
+    spectral_radius: float = 0.9
+    newton_tolerance: float = 1e-6
+    equilibrium_tolerance: float = 1e-6
+    method: str = "time"
+    step_halvings: int = 4
+    time_budget: Union[float, None] = None
+    divergence_displacement: float = 0.05
+
+    def __post_init__(self):
+        item = "analysis settings"
+        if isinstance(self.step_halvings, bool) or not isinstance(self.step_halvings, int) \
+                or not 0 <= self.step_halvings <= 20:
+            raise CaseError(item, "step_halvings", self.step_halvings, "a whole number from 0 to 20")
+        if self.time_budget is not None:
+            _set(self, "time_budget", _number(self.time_budget, item, "time_budget", minimum=0.0, strictly=True))
+        _set(self, "divergence_displacement", _number(self.divergence_displacement, item,
+                                                      "divergence_displacement", minimum=0.0, strictly=True))
+        if self.method not in ANALYSIS_METHODS:
+            raise CaseError(item, "method", self.method, " or ".join(repr(m) for m in ANALYSIS_METHODS))
+        for name in ("steps_per_period", "measured_periods"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < 1:
+                raise CaseError(item, name, value, "a positive whole number")
+        if self.steps_per_period < 8:
+            raise CaseError(item, "steps_per_period", self.steps_per_period, "at least 8")
+        _set(self, "ramp_periods", _number(self.ramp_periods, item, "ramp_periods", minimum=0.0))
+        _set(self, "settle_time_constants", _number(self.settle_time_constants, item,
+                                                    "settle_time_constants", minimum=0.0))
+        if self.settle_time is not None:
+            _set(self, "settle_time", _number(self.settle_time, item, "settle_time", minimum=0.0))
+        for name in ("steady_tolerance", "newton_tolerance", "equilibrium_tolerance"):
+            _set(self, name, _number(getattr(self, name), item, name, minimum=0.0, strictly=True))
+        rho = _number(self.spectral_radius, item, "spectral_radius", minimum=0.0)
+        if rho > 1:
+            raise CaseError(item, "spectral_radius", rho, "a number from 0 to 1")
+        _set(self, "spectral_radius", rho)
+
+
+@dataclass(frozen=True)
+class Effects:
+    """The physical effects a case asks for; what is off is not built.
+
+    Parameters
+    ----------
+    flexible_links : bool
+        Links as reduced flexible bodies where the link asks for it; False
+        makes every link rigid.
+    preload : bool
+        Apply the static loads and solve the preloaded equilibrium first.
+    hinge_damping : bool
+        Hinge damping as given; False sets it to zero.
+    link_damping : bool
+        Rayleigh damping of the flexible links as given; False sets it to zero.
+    clearance : bool
+        Hinge clearance laws where a gap > 0 is given; False ignores the gaps.
+    rig_sensors : bool
+        The test rig's force transducers where the case gives them
+        (``Case.test_rig``); False mounts the pylon pins on rigid ground.
+    gyroscopics : bool
+        Build the rotors' gyroscopic moments when the case gives rotors
+        (``Case.rotors``); False leaves the rotors as inertia lumped in the
+        engine.
+    """
+
+    flexible_links: bool = True
+    preload: bool = True
+    hinge_damping: bool = True
+    link_damping: bool = True
+    clearance: bool = True
+    rig_sensors: bool = True
+    gyroscopics: bool = True
+
+    def __post_init__(self):
+        for item in dataclasses.fields(self):
+            if not isinstance(getattr(self, item.name), bool):
+                raise CaseError("effects", item.name, getattr(self, item.name), "True or False")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One mount study case.
+
+    Parameters
+    ----------
+    name : str
+        Case name.
+    engine : Engine
+        The rigid engine.
+    links : tuple of Link
+        The connecting links.
+    hinges : tuple of Hinge
+        The ball hinges; a hinge may join any two bodies.
+    static_loads : tuple of PointForce, PointMoment, Gravity
+        Constant loads solved for first (the preload).
+    excitations : tuple of RotatingForce, HarmonicForce, Sweep
+        Each excitation (each sweep frequency) is one run.
+    analysis : AnalysisSettings
+        Time step, settle and steady-state settings.
+    effects : Effects
+        The physical effects asked for.
+    description : str
+        Free text.
+    test_rig : ForceTransducers or None
+        The rig's force transducers under the pylon pins (None: the pylon
+        pins sit on rigid ground).
+    rotors : tuple of Rotor
+        Spinning rotors whose gyroscopic moments act on the engine (their
+        mass and inertia are part of ``engine``).
+    """
+
+    name: str
+    engine: Engine
+    links: tuple[Link, ...]
+    hinges: tuple[Hinge, ...]
+    static_loads: tuple[StaticLoad, ...] = ()
+    excitations: tuple[Excitation, ...] = ()
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
+    effects: Effects = field(default_factory=Effects)
+    description: str = ""
+    test_rig: Union[ForceTransducers, None] = None
+    rotors: tuple[Rotor, ...] = ()
+
+    def __post_init__(self):
+        _name(self.name, "case")
+        checks = (("engine", Engine), ("analysis", AnalysisSettings), ("effects", Effects))
+        for name, kind in checks:
+            if not isinstance(getattr(self, name), kind):
+                raise CaseError("case", name, getattr(self, name), f"a {kind.__name__}")
+        if self.test_rig is not None and not isinstance(self.test_rig, ForceTransducers):
+            raise CaseError("case", "test_rig", self.test_rig, "a ForceTransducers or None")
+        groups = (("links", (Link,)), ("hinges", (Hinge,)),
+                  ("static_loads", (PointForce, PointMoment, Gravity)),
+                  ("excitations", (RotatingForce, HarmonicForce, Sweep)), ("rotors", (Rotor,)))
+        for name, kinds in groups:
+            items = tuple(getattr(self, name))
+            for item in items:
+                if not isinstance(item, kinds):
+                    raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
+            _set(self, name, items)
+            seen = set()
+            for item in items:
+                if item.name in seen:
+                    raise CaseError(f"{name[:-1].replace('_', ' ')} {item.name!r}", "name",
+                                    item.name, "a name not used before")
+                seen.add(item.name)
+        links = self.link_map
+        for hinge in self.hinges:
+            for name in ("body_a", "body_b"):
+                body = getattr(hinge, name)
+                if body in _RESERVED:
+                    continue
+                if body not in links:
+                    raise CaseError(f"hinge {hinge.name!r}", name, body,
+                                    f"'pylon', 'engine' or a link name ({', '.join(links)})")
+                if links[body].eye_at(hinge.position) is None:
+                    raise CaseError(f"hinge {hinge.name!r}", "position", hinge.position,
+                                    f"an eye centre of link {body!r}: {links[body].end_a} or "
+                                    f"{links[body].end_b}")
+
+    @property
+    def link_map(self) -> dict[str, Link]:
+        """Links by name."""
+        return {link.name: link for link in self.links}
+
+    @property
+    def pylon_hinges(self) -> tuple[Hinge, ...]:
+        """The pylon-side hinges, whose forces sum to the pylon force."""
+        return tuple(h for h in self.hinges if h.on_pylon)
+
+    def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
+        """Every run of the case: single excitations and expanded sweeps."""
+        runs = []
+        for excitation in self.excitations:
+            runs.extend(excitation.expand() if isinstance(excitation, Sweep) else (excitation,))
+        return tuple(runs)
+
+    def without_link(self, name: str) -> "Case":
+        """The case with link *name* and every hinge attached to it removed."""
+        if name not in self.link_map:
+            raise CaseError("case", "links", name, f"one of {', '.join(self.link_map)}")
+        return dataclasses.replace(
+            self, name=f"{self.name} without {name}",
+            links=tuple(link for link in self.links if link.name != name),
+            hinges=tuple(h for h in self.hinges if name not in h.bodies))
+
+    def with_rigid_links(self) -> "Case":
+        """The case with every link rigid."""
+        return dataclasses.replace(self, effects=dataclasses.replace(self.effects, flexible_links=False))

@@ -1,0 +1,82 @@
+"""Cases to and from JSON-ready dictionaries.
+
+Every dataclass becomes a dictionary of its fields plus ``"type"`` (the class
+name), tuples become lists; decoding reverses that, turning every list back
+into a tuple (the case model stores sequences as tuples). Only the classes
+registered here are decoded, so a case file cannot construct arbitrary
+objects.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+from typing import Any
+
+from workbook.model import case as _case
+
+__all__ = ["to_dict", "from_dict", "to_json", "from_json"]
+
+
+def _registry() -> dict[str, type]:
+    """Classes a case may contain, by name."""
+    import flexbodies
+    from flexbodies.meshing import BoreSpec
+
+    classes = [_case.Case, _case.Engine, _case.Link, _case.Hinge, _case.PointForce,
+               _case.PointMoment, _case.Gravity, _case.RotatingForce, _case.HarmonicForce,
+               _case.Sweep, _case.Rotor, _case.ForceTransducers, _case.AnalysisSettings, _case.Effects,
+               flexbodies.LinkModel,
+               flexbodies.LinkGeometry, flexbodies.Material, flexbodies.MeshSource, BoreSpec]
+    return {cls.__name__: cls for cls in classes}
+
+
+def to_dict(obj: Any) -> Any:
+    """Encode a case (or any part of it) as JSON-ready data."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        data = {"type": type(obj).__name__}
+        data.update({f.name: to_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)})
+        return data
+    if isinstance(obj, (tuple, list)):
+        return [to_dict(item) for item in obj]
+    if isinstance(obj, dict):
+        return {str(key): to_dict(value) for key, value in obj.items()}
+    if hasattr(obj, "item") and callable(obj.item):      # numpy scalar
+        return obj.item()
+    return obj
+
+
+def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
+    """Decode data written by :func:`to_dict`.
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``"type"`` or fields that class does not have; the case
+        classes raise :class:`~workbook.model.case.CaseError` for invalid values.
+    """
+    classes = _registry() if _classes is None else _classes
+    if isinstance(data, list):
+        return tuple(from_dict(item, classes) for item in data)
+    if isinstance(data, dict):
+        if "type" not in data:
+            return {key: from_dict(value, classes) for key, value in data.items()}
+        kind = data["type"]
+        if kind not in classes:
+            raise ValueError(f"unknown item type {kind!r}; expected one of {', '.join(sorted(classes))}")
+        cls = classes[kind]
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(data) - known - {"type"}
+        if unknown:
+            raise ValueError(f"{kind}: unknown fields {sorted(unknown)}; expected {sorted(known)}")
+        return cls(**{key: from_dict(value, classes) for key, value in data.items() if key != "type"})
+    return data
+
+
+def to_json(obj: Any, **kwargs) -> str:
+    """Encode as a JSON text (keyword arguments go to :func:`json.dumps`)."""
+    return json.dumps(to_dict(obj), **kwargs)
+
+
+def from_json(text: str) -> Any:
+    """Decode a JSON text written by :func:`to_json`."""
+    return from_dict(json.loads(text))

@@ -1,0 +1,163 @@
+"""The reference mount (docs/physics.md, section 2): the bundled default case.
+
+A CFM56-class engine (35 kN) hung from the pylon by 8 links and 16 ball-hinge
+spring-dampers grouped in 14 pins; heading thrust 23 kN and gravity as the
+static loads; the low-pressure (59 Hz, at the fan) and high-pressure
+(248.5 Hz, near the centre of gravity) rotor imbalances of 1000 N rotating in
+the lateral-vertical plane as the excitations. Every number is chosen and
+justified in ``docs/reference-mount.md``.
+
+Origin: on the engine axis in the front-mount plane; x heading (forward),
+y lateral, z up (right-handed, so +y is the engine's left seen from behind).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from workbook.model.case import ENGINE, PYLON, AnalysisSettings, Case, Engine, Gravity, Hinge, Link, PointForce, RotatingForce, Rotor, Sweep
+
+__all__ = ["reference_case", "reference_sweep", "HINGE_STIFFNESS", "HINGE_DAMPING_TIME",
+           "LP_ROTOR", "HP_ROTOR", "LP_SPOOL", "HP_SPOOL"]
+
+#: Engine weight 35 kN at g = 9.81 m/s^2, kg.
+ENGINE_MASS = 3568.0
+#: Centre of gravity: 0.55 m aft of the front mount, 30 mm below the axis
+#: (accessory gearbox under the fan case), m.
+ENGINE_CG = (-0.55, 0.0, -0.03)
+#: Radii of gyration: 0.45 m in roll (rotors and casings of 0.4-0.85 m
+#: radius), 0.75 m in pitch and yaw (a 2.5 m long body, L/sqrt(12) = 0.72 m,
+#: with the heavy fan forward), m.
+ROLL_GYRATION, PITCH_GYRATION = 0.45, 0.75
+
+#: Ball-hinge stiffness (spherical bearing and fitting), N/m.
+HINGE_STIFFNESS = 2.0e7
+#: Hinge damping as stiffness-proportional time constant: d = HINGE_DAMPING_TIME * k, s.
+HINGE_DAMPING_TIME = 1.0e-3
+
+FRONT_X, REAR_X, LATERAL_X, THRUST_FORWARD_X = 0.0, -1.60, -1.72, -0.55
+
+LP_ROTOR = RotatingForce("LP rotor", point=(0.35, 0.0, 0.0), frequency_hz=59.0, amplitude=1000.0)
+HP_ROTOR = RotatingForce("HP rotor", point=(-0.70, 0.0, 0.0), frequency_hz=248.5, amplitude=1000.0)
+
+# The spools as gyroscopic rotors (reference_case(rotors=True); off by default).
+# LP spool (fan, booster, LP turbine): 24 wide-chord fan blades of about 7 kg
+# with a radius of gyration of about 0.5 m (1.55 m fan) give about 42 kg m^2;
+# fan disk and spinner (about 100 kg at 0.25 m) 6, the 3-stage booster (about
+# 100 kg at 0.4 m) 16, the 4-stage LP turbine (about 250 kg at 0.38 m) 36:
+# about 100 kg m^2. HP spool (9-stage compressor and 1-stage turbine, about
+# 250 kg at 0.25 m): about 15 kg m^2. Both spools turn clockwise seen from
+# behind, i.e. right-handed about +x (heading), like the imbalance forces
+# above, at the reference rotor frequencies at once.
+LP_SPOOL = Rotor("LP spool", polar_inertia=100.0, frequency_hz=LP_ROTOR.frequency_hz)
+HP_SPOOL = Rotor("HP spool", polar_inertia=15.0, frequency_hz=HP_ROTOR.frequency_hz)
+
+
+def _short_link(length: float, element_size: float | None):
+    """Front and rear links: steel, 50 x 40 mm shank, 38 mm eye radius, 19 mm bore."""
+    from flexbodies import STEEL, LinkGeometry, LinkModel
+
+    return LinkModel(geometry=LinkGeometry(length=length, eye_outer_radius=0.038, bore_radius=0.019,
+                                           thickness=0.040, shank_width=0.050, shank_thickness=0.040),
+                     material=STEEL, element_size=element_size)
+
+
+def _thrust_rod(length: float, element_size: float | None):
+    """Thrust rods: titanium, 60 x 50 mm shank, 40 mm eye radius, 20 mm bore."""
+    from flexbodies import TITANIUM, LinkGeometry, LinkModel
+
+    return LinkModel(geometry=LinkGeometry(length=length, eye_outer_radius=0.040, bore_radius=0.020,
+                                           thickness=0.050, shank_width=0.060, shank_thickness=0.050),
+                     material=TITANIUM, element_size=element_size)
+
+
+def _mirror(point):
+    x, y, z = point
+    return (x, -y, z)
+
+
+def _link_points() -> dict[str, tuple]:
+    """Eye centres (engine-side or forward eye A, pylon-side or aft eye B) of every link, m."""
+    left = {
+        "front-left": ((FRONT_X, 0.100, 0.600), (FRONT_X, 0.220, 0.850)),
+        "rear-left": ((REAR_X, 0.300, 0.400), (REAR_X, 0.300, 0.660)),
+        "thrust-left": ((THRUST_FORWARD_X, 0.180, 0.500), (REAR_X, 0.300, 0.660)),
+    }
+    points = {}
+    for name, (a, b) in left.items():
+        points[name] = (a, b)
+        points[name.replace("left", "right")] = (_mirror(a), _mirror(b))
+    points["rear-middle"] = ((REAR_X, 0.0, 0.460), (REAR_X, 0.0, 0.720))
+    points["rear-lateral"] = ((LATERAL_X, 0.130, 0.550), (LATERAL_X, -0.130, 0.550))
+    return points
+
+
+def _links(element_size: float | None) -> tuple[Link, ...]:
+    links = []
+    for name, (a, b) in _link_points().items():
+        length = float(np.linalg.norm(np.subtract(b, a)))
+        model = (_thrust_rod if name.startswith("thrust") else _short_link)(length, element_size)
+        links.append(Link(name, a, b, model))
+    return tuple(links)
+
+
+def _hinges() -> tuple[Hinge, ...]:
+    """16 spring-damper hinges; up = pylon side, down = engine side."""
+    points = _link_points()
+    k, d = HINGE_STIFFNESS, HINGE_DAMPING_TIME * HINGE_STIFFNESS
+    hinges = []
+    for side in ("left", "right"):
+        hinges += [
+            Hinge(f"front-up-{side}", PYLON, f"front-{side}", points[f"front-{side}"][1], k, d),
+            Hinge(f"front-down-{side}", ENGINE, f"front-{side}", points[f"front-{side}"][0], k, d),
+            Hinge(f"rear-up-{side}", PYLON, f"rear-{side}", points[f"rear-{side}"][1], k, d),
+            Hinge(f"rear-down-{side}", ENGINE, f"rear-{side}", points[f"rear-{side}"][0], k, d),
+            Hinge(f"thrust-forward-{side}", ENGINE, f"thrust-{side}", points[f"thrust-{side}"][0], k, d),
+            # the thrust rod's aft eye rides on the rear link's pylon-side pin
+            Hinge(f"thrust-aft-{side}", f"rear-{side}", f"thrust-{side}", points[f"thrust-{side}"][1], k, d),
+        ]
+    for name in ("middle", "lateral"):
+        hinges += [
+            Hinge(f"rear-up-{name}", PYLON, f"rear-{name}", points[f"rear-{name}"][1], k, d),
+            Hinge(f"rear-down-{name}", ENGINE, f"rear-{name}", points[f"rear-{name}"][0], k, d),
+        ]
+    return tuple(hinges)
+
+
+def reference_sweep(points: int = 25) -> Sweep:
+    """Lateral + vertical rotating 1000 N at the centre of gravity, 5 to 300 Hz."""
+    template = RotatingForce("sweep", point=ENGINE_CG, frequency_hz=1.0, amplitude=1000.0)
+    return Sweep.band("sweep", template, 5.0, 300.0, points, spacing="log")
+
+
+def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = None,
+                   element_size: float | None = None, rotors: bool = False) -> Case:
+    """The reference mount with the LP and HP rotor cases.
+
+    Parameters
+    ----------
+    sweep : bool
+        Add the lateral + vertical sweep of :func:`reference_sweep`.
+    analysis : AnalysisSettings, optional
+        Settings other than the defaults.
+    element_size : float, optional
+        Mesh element size of the links, m (None: the flexbodies default).
+    rotors : bool
+        Add the LP and HP spools (:data:`LP_SPOOL`, :data:`HP_SPOOL`) as
+        gyroscopic rotors; off by default (their inertia is then only lumped
+        in the engine, as in the bundled case).
+
+    Returns
+    -------
+    Case
+    """
+    inertia = ENGINE_MASS * np.diag([ROLL_GYRATION ** 2, PITCH_GYRATION ** 2, PITCH_GYRATION ** 2])
+    engine = Engine(ENGINE_MASS, ENGINE_CG, tuple(map(tuple, inertia)))
+    static_loads = (PointForce("thrust", force=(23_000.0, 0.0, 0.0), point=(ENGINE_CG[0], 0.0, 0.0)),
+                    Gravity("gravity", (0.0, 0.0, -9.81)))
+    excitations = (LP_ROTOR, HP_ROTOR) + ((reference_sweep(),) if sweep else ())
+    return Case(
+        name="reference mount", engine=engine, links=_links(element_size), hinges=_hinges(),
+        static_loads=static_loads, excitations=excitations,
+        analysis=analysis or AnalysisSettings(), rotors=(LP_SPOOL, HP_SPOOL) if rotors else (),
+        description="CFM56-class engine on 8 links and 16 ball hinges (14 pins); see docs/reference-mount.md",
+    )

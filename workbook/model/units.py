@@ -1,0 +1,106 @@
+"""Units of the sheets: unit cells parsed and converted to SI with pint.
+
+Every quantity column of a sheet has a unit cell (the row under the header).
+:func:`si_factor` turns that unit text into the factor to the column's SI
+unit, or raises :class:`UnitProblem` when the unit is unknown or of the wrong
+dimension ("kg" in a stiffness column).
+
+Two conventions differ from a plain pint conversion:
+
+- ``g`` means *standard gravity* (9.80665 m/s^2) in an acceleration column
+  and *gram* everywhere else (a mass, or an unbalance in g mm);
+- frequencies count cycles: 1 rpm = 1/60 Hz (pint alone, which counts a
+  revolution as 2 pi radians, would give 2 pi/60 Hz).
+
+A dimensionless column takes ``-``, ``1``, an empty cell or ``%``.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import re
+
+import pint
+
+from workbook.errors import UnitProblem
+
+__all__ = ["si_factor", "DIMENSIONLESS"]
+
+#: The SI unit text of a dimensionless column.
+DIMENSIONLESS = "-"
+
+_G_TOKEN = re.compile(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])")
+
+
+@functools.lru_cache(maxsize=1)
+def registry() -> pint.UnitRegistry:
+    """The shared pint registry."""
+    return pint.UnitRegistry()
+
+
+def _parse(text: str) -> pint.Quantity:
+    try:
+        return registry().Quantity(1.0, text)
+    except (pint.PintError, AssertionError, AttributeError, SyntaxError, TypeError, ValueError):
+        raise UnitProblem("a known unit") from None
+
+
+@functools.lru_cache(maxsize=None)
+def si_factor(text: str, si_unit: str) -> float:
+    """Factor from the unit *text* to the column's *si_unit*.
+
+    Parameters
+    ----------
+    text : str
+        The unit cell's text, e.g. ``"mm"``, ``"kN/mm"``, ``"rpm"``, ``"t"``.
+    si_unit : str
+        The column's SI unit, e.g. ``"m"``, ``"N/m"``, ``"Hz"``, or
+        :data:`DIMENSIONLESS`.
+
+    Returns
+    -------
+    float
+        Multiply a cell value by this to get it in *si_unit*.
+
+    Raises
+    ------
+    UnitProblem
+        Unknown unit, or a unit of another dimension.
+    """
+    text = text.strip()
+    if si_unit == DIMENSIONLESS:
+        if text in ("", "-", "1"):
+            return 1.0
+        target = "dimensionless"
+    else:
+        target = si_unit
+        if not text:
+            raise UnitProblem(f"a unit of {_dimension_words(si_unit)} (e.g. {si_unit})")
+    expected = f"a unit of {_dimension_words(si_unit)} (e.g. {si_unit})"
+    if registry().Quantity(1.0, target).check("[acceleration]"):
+        text = _G_TOKEN.sub("g0", text)
+    quantity = _parse(text)
+    if registry().Quantity(1.0, target).check("[frequency]"):
+        # a revolution is one cycle: count turns, not radians
+        root = quantity.to_root_units()
+        if root.units == registry().Unit("radian / second"):
+            quantity = quantity.to("turn / second").magnitude * registry().Unit("1 / second")
+    try:
+        factor = float(quantity.to(target).magnitude)
+    except pint.DimensionalityError:
+        raise UnitProblem(expected) from None
+    if not math.isfinite(factor) or factor == 0:
+        raise UnitProblem(expected)
+    return factor
+
+
+_WORDS = {"m": "length", "kg": "mass", "N": "force", "N/m": "stiffness", "N*s/m": "damping",
+          "Hz": "frequency", "s": "time", "1/s": "rate", "kg*m^2": "moment of inertia",
+          "Pa": "modulus", "kg/m^3": "density", "m/s^2": "acceleration", "N*m": "moment",
+          "kg*m": "unbalance", "deg": "angle"}
+
+
+def _dimension_words(si_unit: str) -> str:
+    if si_unit == DIMENSIONLESS:
+        return "no dimension ('-')"
+    return _WORDS.get(si_unit) or str(registry().Quantity(1.0, si_unit).dimensionality)

@@ -1,0 +1,1 @@
+"""Test-rig records: reading them, measuring T and eta, comparing with simulation."""

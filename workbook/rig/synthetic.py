@@ -1,0 +1,86 @@
+"""A synthetic rig record made from a simulated run, for tests and examples.
+
+The steady-state window of a simulated run is written as a Fourier series
+of the rotor frequency f0 (mean plus ``harmonics`` harmonics per channel,
+by :func:`workbook.answers.amplitude.harmonic_amplitude`), and re-evaluated at the
+rig's sample times with a rotor phase that drifts: the speed changes
+linearly by ``drift`` (relative) over the record, its mean staying f0,
+``phi(t) = 2 pi f0 (t + drift (t^2 / (2 D) - t / 2))`` for a record of
+duration D. Each transducer sums its hinges' forces; white noise of
+standard deviation ``noise`` x (the largest force amplitude of that
+transducer, or of the excitation) is added to each channel. The known
+answer is the simulated transmissibility: the drift is slow, so the rig
+signal is the steady response at the instantaneous speed.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from workbook.answers.amplitude import harmonic_amplitude
+from workbook.answers.results import ExcitationResult
+from workbook.rig.records import RigRecord
+
+__all__ = ["synthetic_record", "REFERENCE_TRANSDUCERS"]
+
+#: The seed study's rig: two front and two rear three-way transducers, named
+#: by the pylon-side hinges of the reference mount they carry.
+REFERENCE_TRANSDUCERS = {
+    "front-left": ("front-up-left",),
+    "front-right": ("front-up-right",),
+    "rear-left": ("rear-up-left", "rear-up-middle"),
+    "rear-right": ("rear-up-right", "rear-up-lateral"),
+}
+
+
+def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate_hz: float = 2048.0,
+                     duration: float = 4.0, noise: float = 0.005, drift: float = 0.002, harmonics: int = 3,
+                     seed: int = 0) -> RigRecord:
+    """A rig record of a simulated run with noise and a linear speed drift.
+
+    Parameters
+    ----------
+    result : ExcitationResult
+        A steady simulated run; its measured window is used.
+    transducers : dict of str to sequence of str
+        Pylon-side hinges carried by each transducer.
+    sample_rate_hz : float
+        Hz.
+    duration : float
+        Record length, s.
+    noise : float
+        Noise standard deviation relative to each transducer's largest amplitude.
+    drift : float
+        Relative change of the rotor speed from start to end of the record.
+    harmonics : int
+        Harmonics of the rotor frequency kept from the simulation.
+    seed : int
+        Seed of the noise generator.
+
+    Returns
+    -------
+    RigRecord
+    """
+    f0 = result.frequency_hz
+    window = result.window
+    sim_time = result.time[window]
+    time = np.arange(int(round(duration * sample_rate_hz))) / sample_rate_hz
+    phase = 2 * np.pi * f0 * (time + drift * (time ** 2 / (2 * duration) - time / 2))
+    rng = np.random.default_rng(seed)
+
+    def resampled(history: np.ndarray) -> np.ndarray:
+        values = history[window]
+        signal = np.broadcast_to(values.mean(axis=0), (len(time), values.shape[1])).copy()
+        for k in range(1, harmonics + 1):
+            phasor = harmonic_amplitude(sim_time, values, k * f0)
+            signal += np.real(np.exp(1j * k * phase)[:, None] * phasor[None, :])
+        scale = np.abs(harmonic_amplitude(sim_time, values, f0)).max()
+        return signal + rng.normal(0.0, noise * scale, signal.shape)
+
+    forces = {name: resampled(sum(result.hinge_histories[h] for h in hinges))
+              for name, hinges in transducers.items()}
+    return RigRecord(
+        time, forces, resampled(result.excitation_history),
+        {name: tuple(hinges) for name, hinges in transducers.items()}, sample_rate_hz, f0, result.name,
+        notes={"made by": f"workbook.rig.synthetic.synthetic_record from a simulation: noise {noise:g} x amplitude, "
+                          f"speed drift {drift:g}, seed {seed}",
+               "simulated T x y z": " ".join(f"{t:.6g}" for t in result.transmissibility)})

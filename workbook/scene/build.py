@@ -1,0 +1,608 @@
+"""Build the Exudyn scene of a case and hand back its item numbers.
+
+The scene: the pylon (ground), the engine (one rigid body with a Tait-Bryan
+node at its centre of gravity), the links (reduced flexible bodies from
+:mod:`flexbodies`, or rigid bodies), one Cartesian spring-damper per hinge
+with a force sensor, the static loads, and - when an excitation is given -
+the excitation force. Only what the case asks for is built: no static loads
+without preload, no clearance law where the gap is zero, no damping where it
+is zero or switched off.
+
+Hinge forces: every hinge's connector has the pylon (or else its first
+body) on marker 0, so its ``Force`` output (Exudyn:
+``F = k (p1 - p0) + d (v1 - v0)``, acting as +F on marker 0 and -F on
+marker 1) is the force on the pylon, or on the hinge's first body.
+
+Test-rig force transducers (``case.test_rig`` with ``effects.rig_sensors``):
+one per pylon pin, a point mass at the pin on a Cartesian spring-damper
+from the ground (marker 0, so its ``Force`` is the force on the ground);
+the pin's pylon-side hinges attach to that mass instead of the ground, and
+the transducer forces, not the hinge forces, make the pylon force (what the
+rig measures). Hinges and transducers are the scene's *force channels*
+(:attr:`Scene.force_channels`), each with a force sensor;
+:attr:`Scene.pylon_channels` names those summed into the pylon force.
+
+For Exudyn users, :func:`build_scene` is the entry point: it returns the
+``mbs`` with every item number, ready to extend and to solve with Exudyn's
+own solvers (see ``docs/example_exudyn_script.py``).
+"""
+from __future__ import annotations
+
+import logging
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Any, Callable, Union
+
+import numpy as np
+
+from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, PointForce, PointMoment, SingleFrequencyExcitation
+from workbook.scene.excitation import ExcitationSignal
+from workbook.scene.hinge_law import exudyn_clearance_function
+
+__all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
+           "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
+           "link_is_flexible", "rig_sensors_built", "TRANSDUCER_PREFIX"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class EngineItems:
+    """Exudyn items of the engine.
+
+    Attributes
+    ----------
+    node : int
+        ``NodeRigidBodyRxyz`` at the centre of gravity.
+    body : int
+        ``ObjectRigidBody``.
+    marker_rigid : int
+        ``MarkerBodyRigid`` at the centre of gravity.
+    """
+
+    node: int
+    body: int
+    marker_rigid: int
+
+
+@dataclass(frozen=True)
+class HingeItems:
+    """Exudyn items of a hinge.
+
+    Attributes
+    ----------
+    connector : int
+        ``ObjectConnectorCartesianSpringDamper``.
+    sensor : int
+        ``SensorObject`` of the connector force (stored in memory).
+    markers : tuple of int
+        Marker 0 (pylon, or the hinge's first body) and marker 1.
+    on_pylon : bool
+        Pylon-side hinge: its force is part of the pylon force (with the
+        rig's transducers built, it acts on a transducer instead, and the
+        transducer forces make the pylon force).
+    clearance : bool
+        The clearance law is built (gap > 0 and clearance switched on).
+    law : exudyn.symbolic.UserFunction or None
+        The recorded clearance law (``springForceUserFunction``), if built.
+    """
+
+    connector: int
+    sensor: int
+    markers: tuple
+    on_pylon: bool
+    clearance: bool
+    law: Any = field(default=None, repr=False)
+
+
+#: Transducer names: this prefix and the pylon-side hinges carried, joined by " + ".
+TRANSDUCER_PREFIX = "transducer "
+
+
+@dataclass(frozen=True)
+class TransducerItems:
+    """Exudyn items of a test-rig force transducer under one pylon pin.
+
+    Attributes
+    ----------
+    node : int
+        ``NodePoint`` of the transducer's moving half, at the pin.
+    body : int
+        ``ObjectMassPoint`` on that node.
+    connector : int
+        ``ObjectConnectorCartesianSpringDamper`` from the ground (marker 0) to
+        the mass (marker 1): its ``Force`` is the force on the ground.
+    sensor : int
+        ``SensorObject`` of the connector force (stored in memory).
+    markers : tuple of int
+        Marker 0 on the ground and marker 1 on the mass; the pin's
+        pylon-side hinges attach to marker 1.
+    position : 3 floats
+        The pin, m.
+    hinges : tuple of str
+        The pylon-side hinges the transducer carries.
+    """
+
+    node: int
+    body: int
+    connector: int
+    sensor: int
+    markers: tuple
+    position: tuple
+    hinges: tuple
+
+
+@dataclass(frozen=True)
+class ExcitationItems:
+    """Exudyn items of the excitation.
+
+    Attributes
+    ----------
+    name : str
+    marker : int
+        ``MarkerBodyPosition`` on the engine at the excitation point.
+    load : int
+        ``LoadForceVector`` with a symbolic load user function.
+    signal : ExcitationSignal
+        The force law, also evaluable with numpy.
+    function : exudyn.symbolic.UserFunction
+        The recorded symbolic load function (kept alive here).
+    """
+
+    name: str
+    marker: int
+    load: int
+    signal: ExcitationSignal
+    function: Any = field(repr=False)
+
+
+@dataclass(frozen=True)
+class GyroscopicItems:
+    """Exudyn items of the rotors' gyroscopic moment on the engine.
+
+    Attributes
+    ----------
+    rotors : tuple of str
+        Names of the rotors whose spin angular momenta are summed here.
+    momentum : ndarray, shape (3,)
+        Their total spin angular momentum ``sum(Ip Omega a)`` in engine
+        coordinates, kg m^2/s.
+    object : int
+        ``ObjectGenericODE2`` on the engine node (zero mass matrix) whose
+        symbolic ``forceUserFunction`` is the generalised gyroscopic force.
+    function : exudyn.symbolic.UserFunction
+        The recorded symbolic force function (kept alive here).
+    """
+
+    rotors: tuple
+    momentum: np.ndarray
+    object: int
+    function: Any = field(repr=False)
+
+
+@dataclass
+class Scene:
+    """An Exudyn system built from a case, with the item numbers of its parts.
+
+    Attributes
+    ----------
+    case : Case
+    system : exudyn.SystemContainer
+    mbs : exudyn.MainSystem
+    ground : int
+        The pylon (``ObjectGround``).
+    engine : EngineItems
+    links : dict of str to flexbodies.ExudynLink
+    reduced : dict of str to flexbodies.ReducedLink
+    hinges : dict of str to HingeItems
+    transducers : dict of str to TransducerItems
+        Test-rig force transducers by name (empty: the pylon pins are on
+        rigid ground).
+    static_loads : dict of str to list of int
+        Load numbers per static load (gravity has one per body).
+    excitation : ExcitationItems or None
+    load_scale : float
+        Largest of the static loads and the excitation amplitude, N; scales
+        the Newton tolerances.
+    gyroscopics : GyroscopicItems or None
+        The rotors' gyroscopic moment (None: not built, see
+        :func:`gyroscopics_built`).
+    """
+
+    case: Case
+    system: Any
+    mbs: Any
+    ground: int
+    engine: EngineItems
+    links: dict
+    reduced: dict
+    hinges: dict[str, HingeItems]
+    static_loads: dict[str, list]
+    excitation: Union[ExcitationItems, None]
+    load_scale: float
+    transducers: dict = field(default_factory=dict)
+    gyroscopics: Union[GyroscopicItems, None] = None
+
+    @property
+    def force_channels(self) -> dict:
+        """Every connector with a force sensor: the hinges (HingeItems), then
+        the transducers (TransducerItems), by name."""
+        return {**self.hinges, **self.transducers}
+
+    @property
+    def pylon_channels(self) -> list[str]:
+        """Names of the force channels summed into the pylon force: the
+        transducers when built, else the pylon-side hinges."""
+        if self.transducers:
+            return list(self.transducers)
+        return [name for name, items in self.hinges.items() if items.on_pylon]
+
+    def body_dof(self) -> dict[str, int]:
+        """Degrees of freedom per body (engine, links, transducers)."""
+        dof = {ENGINE: 6}
+        dof.update({name: link.dof for name, link in self.links.items()})
+        dof.update({name: 3 for name in self.transducers})
+        return dof
+
+    def body_nodes(self) -> dict[str, tuple]:
+        """Exudyn node numbers per body (engine, links, transducers)."""
+        nodes = {ENGINE: (self.engine.node,)}
+        nodes.update({name: tuple(link.nodes) for name, link in self.links.items()})
+        nodes.update({name: (items.node,) for name, items in self.transducers.items()})
+        return nodes
+
+    @contextmanager
+    def excitation_paused(self):
+        """Context in which the excitation force is zero (for static solves:
+        Exudyn's static solver evaluates time-dependent loads at its load-step
+        time)."""
+        if self.excitation is None:
+            yield
+            return
+        load, function = self.excitation.load, self.excitation.function
+        self.mbs.SetLoadParameter(load, "loadVectorUserFunction", 0)
+        try:
+            yield
+        finally:
+            self.mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
+
+    @contextmanager
+    def gaps_closed(self):
+        """Context in which every clearance law is replaced by its contact
+        stiffness, as if each gap were closed (for the mechanism check: the
+        gaps of an unloaded mount are open, and inside them only the small
+        residual stiffness of :mod:`workbook.scene.hinge_law` acts)."""
+        laws = {items.connector: items.law for items in self.hinges.values() if items.law is not None}
+        for connector in laws:
+            self.mbs.SetObjectParameter(connector, "springForceUserFunction", 0)
+        try:
+            yield
+        finally:
+            for connector, law in laws.items():
+                self.mbs.SetObjectParameter(connector, "springForceUserFunction", law)
+
+    def hinge_forces(self) -> dict[str, np.ndarray]:
+        """Current force of every force channel (:attr:`force_channels`: the
+        hinges, then the transducers) on its marker-0 body (the pylon for
+        pylon-side hinges, the ground for transducers), N."""
+        import exudyn as exu
+
+        return {name: np.array(self.mbs.GetObjectOutput(items.connector, exu.OutputVariableType.Force))
+                for name, items in self.force_channels.items()}
+
+
+def link_is_flexible(case: Case, name: str) -> bool:
+    """True if link *name* is built as a flexible body in *case*."""
+    return case.effects.flexible_links and case.link_map[name].flexible
+
+
+def rig_sensors_built(case: Case) -> bool:
+    """True if *case* gives test-rig force transducers and asks for them."""
+    return case.test_rig is not None and case.effects.rig_sensors
+
+
+def _reduction_frequency(case: Case, excitation: Union[SingleFrequencyExcitation, None]) -> float:
+    """Highest excitation frequency a reduction must serve, Hz."""
+    if excitation is not None:
+        return excitation.frequency
+    frequencies = [e.frequency for e in case.excitations]
+    return max(frequencies) if frequencies else 0.0
+
+
+def reduce_links(case: Case, excitation: Union[SingleFrequencyExcitation, None] = None,
+                 progress: Union[Callable[[int], None], None] = None) -> dict:
+    """Reduce every link of *case* (cached on disk by :mod:`flexbodies`).
+
+    Flexible links keep the modes their ``modes`` field asks for, judged at the
+    excitation's frequency (default: the case's highest); rigid links need
+    only their mass properties and take the static reduction.
+
+    Parameters
+    ----------
+    case : Case
+    excitation : RotatingForce or HarmonicForce, optional
+    progress : callable, optional
+        Called with the number of links reduced so far, after each link.
+
+    Returns
+    -------
+    dict of str to flexbodies.ReducedLink
+    """
+    from flexbodies import reduce_link
+
+    frequency = _reduction_frequency(case, excitation)
+    reduced = {}
+    for link in case.links:
+        modes = link.modes if link_is_flexible(case, link.name) else "static"
+        reduced[link.name] = reduce_link(link.model, modes=modes, excitation_hz=frequency)
+        if progress is not None:
+            progress(len(reduced))
+    return reduced
+
+
+def _load_scale(case: Case, excitation: Union[SingleFrequencyExcitation, None], link_mass: float) -> float:
+    scale = 1.0
+    if excitation is not None:
+        scale = max(scale, excitation.force_amplitude)
+    if case.effects.preload:
+        for load in case.static_loads:
+            if isinstance(load, PointForce):
+                scale = max(scale, float(np.linalg.norm(load.force)))
+            elif isinstance(load, Gravity):
+                scale = max(scale, (case.engine.mass + link_mass) * float(np.linalg.norm(load.acceleration)))
+    return scale
+
+
+def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] = None, *,
+                reduced: Union[dict, None] = None) -> Scene:
+    """Build the Exudyn system of *case*.
+
+    Parameters
+    ----------
+    case : Case
+    excitation : RotatingForce or HarmonicForce, optional
+        The excitation to apply (with the case's smooth start); None builds
+        the static scene only.
+    reduced : dict of str to flexbodies.ReducedLink, optional
+        Reduced links from :func:`reduce_links` (computed when omitted).
+
+    Returns
+    -------
+    Scene
+        The assembled system and its item numbers. The system is assembled;
+        nothing has been solved.
+    """
+    import exudyn as exu
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    from flexbodies import add_link_to_exudyn
+
+    eii = exu.itemInterface
+    if reduced is None:
+        reduced = reduce_links(case, excitation)
+    system = exu.SystemContainer()
+    mbs = system.AddSystem()
+
+    ground = mbs.AddObject(eii.ObjectGround(visualization=eii.VObjectGround(show=False)))
+    engine = _add_engine(mbs, case)
+
+    links = {}
+    for link in case.links:
+        damping = case.effects.link_damping
+        optional = {} if link.spin_frequency_hz is None else {"spin_frequency_hz": link.spin_frequency_hz}
+        links[link.name] = add_link_to_exudyn(
+            mbs, reduced[link.name], link.end_a, link.end_b,
+            flexible=link_is_flexible(case, link.name), bore_axis=link.bore_axis,
+            stiffness_damping=link.stiffness_damping if damping else 0.0,
+            mass_damping=link.mass_damping if damping else 0.0, name=link.name, **optional)
+
+    transducers = _add_transducers(mbs, case, ground) if rig_sensors_built(case) else {}
+
+    def marker(body_name: str, position) -> int:
+        if body_name == PYLON:
+            if transducers:
+                return next(items.markers[1] for items in transducers.values()
+                            if _same_point(items.position, position))
+            return mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=ground, localPosition=list(position)))
+        if body_name == ENGINE:
+            local = np.subtract(position, case.engine.center_of_mass)
+            return mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=engine.body, localPosition=list(local)))
+        eye = case.link_map[body_name].eye_at(position)
+        return links[body_name].marker_a if eye == "a" else links[body_name].marker_b
+
+    clearance_functions = {}
+    hinges = {}
+    for hinge in case.hinges:
+        first, second = hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
+        markers = (marker(first, hinge.position), marker(second, hinge.position))
+        damping = hinge.damping if case.effects.hinge_damping else 0.0
+        clearance = case.effects.clearance and hinge.radial_clearance > 0
+        stiffness = hinge.gap_contact_stiffness if clearance else hinge.stiffness
+        connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+            name=hinge.name, markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
+            visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
+        law = None
+        if clearance:
+            gap = hinge.radial_clearance
+            if gap not in clearance_functions:
+                clearance_functions[gap] = exudyn_clearance_function(gap)
+            law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
+            mbs.SetObjectParameter(connector, "springForceUserFunction", law)
+        sensor = mbs.AddSensor(eii.SensorObject(
+            name=f"force {hinge.name}", objectNumber=connector, storeInternal=True, writeToFile=False,
+            outputVariableType=exu.OutputVariableType.Force))
+        hinges[hinge.name] = HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
+
+    static_loads = _add_static_loads(mbs, case, engine, links) if case.effects.preload else {}
+    gyroscopics = _add_gyroscopics(mbs, case, engine) if gyroscopics_built(case) else None
+
+    excitation_items = None
+    if excitation is not None:
+        signal = ExcitationSignal.of(excitation, case.analysis.ramp_periods)
+        point = mbs.AddMarker(eii.MarkerBodyPosition(
+            bodyNumber=engine.body, localPosition=list(np.subtract(excitation.point, case.engine.center_of_mass))))
+        load = mbs.AddLoad(eii.LoadForceVector(name=excitation.name, markerNumber=point, loadVector=[0.0] * 3))
+        function = CreateSymbolicUserFunction(mbs, signal.exudyn_user_function(), "loadVectorUserFunction", load)
+        mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
+        excitation_items = ExcitationItems(excitation.name, point, load, signal, function)
+
+    mbs.Assemble()
+    link_mass = sum(link.mass for link in links.values())
+    scene = Scene(case, system, mbs, ground, engine, links, reduced, hinges, static_loads, excitation_items,
+                  _load_scale(case, excitation, link_mass), transducers=transducers,
+                  gyroscopics=gyroscopics)
+    log.info("scene of %r: %d bodies, %d hinges, %d transducers, %d ODE2 coordinates", case.name,
+             1 + len(links), len(hinges), len(transducers), mbs.systemData.ODE2Size())
+    return scene
+
+
+def _same_point(a, b) -> bool:
+    """True if points *a* and *b* are the same pin (within the case's point tolerance)."""
+    return float(np.linalg.norm(np.subtract(a, b))) <= POINT_TOLERANCE
+
+
+def _add_transducers(mbs, case: Case, ground: int) -> dict[str, TransducerItems]:
+    """One force transducer per pylon pin: a point mass at the pin on a
+    spring-damper from the ground (no gravity on it: a rig zeroes its
+    transducers with their fittings mounted)."""
+    import exudyn as exu
+
+    eii = exu.itemInterface
+    rig = case.test_rig
+    pins = []
+    for hinge in case.pylon_hinges:
+        pin = next((pin for pin in pins if _same_point(pin[0], hinge.position)), None)
+        if pin is None:
+            pins.append((hinge.position, [hinge.name]))
+        else:
+            pin[1].append(hinge.name)
+    transducers = {}
+    for position, carried in pins:
+        name = TRANSDUCER_PREFIX + " + ".join(carried)
+        node = mbs.AddNode(eii.NodePoint(name=name, referenceCoordinates=list(position),
+                                         visualization=eii.VNodePoint(show=False)))
+        body = mbs.AddObject(eii.ObjectMassPoint(name=f"{name} mass", mass=rig.mass, nodeNumber=node,
+                                                 visualization=eii.VObjectMassPoint(show=False)))
+        markers = (mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=ground, localPosition=list(position))),
+                   mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
+        connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+            name=name, markerNumbers=list(markers), stiffness=list(rig.stiffness), damping=list(rig.damping),
+            visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
+        sensor = mbs.AddSensor(eii.SensorObject(
+            name=f"force {name}", objectNumber=connector, storeInternal=True, writeToFile=False,
+            outputVariableType=exu.OutputVariableType.Force))
+        transducers[name] = TransducerItems(node, body, connector, sensor, markers, position, tuple(carried))
+    return transducers
+
+
+def _add_engine(mbs, case: Case) -> EngineItems:
+    import exudyn as exu
+
+    eii = exu.itemInterface
+    inertia = case.engine.inertia_matrix
+    node = mbs.AddNode(eii.NodeRigidBodyRxyz(
+        name="engine", referenceCoordinates=list(case.engine.center_of_mass) + [0.0, 0.0, 0.0],
+        visualization=eii.VNodeRigidBodyRxyz(show=False)))
+    body = mbs.AddObject(eii.ObjectRigidBody(
+        name="engine", nodeNumber=node, mass=case.engine.mass,
+        inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[1, 2], inertia[0, 2], inertia[0, 1]],
+        visualization=eii.VObjectRigidBody(show=False)))
+    marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
+    return EngineItems(node, body, marker)
+
+
+def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict[str, list]:
+    """Static loads: forces and moments on the engine, gravity on every body."""
+    import exudyn as exu
+
+    eii = exu.itemInterface
+    loads = {}
+    for load in case.static_loads:
+        if isinstance(load, PointForce):
+            local = np.subtract(load.point, case.engine.center_of_mass)
+            point = mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=engine.body, localPosition=list(local)))
+            loads[load.name] = [mbs.AddLoad(eii.LoadForceVector(name=load.name, markerNumber=point,
+                                                               loadVector=list(load.force)))]
+        elif isinstance(load, PointMoment):
+            loads[load.name] = [mbs.AddLoad(eii.LoadTorqueVector(name=load.name, markerNumber=engine.marker_rigid,
+                                                                loadVector=list(load.moment)))]
+        else:
+            bodies = [engine.body] + [link.body for link in links.values()]
+            loads[load.name] = [
+                mbs.AddLoad(eii.LoadMassProportional(
+                    markerNumber=mbs.AddMarker(eii.MarkerBodyMass(bodyNumber=body)),
+                    loadVector=list(load.acceleration)))
+                for body in bodies]
+    return loads
+
+
+def gyroscopics_built(case: Case) -> bool:
+    """True if *case* gives rotors and asks for their gyroscopic moments."""
+    return bool(case.rotors) and case.effects.gyroscopics
+
+
+def exudyn_gyroscopic_function(momentum):
+    """A ``forceUserFunction`` for an ``ObjectGenericODE2`` on the engine's
+    ``NodeRigidBodyRxyz``: the gyroscopic moment of spinning rotors.
+
+    Rotors of total spin angular momentum ``h0`` (engine coordinates,
+    ``sum(Ip Omega a)``) turn with the engine, ``h = A h0``, and exert on it
+    the moment ``M = -omega x h = h x omega``. With Exudyn's Tait-Bryan
+    angles ``phi`` (``A = Rx(phi0) Ry(phi1) Rz(phi2)``) the global angular
+    velocity is ``omega = G phi'``, the columns of G being ``e_x``,
+    ``Rx e_y`` and ``Rx Ry e_z``, and the generalised force on the angles is
+    ``G^T M`` (none on the translations). Exact for any rotation; zero at rest
+    (the static solves), and its velocity derivative is the gyroscopic
+    matrix ``-Ip Omega [a]x`` of the linearised equations.
+
+    Parameters
+    ----------
+    momentum : 3 floats
+        ``h0``, kg m^2/s.
+
+    Returns
+    -------
+    callable
+        ``f(mbs, t, itemNumber, q, q_t)`` for
+        ``exudyn.advancedUtilities.CreateSymbolicUserFunction``.
+    """
+    import exudyn as exu
+
+    esym = exu.symbolic
+    hx, hy, hz = (float(h) for h in momentum)
+
+    def gyroscopic_force(mbs, t, itemNumber, q, q_t):
+        # the recording passes q and q_t empty: give them the node's six coordinates
+        q.SetVector([0.0] * 6)
+        q_t.SetVector([0.0] * 6)
+        c0, s0 = esym.cos(q[3]), esym.sin(q[3])
+        c1, s1 = esym.cos(q[4]), esym.sin(q[4])
+        c2, s2 = esym.cos(q[5]), esym.sin(q[5])
+        columns = ((1.0, 0.0, 0.0), (0.0, c0, s0), (s1, -s0 * c1, c0 * c1))
+        omega = [columns[0][i] * q_t[3] + columns[1][i] * q_t[4] + columns[2][i] * q_t[5] for i in range(3)]
+        x, y, z = c2 * hx - s2 * hy, s2 * hx + c2 * hy, hz                 # Rz h0
+        x, z = c1 * x + s1 * z, -s1 * x + c1 * z                            # Ry
+        h = (x, c0 * y - s0 * z, s0 * y + c0 * z)                           # Rx
+        moment = (h[1] * omega[2] - h[2] * omega[1], h[2] * omega[0] - h[0] * omega[2],
+                  h[0] * omega[1] - h[1] * omega[0])
+        zero = esym.Real(0.0)
+        return [zero, zero, zero] + [sum((column[i] * moment[i] for i in range(3)), zero) for column in columns]
+
+    return gyroscopic_force
+
+
+def _add_gyroscopics(mbs, case: Case, engine: EngineItems) -> GyroscopicItems:
+    """The rotors' gyroscopic moment on the engine: one ``ObjectGenericODE2``
+    on the engine node for all rotors (the moment is linear in the momentum;
+    one object per rotor cost about 20 us per step each)."""
+    import exudyn as exu
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    eii = exu.itemInterface
+    momentum = sum(rotor.angular_momentum for rotor in case.rotors)
+    item = mbs.AddObject(eii.ObjectGenericODE2(name="rotor gyroscopics", nodeNumbers=[engine.node],
+                                               massMatrix=np.zeros((6, 6)),
+                                               visualization=eii.VObjectGenericODE2(show=False)))
+    function = CreateSymbolicUserFunction(mbs, exudyn_gyroscopic_function(momentum), "forceUserFunction", item)
+    mbs.SetObjectParameter(item, "forceUserFunction", function)
+    return GyroscopicItems(tuple(rotor.name for rotor in case.rotors), momentum, item, function)

@@ -1,0 +1,95 @@
+"""Guards of the solver path: what stops a run, in plain words.
+
+Every numerical trouble a run can meet ends in a :class:`SimulationError`
+whose message says what happened, when (the simulated time) and what to
+change, never in NaN or a silently wrong number:
+
+- :class:`NewtonFailure`: Newton's method did not converge even after the
+  step was halved the allowed number of times (:func:`newton_cause` turns
+  Exudyn's convergence flags into the likely cause);
+- :class:`DivergenceError`: the engine ran away from its preloaded position,
+  or a coordinate became NaN or infinite;
+- :class:`TimeBudgetExceeded`: the run used up its wall-time budget;
+- :class:`ResonanceError`: the excitation sits on an undamped mounted mode,
+  where no steady state exists;
+- :class:`RunTooLong`: the planned run is too long to be meant (a mounted
+  mode so lightly damped that its transient would take days to decay).
+
+The mechanism and equilibrium errors of :mod:`workbook.solve.preload` are
+:class:`SimulationError` too, so a caller catches one class.
+"""
+from __future__ import annotations
+
+from workbook.errors import ResonanceError
+
+__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "UNDAMPED_RATIO", "MAX_STEPS"]
+
+#: A mounted mode with a damping ratio below this counts as undamped (the
+#: linearisation of a scene without damping gives ratios of about 1e-15).
+UNDAMPED_RATIO = 1e-6
+#: Planned time steps above which a run is refused as not meant (about a day
+#: of wall time for the reference mount with flexible links).
+MAX_STEPS = 50_000_000
+
+
+def run_label(case_name: str, run_name: str) -> str:
+    """How the messages name a run: ``case 'NAME', run 'NAME'``."""
+    return f"case {case_name!r}, run {run_name!r}"
+
+
+def newton_cause(convergence) -> str:
+    """The likely cause of a Newton failure from Exudyn's convergence flags.
+
+    Parameters
+    ----------
+    convergence : exudyn solver ``conv`` structure
+        ``MainSolverImplicitSecondOrder().conv`` after the failure.
+
+    Returns
+    -------
+    str
+    """
+    if convergence.linearSolverFailed:
+        return ("the system matrix is singular: a body or link is not restrained (a mechanism), or a stiffness "
+                "is zero")
+    if convergence.massMatrixNotInvertible:
+        return "the mass matrix is not invertible: a body without mass or inertia"
+    if convergence.newtonSolutionDiverged:
+        return ("Newton's iteration diverged: the forces change too much within one step (a very stiff hinge or "
+                "contact, an impact in a clearance, or a run-away motion)")
+    return (f"no convergence within the iteration limit (last residual {convergence.residual:.3g}): a very stiff "
+            "hinge or contact, or an impact in a clearance")
+
+
+def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float, consequence: str) -> None:
+    """Stop if *frequency_hz* lies on (or, within *band*, next to) an undamped mounted mode.
+
+    Without damping the response at a natural frequency grows without bound,
+    and next to it the free vibration never decays: there is no steady state
+    to report.
+
+    Parameters
+    ----------
+    where : str
+        Case and run, for the message.
+    frequency_hz : float
+        Excitation frequency, Hz.
+    modes : list of workbook.solve.modes.Mode
+        The mounted modes.
+    band : float
+        Relative distance ``|f / f_n - 1|`` within which the excitation counts
+        as on the mode.
+    consequence : str
+        What this means for the analysis, for the message.
+
+    Raises
+    ------
+    ResonanceError
+    """
+    for mode in modes:
+        if mode.damping_ratio < UNDAMPED_RATIO and abs(frequency_hz / mode.frequency_hz - 1.0) < band:
+            raise ResonanceError(
+                f"{where}: the excitation at {frequency_hz:.6g} Hz is within {100 * band:.3g} % of the undamped "
+                f"mounted mode at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
+                f"{mode.damping_ratio:.1e}): {consequence}. Give the hinges or links damping, or move the "
+                f"excitation frequency.")

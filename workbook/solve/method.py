@@ -1,0 +1,68 @@
+"""Which analysis answers a case: time domain or frequency domain, and why.
+
+``AnalysisSettings.method``:
+
+- ``"auto"``: the frequency domain when the scene is linear (no hinge
+  clearance law is built), since the harmonic solution of the linearised
+  scene is then exact and costs no transient; the time domain when a
+  clearance law makes the scene nonlinear;
+- ``"time"`` or ``"frequency"``: forced by the user. Forcing the frequency
+  domain on a scene with clearance linearises the clearance laws about the
+  preloaded state (gaps frozen open or closed): the card says so.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from workbook.model.case import Case
+
+__all__ = ["MethodChoice", "choose_method", "TIME", "FREQUENCY"]
+
+TIME, FREQUENCY = "time", "frequency"
+
+
+@dataclass(frozen=True)
+class MethodChoice:
+    """The analysis method of a case and the reason for it.
+
+    Attributes
+    ----------
+    method : {"time", "frequency"}
+    reason : str
+    """
+
+    method: str
+    reason: str
+
+    @property
+    def label(self) -> str:
+        return f"{self.method} domain"
+
+
+def _clearance_hinges(case: Case) -> list[str]:
+    if not case.effects.clearance:
+        return []
+    return [h.name for h in case.hinges if h.radial_clearance > 0]
+
+
+def choose_method(case: Case) -> MethodChoice:
+    """Choose the analysis method of *case* from ``case.analysis.method``."""
+    asked = case.analysis.method
+    gaps = _clearance_hinges(case)
+    nonlinear = (f"hinge clearance on {', '.join(repr(g) for g in gaps)} makes the scene nonlinear"
+                 if gaps else "")
+    if asked == TIME:
+        return MethodChoice(TIME, "the case asks for it (method 'time')"
+                            + (f"; {nonlinear}" if gaps else "; the scene is linear, so the frequency domain "
+                               "would give the same answers faster"))
+    if asked == FREQUENCY:
+        if gaps:
+            return MethodChoice(FREQUENCY, f"the case asks for it (method 'frequency') although {nonlinear}: "
+                                "the clearance laws are linearised about the preloaded state (gaps frozen "
+                                "as they are there), an approximation")
+        return MethodChoice(FREQUENCY, "the case asks for it (method 'frequency'); the scene is linear, "
+                            "so the harmonic solution is exact")
+    if gaps:
+        return MethodChoice(TIME, f"auto: {nonlinear}; the time domain resolves the contact")
+    return MethodChoice(FREQUENCY, "auto: the scene is linear (no hinge clearance), so the harmonic solution "
+                        "is exact")

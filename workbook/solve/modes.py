@@ -1,0 +1,250 @@
+"""Linearised modes of a scene: free motions (mechanisms) and mounted modes.
+
+Exudyn linearises the system at its initial state (``ComputeLinearizedSystem``:
+M, K, D, geometric stiffness included). Euler-parameter nodes of the links add
+one algebraic constraint each; the matrices are projected onto the null
+space of the constraint Jacobian. Then
+
+- a *free motion* is an eigenvector of ``K x = w^2 M x`` with w close to zero:
+  the scene is a mechanism; it is described by the engine's motion (heading,
+  lateral, vertical translation; roll, pitch, yaw) or, when the engine does
+  not move, by the links that do;
+- a *mounted mode* is a mode in which most of the kinetic energy is in the
+  engine: the engine's rigid-body modes on its mount. Their modal decay
+  rates ``sigma = phi^T D phi / (2 phi^T M phi)`` set the settle time.
+
+Spinning rotors (``Case.rotors``, built as an ``ObjectGenericODE2`` on the
+engine node, see :func:`workbook.scene.build.exudyn_gyroscopic_function`) make D
+skew-symmetric in the engine's rotation coordinates: Exudyn differentiates
+the rotor force with respect to the velocities, so its D already holds the
+gyroscopic matrix ``G`` (exactly, at the preloaded rotation; about the
+reference state ``G = -[h]x`` with h the rotors' spin angular momentum).
+The linearisation records G separately, and the modes are then those of the
+undamped gyroscopic system ``M x'' + G x' + K x = 0``: eigenvalues
+``+-i w``, split by the spin into forward and backward whirl.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from workbook.model.case import ENGINE
+from workbook.scene.build import Scene
+
+__all__ = ["Linearization", "Mode", "linearize", "modes_of", "free_motions", "mounted_modes",
+           "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
+
+#: Modes below this frequency count as free motions (mechanisms), Hz. The
+#: links' spin restraints add modes at about 1 Hz and more.
+FREE_FREQUENCY_HZ = 0.05
+#: Names of the engine's six motions, in the order of its node coordinates.
+ENGINE_MOTIONS = ("heading translation (x)", "lateral translation (y)", "vertical translation (z)",
+                  "roll (rotation about x)", "pitch (rotation about y)", "yaw (rotation about z)")
+#: A mode is a mounted mode when at least this share of its kinetic energy is in the engine.
+ENGINE_SHARE = 0.5
+
+
+@dataclass(frozen=True)
+class Linearization:
+    """Linearised equations ``M x'' + D x' + K x = f`` in independent coordinates.
+
+    Attributes
+    ----------
+    mass, stiffness, damping : ndarray, shape (n, n)
+        Projected matrices (kg, N/m, N s/m in the coordinates' units).
+    basis : ndarray, shape (N, n)
+        Full ODE2 coordinates from independent ones: ``q = basis @ x``.
+    full_mass : ndarray, shape (N, N)
+        Unprojected mass matrix.
+    body_coordinates : dict of str to ndarray of int
+        Full ODE2 coordinate indices of each body.
+    gyroscopic : ndarray, shape (n, n), or None
+        The rotors' gyroscopic matrix G (skew-symmetric, N m s), projected;
+        *damping* already contains it. None when no rotor is built.
+    """
+
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    basis: np.ndarray
+    full_mass: np.ndarray
+    body_coordinates: dict
+    gyroscopic: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
+class Mode:
+    """One linearised mode.
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Undamped natural frequency, Hz.
+    decay_rate : float
+        Modal decay rate sigma, 1/s (free vibration decays as exp(-sigma t)).
+    engine_share : float
+        Share of the modal kinetic energy in the engine, 0 to 1.
+    engine_shape : ndarray, shape (6,)
+        The engine's motion (x, y, z in m; rotations about x, y, z in rad),
+        largest component 1 in magnitude.
+    body_shares : dict of str to float
+        Share of the modal kinetic energy per body.
+    """
+
+    frequency_hz: float
+    decay_rate: float
+    engine_share: float
+    engine_shape: np.ndarray
+    body_shares: dict
+
+    @property
+    def damping_ratio(self) -> float:
+        """Modal damping ratio zeta = sigma / w."""
+        omega = 2 * np.pi * self.frequency_hz
+        return self.decay_rate / omega if omega > 0 else float("inf")
+
+    @property
+    def description(self) -> str:
+        """The engine's dominant motions, or the moving links when the engine is still."""
+        if self.engine_share >= 0.1:
+            return describe_engine_motion(self.engine_shape)
+        moving = sorted(self.body_shares.items(), key=lambda item: -item[1])
+        names = [name for name, share in moving if share >= 0.1 * moving[0][1]][:3]
+        return "motion of " + ", ".join(repr(name) for name in names) + " with the engine still"
+
+
+def _body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
+    import exudyn as exu
+
+    mbs = scene.mbs
+    indices = {}
+    for body, nodes in scene.body_nodes().items():
+        coordinates = []
+        for node in nodes:
+            start = mbs.GetNodeODE2Index(node)
+            size = len(mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates))
+            coordinates.extend(range(start, start + size))
+        indices[body] = np.array(coordinates, dtype=int)
+    return indices
+
+
+def linearize(scene: Scene) -> Linearization:
+    """Linearise *scene* at its initial state (after a static solve with
+    ``updateInitialValues=True``: the preloaded state).
+
+    With rotors built (``scene.gyroscopics``), the gyroscopic matrix is the
+    skew-symmetric part of Exudyn's D in the engine's rotation coordinates
+    (the only skew-symmetric damping of the scene: hinge and Rayleigh damping
+    are symmetric).
+    """
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    mbs = scene.mbs
+    matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
+                                           returnConstraintJacobian=True)
+    mass, stiffness, damping = (np.asarray(m) for m in matrices[:3])
+    size = mass.shape[0]
+    if mbs.systemData.AEsize() > 0:
+        jacobian = np.asarray(matrices[3])
+        left, singular, _ = sla.svd(jacobian)
+        rank = int((singular > 1e-12 * max(singular.max(), 1.0)).sum())
+        basis = left[:, rank:]
+    else:
+        basis = np.eye(size)
+    project = lambda matrix: basis.T @ matrix @ basis  # noqa: E731
+    coordinates = _body_coordinates(scene)
+    gyroscopic = None
+    if scene.gyroscopics is not None:
+        rotations = np.ix_(coordinates[ENGINE][3:], coordinates[ENGINE][3:])
+        gyroscopic = np.zeros_like(damping)
+        gyroscopic[rotations] = (damping[rotations] - damping[rotations].T) / 2
+        gyroscopic = project(gyroscopic)
+    return Linearization(project(mass), project(stiffness), project(damping), basis, mass, coordinates,
+                         gyroscopic)
+
+
+def _eigen(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
+    """Squared circular frequencies (rad^2/s^2) and mode vectors, by ascending frequency.
+
+    Without rotors: ``K x = w^2 M x``. With rotors: the undamped gyroscopic
+    system ``(lambda^2 M + lambda G + K) x = 0`` in first-order form; its
+    eigenvalues come in pairs ``+-i w`` and the one with ``Im lambda > 0``
+    of each pair is kept; of the real ones (free motions near zero, or a
+    negative-stiffness pair ``+-lambda`` counting as ``w^2 = -lambda^2``)
+    the larger half.
+    """
+    if lin.gyroscopic is None:
+        eigenvalues, vectors = sla.eig(lin.stiffness, lin.mass)
+        order = np.argsort(eigenvalues.real)
+        return eigenvalues.real[order], vectors[:, order]
+    size = lin.mass.shape[0]
+    identity, zero = np.eye(size), np.zeros((size, size))
+    eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]),
+                                   np.block([[identity, zero], [zero, lin.mass]]))
+    tolerance = 1e-9 * np.abs(eigenvalues).max()
+    half_plane = np.where(eigenvalues.imag > tolerance, 0, np.where(eigenvalues.imag < -tolerance, 2, 1))
+    keep = np.lexsort((-eigenvalues.real, half_plane))[:size]
+    squared = -(eigenvalues[keep] ** 2).real
+    order = np.argsort(squared)
+    return squared[order], vectors[:size, keep[order]]
+
+
+def modes_of(linearization: Linearization) -> list[Mode]:
+    """All modes of a linearisation, by ascending frequency."""
+    lin = linearization
+    squared_frequencies, vectors = _eigen(lin)
+    modes = []
+    for index, omega_squared in enumerate(squared_frequencies):
+        vector = vectors[:, index]
+        full = lin.basis @ vector
+        kinetic = float(np.real(np.conj(vector) @ lin.mass @ vector))
+        shares = {}
+        for body, coordinates in lin.body_coordinates.items():
+            part = full[coordinates]
+            shares[body] = float(np.real(np.conj(part) @ lin.full_mass[np.ix_(coordinates, coordinates)] @ part)
+                                 / kinetic)
+        engine = _real_shape(full[lin.body_coordinates[ENGINE]])
+        decay = float(np.real(np.conj(vector) @ lin.damping @ vector)) / (2 * kinetic)
+        modes.append(Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), decay, shares[ENGINE],
+                          engine, {b: s for b, s in shares.items() if b != ENGINE}))
+    return modes
+
+
+def _real_shape(part: np.ndarray) -> np.ndarray:
+    """A (possibly complex) mode-shape part turned real, largest component 1:
+    each component's magnitude relative to the largest, negative when it is
+    more than 90 degrees out of phase with it (a whirl mode's pitch and yaw,
+    90 degrees apart, both count)."""
+    peak = part[np.argmax(np.abs(part))]
+    if abs(peak) == 0:
+        return np.zeros(len(part))
+    ratio = part / peak
+    return np.where(ratio.real < -1e-9 * np.abs(ratio), -1.0, 1.0) * np.abs(ratio)
+
+
+def describe_engine_motion(shape: np.ndarray, length_scale: float = 1.0) -> str:
+    """Name the dominant engine motions of a 6-component shape.
+
+    Rotations are weighed by *length_scale* (m) against translations.
+    """
+    weights = np.abs(np.asarray(shape, dtype=float)) * np.r_[1, 1, 1, [length_scale] * 3]
+    if weights.max() == 0:
+        return "no engine motion"
+    order = np.argsort(-weights)
+    parts = [f"{ENGINE_MOTIONS[i]}" + ("" if k == 0 else f" ({weights[i] / weights[order[0]]:.2f})")
+             for k, i in enumerate(order) if weights[i] >= 0.3 * weights[order[0]]]
+    return "engine " + " with ".join(parts)
+
+
+def free_motions(modes: list[Mode]) -> list[Mode]:
+    """The modes below :data:`FREE_FREQUENCY_HZ`: free motions of a mechanism."""
+    return [mode for mode in modes if mode.frequency_hz < FREE_FREQUENCY_HZ]
+
+
+def mounted_modes(modes: list[Mode]) -> list[Mode]:
+    """The engine's modes on its mount (most kinetic energy in the engine)."""
+    return [mode for mode in modes if mode.engine_share >= ENGINE_SHARE and mode.frequency_hz >= FREE_FREQUENCY_HZ]

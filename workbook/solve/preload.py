@@ -1,0 +1,225 @@
+"""Static preload: mechanism check, static solve, equilibrium check.
+
+1. The scene is linearised in its reference configuration; a mode with
+   (near) zero frequency is a free motion and the run stops with
+   :class:`MechanismError` naming it (a ball-jointed mount with a link
+   missing is a mechanism, and a static solve would fail or return absurd
+   forces).
+2. The static loads are solved for (Newton, tolerance scaled to the loads),
+   and the solution becomes the initial state of the dynamic run.
+3. The pylon force - the vector sum of the pylon-side hinge forces, or of
+   the test-rig transducer forces when they are built - must equal the
+   applied static loads (forces on the engine plus the weight of every body;
+   the transducers carry no weight, see
+   :class:`~workbook.model.case.ForceTransducers`) to ``equilibrium_tolerance``,
+   or the run stops with :class:`EquilibriumError`.
+"""
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import numpy as np
+
+from workbook.errors import EquilibriumError, MechanismError
+from workbook.scene.build import Scene
+from workbook.solve.modes import Mode, free_motions, linearize, modes_of
+
+__all__ = ["Preload", "applied_static_force", "check_mechanism",
+           "check_equilibrium", "solve_preload", "spring_roundoff_force", "ROUNDOFF_MARGIN"]
+
+log = logging.getLogger(__name__)
+
+#: Newton tolerances stay this many times above the round-off of the stiffest
+#: spring's force (:func:`spring_roundoff_force`).
+ROUNDOFF_MARGIN = 10.0
+
+
+@dataclass(frozen=True)
+class Preload:
+    """The preloaded equilibrium.
+
+    Attributes
+    ----------
+    hinge_forces : dict of str to ndarray, shape (3,)
+        Static force of each force channel (:attr:`Scene.force_channels`):
+        of each hinge on the pylon (pylon-side hinges) or on the hinge's
+        first body, and of each test-rig transducer on the ground, N.
+    pylon_force : ndarray, shape (3,)
+        Vector sum over the pylon channels (:attr:`Scene.pylon_channels`):
+        the force on the pylon, N.
+    applied_force : ndarray, shape (3,)
+        Sum of the applied static loads (forces and weights), N.
+    relative_mismatch : float
+        ``|pylon_force - applied_force| / |applied_force|``.
+    solved : bool
+        False when the case has no preload (nothing was solved).
+    """
+
+    hinge_forces: dict
+    pylon_force: np.ndarray
+    applied_force: np.ndarray
+    relative_mismatch: float
+    solved: bool
+
+
+def applied_static_force(scene: Scene) -> np.ndarray:
+    """Resultant of the constant forces applied in the scene's Exudyn system, N.
+
+    Read from the system itself, so that loads a script adds to ``scene.mbs``
+    count too: every ``LoadForceVector`` without a user function and every
+    ``LoadMassProportional`` times its body's mass. Loads with user functions
+    (the excitation, paused during the static solve) do not count.
+
+    Raises
+    ------
+    ValueError
+        For a mass-proportional load on a body whose mass is unknown.
+    """
+    mbs = scene.mbs
+    masses = {scene.engine.body: scene.case.engine.mass}
+    masses.update({link.body: link.mass for link in scene.links.values()})
+    total = np.zeros(3)
+    for index in range(mbs.systemData.NumberOfLoads()):
+        load = mbs.GetLoad(index)
+        if load["loadType"] not in ("ForceVector", "MassProportional") or load["loadVectorUserFunction"] != 0:
+            continue
+        vector = np.asarray(load["loadVector"], dtype=float)
+        if load["loadType"] == "ForceVector":
+            total += vector
+            continue
+        body = mbs.GetMarker(load["markerNumber"])["bodyNumber"]
+        mass = masses.get(body, mbs.GetObject(body).get("mass"))
+        if mass is None:
+            raise ValueError(f"load {load['name']!r}: mass of body {body} unknown for the equilibrium check")
+        total += mass * vector
+    return total
+
+
+def spring_roundoff_force(scene: Scene) -> float:
+    """Force the static Newton iteration can resolve on the stiffest spring, N.
+
+    A spring force ``k (p1 - p0)`` is computed from positions of size
+    ``|p|``, known to the machine epsilon ``eps``: its round-off is
+    ``k eps |p|``, which a Newton tolerance must not undercut (a 1e12 N/m
+    transducer 1.7 m from the origin: 4e-4 N, ten times the default
+    tolerance on the reference mount). Returned with a margin of
+    :data:`ROUNDOFF_MARGIN`.
+    """
+    case = scene.case
+    stiffness = [max(h.stiffness, h.gap_contact_stiffness) for h in case.hinges]
+    if scene.transducers:
+        stiffness += list(case.test_rig.stiffness)
+    reach = max((float(np.abs(h.position).max()) for h in case.hinges), default=0.0)
+    return ROUNDOFF_MARGIN * max(stiffness, default=0.0) * np.finfo(float).eps * max(reach, 1.0)
+
+
+def check_mechanism(scene: Scene) -> list[Mode]:
+    """Linearise the scene as built and stop if it has free motions.
+
+    Returns
+    -------
+    list of Mode
+        All modes of the unloaded scene.
+
+    Raises
+    ------
+    MechanismError
+        Naming each free motion.
+    """
+    # a clearance restrains once its gap closes: check with the gaps closed
+    with scene.gaps_closed():
+        modes = modes_of(linearize(scene))
+    free = free_motions(modes)
+    if free:
+        case = scene.case
+        hinged = {(body, case.link_map[body].eye_at(h.position)) for h in case.hinges for body in h.bodies
+                  if body in case.link_map}
+        loose = [f"link {link.name!r} eye {eye.upper()} at {getattr(link, 'end_' + eye)} m"
+                 for link in case.links for eye in ("a", "b") if (link.name, eye) not in hinged]
+        raise MechanismError(case.name, [mode.description for mode in free], loose)
+    return modes
+
+
+def solve_preload(scene: Scene) -> Preload:
+    """Check for mechanisms, solve the static equilibrium, check it.
+
+    The solution is written to the scene's initial values, so a following
+    dynamic run starts preloaded.
+
+    Raises
+    ------
+    MechanismError
+        The mount has a free motion.
+    EquilibriumError
+        The static solve failed, or the pylon force (pylon-side hinges or
+        rig transducers) differs from the applied static loads by more than
+        the case's tolerance.
+    """
+    import exudyn as exu
+
+    check_mechanism(scene)
+    case = scene.case
+    tolerance = case.analysis.equilibrium_tolerance
+    if case.effects.preload and scene.static_loads:
+        settings = exu.SimulationSettings()
+        settings.solution.file.write = False
+        settings.solution.sensors.writePeriod = 1.0
+        # Newton a thousand times tighter than the check (not below round-off,
+        # neither of the loads nor of the stiffest spring's force)
+        relative = max(1e-3 * tolerance, 1e-12)
+        settings.staticSolver.newton.absoluteTolerance = max(relative * scene.load_scale,
+                                                             spring_roundoff_force(scene))
+        settings.staticSolver.newton.relativeTolerance = relative
+        # keep the tolerance relative to the loads: a first Newton step that
+        # overshoots (a closed clearance gap) must not loosen it
+        settings.staticSolver.newton.adaptInitialResidual = False
+        settings.staticSolver.verboseMode = 0
+        try:
+            with scene.excitation_paused():
+                converged = scene.mbs.SolveStatic(settings, updateInitialValues=True)
+        except exu.SolverError as error:
+            raise EquilibriumError(f"case {case.name!r}: the static solve failed: {error}") from error
+        if not converged:
+            raise EquilibriumError(f"case {case.name!r}: the static solve did not converge "
+                                   f"(load scale {scene.load_scale:.4g} N)")
+    forces = scene.hinge_forces()
+    pylon = sum((forces[name] for name in scene.pylon_channels), np.zeros(3))
+    applied = applied_static_force(scene)
+    mismatch = check_equilibrium(case.name, pylon, applied, tolerance, scene.load_scale)
+    log.info("preload of %r: pylon force %s N, relative mismatch %.1e", case.name, np.round(pylon, 1), mismatch)
+    return Preload(forces, pylon, applied, mismatch, bool(case.effects.preload and scene.static_loads))
+
+
+def check_equilibrium(case_name: str, pylon_force, applied_force, tolerance: float, load_scale: float) -> float:
+    """Compare the pylon force with the applied static loads.
+
+    Parameters
+    ----------
+    case_name : str
+    pylon_force, applied_force : array_like, shape (3,)
+        N.
+    tolerance : float
+        Largest relative mismatch.
+    load_scale : float
+        Reference force when no static force is applied, N.
+
+    Returns
+    -------
+    float
+        The relative mismatch.
+
+    Raises
+    ------
+    EquilibriumError
+        If the mismatch exceeds the tolerance.
+    """
+    pylon, applied = np.asarray(pylon_force, dtype=float), np.asarray(applied_force, dtype=float)
+    reference = np.linalg.norm(applied) if np.linalg.norm(applied) > 0 else load_scale
+    mismatch = float(np.linalg.norm(pylon - applied) / reference)
+    if not mismatch <= tolerance:
+        raise EquilibriumError(
+            f"case {case_name!r}: the pylon-side hinge forces sum to {np.round(pylon, 3).tolist()} N but the "
+            f"applied static loads sum to {np.round(applied, 3).tolist()} N (relative mismatch {mismatch:.2e} "
+            f"> {tolerance:.0e}); the preload is not trustworthy")
+    return mismatch

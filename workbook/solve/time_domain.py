@@ -1,0 +1,340 @@
+"""Time-domain run of one excitation: plan, integrate, extract amplitudes.
+
+The plan (all whole excitation periods):
+
+- step: one period / ``steps_per_period`` (the highest excitation frequency of
+  the run sets it; 40 steps per period or more);
+- ramp: the excitation rises smoothly over ``ramp_periods`` periods;
+- settle: ``settle_time_constants`` decay time constants ``1 / (zeta w)`` of
+  the least damped mounted mode (or a fixed ``settle_time``); undamped modes
+  (zeta below :data:`workbook.solve.guards.UNDAMPED_RATIO`) cannot settle and are
+  reported instead;
+- two measured windows of ``measured_periods`` periods each.
+
+Integration: Exudyn's implicit generalized-alpha with modified Newton, from
+the preloaded state, in segments: the ramp and settle time in at most
+:data:`TRANSIENT_SEGMENTS` segments with the hinge-force sensors not
+storing, then the two measured windows as one segment with the sensors
+storing every step. Memory therefore grows with the measured windows only,
+not with the length of the run. Between segments the run is checked
+(:mod:`workbook.solve.guards`): a segment whose Newton iteration fails is run
+again with the step halved (at most ``step_halvings`` times); a run-away
+engine or a NaN stops the run; so does an exhausted ``time_budget``.
+Restarting generalized-alpha at a segment boundary recomputes the
+accelerations from the equations of motion; on the reference mount (rigid
+links, LP rotor) this moved T_x and T_z by less than 1e-6 and the nearly
+cancelled T_y (0.0012) by 2.4e-4 relative against one unbroken run.
+
+Extraction: the amplitude at the excitation frequency by single-bin DFT of
+the mean-removed last window, per hinge and for the pylon sum; the run is
+steady when the pylon amplitudes of the two windows agree within
+``steady_tolerance``, else the result carries a warning.
+"""
+from __future__ import annotations
+
+import logging
+import math
+import time as wall_clock
+from dataclasses import dataclass, field
+from typing import Callable, Union
+
+import numpy as np
+
+from workbook.answers.amplitude import harmonic_amplitude, steady_amplitude
+from workbook.answers.results import ExcitationResult
+from workbook.errors import DivergenceError, NewtonFailure, RunTooLong, TimeBudgetExceeded
+from workbook.model.case import AnalysisSettings
+from workbook.scene.build import Scene
+from workbook.scene.excitation import ExcitationSignal
+from workbook.solve.guards import MAX_STEPS, UNDAMPED_RATIO, check_undamped_resonance, newton_cause, run_label
+from workbook.solve.modes import Mode
+
+__all__ = ["TimePlan", "plan_run", "integrate", "extract", "TimeHistories", "TRANSIENT_SEGMENTS"]
+
+log = logging.getLogger(__name__)
+
+#: The ramp and settle time are integrated in at most this many segments
+#: (checks, progress and the time budget act between segments).
+TRANSIENT_SEGMENTS = 50
+
+
+@dataclass(frozen=True)
+class TimePlan:
+    """Step size and durations of one run.
+
+    Attributes
+    ----------
+    frequency_hz : float
+        Excitation frequency, Hz.
+    step : float
+        Time step, s.
+    steps_per_period : int
+    ramp_periods, settle_periods, measured_periods : int
+        Whole periods of the smooth start, of the settling after it, and of
+        each of the two measured windows.
+    settle_reason : str
+        How the settle time was chosen.
+    undamped_hz : tuple of float
+        Mounted modes without damping, Hz: their free vibration started by
+        the ramp never decays.
+    """
+
+    frequency_hz: float
+    step: float
+    steps_per_period: int
+    ramp_periods: int
+    settle_periods: int
+    measured_periods: int
+    settle_reason: str
+    undamped_hz: tuple = ()
+
+    @property
+    def periods(self) -> int:
+        """Total periods simulated."""
+        return self.ramp_periods + self.settle_periods + 2 * self.measured_periods
+
+    @property
+    def steps(self) -> int:
+        return self.periods * self.steps_per_period
+
+    @property
+    def end_time(self) -> float:
+        """s."""
+        return self.steps * self.step
+
+    def segments(self) -> list[tuple[int, int, bool]]:
+        """The integration segments as ``(first step, last step, store)``.
+
+        The ramp and settle time in at most :data:`TRANSIENT_SEGMENTS`
+        segments of whole periods, not stored; then the two measured windows
+        as one stored segment.
+        """
+        transient = self.ramp_periods + self.settle_periods
+        per_segment = max(1, math.ceil(transient / TRANSIENT_SEGMENTS))
+        bounds = list(range(0, transient, per_segment)) + [transient]
+        segments = [(a * self.steps_per_period, b * self.steps_per_period, False)
+                    for a, b in zip(bounds, bounds[1:])]
+        return segments + [(transient * self.steps_per_period, self.steps, True)]
+
+
+def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, mounted: list[Mode], where: str = "run"
+             ) -> TimePlan:
+    """Choose the step and the durations of a run.
+
+    Parameters
+    ----------
+    analysis : AnalysisSettings
+    signal : ExcitationSignal
+    mounted : list of Mode
+        The mounted modes of the preloaded scene; the least damped one sets
+        the settle time unless the settings fix it.
+    where : str
+        Case and run, for error messages.
+
+    Raises
+    ------
+    ResonanceError
+        The excitation lies on an undamped mounted mode, closer than the
+        measured window can tell apart (1 / ``measured_periods``).
+    RunTooLong
+        The plan has more than :data:`workbook.solve.guards.MAX_STEPS` steps.
+    """
+    frequency = signal.frequency_hz
+    period = 1.0 / frequency
+    check_undamped_resonance(
+        where, frequency, mounted, 1.0 / analysis.measured_periods,
+        f"the free vibration started by the ramp never decays, and a {analysis.measured_periods}-period window "
+        f"cannot tell it from the response (on the mode itself the response grows without bound)")
+    damped = [m for m in mounted if m.damping_ratio >= UNDAMPED_RATIO]
+    undamped = tuple(m.frequency_hz for m in mounted if m.damping_ratio < UNDAMPED_RATIO)
+    if analysis.settle_time is not None:
+        settle, reason = analysis.settle_time, f"fixed settle time {analysis.settle_time:g} s"
+    elif not damped:
+        lowest = min((m.frequency_hz for m in mounted), default=frequency)
+        settle = 20.0 / lowest
+        reason = "undamped mounted modes: 20 periods of the lowest one (the transient will not decay)"
+    else:
+        slowest = min(damped, key=lambda m: m.decay_rate)
+        settle = analysis.settle_time_constants / slowest.decay_rate
+        reason = (f"{analysis.settle_time_constants:g} x 1/(zeta w) = {settle:.3g} s of the least damped "
+                  f"mounted mode ({slowest.frequency_hz:.3g} Hz, zeta {slowest.damping_ratio:.3g})")
+    plan = TimePlan(frequency, period / analysis.steps_per_period, analysis.steps_per_period,
+                    math.ceil(analysis.ramp_periods - 1e-9), math.ceil(settle * frequency - 1e-9),
+                    analysis.measured_periods, reason, undamped)
+    if plan.steps > MAX_STEPS:
+        raise RunTooLong(f"{where}: the plan needs {plan.steps:.3g} time steps ({plan.end_time:.3g} s simulated; "
+                         f"settle time: {reason}), more than {MAX_STEPS:.0e}. Add damping, set a fixed settle time "
+                         f"or answer the case in the frequency domain.")
+    return plan
+
+
+@dataclass
+class TimeHistories:
+    """Stored histories of one run.
+
+    Attributes
+    ----------
+    time : ndarray, shape (n,)
+        s; the measured windows only.
+    hinge_forces : dict of str to ndarray, shape (n, 3)
+        Force of each force channel (``Scene.force_channels``): each hinge on the
+        pylon (pylon-side hinges) or on its first body, each rig transducer on the ground, N.
+    retries : list of str
+        Segments run again with a smaller step after a Newton failure: when,
+        which step, why.
+    """
+
+    time: np.ndarray
+    hinge_forces: dict
+    retries: list = field(default_factory=list)
+
+
+def _simulation_settings(scene: Scene, plan: TimePlan):
+    import exudyn as exu
+
+    analysis = scene.case.analysis
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    settings.solution.sensors.writePeriod = plan.step
+    integration = settings.timeIntegration
+    integration.verboseMode = 0
+    # a failed segment is re-run by integrate() with a halved step; Exudyn's own
+    # step adaptation would sample the measured window unevenly
+    integration.adaptiveStep = False
+    integration.generalizedAlpha.spectralRadius = analysis.spectral_radius
+    integration.newton.useModifiedNewton = True
+    integration.newton.absoluteTolerance = analysis.newton_tolerance * scene.load_scale
+    return settings
+
+
+def _advance_initial_state(mbs) -> None:
+    """Make the state reached the initial state of the next segment."""
+    import exudyn as exu
+
+    data = mbs.systemData
+    data.SetSystemState(systemStateList=data.GetSystemState(), configuration=exu.ConfigurationType.Initial)
+    data.SetODE2Coordinates_tt(coordinates=data.GetODE2Coordinates_tt(), configuration=exu.ConfigurationType.Initial)
+
+
+def _solve_segment(scene: Scene, settings, plan: TimePlan, first: int, last: int, where: str,
+                   retries: list) -> None:
+    """Integrate steps *first* to *last*, halving the step after a Newton failure."""
+    import exudyn as exu
+
+    integration = settings.timeIntegration
+    start, end = first * plan.step, last * plan.step
+    halvings = scene.case.analysis.step_halvings
+    cause = ""
+    for halving in range(halvings + 1):
+        integration.startTime, integration.endTime = start, end
+        integration.numberOfSteps = (last - first) * 2 ** halving
+        solver = exu.MainSolverImplicitSecondOrder()
+        if solver.SolveSystem(scene.mbs, settings):
+            _advance_initial_state(scene.mbs)
+            if halving:
+                retries.append(f"{start:.6g} to {end:.6g} s: step halved {halving} time(s) to "
+                               f"{plan.step / 2 ** halving:.3g} s after: {cause}")
+                log.info("%s: %s", where, retries[-1])
+            return
+        cause = newton_cause(solver.conv)
+    raise NewtonFailure(where, start, end, plan.step / 2 ** halvings, halvings, cause)
+
+
+def _check_motion(scene: Scene, preloaded: np.ndarray, simulated: float, where: str) -> None:
+    """Stop on NaN or infinite coordinates, or on a run-away engine."""
+    import exudyn as exu
+
+    coordinates = np.asarray(scene.mbs.systemData.GetODE2Coordinates())
+    if not np.all(np.isfinite(coordinates)):
+        raise DivergenceError(f"{where}: at t = {simulated:.6g} s the solution contains NaN or infinite values: "
+                              f"the integration diverged")
+    position = np.asarray(scene.mbs.GetNodeOutput(scene.engine.node, exu.OutputVariableType.Position))
+    moved = float(np.linalg.norm(position - preloaded))
+    limit = scene.case.analysis.divergence_displacement
+    if moved > limit:
+        raise DivergenceError(
+            f"{where}: at t = {simulated:.6g} s the engine's centre of gravity is {1e3 * moved:.4g} mm from its "
+            f"preloaded position (limit {1e3 * limit:g} mm, divergence_displacement): the motion diverges. "
+            f"Check the hinge stiffnesses and damping, or raise the limit if such motion is meant.")
+
+
+def integrate(scene: Scene, plan: TimePlan, progress: Union[Callable[[float], None], None] = None
+              ) -> TimeHistories:
+    """Run generalized-alpha over the plan from the scene's initial (preloaded) state.
+
+    The scene's initial state is advanced segment by segment and ends as
+    the state at the end of the run.
+
+    Parameters
+    ----------
+    scene : Scene
+        With an excitation; solved for its preload.
+    plan : TimePlan
+    progress : callable, optional
+        Called with the simulated time after each segment, s.
+
+    Raises
+    ------
+    NewtonFailure
+        Newton's method failed in a segment even at the smallest step.
+    DivergenceError
+        The engine ran away, or a value became NaN or infinite.
+    TimeBudgetExceeded
+        The run used up the case's ``time_budget``.
+    """
+    import exudyn as exu
+
+    analysis = scene.case.analysis
+    where = run_label(scene.case.name, scene.excitation.name)
+    settings = _simulation_settings(scene, plan)
+    preloaded = np.asarray(scene.mbs.GetNodeOutput(scene.engine.node, exu.OutputVariableType.Position,
+                                                   configuration=exu.ConfigurationType.Initial))
+    began = wall_clock.perf_counter()
+    retries = []
+    for first, last, store in plan.segments():
+        for items in scene.force_channels.values():
+            scene.mbs.SetSensorParameter(items.sensor, "storeInternal", store)
+        _solve_segment(scene, settings, plan, first, last, where, retries)
+        _check_motion(scene, preloaded, last * plan.step, where)
+        if progress is not None:
+            progress(last * plan.step)
+        elapsed = wall_clock.perf_counter() - began
+        if analysis.time_budget is not None and elapsed > analysis.time_budget and last < plan.steps:
+            raise TimeBudgetExceeded(where, analysis.time_budget, elapsed, last * plan.step, plan.end_time)
+    forces = {name: scene.mbs.GetSensorStoredData(items.sensor) for name, items in scene.force_channels.items()}
+    time = next(iter(forces.values()))[:, 0] if forces else np.zeros(0)
+    histories = TimeHistories(time, {name: data[:, 1:4] for name, data in forces.items()}, retries)
+    if not all(np.all(np.isfinite(f)) for f in histories.hinge_forces.values()):
+        raise DivergenceError(f"{where}: the stored hinge forces contain NaN or infinite values")
+    return histories
+
+
+def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> ExcitationResult:
+    """Amplitudes at the excitation frequency, the steady-state check and warnings."""
+    analysis = scene.case.analysis
+    signal = scene.excitation.signal
+    time = histories.time
+    pylon = sum((histories.hinge_forces[name] for name in scene.pylon_channels), np.zeros((len(time), 3)))
+    steady = steady_amplitude(time, pylon, plan.frequency_hz, plan.measured_periods, analysis.steady_tolerance)
+    window = steady.window
+    hinge_amplitudes = {name: np.abs(harmonic_amplitude(time[window], forces[window], plan.frequency_hz))
+                        for name, forces in histories.hinge_forces.items()}
+    warnings = []
+    if not steady.steady:
+        warnings.append(
+            f"not steady: the pylon-force amplitudes of the last two {plan.measured_periods}-period windows "
+            f"differ by {100 * steady.relative_change:.2f} % (> {100 * analysis.steady_tolerance:.2g} %); "
+            f"lengthen the settle time or check the damping")
+        log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
+    if plan.undamped_hz:
+        warnings.append(
+            f"undamped mounted modes at {', '.join(f'{f:.4g}' for f in plan.undamped_hz)} Hz: the free vibration "
+            f"started by the ramp never decays and is part of the measured forces; the frequency domain gives "
+            f"the steady answer")
+        log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
+    return ExcitationResult(
+        name=scene.excitation.name, frequency_hz=plan.frequency_hz, excitation_amplitude=signal.amplitude,
+        pylon_amplitude=steady.amplitude, hinge_amplitudes=hinge_amplitudes, pylon_hinges=list(scene.pylon_channels),
+        steady_change=steady.relative_change, steady_tolerance=analysis.steady_tolerance, warnings=warnings,
+        time=time, hinge_histories=histories.hinge_forces, pylon_history=pylon,
+        excitation_history=signal.force(time), window=window)

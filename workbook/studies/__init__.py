@@ -1,0 +1,1 @@
+"""Studies over many runs: the accuracy-against-time ladder and parameter studies."""

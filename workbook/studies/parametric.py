@@ -1,0 +1,217 @@
+"""Parameter studies: which case parameters vary, the study rows, and each row's case.
+
+A study is a tuple of rows; a row maps parameter names to values. Each row's
+case is the base case with those values put in (``dataclasses.replace`` on
+the frozen case), so that a row is plain picklable data for a worker.
+
+Parameters (SI units):
+
+=================  =====  ====================================================
+name               unit   what it sets
+=================  =====  ====================================================
+hinge_stiffness    N/m    translational stiffness of every hinge
+hinge_damping      N s/m  translational damping of every hinge
+clearance          m      radial clearance of every hinge
+section_scale      -      factor on the cross-section of every link (shank width
+                          and thickness, eye thickness)
+material           text   preset material of every link (steel, titanium)
+frequency          Hz     frequency of every single-frequency excitation
+removed_link       text   a link removed with its hinges (``none``: all kept)
+=================  =====  ====================================================
+
+Rows come from lists or ranges (:func:`grid`, all combinations) or from a
+Latin hypercube over ranges (:func:`latin_hypercube`).
+"""
+from __future__ import annotations
+
+import dataclasses
+import itertools
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from workbook.errors import CaseError
+from workbook.model.case import Case, HarmonicForce, RotatingForce
+
+__all__ = ["Parameter", "PARAMETERS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases"]
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A parameter a study may vary.
+
+    Attributes
+    ----------
+    name : str
+    unit : str
+        SI unit (``-`` for none, ``text`` for a choice).
+    help : str
+    apply : callable
+        ``apply(case, value) -> Case``.
+    """
+
+    name: str
+    unit: str
+    help: str
+    apply: Callable[[Case, Any], Case]
+
+    @property
+    def numeric(self) -> bool:
+        return self.unit != "text"
+
+
+def _hinges(case: Case, **changes) -> Case:
+    return dataclasses.replace(case, hinges=tuple(dataclasses.replace(h, **changes) for h in case.hinges))
+
+
+def _link_models(case: Case, change: Callable, parameter: str, value: Any) -> Case:
+    links = []
+    for link in case.links:
+        if link.model.geometry is None:
+            raise CaseError(f"link {link.name!r}", "model", "a mesh file", "a parametric link geometry")
+        try:
+            links.append(dataclasses.replace(link, model=change(link.model)))
+        except ValueError as error:  # flexbodies rejects the changed geometry or material
+            raise CaseError(f"link {link.name!r}", parameter, value, f"a value giving a valid link ({error})") from None
+    return dataclasses.replace(case, links=tuple(links))
+
+
+def _section(case: Case, scale: float) -> Case:
+    if not scale > 0:
+        raise CaseError("study", "section_scale", scale, "a positive factor")
+
+    def change(model):
+        geometry = model.geometry
+        return dataclasses.replace(model, geometry=dataclasses.replace(
+            geometry, shank_width=geometry.shank_width * scale, shank_thickness=geometry.shank_thickness * scale,
+            thickness=geometry.thickness * scale))
+
+    return _link_models(case, change, "section_scale", scale)
+
+
+def _material(case: Case, name: str) -> Case:
+    from flexbodies import material
+
+    try:
+        preset = material(name)
+    except ValueError as error:
+        raise CaseError("study", "material", name, str(error)) from None
+    return _link_models(case, lambda model: dataclasses.replace(model, material=preset), "material", name)
+
+
+def _frequency(case: Case, frequency_hz: float) -> Case:
+    excitations = []
+    for excitation in case.excitations:
+        if not isinstance(excitation, (RotatingForce, HarmonicForce)):
+            raise CaseError(f"excitation {excitation.name!r}", "frequency", frequency_hz,
+                            "a single-frequency excitation (a sweep sets its own frequencies)")
+        excitations.append(dataclasses.replace(excitation, frequency_hz=float(frequency_hz), rpm=None))
+    return dataclasses.replace(case, excitations=tuple(excitations))
+
+
+PARAMETERS = {p.name: p for p in (
+    Parameter("hinge_stiffness", "N/m", "translational stiffness of every hinge",
+              lambda case, v: _hinges(case, stiffness=float(v))),
+    Parameter("hinge_damping", "N*s/m", "translational damping of every hinge",
+              lambda case, v: _hinges(case, damping=float(v))),
+    Parameter("clearance", "m", "radial clearance of every hinge",
+              lambda case, v: _hinges(case, radial_clearance=float(v))),
+    Parameter("section_scale", "-", "factor on the cross-section of every link (shank width and thickness, "
+              "eye thickness)",
+              lambda case, v: _section(case, float(v))),
+    Parameter("material", "text", "preset material of every link (steel, titanium)", _material),
+    Parameter("frequency", "Hz", "frequency of every single-frequency excitation", _frequency),
+    Parameter("removed_link", "text", "a link removed with its hinges (none: all kept)",
+              lambda case, name: case if name == "none" else case.without_link(name)),
+)}
+
+
+def _check_names(names) -> None:
+    unknown = [n for n in names if n not in PARAMETERS]
+    if unknown:
+        raise ValueError(f"unknown study parameter(s) {', '.join(map(repr, unknown))}; "
+                         f"known: {', '.join(PARAMETERS)}")
+
+
+def grid(values: dict[str, list]) -> tuple[dict, ...]:
+    """Every combination of the listed values, the last parameter varying fastest.
+
+    Parameters
+    ----------
+    values : dict of str to list
+        Values per parameter (SI units).
+
+    Returns
+    -------
+    tuple of dict
+    """
+    _check_names(values)
+    names = list(values)
+    return tuple(dict(zip(names, combination)) for combination in itertools.product(*values.values()))
+
+
+def linear_range(start: float, stop: float, points: int) -> list[float]:
+    """*points* evenly spaced values from *start* to *stop*."""
+    if points < 1:
+        raise ValueError(f"a range needs at least one point, got {points}")
+    return [float(v) for v in np.linspace(start, stop, points)]
+
+
+def latin_hypercube(bounds: dict[str, tuple[float, float]], samples: int, seed: int = 0) -> tuple[dict, ...]:
+    """*samples* rows of a Latin hypercube over the numeric ranges *bounds*.
+
+    Parameters
+    ----------
+    bounds : dict of str to (low, high)
+        Range per numeric parameter (SI units).
+    samples : int
+    seed : int
+        Seed of :class:`scipy.stats.qmc.LatinHypercube`.
+
+    Returns
+    -------
+    tuple of dict
+    """
+    from scipy.stats import qmc
+
+    _check_names(bounds)
+    text = [n for n in bounds if not PARAMETERS[n].numeric]
+    if text:
+        raise ValueError(f"a Latin hypercube needs numeric ranges; {', '.join(text)} takes a list")
+    if samples < 1:
+        raise ValueError(f"a Latin hypercube needs at least one sample, got {samples}")
+    unit = qmc.LatinHypercube(d=len(bounds), seed=seed).random(samples)
+    low, high = np.array(list(bounds.values()), dtype=float).T
+    points = qmc.scale(unit, low, high) if len(bounds) else unit
+    return tuple({name: float(value) for name, value in zip(bounds, row)} for row in points)
+
+
+def row_case(case: Case, row: dict, index: int) -> Case:
+    """The case of study row *index*: *case* with the row's parameter values.
+
+    Raises
+    ------
+    CaseError
+        A value the case rejects (e.g. a stiffness of 0).
+    """
+    _check_names(row)
+    for name, value in row.items():
+        case = PARAMETERS[name].apply(case, value)
+    return dataclasses.replace(case, name=f"{case.name} / row {index}")
+
+
+def study_cases(case: Case, rows: tuple) -> list:
+    """The case of every row, or the CaseError that row's values raise.
+
+    Returns
+    -------
+    list of Case or CaseError
+    """
+    cases = []
+    for index, row in enumerate(rows):
+        try:
+            cases.append(row_case(case, row, index))
+        except CaseError as error:
+            cases.append(error)
+    return cases
