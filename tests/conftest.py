@@ -1,12 +1,25 @@
-"""Shared test set-up: single-threaded BLAS and a per-session reduction cache."""
+"""Shared test set-up: single-threaded BLAS, a per-session reduction cache and
+the coarse reference mount several test modules run."""
 import os
 
 import pytest
 from threadpoolctl import threadpool_limits
 
+from workbook.model.case import AnalysisSettings
+from workbook.model.reference import reference_case
+
 # Multithreaded BLAS makes the small dense solves of this package erratic and
 # many times slower on a shared 2-core machine.
 _blas_limit = threadpool_limits(limits=1)
+
+#: Link mesh element size of the coarse reference mount, m: the checks that
+#: use it compare runs with each other, not with the converged mesh.
+COARSE_ELEMENT_SIZE = 0.03
+
+#: Short but steady time runs: the 10-period smooth start leaves the mounted
+#: modes almost unexcited, so half a decay time constant of settling and
+#: 10-period windows suffice (the steady checks of the tests confirm it).
+SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -15,3 +28,9 @@ def cache_dir(tmp_path_factory):
     path = tmp_path_factory.mktemp("reduction-cache")
     os.environ["MOUNTWB_CACHE"] = str(path)
     return path
+
+
+@pytest.fixture(scope="session")
+def coarse_reference(cache_dir):
+    """The reference mount (LP and HP rotors) with coarse link meshes and short time runs."""
+    return reference_case(element_size=COARSE_ELEMENT_SIZE, analysis=SHORT)

@@ -1,15 +1,24 @@
 """`mountwb links`: what each link of the reference mount became, and why."""
 import numpy as np
+import pytest
 
 from flexbodies.selection import LOW_FREQUENCY_RATIO
 from workbook.answers.link_table import link_table
 from workbook.cli.main import main
-from workbook.model.reference import reference_case
+from workbook.model.codec import to_json
 from workbook.scene.build import reduce_links
 
 
-def test_link_table_follows_the_low_frequency_rule(cache_dir):
-    case = reference_case()
+@pytest.fixture(scope="module")
+def coarse_case_file(coarse_reference, tmp_path_factory):
+    """The coarse reference mount as a JSON case: these tests are about the table and the cache, not the mesh."""
+    path = tmp_path_factory.mktemp("links") / "coarse.json"
+    path.write_text(to_json(coarse_reference))
+    return path
+
+
+def test_link_table_follows_the_low_frequency_rule(coarse_reference):
+    case = coarse_reference
     table = link_table(case, reduce_links(case))
     assert list(table.index) == [link.name for link in case.links]
     rule_met = table["f_exc/f1"] < LOW_FREQUENCY_RATIO
@@ -22,13 +31,13 @@ def test_link_table_follows_the_low_frequency_rule(cache_dir):
     assert table["why"].str.contains("rule met|rule not met").all()
 
 
-def test_links_command_prints_every_link_and_reuses_the_cache(cache_dir, capsys, tmp_path):
-    assert main(["links", "--export", str(tmp_path)]) == 0
+def test_links_command_prints_every_link_and_reuses_the_cache(coarse_reference, coarse_case_file, capsys, tmp_path):
+    assert main(["links", str(coarse_case_file), "--export", str(tmp_path)]) == 0
     output = capsys.readouterr().out
-    case = reference_case()
+    case = coarse_reference
     for link in case.links:
         assert f"{link.name}: low-frequency rule" in output
         assert (tmp_path / f"{link.name}.npz").is_file()
-    assert main(["links"]) == 0
+    assert main(["links", str(coarse_case_file)]) == 0
     rows = [line for line in capsys.readouterr().out.splitlines() if line.split()[:1] in ([link.name] for link in case.links)]
     assert len(rows) == len(case.links) and all(row.rstrip().endswith("hit") for row in rows)

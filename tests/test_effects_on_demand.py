@@ -38,6 +38,7 @@ def _spring_laws(scene):
             for items in scene.hinges.values()]
 
 
+@pytest.mark.slow
 def test_no_contact_law_without_clearance(rigid):
     plain = build_scene(rigid, LP_ROTOR)
     assert all(law == 0 for law in _spring_laws(plain))
@@ -64,6 +65,7 @@ def test_no_hinge_damping_when_switched_off(rigid):
     assert all(np.all(np.asarray(d) == 0) for d in damping(undamped))
 
 
+@pytest.mark.slow
 def test_the_low_frequency_rule_builds_no_fixed_interface_modes(cache_dir):
     """At 59 Hz the front and rear links (mounted f1 above 600 Hz) meet the
     rule and carry static modes only; the thrust rods (f1 about 100 Hz) do not."""

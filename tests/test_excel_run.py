@@ -95,11 +95,13 @@ def _sheet_rows(ws, header_row=2):
             if any(v is not None for v in values)]
 
 
+@pytest.mark.slow
 def test_input_sheets_are_unchanged(ran):
     path, before, _, _ = ran
     assert _snapshot(path) == before
 
 
+@pytest.mark.slow
 def test_results_written_back_match_a_python_run(ran):
     path = ran[0]
     wb = load_workbook(path)
@@ -141,6 +143,7 @@ def test_run_on_the_test_rig(tmp_path):
     assert [sheet[d]["T"] for d in "xyz"] == pytest.approx(list(python.transmissibility), rel=1e-9)
 
 
+@pytest.mark.slow
 def test_test_data_error(ran):
     wb = load_workbook(ran[0])
     lp_y = next(r for r in _sheet_rows(wb["Result efficiency"]) if r["run"] == "LP rotor" and r["direction"] == "y")
@@ -153,6 +156,7 @@ def test_test_data_error(ran):
     assert all(r["error %"] is None for r in others)
 
 
+@pytest.mark.slow
 def test_report_workbook(ran):
     path, _, digest, report = ran
     wb = load_workbook(report)

@@ -204,6 +204,7 @@ def test_reference_link_free_free_frequency(reference_link):
     assert 15_000 <= reference_link.ndof <= 25_000
 
 
+@pytest.mark.slow
 def test_reference_link_mesh_convergence(reference_link):
     """Default size against a 7 mm mesh (~33k DOF): first two modes within 1 %."""
     fine = assemble(mesh_link(REFERENCE, element_size=0.007), STEEL)

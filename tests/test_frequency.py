@@ -8,7 +8,6 @@ from test_sdof import NATURAL_HZ, closed_form, sdof_case
 
 from workbook.answers.results import PYLON_SUM
 from workbook.model.case import AnalysisSettings, Effects, Sweep
-from workbook.model.reference import reference_case
 from workbook.scene.build import build_scene, reduce_links
 from workbook.solve.frequency_pipeline import prepare
 from workbook.solve.method import choose_method
@@ -18,20 +17,19 @@ from workbook.solve.preload import solve_preload
 from workbook.solve.sweep import run_sweep
 from workbook.solve.time_domain import TimePlan, integrate
 
-# as in test_mount_time: coarse link meshes, short but steady time runs
-ELEMENT_SIZE = 0.03
-SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
+# the coarse reference mount of conftest: coarse link meshes, short but steady time runs
 
 
 @pytest.fixture(scope="module")
-def reference(cache_dir):
-    return reference_case(element_size=ELEMENT_SIZE, analysis=SHORT)
+def reference(coarse_reference):
+    return coarse_reference
 
 
 def _with_method(case, method):
     return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method=method))
 
 
+@pytest.mark.slow
 def test_frequency_domain_matches_time_domain_on_the_reference_mount(reference):
     time_result = run_case(reference)
     frequency_result = run_case(_with_method(reference, "frequency"))
@@ -92,6 +90,7 @@ def _spectral_peak(time, signal):
     return (k + shift) / (size * (time[1] - time[0]))
 
 
+@pytest.mark.slow
 def test_mounted_modes_match_a_free_vibration_run(reference):
     """Undamped scene, preloaded; started with the velocity of one mounted mode,
     it vibrates at that mode's frequency (spectral peak of a hinge force)."""
@@ -125,6 +124,7 @@ def test_mounted_modes_match_a_free_vibration_run(reference):
         assert peak == pytest.approx(mode.frequency_hz, rel=0.01), (mode.description, hinge, axis)
 
 
+@pytest.mark.slow
 def test_sweep_tabulates_modes_and_plots(reference, tmp_path):
     import matplotlib
 

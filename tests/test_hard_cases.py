@@ -21,9 +21,9 @@ from flexbodies.meshing import LinkMesh
 from workbook.errors import MechanismError, ResonanceError, SimulationError
 from workbook.model.case import HarmonicForce
 from workbook.model.reference import HINGE_DAMPING_TIME, LP_ROTOR, reference_case
-from workbook.solve.frequency_pipeline import prepare, run_case_frequency
 from workbook.solve.modes import mounted_modes
 from workbook.solve.pipeline import run_excitation
+from workbook.solve.frequency_pipeline import prepare, run_case_frequency
 
 
 @pytest.fixture(scope="module")
@@ -105,6 +105,7 @@ SHAKE = HarmonicForce("vertical shake", point=(-0.55, 0.0, -0.03), direction=(0,
                       frequency_hz=59.0)
 
 
+@pytest.mark.slow
 def test_rattling_in_every_hinge_without_preload_is_periodic_and_bounded(rigid):
     """20 um gaps on all 16 hinges, no preload, 60 kN at 59 Hz: the engine
     (free inside the gaps) moves about 0.12 mm and impacts on every cycle."""
@@ -138,6 +139,7 @@ def test_one_newton_on_the_58_kN_preload_gives_the_same_transmissibility(cache_d
 # --- 5. the low-frequency approximation forced where it does not hold ----------------------------------
 
 
+@pytest.mark.slow
 def test_forcing_static_modes_near_a_thrust_rod_fundamental_warns_and_auto_keeps_modes(cache_dir):
     case = reference_case()
     near = dataclasses.replace(LP_ROTOR, name="near the thrust rods", frequency_hz=90.0)
@@ -185,6 +187,7 @@ def test_nearly_incompressible_material_does_not_lock():
 # --- 7. a very long run -------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_long_run_stores_the_measured_windows_only(rigid):
     """Memory does not grow with the run: 60 s of settling (142k steps) keeps
     the same number of stored samples as 1 s."""

@@ -45,9 +45,10 @@ def test_auto_reuses_the_file_of_an_equal_decision(tmp_path):
     "change",
     [
         {"material": TITANIUM},
-        {"element_size": 0.010},
-        {"interface": "RBE3"},
-        {"geometry": LinkGeometry(length=0.21, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020, shank_width=0.030, shank_thickness=0.020)},
+        pytest.param({"element_size": 0.010}, marks=pytest.mark.slow),
+        pytest.param({"interface": "RBE3"}, marks=pytest.mark.slow),
+        pytest.param({"geometry": LinkGeometry(length=0.21, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020, shank_width=0.030,
+                                               shank_thickness=0.020)}, marks=pytest.mark.slow),
     ],
     ids=["material", "mesh size", "coupling", "geometry"],
 )
@@ -59,12 +60,14 @@ def test_a_changed_input_recomputes(tmp_path, change):
     assert len(_link_files(tmp_path)) == 2
 
 
+@pytest.mark.slow
 def test_a_changed_mode_selection_recomputes(tmp_path):
     static = reduce_link(_model(), "static", cache_dir=tmp_path)
     six = reduce_link(_model(), 6, cache_dir=tmp_path)
     assert not six.cache_hit and six.n_modes == static.n_modes + 6
 
 
+@pytest.mark.slow
 def test_a_changed_mesh_file_recomputes(tmp_path):
     from flexbodies import BoreSpec, MeshSource, mesh_link
 
@@ -89,6 +92,7 @@ def _corrupt(path):
     path.write_bytes(bytes(data))
 
 
+@pytest.mark.slow
 def test_a_corrupted_file_is_not_used(tmp_path, caplog):
     good = reduce_link(_model(), "static", cache_dir=tmp_path)
     (path,) = _link_files(tmp_path)

@@ -46,6 +46,7 @@ def _static_settings():
     return ss
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("fixture", ["link_static", "link_12_modes"])
 def test_static_pull_in_exudyn_matches_fe_stiffness(request, fixture):
     link = request.getfixturevalue(fixture)

@@ -6,20 +6,20 @@ import pytest
 
 from workbook.errors import EquilibriumError, MechanismError
 from workbook.model.case import Gravity, PointForce
-from workbook.model.reference import ENGINE_CG, reference_case
+from workbook.model.reference import ENGINE_CG
 from workbook.scene.build import build_scene
 from workbook.solve.modes import linearize, modes_of, mounted_modes
 from workbook.solve.preload import check_equilibrium, solve_preload
 
-# Coarse link meshes: statics need the links' stiffness, which Craig-Bampton
-# reproduces exactly for any mesh; 30 mm elements keep the reductions short.
-ELEMENT_SIZE = 0.03
+# The coarse reference mount of conftest: statics need the links' stiffness,
+# which Craig-Bampton reproduces exactly for any mesh; 30 mm elements keep the
+# reductions short.
 MIRROR = np.array([1.0, -1.0, 1.0])
 
 
 @pytest.fixture(scope="module")
-def reference(cache_dir):
-    return reference_case(element_size=ELEMENT_SIZE)
+def reference(coarse_reference):
+    return coarse_reference
 
 
 @pytest.fixture(scope="module")

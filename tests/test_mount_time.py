@@ -7,24 +7,18 @@ import numpy as np
 import pytest
 
 from workbook.answers.results import PYLON_SUM
-from workbook.model.case import AnalysisSettings
-from workbook.model.reference import reference_case
 from workbook.scene.build import reduce_links
 from workbook.solve.pipeline import run_case
 
 matplotlib.use("Agg")
 
-# Coarse link meshes and short runs: the checks compare runs with each other.
-# The 10-period smooth start leaves the mounted modes almost unexcited, so
-# half a decay time constant of settling and 10-period windows suffice
-# (the steady check below confirms it).
-ELEMENT_SIZE = 0.03
-SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
+# The coarse reference mount of conftest (coarse link meshes, short runs):
+# the checks compare runs with each other.
 
 
 @pytest.fixture(scope="module")
-def reference(cache_dir):
-    return reference_case(element_size=ELEMENT_SIZE, analysis=SHORT)
+def reference(coarse_reference):
+    return coarse_reference
 
 
 @pytest.fixture(scope="module")
@@ -55,8 +49,9 @@ def test_pylon_sum_is_the_vector_sum_of_pylon_side_hinges(result):
     assert np.all(run.pylon_amplitude <= sum(run.hinge_amplitudes[n] for n in run.pylon_hinges) + 1e-9)
 
 
+@pytest.mark.slow
 def test_halving_the_time_step_changes_transmissibility_by_less_than_half_a_percent(reference, result):
-    finer = dataclasses.replace(reference, analysis=dataclasses.replace(SHORT, steps_per_period=80))
+    finer = dataclasses.replace(reference, analysis=dataclasses.replace(reference.analysis, steps_per_period=80))
     fine = run_case(finer)
     for coarse_run, fine_run in zip(result.runs, fine.runs):
         change = fine_run.transmissibility / coarse_run.transmissibility - 1
@@ -71,6 +66,7 @@ def _short_links_with(case, modes):
     return dataclasses.replace(case, links=links)
 
 
+@pytest.mark.slow
 def test_static_modes_match_twenty_fixed_interface_modes_where_the_rule_holds(reference):
     static_case = _short_links_with(reference, "static")
     modal_case = _short_links_with(reference, 20)

@@ -97,6 +97,7 @@ def test_processes_equal_serial_and_failing_rows_are_reported(base, rows, serial
     assert np.all(np.diff(ok["T x"].to_numpy()) > 0)
 
 
+@pytest.mark.slow
 def test_dask_cluster_equals_local(base, rows, serial, tmp_path):
     from distributed import LocalCluster
 

@@ -21,7 +21,7 @@ def fe_model():
     return fe
 
 
-@pytest.fixture(scope="module", params=["RBE2", "RBE3"])
+@pytest.fixture(scope="module", params=["RBE2", pytest.param("RBE3", marks=pytest.mark.slow)])
 def coupled(request, fe_model):
     return couple(fe_model, request.param)
 
@@ -64,6 +64,7 @@ def test_rbe3_is_softer_than_rbe2(fe_model):
     assert axial["RBE3"] < axial["RBE2"]
 
 
+@pytest.mark.slow
 def test_craig_bampton_frequencies_converge_to_full_fe(coupled):
     full = free_free_frequencies(coupled.stiffness, coupled.mass, count=3)
     largest = craig_bampton(coupled.stiffness, coupled.mass, coupled.coupling.boundary, count=20)

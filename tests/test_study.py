@@ -7,20 +7,18 @@ import pytest
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
-from workbook.model.case import AnalysisSettings
 from workbook.model.codec import to_json
-from workbook.model.reference import reference_case
 from workbook.studies.accuracy import REFERENCE_RUNG
 
-SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
+# every test reads the study the module's fixture runs once (a ladder of runs)
+pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module")
-def study(cache_dir, tmp_path_factory):
+def study(coarse_reference, tmp_path_factory):
     """Run the CLI once into a folder that already holds a user's accuracy-study.md."""
     folder = tmp_path_factory.mktemp("study")
-    case = reference_case(element_size=0.03, analysis=SHORT)
-    case = dataclasses.replace(case, excitations=(case.excitations[1],))
+    case = dataclasses.replace(coarse_reference, excitations=(coarse_reference.excitations[1],))
     path = folder / "hp.json"
     path.write_text(to_json(case))
     (folder / "accuracy-study.md").write_text("a user's notes\n")
