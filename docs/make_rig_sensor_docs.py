@@ -26,9 +26,8 @@ from generated_sections import replace_section  # noqa: E402
 from workbook.model.case import AnalysisSettings, ForceTransducers  # noqa: E402
 from workbook.model.reference import LP_ROTOR, reference_case  # noqa: E402
 from workbook.scene.build import reduce_links  # noqa: E402
-from workbook.solve.frequency_pipeline import prepare  # noqa: E402
 from workbook.solve.modes import mounted_modes  # noqa: E402
-from workbook.solve.pipeline import run_excitation  # noqa: E402
+from workbook.solve.pipeline import prepare, run_excitation  # noqa: E402
 
 DOCS = Path(__file__).resolve().parent
 #: Stiffnesses of the table, N/m per direction (None: the pylon pins on rigid ground).

@@ -9,10 +9,9 @@ from test_sdof import NATURAL_HZ, closed_form, sdof_case
 from workbook.answers.results import PYLON_SUM
 from workbook.model.case import AnalysisSettings, Effects, Sweep
 from workbook.scene.build import build_scene, reduce_links
-from workbook.solve.frequency_pipeline import prepare
 from workbook.solve.method import choose_method
 from workbook.solve.modes import mounted_modes
-from workbook.solve.pipeline import run_case
+from workbook.solve.pipeline import prepare, run_case
 from workbook.solve.preload import solve_preload
 from workbook.solve.sweep import run_sweep
 from workbook.solve.time_domain import TimePlan, integrate

@@ -22,8 +22,7 @@ from workbook.errors import MechanismError, ResonanceError, SimulationError
 from workbook.model.case import HarmonicForce
 from workbook.model.reference import HINGE_DAMPING_TIME, LP_ROTOR, reference_case
 from workbook.solve.modes import mounted_modes
-from workbook.solve.pipeline import run_excitation
-from workbook.solve.frequency_pipeline import prepare, run_case_frequency
+from workbook.solve.pipeline import prepare, run_case, run_excitation
 
 
 @pytest.fixture(scope="module")
@@ -44,7 +43,7 @@ def _time(case, excitation=LP_ROTOR):
 
 
 def _frequency(case, excitation=LP_ROTOR):
-    return run_case_frequency(dataclasses.replace(case, excitations=(excitation,))).runs[0]
+    return run_case(_with(dataclasses.replace(case, excitations=(excitation,)), method="frequency")).runs[0]
 
 
 # --- 1. very stiff hinges ---------------------------------------------------------------------------

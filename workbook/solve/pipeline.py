@@ -1,30 +1,130 @@
-"""Run a case: every excitation through reduction, scene, preload, modes,
-time integration and amplitude extraction, each stage timed."""
+"""Run a case: one sequence of stages for every method.
+
+Every excitation goes through the same stages, each timed:
+
+1. reduce links (for the excitation's frequency, or a sweep's highest);
+2. build the scene;
+3. static preload;
+4. linearisation and mounted modes (the harmonic model in the frequency
+   domain);
+5. solve: time integration and amplitude extraction (time domain) or one
+   dense complex solve per frequency (frequency domain);
+6. answers: the :class:`~workbook.answers.results.ExcitationResult` and its
+   model card.
+
+Stages 1-4 are :func:`prepare`. In the frequency domain a single excitation
+and a whole sweep each cost one :func:`prepare`; in the time domain every
+sweep frequency is its own run (its links reduced for the sweep's highest
+frequency so that every point uses the same link models).
+"""
 from __future__ import annotations
 
+import dataclasses
 import logging
-from typing import Union
+import time
 
-from workbook.answers.model_card import model_card
-from workbook.answers.results import MountResult
+from workbook.answers.model_card import ModelCard, model_card
+from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, SingleFrequencyExcitation, Sweep
-from workbook.scene.build import build_scene, reduce_links
-from workbook.solve.frequency_pipeline import run_case_frequency
-from workbook.solve.guards import run_label
+from workbook.scene.build import Scene, build_scene, reduce_links
+from workbook.scene.hinge_law import linearised_gap_warnings
+from workbook.solve.guards import check_undamped_resonance, run_label
+from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, MethodChoice, choose_method
-from workbook.solve.modes import linearize, modes_of, mounted_modes
-from workbook.solve.preload import solve_preload
+from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
+from workbook.solve.preload import Preload, solve_preload
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
 from workbook.solve.time_domain import extract, integrate, plan_run
 
-__all__ = ["run_excitation", "run_case"]
+__all__ = ["PreparedScene", "prepare", "run_excitation", "solve_frequencies", "run_case", "RESONANCE_BAND"]
 
 log = logging.getLogger(__name__)
 
+#: Relative distance from an undamped mounted mode at which the harmonic
+#: solution is refused (the dynamic matrix is singular on the mode).
+RESONANCE_BAND = 1e-6
+
+
+@dataclasses.dataclass
+class PreparedScene:
+    """A preloaded scene with its mounted modes (stages 1-4 of a run).
+
+    Attributes
+    ----------
+    scene : Scene
+    preload : Preload
+    modes : list of Mode
+        Every linearised mode, ascending.
+    model : HarmonicModel or None
+        The harmonic model (None when prepared for the time domain).
+    timings : dict of str to float
+        Wall time per stage, s.
+    """
+
+    scene: Scene
+    preload: Preload
+    modes: list[Mode]
+    model: HarmonicModel | None
+    timings: dict[str, float]
+
+
+def _reduce(case: Case, excitation: SingleFrequencyExcitation, reduce_for: SingleFrequencyExcitation,
+            progress: ProgressFactory | None) -> dict:
+    if progress is None or not case.links:
+        return reduce_links(case, reduce_for)
+    update, close = progress(f"{excitation.name}: reducing links", len(case.links))
+    try:
+        return reduce_links(case, reduce_for, update)
+    finally:
+        close()
+
+
+def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
+            reduce_for: SingleFrequencyExcitation | None = None, reduced: dict | None = None,
+            progress: ProgressFactory | None = None, harmonic: bool = True) -> PreparedScene:
+    """Reduce, build, preload and linearise the scene of *case* with *excitation*.
+
+    Parameters
+    ----------
+    case : Case
+    excitation : RotatingForce or HarmonicForce
+        Sets the excitation point (and, by default, the reduction frequency).
+    reduce_for : RotatingForce or HarmonicForce, optional
+        The excitation whose frequency the link reductions must serve.
+    reduced : dict, optional
+        Reduced links to use (skips the reduction).
+    progress : callable, optional
+        Progress factory for the link reduction (see :data:`ProgressFactory`).
+    harmonic : bool
+        Build the harmonic model (frequency domain); False linearises for the
+        mounted modes only (time domain).
+
+    Raises
+    ------
+    workbook.errors.SimulationError
+        A mechanism or a failed equilibrium.
+    """
+    timings: dict[str, float] = {}
+    with timed(timings, "reduce links"):
+        if reduced is None:
+            reduced = _reduce(case, excitation, reduce_for or excitation, progress)
+    with timed(timings, "build scene"):
+        scene = build_scene(case, excitation, reduced=reduced)
+    with timed(timings, "static preload"):
+        preload = solve_preload(scene)
+    model = None
+    if harmonic:
+        with timed(timings, "linearisation"):
+            model = harmonic_model(scene)
+    with timed(timings, "mounted modes"):
+        modes = modes_of(model.linearization if model else linearize(scene))
+    return PreparedScene(scene, preload, modes, model, timings)
+
+
 def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
-                   reduce_for: Union[SingleFrequencyExcitation, None] = None,
-                   progress: Union[ProgressFactory, None] = None,
-                   method: Union[MethodChoice, None] = None):
+                   reduce_for: SingleFrequencyExcitation | None = None,
+                   progress: ProgressFactory | None = None,
+                   method: MethodChoice | None = None) -> tuple[ExcitationResult, ModelCard, Preload]:
     """Run one single-frequency excitation of *case* in the time domain.
 
     Parameters
@@ -48,30 +148,15 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
 
     Raises
     ------
-    workbook.solve.guards.SimulationError
+    workbook.errors.SimulationError
         A mechanism or a failed equilibrium (preload stage), an excitation on
         an undamped mode, a failed or diverging integration, or an exhausted
         time budget; the message says when and why.
     """
-    timings = {}
-    with timed(timings, "reduce links"):
-        reduction = reduce_for or excitation
-        if progress is None or not case.links:
-            reduced = reduce_links(case, reduction)
-        else:
-            update, close = progress(f"{excitation.name}: reducing links", len(case.links))
-            try:
-                reduced = reduce_links(case, reduction, update)
-            finally:
-                close()
-    with timed(timings, "build scene"):
-        scene = build_scene(case, excitation, reduced=reduced)
-    with timed(timings, "static preload"):
-        preload = solve_preload(scene)
-    with timed(timings, "mounted modes"):
-        mounted = mounted_modes(modes_of(linearize(scene)))
-    plan = plan_run(case.analysis, scene.excitation.signal, mounted,
-                    where=run_label(case.name, excitation.name))
+    prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
+    timings, scene = prepared.timings, prepared.scene
+    mounted = mounted_modes(prepared.modes)
+    plan = plan_run(case.analysis, scene.excitation.signal, mounted, where=run_label(case.name, excitation.name))
     log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
     with timed(timings, "time integration"):
         if progress is None:
@@ -84,30 +169,105 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 close()
     with timed(timings, "amplitude extraction"):
         result = extract(scene, plan, histories)
-    result.warnings.extend(link_warnings(case, reduced))
-    card = model_card(scene, preload, mounted, plan, timings, method)
+    result.warnings.extend(link_warnings(case, scene.reduced))
+    card = model_card(scene, prepared.preload, mounted, plan, timings, method)
     card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
-    return result, card, preload
+    return result, card, prepared.preload
 
 
-def run_case(case: Case, *, progress: Union[ProgressFactory, None] = None) -> MountResult:
-    """Run every excitation of *case* (sweeps frequency by frequency) by the
-    method the case asks for (:func:`workbook.solve.method.choose_method`).
+def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
+    return {
+        "analysis": "frequency domain: (K - w^2 M + i w D) z = B f per frequency (dense complex solve), "
+                    "F_hinge = (C_k + i w C_d) z",
+        "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness included); "
+                         "Euler-parameter constraints projected out (null space by SVD)",
+        "independent coordinates": model.dof,
+        "input and outputs": f"central differences of Exudyn's engine-point position and the hinge (and "
+                             f"transducer) Force outputs (coordinate step {COORDINATE_STEP:g}, velocity step "
+                             f"{VELOCITY_STEP:g})",
+        "damping": "viscous: hinge damping and Rayleigh link damping exactly as in the time domain, plus the "
+                   "rotors' gyroscopic coupling when built",
+        "static equilibrium check": f"relative {case.analysis.equilibrium_tolerance:g}",
+    }
+
+
+def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleFrequencyExcitation, ...],
+                      method: MethodChoice, *, progress: ProgressFactory | None = None
+                      ) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict[str, Preload]]:
+    """Frequency-domain answers of the single-frequency excitations *points*
+    on a scene prepared with its harmonic model (at the excitation point it
+    was prepared with or any other point of the engine).
+
+    Returns
+    -------
+    runs : list of ExcitationResult
+    cards : dict of str to ModelCard
+    preloads : dict of str to Preload
+    """
+    model = prepared.model
+    mounted = mounted_modes(prepared.modes)
+    solver = _frequency_solver(case, model)
+    gaps = [h for h in case.hinges if prepared.scene.hinges[h.name].clearance]
+    update, close = progress(f"{points[0].name}: frequencies", len(points)) if progress else (None, None)
+    runs, cards, preloads = [], {}, {}
+    try:
+        for done, excitation in enumerate(points, start=1):
+            check_undamped_resonance(run_label(case.name, excitation.name), excitation.frequency, mounted,
+                                     RESONANCE_BAND, "the response grows without bound: no steady state exists")
+            start = time.perf_counter()
+            result = model.result(excitation, case.analysis.steady_tolerance)
+            result.warnings.extend(link_warnings(case, prepared.scene.reduced))
+            result.warnings.extend(linearised_gap_warnings(gaps, prepared.preload.hinge_forces,
+                                                           result.hinge_amplitudes))
+            timings = dict(prepared.timings, **{"harmonic solve": time.perf_counter() - start})
+            card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method, solver)
+            card.run_name = excitation.name
+            runs.append(result)
+            cards[result.name] = card
+            preloads[result.name] = prepared.preload
+            if update:
+                update(done)
+    finally:
+        if close:
+            close()
+    return runs, cards, preloads
+
+
+def run_case(case: Case, *, progress: ProgressFactory | None = None,
+             method: MethodChoice | None = None) -> MountResult:
+    """Run every excitation of *case* by the method the case asks for.
+
+    Parameters
+    ----------
+    case : Case
+    progress : callable, optional
+        Progress factory for the long stages (see :data:`ProgressFactory`).
+    method : MethodChoice, optional
+        The method and why (default: :func:`workbook.solve.method.choose_method`
+        of the case).
 
     Returns
     -------
     MountResult
     """
-    method = choose_method(case)
-    if method.method == FREQUENCY:
-        return run_case_frequency(case, method, progress=progress)
+    method = method or choose_method(case)
     runs, cards, preloads = [], {}, {}
     for item in case.excitations:
         points = item.expand() if isinstance(item, Sweep) else (item,)
-        for excitation in points:
-            result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress,
-                                                   method=method)
-            runs.append(result)
-            cards[result.name] = card
-            preloads[result.name] = preload
+        if method.method == FREQUENCY:
+            prepared = prepare(case, points[0], reduce_for=points[-1], progress=progress)
+            item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, method,
+                                                                     progress=progress)
+        else:
+            item_runs, item_cards, item_preloads = [], {}, {}
+            for excitation in points:
+                result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress,
+                                                       method=method)
+                item_runs.append(result)
+                item_cards[result.name] = card
+                item_preloads[result.name] = preload
+        runs += item_runs
+        cards.update(item_cards)
+        preloads.update(item_preloads)
+    log.info("%s: %d %s runs", case.name, len(runs), method.label)
     return MountResult(case.name, runs, cards, preloads)

@@ -19,6 +19,7 @@ from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.solve.method import FREQUENCY, MethodChoice
 from workbook.solve.modes import ENGINE_SHARE, FREE_FREQUENCY_HZ, Mode
+from workbook.solve.pipeline import prepare, solve_frequencies
 
 __all__ = ["SweepAnswer", "run_sweep", "modes_in_band"]
 
@@ -146,12 +147,10 @@ def run_sweep(case: Case, sweep: Sweep, *, reduced=None) -> SweepAnswer:
     -------
     SweepAnswer
     """
-    from workbook.solve.frequency_pipeline import prepare, results_of
-
     points = sweep.expand()
     prepared = prepare(case, points[0], reduce_for=points[-1], reduced=reduced)
     method = MethodChoice(FREQUENCY, "a sweep runs in the frequency domain: one linearisation serves "
                                        "every frequency")
-    runs, cards, preloads = results_of(case, prepared, points, method)
+    runs, cards, preloads = solve_frequencies(case, prepared, points, method)
     return SweepAnswer(sweep, MountResult(case.name, runs, cards, preloads),
                        modes_in_band(prepared.modes, sweep.frequencies_hz[-1]))

@@ -34,6 +34,7 @@ import numpy as np
 
 from workbook.model.case import DIRECTIONS, Case, SingleFrequencyExcitation
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
+from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
 
 __all__ = ["Rung", "RungResult", "AccuracyStudy", "ladder", "run_study", "REFERENCE_RUNG"]
 
@@ -137,14 +138,10 @@ class RungResult:
 def _solve(case: Case, excitation: SingleFrequencyExcitation, method: str):
     """T (3,) and DOF of one excitation of a prepared rung case."""
     if method == FREQUENCY:
-        from workbook.solve.frequency_pipeline import prepare, results_of
-
         prepared = prepare(case, excitation)
         choice = MethodChoice(FREQUENCY, "accuracy study rung")
-        runs, cards, _ = results_of(case, prepared, (excitation,), choice)
+        runs, cards, _ = solve_frequencies(case, prepared, (excitation,), choice)
     else:
-        from workbook.solve.pipeline import run_excitation
-
         run, card, _ = run_excitation(case, excitation)
         runs, cards = [run], {run.name: card}
     return runs[0].transmissibility, cards[runs[0].name].total_dof
