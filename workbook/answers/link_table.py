@@ -8,7 +8,6 @@ from __future__ import annotations
 import pandas as pd
 
 from workbook.model.case import Case
-from workbook.scene.build import link_is_flexible
 
 __all__ = ["link_table"]
 
@@ -36,7 +35,7 @@ def link_table(case: Case, reduced: dict) -> pd.DataFrame:
     rows = []
     for link in case.links:
         item = reduced[link.name]
-        flexible = link_is_flexible(case, link.name)
+        flexible = case.link_is_flexible(link.name)
         ratio = item.decision.ratio
         rows.append({
             "link": link.name,

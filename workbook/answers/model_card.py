@@ -126,13 +126,12 @@ def model_card(scene, preload, mounted, plan, timings: dict, method=None, solver
         Solver settings to record instead of those of *plan*.
     """
     from workbook.model.case import ENGINE
-    from workbook.scene.build import link_is_flexible
 
     case = scene.case
     bodies = [BodyEntry(ENGINE, "rigid body", 6, 0, case.engine.mass, "one rigid body: mass, CG and inertia from the case")]
     for link in case.links:
         reduced, item = scene.reduced[link.name], scene.links[link.name]
-        if link_is_flexible(case, link.name):
+        if case.link_is_flexible(link.name):
             bodies.append(BodyEntry(link.name, "flexible link (Craig-Bampton)", item.dof,
                                     reduced.n_fixed_interface, item.mass, reduced.decision.reason))
         else:
@@ -149,10 +148,8 @@ def model_card(scene, preload, mounted, plan, timings: dict, method=None, solver
 
 
 def _effects(scene, preload, method=None) -> list[EffectEntry]:
-    from workbook.scene.build import link_is_flexible
-
     case, effects = scene.case, scene.case.effects
-    flexible = [link.name for link in case.links if link_is_flexible(case, link.name)]
+    flexible = [link.name for link in case.links if case.link_is_flexible(link.name)]
     damped_links = [link.name for link in case.links
                     if link.name in flexible and (link.stiffness_damping > 0 or link.mass_damping > 0)]
     gaps = [h for h in case.hinges if h.radial_clearance > 0]

@@ -1,12 +1,6 @@
 """Answers of a mount run: amplitudes, transmissibility, isolation efficiency.
 
-Definitions (docs/physics.md, section 5), per direction d in x, y, z:
-
-- transmissibility ``T_d = |F_d(f)| / |F_exc(f)|`` with ``|F_exc|`` the
-  amplitude of the excitation force;
-- isolation efficiency ``eta_d = (1 - T_d) * 100 %``;
-- level ``20 log10(T_d)`` dB.
-
+The formulas (T, eta, dB, the pylon sum) live in :mod:`workbook.answers.isolation`.
 The pylon force is the vector sum of the pylon-side hinge forces, or of the test rig's
 transducer forces when the case has them (``Scene.pylon_channels``).
 :class:`MountResult` tabulates itself (pandas), plots itself (matplotlib)
@@ -20,23 +14,13 @@ from typing import Any
 
 import numpy as np
 
+from workbook.answers.isolation import efficiency, level_db, transmissibility
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM", "efficiency", "level_db"]
+__all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM"]
 
 #: Row label of the pylon sum in the tables.
 PYLON_SUM = "pylon sum"
-
-
-def efficiency(transmissibility: np.ndarray) -> np.ndarray:
-    """Isolation efficiency (1 - T) * 100, %."""
-    return (1.0 - np.asarray(transmissibility)) * 100.0
-
-
-def level_db(transmissibility: np.ndarray) -> np.ndarray:
-    """20 log10(T), dB (-inf for T = 0)."""
-    with np.errstate(divide="ignore"):
-        return 20.0 * np.log10(np.asarray(transmissibility, dtype=float))
 
 
 class PylonAnswers:
@@ -49,7 +33,7 @@ class PylonAnswers:
     @property
     def transmissibility(self) -> np.ndarray:
         """Pylon-force transmissibility per direction x, y, z."""
-        return self.pylon_amplitude / self.excitation_amplitude
+        return transmissibility(self.pylon_amplitude, self.excitation_amplitude)
 
     @property
     def efficiency(self) -> np.ndarray:
@@ -176,7 +160,7 @@ class MountResult:
         for run in self.runs:
             for location, amplitude in run.amplitudes().items():
                 for axis, value in zip(DIRECTIONS, amplitude):
-                    t = value / run.excitation_amplitude
+                    t = transmissibility(value, run.excitation_amplitude)
                     rows.append((run.name, run.frequency_hz, location, location == PYLON_SUM
                                  or location in run.pylon_hinges, axis, value, t,
                                  float(efficiency(t)), float(level_db(t))))
@@ -299,7 +283,7 @@ class MountResult:
 
 
 def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float]]:
-    t = np.asarray(amplitude) / reference
+    t = transmissibility(amplitude, reference)
     answers = {}
     for axis, a, ti in zip(DIRECTIONS, amplitude, t):
         db = float(level_db(ti))

@@ -29,6 +29,7 @@ from openpyxl.chart import BarChart, Reference, ScatterChart, Series
 from openpyxl.drawing.image import Image
 from openpyxl.styles import Font
 
+from workbook.answers.isolation import efficiency
 from workbook.excel.files import lock_file, save_atomic
 from workbook.excel.reader import CaseBook
 from workbook.excel.writer import RunResult, card_lines, result_frames
@@ -81,7 +82,7 @@ def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
     frame = frame[frame["test amplitude N"].notna()]
     t_test = frame["T"] * frame["test amplitude N"] / frame["amplitude N"]
     rows = [[row["run"], row["frequency Hz"], row["direction"], row["T"], t, row["error %"], row["eta %"],
-             (1 - t) * 100] for (_, row), t in zip(frame.iterrows(), t_test)]
+             efficiency(t)] for (_, row), t in zip(frame.iterrows(), t_test)]
     _rows(ws, ["run", "frequency Hz", "direction", "T sim", "T test", "error %", "eta sim %", "eta test %"], rows,
           start=3)
 

@@ -32,6 +32,7 @@ from openpyxl.styles import Font, PatternFill
 from openpyxl.utils import get_column_letter
 
 import workbook.excel.layout as L
+from workbook.answers.isolation import efficiency, relative_error
 from workbook.answers.results import PYLON_SUM
 from workbook.excel.files import lock_file, restore_formula_values, save_atomic, unsupported_content
 from workbook.excel.runs import RunSpec, TestPoint
@@ -102,7 +103,7 @@ def _long_frame(runs: list[RunResult], tests: tuple) -> pd.DataFrame:
     for row in frame.to_dict("records"):
         test = _match_test(by_key.get((row["run"], row["location"], row["direction"]), []), row["frequency Hz"])
         test_amplitude.append(None if test is None else test.amplitude)
-        test_error.append(None if test is None else (row["amplitude N"] - test.amplitude) / test.amplitude * 100)
+        test_error.append(None if test is None else float(relative_error(row["amplitude N"], test.amplitude)))
     frame["test amplitude N"] = test_amplitude
     frame["error %"] = test_error
     return frame
@@ -126,7 +127,7 @@ def result_frames(runs: list[RunResult], tests: tuple = ()) -> dict[str, pd.Data
         for run in sweeps:
             for point in run.result.runs:
                 t = point.transmissibility
-                rows.append([run.spec.name, point.frequency_hz, *t, *((1 - t) * 100)])
+                rows.append([run.spec.name, point.frequency_hz, *t, *efficiency(t)])
         frames["sweep"] = pd.DataFrame(rows, columns=["run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS),
                                                       *(f"eta % {d}" for d in DIRECTIONS)])
     return frames

@@ -836,6 +836,24 @@ class Case:
         """Links by name."""
         return {link.name: link for link in self.links}
 
+    def link_is_flexible(self, name: str) -> bool:
+        """True if link *name* is built as a flexible body (the link asks for it
+        and the case's effects allow flexible links)."""
+        return self.effects.flexible_links and self.link_map[name].flexible
+
+    def link_modes(self, name: str) -> Union[str, int, float]:
+        """The link mode rule: the modes the reduction of link *name* keeps.
+
+        A flexible link keeps what its ``modes`` field asks for; a rigid link
+        needs only its mass properties and takes the static reduction.
+        """
+        return self.link_map[name].modes if self.link_is_flexible(name) else "static"
+
+    @property
+    def rig_sensors_built(self) -> bool:
+        """True if the case gives test-rig force transducers and asks for them."""
+        return self.test_rig is not None and self.effects.rig_sensors
+
     @property
     def pylon_hinges(self) -> tuple[Hinge, ...]:
         """The pylon-side hinges, whose forces sum to the pylon force."""

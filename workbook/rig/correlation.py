@@ -26,7 +26,8 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from workbook.answers.amplitude import harmonic_amplitude, period_window, steady_amplitude
-from workbook.answers.results import ExcitationResult, PylonAnswers, efficiency
+from workbook.answers.isolation import efficiency, relative_error
+from workbook.answers.results import ExcitationResult, PylonAnswers
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS
 from workbook.rig.records import RigRecord
@@ -192,6 +193,6 @@ def comparison_frame(measurement: Measurement, simulated: ExcitationResult):
     import pandas as pd
 
     sim, test = simulated.transmissibility, measurement.transmissibility
-    return pd.DataFrame({"T sim": sim, "T test": test, "error %": (sim - test) / test * 100.0,
+    return pd.DataFrame({"T sim": sim, "T test": test, "error %": relative_error(sim, test),
                          "eta sim %": efficiency(sim), "eta test %": efficiency(test)},
                         index=pd.Index(DIRECTIONS, name="direction"))

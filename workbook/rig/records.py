@@ -29,6 +29,7 @@ from typing import Union
 
 import numpy as np
 
+from workbook.answers.isolation import pylon_sum
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS
 
@@ -83,7 +84,7 @@ class RigRecord:
     @property
     def pylon(self) -> np.ndarray:
         """Pylon force: the vector sum of the transducers, shape (n, 3), N."""
-        return sum(self.transducers.values(), np.zeros((len(self.time), 3)))
+        return pylon_sum(self.transducers, self.transducers)
 
     def check_hinges(self, pylon_hinges) -> None:
         """Raise RecordError unless the transducers carry every pylon-side hinge exactly once.

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from workbook.answers.amplitude import harmonic_amplitude
+from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.rig.records import RigRecord
 
@@ -76,7 +77,7 @@ def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate
         scale = np.abs(harmonic_amplitude(sim_time, values, f0)).max()
         return signal + rng.normal(0.0, noise * scale, signal.shape)
 
-    forces = {name: resampled(sum(result.hinge_histories[h] for h in hinges))
+    forces = {name: resampled(pylon_sum(result.hinge_histories, hinges))
               for name, hinges in transducers.items()}
     return RigRecord(
         time, forces, resampled(result.excitation_history),

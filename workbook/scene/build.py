@@ -41,7 +41,7 @@ from workbook.scene.hinge_law import exudyn_clearance_function
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "link_is_flexible", "rig_sensors_built", "TRANSDUCER_PREFIX"]
+           "TRANSDUCER_PREFIX"]
 
 log = logging.getLogger(__name__)
 
@@ -291,16 +291,6 @@ class Scene:
                 for name, items in self.force_channels.items()}
 
 
-def link_is_flexible(case: Case, name: str) -> bool:
-    """True if link *name* is built as a flexible body in *case*."""
-    return case.effects.flexible_links and case.link_map[name].flexible
-
-
-def rig_sensors_built(case: Case) -> bool:
-    """True if *case* gives test-rig force transducers and asks for them."""
-    return case.test_rig is not None and case.effects.rig_sensors
-
-
 def _reduction_frequency(case: Case, excitation: Union[SingleFrequencyExcitation, None]) -> float:
     """Highest excitation frequency a reduction must serve, Hz."""
     if excitation is not None:
@@ -333,8 +323,7 @@ def reduce_links(case: Case, excitation: Union[SingleFrequencyExcitation, None] 
     frequency = _reduction_frequency(case, excitation)
     reduced = {}
     for link in case.links:
-        modes = link.modes if link_is_flexible(case, link.name) else "static"
-        reduced[link.name] = reduce_link(link.model, modes=modes, excitation_hz=frequency)
+        reduced[link.name] = reduce_link(link.model, modes=case.link_modes(link.name), excitation_hz=frequency)
         if progress is not None:
             progress(len(reduced))
     return reduced
@@ -392,11 +381,11 @@ def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] =
         optional = {} if link.spin_frequency_hz is None else {"spin_frequency_hz": link.spin_frequency_hz}
         links[link.name] = add_link_to_exudyn(
             mbs, reduced[link.name], link.end_a, link.end_b,
-            flexible=link_is_flexible(case, link.name), bore_axis=link.bore_axis,
+            flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
             stiffness_damping=link.stiffness_damping if damping else 0.0,
             mass_damping=link.mass_damping if damping else 0.0, name=link.name, **optional)
 
-    transducers = _add_transducers(mbs, case, ground) if rig_sensors_built(case) else {}
+    transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
 
     def marker(body_name: str, position) -> int:
         if body_name == PYLON:

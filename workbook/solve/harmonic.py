@@ -30,6 +30,7 @@ from typing import Callable
 import numpy as np
 import scipy.linalg as sla
 
+from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.model.case import ENGINE, SingleFrequencyExcitation
 from workbook.scene.build import Scene
@@ -120,7 +121,7 @@ class HarmonicModel:
                            check_finite=False)
         forces = ((self.stiffness_output + 1j * omega * self.damping_output) @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces))
-        pylon = sum((hinges[name] for name in self.pylon_hinges), np.zeros(3, dtype=complex))
+        pylon = pylon_sum(hinges, self.pylon_hinges)
         return FrequencyResponse(frequency_hz, hinges, pylon)
 
     def result(self, excitation: SingleFrequencyExcitation, steady_tolerance: float) -> ExcitationResult:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from workbook.answers.isolation import pylon_sum
 from workbook.errors import EquilibriumError, MechanismError
 from workbook.scene.build import Scene
 from workbook.solve.modes import Mode, free_motions, linearize, modes_of
@@ -184,7 +185,7 @@ def solve_preload(scene: Scene) -> Preload:
             raise EquilibriumError(f"case {case.name!r}: the static solve did not converge "
                                    f"(load scale {scene.load_scale:.4g} N)")
     forces = scene.hinge_forces()
-    pylon = sum((forces[name] for name in scene.pylon_channels), np.zeros(3))
+    pylon = pylon_sum(forces, scene.pylon_channels)
     applied = applied_static_force(scene)
     mismatch = check_equilibrium(case.name, pylon, applied, tolerance, scene.load_scale)
     log.info("preload of %r: pylon force %s N, relative mismatch %.1e", case.name, np.round(pylon, 1), mismatch)

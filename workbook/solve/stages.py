@@ -7,7 +7,6 @@ from contextlib import contextmanager
 from typing import Callable
 
 from workbook.model.case import Case
-from workbook.scene.build import link_is_flexible
 
 __all__ = ["ProgressFactory", "timed", "link_warnings"]
 
@@ -30,4 +29,4 @@ def link_warnings(case: Case, reduced: dict) -> list[str]:
     """Warnings of the flexible links whose mode selection is unsafe at the
     run's excitation (``flexbodies.ModeDecision.warning``)."""
     return [f"link {name!r}: {link.decision.warning}" for name, link in reduced.items()
-            if link_is_flexible(case, name) and link.decision.warning]
+            if case.link_is_flexible(name) and link.decision.warning]

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from workbook.answers.isolation import transmissibility
 from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.solve.method import FREQUENCY, MethodChoice
@@ -68,7 +69,7 @@ class SweepAnswer:
 
     def transmissibility(self, location: str = PYLON_SUM) -> np.ndarray:
         """T per direction of the pylon sum or of a hinge, shape (frequencies, 3)."""
-        return np.array([run.amplitudes()[location] / run.excitation_amplitude for run in self.result.runs])
+        return np.array([transmissibility(run.amplitudes()[location], run.excitation_amplitude) for run in self.result.runs])
 
     def modes_frame(self):
         """The modes in band: frequency (Hz), damping ratio (%), kind, engine

@@ -41,6 +41,7 @@ from typing import Callable, Union
 import numpy as np
 
 from workbook.answers.amplitude import harmonic_amplitude, steady_amplitude
+from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.errors import DivergenceError, NewtonFailure, RunTooLong, TimeBudgetExceeded
 from workbook.model.case import AnalysisSettings
@@ -314,7 +315,7 @@ def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> Excitatio
     analysis = scene.case.analysis
     signal = scene.excitation.signal
     time = histories.time
-    pylon = sum((histories.hinge_forces[name] for name in scene.pylon_channels), np.zeros((len(time), 3)))
+    pylon = pylon_sum(histories.hinge_forces, scene.pylon_channels)
     steady = steady_amplitude(time, pylon, plan.frequency_hz, plan.measured_periods, analysis.steady_tolerance)
     window = steady.window
     hinge_amplitudes = {name: np.abs(harmonic_amplitude(time[window], forces[window], plan.frequency_hz))

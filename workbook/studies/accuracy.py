@@ -32,6 +32,7 @@ from typing import Callable, Union
 
 import numpy as np
 
+from flexbodies.selection import MODE_MARGIN
 from workbook.model.case import DIRECTIONS, Case, SingleFrequencyExcitation
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
 from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
@@ -42,8 +43,6 @@ log = logging.getLogger(__name__)
 
 #: Label of the reference rung.
 REFERENCE_RUNG = "Craig-Bampton, 20 modes"
-#: Fixed-interface modes of the seed study's method: up to this multiple of f_exc.
-SEED_MODE_MARGIN = 4.0
 
 
 @dataclass(frozen=True)
@@ -69,7 +68,7 @@ class Rung:
     @property
     def description(self) -> str:
         links = {"rigid": "rigid links", "static": "static modes only", "case": "links as the case asks",
-                 "seed": f"every link: fixed-interface modes to {SEED_MODE_MARGIN:g} x f_exc (at least 1)"}
+                 "seed": f"every link: fixed-interface modes to {MODE_MARGIN:g} x f_exc (at least 1)"}
         fidelity = links.get(self.links, f"{self.links} fixed-interface modes per link")
         method = (f"time domain, {self.steps_per_period} steps/period" if self.method == TIME and
                   self.steps_per_period else f"{self.method} domain")
@@ -91,7 +90,7 @@ def _seed_modes(link, excitation: SingleFrequencyExcitation):
     """Modes of a link in the seed study's method: up to 4 f_exc, at least one."""
     from flexbodies import reduce_link
 
-    cutoff = SEED_MODE_MARGIN * excitation.frequency
+    cutoff = MODE_MARGIN * excitation.frequency
     kept = reduce_link(link.model, modes=cutoff, excitation_hz=excitation.frequency).n_fixed_interface
     return cutoff if kept > 0 else 1
 

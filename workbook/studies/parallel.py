@@ -20,7 +20,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from typing import Callable, Union
 
-from workbook.answers.results import efficiency
+from workbook.answers.isolation import efficiency
 from workbook.model.case import DIRECTIONS, Case
 
 __all__ = ["RowOutcome", "prepare", "run_row", "run_rows", "SERIAL"]
@@ -81,7 +81,6 @@ def prepare(cases: list[Union[Case, BaseException]]) -> list[Union[Case, RowOutc
         link reduction failed.
     """
     from flexbodies import reduce_link
-    from workbook.scene.build import link_is_flexible
 
     reduced, prepared = set(), []
     for index, case in enumerate(cases):
@@ -92,7 +91,7 @@ def prepare(cases: list[Union[Case, BaseException]]) -> list[Union[Case, RowOutc
             for item in case.excitations:
                 frequency = item.frequency  # run_case reduces for a sweep's highest frequency
                 for link in case.links:
-                    modes = link.modes if link_is_flexible(case, link.name) else "static"
+                    modes = case.link_modes(link.name)
                     key = (link.model, modes, frequency if modes == "auto" else None)
                     if key not in reduced:
                         reduce_link(link.model, modes=modes, excitation_hz=frequency)
