@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Union
+from typing import Any
 
 __all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
@@ -80,9 +80,9 @@ class Problem:
     """
 
     file: str
-    sheet: Union[str, None]
-    cell: Union[str, None]
-    column: Union[str, None]
+    sheet: str | None
+    cell: str | None
+    column: str | None
     value: Any
     expected: str
 
@@ -119,7 +119,7 @@ class RecordError(ValueError):
         Column header at fault.
     """
 
-    def __init__(self, path, message: str, *, line: Union[int, None] = None, column: Union[str, None] = None):
+    def __init__(self, path, message: str, *, line: int | None = None, column: str | None = None):
         self.path, self.line, self.column = str(path), line, column
         where = "".join((f", line {line}" if line is not None else "",
                          f", column {column!r}" if column is not None else ""))

@@ -9,6 +9,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+from workbook.scene.build import Scene
+
 __all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
 
 
@@ -109,7 +111,8 @@ class ModelCard:
         return "\n".join(lines)
 
 
-def model_card(scene, preload, mounted, plan, timings: dict, method=None, solver: dict | None = None) -> ModelCard:
+def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, float], method=None,
+               solver: dict | None = None) -> ModelCard:
     """Fill the model card of a run.
 
     Parameters

@@ -10,7 +10,6 @@ import dataclasses
 import json
 import sys
 from pathlib import Path
-from typing import Union
 
 from workbook.errors import CaseError, UsageError
 from workbook.model.case import Case
@@ -24,7 +23,7 @@ __all__ = ["WORKBOOK_SUFFIXES", "is_workbook", "load_case", "progress_factory"]
 WORKBOOK_SUFFIXES = (".xlsx", ".xlsm")
 
 
-def is_workbook(name: Union[str, None]) -> bool:
+def is_workbook(name: str | None) -> bool:
     """True if *name* names a case workbook (by its ending)."""
     return name is not None and Path(name).suffix.lower() in WORKBOOK_SUFFIXES
 
@@ -42,8 +41,8 @@ def _json_case(path: str) -> Case:
     return case
 
 
-def load_case(path: Union[str, None] = None, *, run: Union[str, None] = None, rigid: bool = False,
-              time_budget: Union[float, None] = None) -> Case:
+def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = False,
+              time_budget: float | None = None) -> Case:
     """The case a command works on.
 
     Parameters

@@ -19,6 +19,7 @@ from openpyxl.utils import get_column_letter
 import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
 from workbook.excel.runs import FIDELITY_RIGID
+from workbook.model.case import ModeCutoff
 from workbook.model.units import si_factor
 
 __all__ = ["Record", "SheetReader", "open_workbook"]
@@ -256,19 +257,20 @@ def _as_modes(value: Any, column: L.Column) -> Union[str, int, float]:
         if value < 0 or value != int(value):
             raise _Bad(expected)
         return int(value)
-    text = _as_text(value, column).lower()
+    raw = _as_text(value, column)
+    text = raw.lower()
     if text in ("auto", "static"):
         return text
     if text.isdigit():
         return int(text)
-    match = _CUTOFF.match(text)
+    match = _CUTOFF.match(raw)             # units are case-sensitive: mHz is not MHz
     if match:
         try:
             cutoff = float(match.group(1)) * si_factor(match.group(2), "Hz")
         except (ValueError, UnitProblem):
             raise _Bad(expected) from None
         if cutoff > 0 and math.isfinite(cutoff):
-            return cutoff
+            return ModeCutoff(cutoff)
     raise _Bad(expected)
 
 

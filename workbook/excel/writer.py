@@ -33,7 +33,7 @@ from openpyxl.utils import get_column_letter
 
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
-from workbook.answers.results import PYLON_SUM
+from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.excel.files import lock_file, restore_formula_values, save_atomic, unsupported_content
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.model.case import DIRECTIONS
@@ -57,12 +57,12 @@ class RunResult:
     Attributes
     ----------
     spec : RunSpec
-    result : workbook.answers.results.MountResult
+    result : MountResult
         One excitation result per frequency (several for a sweep).
     """
 
     spec: RunSpec
-    result: object
+    result: MountResult
 
 
 @dataclass(frozen=True)

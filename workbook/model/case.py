@@ -19,8 +19,9 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from dataclasses import dataclass, field
-from typing import Any, Union
+from typing import Any
 
 import numpy as np
 
@@ -29,7 +30,7 @@ from workbook.errors import CaseError
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
-    "SingleFrequencyExcitation", "ForceTransducers", "Rotor"]
+    "SingleFrequencyExcitation", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request"]
 
 PYLON = "pylon"
 ENGINE = "engine"
@@ -68,6 +69,60 @@ def _number(value: Any, item: str, name: str, *, minimum: float = -math.inf,
         bound = f"{'>' if strictly else '>='} {minimum:g}" if minimum > -math.inf else "finite"
         raise CaseError(item, name, value, f"a number {bound}")
     return number
+
+
+class ModeCutoff(float):
+    """A cut-off frequency of a link's fixed-interface modes, Hz.
+
+    A mode count is a whole number (``modes=12`` keeps 12 modes); a cut-off
+    is this type or a text with its unit (``modes=ModeCutoff(500.0)`` or
+    ``modes="500 Hz"`` keeps the modes up to 500 Hz). A plain float is
+    refused, so ``modes=12.0`` cannot silently mean 12 Hz. It is a float for
+    :mod:`flexbodies` (which reads a float as a cut-off) and for JSON (where
+    a number with a fraction in a link's ``modes`` is a cut-off).
+    """
+
+    def __repr__(self) -> str:
+        return f"ModeCutoff({float(self)!r})"
+
+    def __str__(self) -> str:
+        return f"{float(self):g} Hz"
+
+
+#: What a link's reduction keeps: ``"auto"`` (the low-frequency rule),
+#: ``"static"`` (static modes only), a mode count or a cut-off frequency.
+ModeRequest = str | int | ModeCutoff
+
+_CUTOFF_TEXT = re.compile(r"^\s*(?:up to\s+)?([0-9]*\.?[0-9]+(?:e[+-]?[0-9]+)?)\s*hz\s*$", re.IGNORECASE)
+
+
+def mode_request(value: Any, item: str = "link") -> ModeRequest:
+    """*value* as a :data:`ModeRequest`, or raise CaseError.
+
+    Accepts ``"auto"``, ``"static"``, a whole number >= 0 (a count), a
+    :class:`ModeCutoff` > 0 or a text ``"<f> Hz"`` / ``"up to <f> Hz"`` (a
+    cut-off); refuses a plain float (count or cut-off? say which).
+    """
+    expected = "'auto', 'static', a whole mode count such as 12 or a cut-off such as '500 Hz'"
+    if isinstance(value, ModeCutoff):
+        if not (value > 0 and math.isfinite(value)):
+            raise CaseError(item, "modes", value, "a cut-off frequency > 0 Hz")
+        return value
+    if isinstance(value, str):
+        word = value.strip().lower()
+        if word in ("auto", "static"):
+            return word
+        match = _CUTOFF_TEXT.match(word)
+        if match:
+            return mode_request(ModeCutoff(float(match.group(1))), item)
+        raise CaseError(item, "modes", value, expected)
+    if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
+        return value
+    if isinstance(value, float):
+        raise CaseError(item, "modes", value, f"{expected} (a plain float is ambiguous: "
+                        f"write {int(value) if value.is_integer() and value >= 0 else 'a whole number'} for a count "
+                        f"or '{value:g} Hz' for a cut-off)")
+    raise CaseError(item, "modes", value, expected)
 
 
 def _name(value: Any, item: str) -> str:
@@ -138,9 +193,10 @@ class Link:
         must equal the link model's eye distance.
     model : flexbodies.LinkModel
         Geometry or mesh, material, meshing and interface choices.
-    modes : {"auto", "static"} or int or float
+    modes : {"auto", "static"} or int or ModeCutoff or str
         Craig-Bampton fixed-interface modes kept: the low-frequency rule, none,
-        a count, or a cut-off frequency in Hz.
+        a count, or a cut-off frequency (:class:`ModeCutoff` or ``"500 Hz"``);
+        see :func:`mode_request`.
     flexible : bool
         False models the link as a rigid body with the same mass properties.
     stiffness_damping : float
@@ -158,12 +214,12 @@ class Link:
     end_a: Vector3
     end_b: Vector3
     model: Any
-    modes: Union[str, int, float] = "auto"
+    modes: ModeRequest = "auto"
     flexible: bool = True
     stiffness_damping: float = 0.0
     mass_damping: float = 0.0
-    spin_frequency_hz: Union[float, None] = None
-    bore_axis: Union[Vector3, None] = None
+    spin_frequency_hz: float | None = None
+    bore_axis: Vector3 | None = None
 
     def __post_init__(self):
         item = f"link {self.name!r}"
@@ -179,13 +235,7 @@ class Link:
             raise CaseError(item, "end_b", self.end_b,
                             f"a point {geometry.length:g} m from end_a (the link's eye distance); "
                             f"the ends are {self.length:g} m apart")
-        modes = self.modes
-        valid_modes = (modes in ("auto", "static") if isinstance(modes, str)
-                       else (not isinstance(modes, bool) and isinstance(modes, (int, float))
-                             and modes >= 0 and math.isfinite(modes)))
-        if not valid_modes:
-            raise CaseError(item, "modes", modes,
-                            "'auto', 'static', a mode count or a cut-off frequency in Hz")
+        _set(self, "modes", mode_request(self.modes, item))
         if not isinstance(self.flexible, bool):
             raise CaseError(item, "flexible", self.flexible, "True or False")
         _set(self, "stiffness_damping",
@@ -202,7 +252,7 @@ class Link:
         """Distance between the eye centres, m."""
         return float(np.linalg.norm(np.subtract(self.end_b, self.end_a)))
 
-    def eye_at(self, point: Vector3) -> Union[str, None]:
+    def eye_at(self, point: Vector3) -> str | None:
         """Return ``"a"`` or ``"b"`` if *point* is that eye's centre, else None."""
         for eye, end in (("a", self.end_a), ("b", self.end_b)):
             if np.linalg.norm(np.subtract(point, end)) <= POINT_TOLERANCE:
@@ -239,7 +289,7 @@ class Hinge:
     stiffness: float
     damping: float = 0.0
     radial_clearance: float = 0.0
-    contact_stiffness: Union[float, None] = None
+    contact_stiffness: float | None = None
 
     def __post_init__(self):
         item = f"hinge {self.name!r}"
@@ -314,7 +364,7 @@ class Gravity:
                                             "acceleration"))
 
 
-StaticLoad = Union[PointForce, PointMoment, Gravity]
+StaticLoad = PointForce | PointMoment | Gravity
 
 
 @dataclass(frozen=True)
@@ -419,10 +469,10 @@ class RotatingForce(_OneFrequency):
 
     name: str
     point: Vector3
-    frequency_hz: Union[float, None] = None
-    rpm: Union[float, None] = None
-    amplitude: Union[float, None] = None
-    unbalance: Union[float, None] = None
+    frequency_hz: float | None = None
+    rpm: float | None = None
+    amplitude: float | None = None
+    unbalance: float | None = None
     axis: Vector3 = (1.0, 0.0, 0.0)
     phase_deg: float = 0.0
 
@@ -486,8 +536,8 @@ class HarmonicForce(_OneFrequency):
     point: Vector3
     direction: Vector3
     amplitude: float
-    frequency_hz: Union[float, None] = None
-    rpm: Union[float, None] = None
+    frequency_hz: float | None = None
+    rpm: float | None = None
     phase_deg: float = 0.0
 
     def __post_init__(self):
@@ -511,7 +561,7 @@ class HarmonicForce(_OneFrequency):
         return self.amplitude * math.cos(phase) * d, -self.amplitude * math.sin(phase) * d
 
 
-SingleFrequencyExcitation = Union[RotatingForce, HarmonicForce]
+SingleFrequencyExcitation = RotatingForce | HarmonicForce
 
 
 @dataclass(frozen=True)
@@ -541,8 +591,8 @@ class Rotor(_OneFrequency):
 
     name: str
     polar_inertia: float
-    frequency_hz: Union[float, None] = None
-    rpm: Union[float, None] = None
+    frequency_hz: float | None = None
+    rpm: float | None = None
     axis: Vector3 = (1.0, 0.0, 0.0)
 
     def __post_init__(self):
@@ -614,7 +664,7 @@ class Sweep:
                      for f in self.frequencies_hz)
 
 
-Excitation = Union[RotatingForce, HarmonicForce, Sweep]
+Excitation = RotatingForce | HarmonicForce | Sweep
 
 
 @dataclass(frozen=True)
@@ -669,7 +719,7 @@ class AnalysisSettings:
     steps_per_period: int = 40
     ramp_periods: float = 10.0
     settle_time_constants: float = 1.0
-    settle_time: Union[float, None] = None
+    settle_time: float | None = None
     measured_periods: int = 20
     steady_tolerance: float = 0.005
     spectral_radius: float = 0.9
@@ -677,7 +727,7 @@ class AnalysisSettings:
     equilibrium_tolerance: float = 1e-6
     method: str = "time"
     step_halvings: int = 4
-    time_budget: Union[float, None] = None
+    time_budget: float | None = None
     divergence_displacement: float = 0.05
 
     def __post_init__(self):
@@ -791,7 +841,7 @@ class Case:
     analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
     effects: Effects = field(default_factory=Effects)
     description: str = ""
-    test_rig: Union[ForceTransducers, None] = None
+    test_rig: ForceTransducers | None = None
     rotors: tuple[Rotor, ...] = ()
 
     def __post_init__(self):
@@ -841,7 +891,7 @@ class Case:
         and the case's effects allow flexible links)."""
         return self.effects.flexible_links and self.link_map[name].flexible
 
-    def link_modes(self, name: str) -> Union[str, int, float]:
+    def link_modes(self, name: str) -> ModeRequest:
         """The link mode rule: the modes the reduction of link *name* keeps.
 
         A flexible link keeps what its ``modes`` field asks for; a rigid link

@@ -68,7 +68,10 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
         unknown = set(data) - known - {"type"}
         if unknown:
             raise ValueError(f"{kind}: unknown fields {sorted(unknown)}; expected {sorted(known)}")
-        return cls(**{key: from_dict(value, classes) for key, value in data.items() if key != "type"})
+        fields = {key: from_dict(value, classes) for key, value in data.items() if key != "type"}
+        if cls is _case.Link and isinstance(fields.get("modes"), float):
+            fields["modes"] = _case.ModeCutoff(fields["modes"])     # a number with a fraction: a cut-off, Hz
+        return cls(**fields)
     return data
 
 

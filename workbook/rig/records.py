@@ -25,7 +25,6 @@ import csv
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Union
 
 import numpy as np
 
@@ -107,7 +106,7 @@ class RigRecord:
                               f"pylon-side hinges ({', '.join(pylon_hinges)}): {'; '.join(problems)}")
 
 
-def read_record(path: Union[str, Path]) -> RigRecord:
+def read_record(path: str | Path) -> RigRecord:
     """Read and check a rig record CSV.
 
     Raises
@@ -238,7 +237,7 @@ def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:
                           f"sampled at {sampled:.6g} Hz (step {step:.6g} s expected)", column="time [s]")
 
 
-def write_record(path: Union[str, Path], record: RigRecord, *, digits: int = 4) -> Path:
+def write_record(path: str | Path, record: RigRecord, *, digits: int = 4) -> Path:
     """Write *record* as a rig record CSV (forces in N with *digits* decimals, time in s).
 
     Returns

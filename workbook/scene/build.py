@@ -31,7 +31,7 @@ from __future__ import annotations
 import logging
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Callable, Union
+from typing import Any, Callable
 
 import numpy as np
 
@@ -218,10 +218,10 @@ class Scene:
     reduced: dict
     hinges: dict[str, HingeItems]
     static_loads: dict[str, list]
-    excitation: Union[ExcitationItems, None]
+    excitation: ExcitationItems | None
     load_scale: float
     transducers: dict = field(default_factory=dict)
-    gyroscopics: Union[GyroscopicItems, None] = None
+    gyroscopics: GyroscopicItems | None = None
 
     @property
     def force_channels(self) -> dict:
@@ -291,7 +291,7 @@ class Scene:
                 for name, items in self.force_channels.items()}
 
 
-def _reduction_frequency(case: Case, excitation: Union[SingleFrequencyExcitation, None]) -> float:
+def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | None) -> float:
     """Highest excitation frequency a reduction must serve, Hz."""
     if excitation is not None:
         return excitation.frequency
@@ -299,8 +299,8 @@ def _reduction_frequency(case: Case, excitation: Union[SingleFrequencyExcitation
     return max(frequencies) if frequencies else 0.0
 
 
-def reduce_links(case: Case, excitation: Union[SingleFrequencyExcitation, None] = None,
-                 progress: Union[Callable[[int], None], None] = None) -> dict:
+def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None,
+                 progress: Callable[[int], None] | None = None) -> dict:
     """Reduce every link of *case* (cached on disk by :mod:`flexbodies`).
 
     Flexible links keep the modes their ``modes`` field asks for, judged at the
@@ -329,7 +329,7 @@ def reduce_links(case: Case, excitation: Union[SingleFrequencyExcitation, None] 
     return reduced
 
 
-def _load_scale(case: Case, excitation: Union[SingleFrequencyExcitation, None], link_mass: float) -> float:
+def _load_scale(case: Case, excitation: SingleFrequencyExcitation | None, link_mass: float) -> float:
     scale = 1.0
     if excitation is not None:
         scale = max(scale, excitation.force_amplitude)
@@ -342,8 +342,8 @@ def _load_scale(case: Case, excitation: Union[SingleFrequencyExcitation, None], 
     return scale
 
 
-def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] = None, *,
-                reduced: Union[dict, None] = None) -> Scene:
+def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None, *,
+                reduced: dict | None = None) -> Scene:
     """Build the Exudyn system of *case*.
 
     Parameters

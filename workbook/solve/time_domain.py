@@ -36,7 +36,7 @@ import logging
 import math
 import time as wall_clock
 from dataclasses import dataclass, field
-from typing import Callable, Union
+from typing import Callable
 
 import numpy as np
 
@@ -259,7 +259,7 @@ def _check_motion(scene: Scene, preloaded: np.ndarray, simulated: float, where: 
             f"Check the hinge stiffnesses and damping, or raise the limit if such motion is meant.")
 
 
-def integrate(scene: Scene, plan: TimePlan, progress: Union[Callable[[float], None], None] = None
+def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | None = None
               ) -> TimeHistories:
     """Run generalized-alpha over the plan from the scene's initial (preloaded) state.
 

@@ -28,12 +28,12 @@ import statistics
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, Union
+from typing import Callable
 
 import numpy as np
 
 from flexbodies.selection import MODE_MARGIN
-from workbook.model.case import DIRECTIONS, Case, SingleFrequencyExcitation
+from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
 from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
 
@@ -63,7 +63,7 @@ class Rung:
     label: str
     links: str
     method: str
-    steps_per_period: Union[int, None] = None
+    steps_per_period: int | None = None
 
     @property
     def description(self) -> str:
@@ -90,7 +90,7 @@ def _seed_modes(link, excitation: SingleFrequencyExcitation):
     """Modes of a link in the seed study's method: up to 4 f_exc, at least one."""
     from flexbodies import reduce_link
 
-    cutoff = MODE_MARGIN * excitation.frequency
+    cutoff = ModeCutoff(MODE_MARGIN * excitation.frequency)
     kept = reduce_link(link.model, modes=cutoff, excitation_hz=excitation.frequency).n_fixed_interface
     return cutoff if kept > 0 else 1
 
@@ -274,7 +274,7 @@ class AccuracyStudy:
         ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), fontsize="small", frameon=False)
         return fig
 
-    def write(self, folder: Union[str, Path], stem: str = "accuracy-study") -> list[Path]:
+    def write(self, folder: str | Path, stem: str = "accuracy-study") -> list[Path]:
         """Write the markdown table, the Pareto plot (PNG) and the sheet (.xlsx, one sheet).
 
         Existing files are never overwritten: when any of ``stem.md``,
@@ -305,8 +305,8 @@ class AccuracyStudy:
         return paths
 
 
-def run_study(case: Case, *, repeats: int = 3, rungs: Union[list, None] = None,
-              progress: Union[Callable[[str], None], None] = None) -> AccuracyStudy:
+def run_study(case: Case, *, repeats: int = 3, rungs: list | None = None,
+              progress: Callable[[str], None] | None = None) -> AccuracyStudy:
     """Run *case* through the ladder.
 
     Parameters

@@ -18,7 +18,7 @@ import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
-from typing import Callable, Union
+from typing import Callable
 
 from workbook.answers.isolation import efficiency
 from workbook.model.case import DIRECTIONS, Case
@@ -66,7 +66,7 @@ def _failed(index: int, error: BaseException, wall_time: float = 0.0) -> RowOutc
     return RowOutcome(index, [], "failed", f"{type(error).__name__}: {error}", wall_time)
 
 
-def prepare(cases: list[Union[Case, BaseException]]) -> list[Union[Case, RowOutcome]]:
+def prepare(cases: list[Case | BaseException]) -> list[Case | RowOutcome]:
     """Reduce every distinct link of the cases once (filling the disk cache).
 
     Parameters
@@ -137,8 +137,8 @@ def run_row(index: int, case: Case) -> RowOutcome:
     return RowOutcome(index, runs, wall_time=time.perf_counter() - start)
 
 
-def run_rows(cases: list[Union[Case, BaseException]], *, workers: int = SERIAL, dask: Union[str, None] = None,
-             progress: Union[Callable[[int, int], None], None] = None) -> list[RowOutcome]:
+def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: str | None = None,
+             progress: Callable[[int, int], None] | None = None) -> list[RowOutcome]:
     """Run the rows' cases and return their outcomes in row order.
 
     Parameters

@@ -8,7 +8,6 @@ table row with its error and no answers).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Union
 
 import numpy as np
 
@@ -95,7 +94,7 @@ def plot_sensitivity(frame, parameters: list[str]):
     return fig
 
 
-def write_study(frame, parameters: list[str], folder: Union[str, Path], table_format: str = "csv") -> list[Path]:
+def write_study(frame, parameters: list[str], folder: str | Path, table_format: str = "csv") -> list[Path]:
     """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot.
 
     Returns
