@@ -15,13 +15,29 @@ from pathlib import Path
 from typing import Any, Callable, Union
 
 from openpyxl.utils import get_column_letter
+from openpyxl.utils.cell import coordinate_to_tuple
 
 import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
 from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.units import si_factor
 
-__all__ = ["Record", "SheetReader", "open_workbook"]
+__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells"]
+
+
+def peek(ws, coordinate: str) -> Any:
+    """The value of cell *coordinate* of *ws*, without creating the cell (None if it is not stored).
+
+    ``ws[coordinate]`` and ``ws.cell()`` add an empty cell to the sheet,
+    which a later save would write.
+    """
+    cell = ws._cells.get(coordinate_to_tuple(coordinate))
+    return None if cell is None else cell.value
+
+
+def stored_cells(ws) -> list:
+    """The cells stored in *ws* (those in the file), by row then column; no empty cell is created."""
+    return [ws._cells[key] for key in sorted(ws._cells)]
 
 
 @dataclass

@@ -1,8 +1,12 @@
 """Write run results back into the case workbook, safely.
 
-Result sheets are named ``Result ...`` and carry a marker in a hidden cell,
-so a later run replaces them and never a sheet of the user's that happens to
-share a name. The input sheets are left as openpyxl read them (values,
+Result sheets are named ``Result efficiency``, ``Result hinges``, ``Result
+sweep`` and ``Result model card``; each carries, in a hidden cell, a marker
+naming the sheet it was written as. A later run replaces a sheet only when
+its name is one of these and its marker names that same sheet: a copy of a
+result sheet (``Result efficiency (2)``) or a renamed one (``Result LP
+baseline``) is the user's and is kept, like any sheet of the user's that
+happens to share a name. The input sheets are left as openpyxl read them (values,
 styles, drop-downs, comments).
 
 The case workbook is not overwritten (the results go to a separate, new
@@ -35,6 +39,7 @@ import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.excel.files import lock_file, restore_formula_values, save_atomic, unsupported_content
 from workbook.excel.runs import RunSpec, TestPoint
+from workbook.excel.sheets import peek
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
@@ -42,7 +47,7 @@ __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_r
 
 log = logging.getLogger(__name__)
 
-#: Text of the hidden marker cell of every result sheet.
+#: Text of the hidden marker cell of every result sheet, followed by ": <sheet title>".
 MARKER = "mountwb result sheet"
 #: Marker cell (its column is hidden).
 MARKER_CELL = "Z1"
@@ -144,14 +149,26 @@ def _sheet_title(name: str) -> str:
     return f"{L.RESULT_PREFIX}{name}"
 
 
+def _marker(title: str) -> str:
+    return f"{MARKER}: {title}"
+
+
 def _mark(ws) -> None:
-    ws[MARKER_CELL] = MARKER
+    ws[MARKER_CELL] = _marker(ws.title)
     ws.column_dimensions[MARKER_CELL.rstrip("0123456789")].hidden = True
 
 
 def is_result_sheet(ws) -> bool:
-    """True if *ws* is a result sheet written by this module."""
-    return ws[MARKER_CELL].value == MARKER
+    """True if *ws* is a result sheet this package wrote, under the name it has now.
+
+    A copy or a renamed result sheet keeps the marker of the sheet it came
+    from, so its name and marker differ: it is the user's. (Workbooks written
+    before the marker named its sheet carry the bare :data:`MARKER`.)
+    """
+    if ws.title not in RESULT_SHEETS:
+        return False
+    value = peek(ws, MARKER_CELL)
+    return value == _marker(ws.title) or value == MARKER
 
 
 def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
@@ -179,13 +196,17 @@ _NOTES = {
 }
 
 
+#: Every sheet title a write may create (and so may replace).
+RESULT_SHEETS = tuple(_sheet_title(name) for name in (*_NOTES, "model card"))
+
+
 def result_sheet_names(frames: dict) -> list[str]:
     """Titles of the result sheets a write creates."""
     return [_sheet_title(name) for name in frames] + [_sheet_title("model card")]
 
 
 def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str) -> list[str]:
-    """Add the result sheets to an openpyxl *workbook* (our old ones are removed first).
+    """Add the result sheets to an openpyxl *workbook* (the ones it wrote before are removed first).
 
     Returns
     -------
@@ -193,7 +214,7 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
         The sheet titles written.
     """
     for ws in list(workbook.worksheets):
-        if ws.title.startswith(L.RESULT_PREFIX) and is_result_sheet(ws):
+        if is_result_sheet(ws):
             workbook.remove(ws)
     frames = result_frames(runs, tests)
     for name, frame in frames.items():
