@@ -280,6 +280,11 @@ BAD_INPUTS = {
     "two rows in the Test rig sheet": (_edit({**RIG_ROW, **{(sheet, header, 4): value for (sheet, header, _), value
                                                              in RIG_ROW.items()}}),
                                        ["sheet 'Test rig'", "row 4", "exactly one row"]),
+    "ambiguous text number": (_edit({("Engine", "mass", 3): "3,568"}),
+                              ["sheet 'Engine'", "cell A3", "'3,568'", "3568 (',' separating thousands)",
+                               "3.568 (',' as the decimal separator)"]),
+    "ambiguous text number with a dot": (_edit({("Hinges", "stiffness", 4): "2.500"}),
+                                         ["sheet 'Hinges'", "cell G4", "2500", "2.5"]),
     "bad rig sensors switch": (_edit({("Case", "rig sensors", 3): "sometimes"}),
                                ["sheet 'Case'", "cell V3", "yes or no"]),
 }
@@ -373,3 +378,11 @@ def test_the_case_sheet_chooses_the_analysis_method(tmp_path):
     assert read_workbook(path).case.analysis.method == "time"
     set_cells(path, {("Case", "method", 3): "auto"})
     assert read_workbook(path).case.analysis.method == "auto"
+
+
+@pytest.mark.parametrize("text, mass", [("3568", 3568.0), ("3 568", 3568.0), ("3568,5", 3568.5), ("3.568,5", 3568.5),
+                                        ("3,568.5", 3568.5), ("0,5", 0.5), ("1,234,567", 1234567.0)])
+def test_text_numbers_with_one_reading_are_read(tmp_path, text, mass):
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Engine", "mass", 3): text})
+    assert read_workbook(path).case.engine.mass == mass

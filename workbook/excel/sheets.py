@@ -218,16 +218,44 @@ class _Bad(ValueError):
 def _as_number(value: Any, column: L.Column) -> float:
     if isinstance(value, bool):
         raise _Bad("a number")
-    if isinstance(value, (int, float)):
-        number = float(value)
-    else:
-        try:
-            number = float(str(value).strip().replace(",", "."))
-        except ValueError:
-            raise _Bad("a number") from None
+    number = float(value) if isinstance(value, (int, float)) else _text_number(str(value))
     if not math.isfinite(number):
         raise _Bad("a finite number")
     return number
+
+
+#: Digits grouped in threes by a separator: 1,234 or 12.345.678.
+_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$")
+_PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
+
+
+def _text_number(text: str) -> float:
+    """A number typed as text, read only when its separators leave one reading.
+
+    ``3,5`` is 3.5, ``1.234,5`` and ``1,234.5`` are 1234.5, ``1,234,567`` is
+    1234567; but ``3,568`` (or ``3.568``) may be 3568 (a thousands
+    separator) or 3.568 (a decimal separator) and is refused with both
+    readings. A number entered as a number is never ambiguous.
+    """
+    compact = text.strip().replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
+    grouped = _GROUPED.match(compact)
+    separator = grouped.group("sep") if grouped else None
+    if grouped and compact.count(separator) == 1:
+        thousands, decimal = compact.replace(separator, ""), compact.replace(separator, ".")
+        raise _Bad(f"a number whose separators can be read one way only: {text.strip()!r} reads as "
+                   f"{thousands} ({separator!r} separating thousands) or as {decimal} ({separator!r} as the "
+                   f"decimal separator); type {thousands} or {decimal}, or enter the cell as a number")
+    if grouped:
+        return float(compact.replace(grouped.group("sep"), ""))
+    if "," in compact and "." in compact:
+        decimal = "," if compact.rindex(",") > compact.rindex(".") else "."
+        whole, _, fraction = compact.rpartition(decimal)
+        if _GROUPED.match(whole) and _GROUPED.match(whole).group("sep") != decimal and fraction.isdigit():
+            return float(whole.replace("," if decimal == "." else ".", "") + "." + fraction)
+        raise _Bad("a number")
+    if not _PLAIN.match(compact) and compact.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
+        raise _Bad("a number")
+    return float(compact.replace(",", "."))
 
 
 def _as_integer(value: Any, column: L.Column) -> int:
