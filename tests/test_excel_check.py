@@ -58,9 +58,9 @@ def _members(path):
 
 @pytest.mark.parametrize("make, committed", [(template_workbook, TEMPLATE), (reference_workbook, REFERENCE)])
 def test_committed_workbooks_are_what_the_code_generates(tmp_path, make, committed):
-    generated = write_workbook(make(), tmp_path / committed.name)
+    generated, _ = write_workbook(make(), tmp_path / committed.name)
     assert _members(generated) == _members(committed), \
-        f"{committed.name} is stale: regenerate it with `mountwb template {committed} [--reference]`"
+        f"{committed.name} is stale: regenerate it with `mountwb template {committed} [--reference] --replace`"
 
 
 def test_reference_workbook_is_the_python_default():

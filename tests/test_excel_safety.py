@@ -5,11 +5,18 @@ Excel and LibreOffice write them) and runs the real commands on them.
 """
 from __future__ import annotations
 
+import os
 import shutil
+import signal
+import stat
+import subprocess
+import sys
+import time
+import zipfile
 
 import pytest
-from excel_helpers import copy_reference, make_cheap
-from openpyxl import load_workbook
+from excel_helpers import ROOT, copy_reference, make_cheap, sha256
+from openpyxl import Workbook, load_workbook
 
 from workbook.cli.main import main
 
@@ -29,7 +36,6 @@ def _copy(source, folder, name="case.xlsx"):
     return target
 
 
-@pytest.mark.slow
 def test_copied_and_renamed_result_sheets_are_the_users(cheap_ran, tmp_path):
     path = _copy(cheap_ran, tmp_path)
     wb = load_workbook(path)
@@ -44,3 +50,105 @@ def test_copied_and_renamed_result_sheets_are_the_users(cheap_ran, tmp_path):
     assert wb["Result efficiency (2)"]["A1"].value == "kept for the design review"
     assert wb["Result LP baseline"].max_row == wb["Result hinges"].max_row
     assert sum(n == "Result efficiency" for n in wb.sheetnames) == 1
+
+
+# -- files changed only as asked ---------------------------------------------------------------------------------
+
+_XLSX_MAIN = "application/vnd.openxmlformats-officedocument.spreadsheetml.sheet.main+xml"
+_XLSM_MAIN = "application/vnd.ms-excel.sheet.macroEnabled.main+xml"
+
+
+def _content_types(path):
+    with zipfile.ZipFile(path) as archive:
+        return archive.read("[Content_Types].xml").decode()
+
+
+def _rezip(path, edit):
+    """Rewrite the zip parts of *path*: ``edit(name, text) -> text`` for XML parts."""
+    with zipfile.ZipFile(path) as archive:
+        parts = {name: archive.read(name) for name in archive.namelist()}
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in parts.items():
+            if name.endswith((".xml", ".rels", ".vml")):
+                data = edit(name, data.decode()).encode()
+            archive.writestr(name, data)
+
+
+def test_a_macro_free_xlsm_stays_macro_enabled_and_keeps_its_permissions(tmp_path):
+    path = copy_reference(tmp_path, "case.xlsm")
+    make_cheap(path)
+    _rezip(path, lambda name, text: text.replace(_XLSX_MAIN, _XLSM_MAIN))
+    os.chmod(path, 0o640)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert _XLSM_MAIN in _content_types(path) and _XLSX_MAIN not in _content_types(path)
+    assert stat.S_IMODE(path.stat().st_mode) == 0o640
+    assert "Result efficiency" in load_workbook(path).sheetnames
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsm"]
+
+
+def test_template_never_replaces_a_file_unless_asked(tmp_path, capsys):
+    path = copy_reference(tmp_path)
+    digest = sha256(path)
+    assert main(["template", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert sha256(path) == digest
+    beside = [p for p in tmp_path.iterdir() if p.name.startswith("case-template-")]
+    assert len(beside) == 1 and f"template written to {beside[0]}" in out and "case.xlsx exists" in out
+    assert main(["template", str(path), "--replace"]) == 0
+    assert sha256(path) != digest and "Result efficiency" not in load_workbook(path).sheetnames
+
+
+def test_a_workbook_open_in_libreoffice_is_not_overwritten(cheap_ran, tmp_path, capsys):
+    path = _copy(cheap_ran, tmp_path)
+    (tmp_path / ".~lock.case.xlsx#").write_text(",engineer,host,22.11.2026 21:00,file:///home/engineer/.config;")
+    digest = sha256(path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "open in LibreOffice (lock file .~lock.case.xlsx# present)" in out
+    assert sha256(path) == digest
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith("case-results-")]) == 1
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith("case-report-")]) == 1
+
+
+def test_a_report_replaces_only_a_report(cheap_ran, tmp_path, capsys):
+    path = _copy(cheap_ran, tmp_path)
+    notes = tmp_path / "notes.xlsx"
+    Workbook().save(notes)
+    digest = sha256(notes)
+    report = tmp_path / "report.xlsx"
+    for target in (notes, report, report):
+        assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(target)]) == 0
+    assert sha256(notes) == digest
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names[:1] == ["case.xlsx"] and names[-2:] == ["notes.xlsx", "report.xlsx"] and len(names) == 4
+    assert names[1].startswith("notes-report-")
+    assert load_workbook(report).sheetnames[0] == "Summary"
+
+
+_SAVE_FOREVER = """
+import sys
+from openpyxl import Workbook
+from workbook.excel.files import save_atomic
+wb = Workbook()
+for row in range(1, 4001):
+    wb.active.append([row, row * 0.5, "some text in a cell", row * 2.0, "more text"])
+open(sys.argv[2], "w").close()
+while True:
+    save_atomic(wb, sys.argv[1])
+"""
+
+
+def test_a_kill_during_a_save_leaves_no_file_behind(tmp_path):
+    path = copy_reference(tmp_path)
+    ready = tmp_path.parent / f"{tmp_path.name}-ready"
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]))
+    for delay in (0.3, 0.7, 1.1):
+        ready.unlink(missing_ok=True)
+        process = subprocess.Popen([sys.executable, "-c", _SAVE_FOREVER, str(path), str(ready)], env=env)
+        while not ready.exists():
+            time.sleep(0.05)
+        time.sleep(delay)
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]
+        load_workbook(path)

@@ -20,6 +20,7 @@ from __future__ import annotations
 import datetime
 import io
 import platform
+import zipfile
 from importlib import metadata
 from pathlib import Path
 from typing import Union
@@ -29,12 +30,15 @@ from openpyxl.chart import BarChart, Reference, ScatterChart, Series
 from openpyxl.drawing.image import Image
 from openpyxl.styles import Font
 
-from workbook.excel.files import lock_file, save_atomic
+from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.reader import CaseBook
-from workbook.excel.writer import RunResult, card_lines, result_frames
+from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["write_report", "PACKAGES"]
+__all__ = ["write_report", "is_report", "PACKAGES", "REPORT_KEYWORDS"]
+
+#: Document keywords that mark a report workbook (an existing report may be replaced).
+REPORT_KEYWORDS = "mountwb report"
 
 #: Distributions whose versions the metadata sheet records.
 PACKAGES = ("engine-mount-workbook", "exudyn", "scikit-fem", "numpy", "scipy", "pandas", "openpyxl", "pint",
@@ -168,23 +172,30 @@ def _metadata(ws, book: CaseBook, runs: list[RunResult]) -> None:
     ws.column_dimensions["A"].width, ws.column_dimensions["B"].width = 28, 80
 
 
-def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult]) -> Path:
-    """Write the report workbook of *runs* to *path* (atomically).
+def is_report(path: Path) -> bool:
+    """True if the file at *path* is a report workbook this module wrote (its keywords say so)."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            core = archive.read("docProps/core.xml")
+    except (OSError, KeyError, zipfile.BadZipFile):
+        return False
+    return f"<cp:keywords>{REPORT_KEYWORDS}</cp:keywords>".encode() in core
 
-    Raises
-    ------
-    ValueError
-        *path* is the case workbook itself.
-    PermissionError
-        *path* is open in Excel (its lock file is present).
+
+def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult]) -> WriteOutcome:
+    """Write the report workbook of *runs* to *path* (atomically), or beside it.
+
+    An existing *path* is replaced only if it is a report this module wrote
+    and not open in Excel or LibreOffice; otherwise (the case workbook
+    itself, any other file) the report goes to a new name beside it.
+
+    Returns
+    -------
+    WriteOutcome
     """
-    path = Path(path)
-    if path.resolve() == book.path.resolve():
-        raise ValueError(f"the report cannot overwrite the case workbook {path.name}; choose another file")
-    lock = lock_file(path)
-    if lock is not None:
-        raise PermissionError(f"{path.name} is open in Excel (lock file {lock.name}); close it and run again")
+    target, reason = new_file_target(path, "report", is_report)
     workbook = Workbook()
+    workbook.properties.creator, workbook.properties.keywords = "mountwb", REPORT_KEYWORDS
     workbook.active.title = "Summary"
     _summary(workbook.active, book.case.name, runs)
     if book.tests:
@@ -195,4 +206,4 @@ def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult]) 
     for row, line in enumerate(card_lines(runs), start=1):
         cards.cell(row, 1, line).font = Font(name="Consolas", bold=line.startswith("Run '"))
     _metadata(workbook.create_sheet("Metadata"), book, runs)
-    return save_atomic(workbook, path)
+    return WriteOutcome(save_atomic(workbook, target), reason)

@@ -20,7 +20,7 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.datavalidation import DataValidation
 
 import workbook.excel.layout as L
-from workbook.excel.files import save_atomic
+from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.model import case as cm
 from workbook.model.units import si_factor
@@ -279,6 +279,14 @@ def reference_workbook() -> Workbook:
     return case_workbook(reference_case(sweep=True), REFERENCE_RUNS)
 
 
-def write_workbook(workbook: Workbook, path: Union[str, Path]) -> Path:
-    """Save a generated workbook (atomically)."""
-    return save_atomic(workbook, path)
+def write_workbook(workbook: Workbook, path: Union[str, Path], replace: bool = False):
+    """Save a generated workbook (atomically); an existing file is replaced only if *replace*.
+
+    Returns
+    -------
+    (Path, str or None)
+        The file written (*path*, or a new name beside an existing *path*)
+        and the reason it is not *path* (None: it is).
+    """
+    target, reason = new_file_target(path, "template", lambda _: replace)
+    return save_atomic(workbook, target), reason

@@ -12,7 +12,8 @@ styles, drop-downs, comments).
 The case workbook is not overwritten (the results go to a separate, new
 workbook beside it, and the reason is given) when:
 
-- it is open in Excel (the lock file ``~$<name>`` is present);
+- it is open in Excel or LibreOffice (the lock file ``~$<name>`` or
+  ``.~lock.<name>#`` is present);
 - it holds content openpyxl would drop (charts, images, pivot tables,
   macros, external links, data-validation extensions, ...);
 - a sheet named like a result sheet exists that is not ours;
@@ -37,7 +38,7 @@ from openpyxl.utils import get_column_letter
 
 import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
-from workbook.excel.files import lock_file, restore_formula_values, save_atomic, unsupported_content
+from workbook.excel.files import lock_file, lock_message, name_beside, restore_formula_values, save_atomic, unsupported_content
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.sheets import peek
 from workbook.model.case import DIRECTIONS
@@ -235,7 +236,7 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
     """(reason or None, the loaded workbook or None)."""
     lock = lock_file(path)
     if lock is not None:
-        return f"it is open in Excel (lock file {lock.name} present); close it and run again to write into it", None
+        return lock_message(lock), None
     if hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
         return "it changed on disk while the runs were computed", None
     dropped = unsupported_content(path)
@@ -267,16 +268,6 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     return cached
 
 
-def _separate_path(path: Path) -> Path:
-    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    candidate = path.with_name(f"{path.stem}-results-{stamp}.xlsx")
-    number = 1
-    while candidate.exists():
-        number += 1
-        candidate = path.with_name(f"{path.stem}-results-{stamp}-{number}.xlsx")
-    return candidate
-
-
 def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], tests: tuple = ()) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
@@ -300,10 +291,10 @@ def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], te
     if reason is None:
         add_result_sheets(workbook, runs, tests, stamp)
         cached = _cached_formula_values(path, workbook)
-        return WriteOutcome(save_atomic(workbook, path, lambda saved: restore_formula_values(saved, cached)), None)
+        return WriteOutcome(save_atomic(workbook, path, lambda data: restore_formula_values(data, cached)), None)
     separate = Workbook()
     separate.remove(separate.active)
     add_result_sheets(separate, runs, tests, stamp)
-    target = save_atomic(separate, _separate_path(path))
-    log.warning("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
+    target = save_atomic(separate, name_beside(path, "results"))
+    log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)
