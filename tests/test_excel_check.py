@@ -7,7 +7,7 @@ import re
 import zipfile
 
 import pytest
-from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference, set_cells, sha256
+from excel_helpers import REFERENCE, TEMPLATE, column_of, compound_file, copy_reference, give_cached_value, set_cells, sha256
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
@@ -206,6 +206,15 @@ def _zip_of_text(path):
     return buffer.getvalue()
 
 
+def _date_formatted_mass(wb):
+    wb["Engine"]["A3"].number_format = "yyyy-mm-dd"
+
+
+def _formula_error(path):
+    set_cells(path, {("Engine", "mass", 3): '=1+"a"'})
+    give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", "#VALUE!", error=True)
+
+
 BAD_INPUTS = {
     "missing sheet": (_edit_wb(lambda wb: wb.remove(wb["Hinges"])), ["sheet 'Hinges'"]),
     "missing column": (_edit_wb(lambda wb: wb["Hinges"].delete_cols(column_of(wb["Hinges"], "stiffness"))),
@@ -285,6 +294,24 @@ BAD_INPUTS = {
                                "3.568 (',' as the decimal separator)"]),
     "ambiguous text number with a dot": (_edit({("Hinges", "stiffness", 4): "2.500"}),
                                          ["sheet 'Hinges'", "cell G4", "2500", "2.5"]),
+    "merged cells": (_edit_wb(lambda wb: wb["Hinges"].merge_cells("B3:C5")),
+                     ["sheet 'Hinges'", "cell B3:C5", "not merged"]),
+    "number formatted as a date": (_edit_wb(_date_formatted_mass),
+                                   ["sheet 'Engine'", "cell A3", "'3568 formatted as the date 1909-10-07'",
+                                    "format it as a number"]),
+    "formula error": (_formula_error, ["sheet 'Engine'", "cell A3", "'#VALUE!'", "formula error #VALUE!"]),
+    "RPM": (_edit({("Excitations", "frequency", 2): "RPM"}), ["cell F2", "'RPM'", "did you mean 'rpm'?"]),
+    "U/min": (_edit({("Excitations", "frequency", 2): "U/min"}), ["cell F2", "'U/min'", "did you mean 'rpm'?"]),
+    "Ns/m": (_edit({("Hinges", "damping", 2): "Ns/m"}), ["cell H2", "'Ns/m'", "did you mean 'N*s/m'?"]),
+    "a stray value in the last row": (_edit_wb(lambda wb: wb["Hinges"].cell(1048576, 1, "x")),
+                                      ["sheet 'Hinges'", "cell A1048576", "'x'", "at most 10000 rows are read"]),
+    "an .xls workbook": (_write_bytes(lambda p: compound_file({"Workbook": 4096})),
+                         ["case.xlsx", "Excel 97-2003 workbook (.xls)", "save it as Excel Workbook .xlsx"]),
+    "a password-protected workbook": (_write_bytes(lambda p: compound_file({"EncryptionInfo": 4096,
+                                                                             "EncryptedPackage": 8192})),
+                                      ["case.xlsx", "encrypted with a password", "without a password"]),
+    "a rig record naming a device": (_edit({("Test data", "run", 3): "LP rotor", ("Test data", "rig record", 3): "/dev/zero"}),
+                                     ["sheet 'Test data'", "'/dev/zero'", "not a regular file"]),
     "bad rig sensors switch": (_edit({("Case", "rig sensors", 3): "sometimes"}),
                                ["sheet 'Case'", "cell V3", "yes or no"]),
 }

@@ -11,7 +11,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, make_cheap, set_cells, sha256
+from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, give_cached_value, make_cheap, set_cells, sha256
 from openpyxl import Workbook, load_workbook
 from openpyxl.chart import BarChart, Reference
 from openpyxl.comments import Comment
@@ -182,7 +182,7 @@ def test_rerun_replaces_our_sheets_and_keeps_formula_values(cheap, tmp_path, cap
     path = tmp_path / "case.xlsx"
     shutil.copyfile(cheap, path)
     set_cells(path, {("Engine", "mass", 3): "=3000+568"})
-    _give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", 3568)
+    give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", 3568)
     for _ in range(2):
         assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
     wb = load_workbook(path)
@@ -192,19 +192,6 @@ def test_rerun_replaces_our_sheets_and_keeps_formula_values(cheap, tmp_path, cap
     assert wb["Engine"]["A3"].value == "=3000+568"
     assert load_workbook(path, data_only=True)["Engine"]["A3"].value == 3568
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]      # no temporary files left
-
-
-def _give_cached_value(path, member, cell, value):
-    with zipfile.ZipFile(path) as archive:
-        contents = {name: archive.read(name) for name in archive.namelist()}
-    xml = contents[member].decode()
-    start = xml.index(f'<c r="{cell}"')
-    end = xml.index("</c>", start)
-    contents[member] = (xml[:start] + xml[start:end].replace("<v></v>", "").replace("<v />", "")
-                        + f"<v>{value}</v>" + xml[end:]).encode()
-    with zipfile.ZipFile(path, "w") as archive:
-        for name, data in contents.items():
-            archive.writestr(name, data)
 
 
 def _user_sheet(path):

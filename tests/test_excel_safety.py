@@ -6,6 +6,7 @@ Excel and LibreOffice write them) and runs the real commands on them.
 from __future__ import annotations
 
 import os
+import resource
 import shutil
 import signal
 import stat
@@ -19,6 +20,9 @@ from excel_helpers import ROOT, copy_reference, make_cheap, sha256
 from openpyxl import Workbook, load_workbook
 
 from workbook.cli.main import main
+from workbook.errors import WorkbookError
+from workbook.excel.reader import read_workbook
+from workbook.excel.sheets import MAX_UNPACKED_BYTES
 
 
 @pytest.fixture(scope="module")
@@ -152,3 +156,71 @@ def test_a_kill_during_a_save_leaves_no_file_behind(tmp_path):
         process.wait()
         assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]
         load_workbook(path)
+
+
+# -- bounded reading, messages -----------------------------------------------------------------------------------
+
+
+def test_merged_cells_are_one_problem_not_many(tmp_path):
+    path = copy_reference(tmp_path)
+    wb = load_workbook(path)
+    wb["Links"].merge_cells("C3:G5")
+    wb.save(path)
+    with pytest.raises(WorkbookError) as error:
+        read_workbook(path)
+    assert [(p.sheet, p.cell) for p in error.value.problems] == [("Links", "C3:G5")]
+
+
+def _limited(megabytes):
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (megabytes * 2**20, megabytes * 2**20))
+    return limit
+
+
+def _mountwb(*args, memory_mb=1500):
+    """``mountwb ARGS`` in a process of its own, with at most *memory_mb* of address space."""
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+               OPENBLAS_NUM_THREADS="1")
+    return subprocess.run([sys.executable, "-m", "workbook.cli.main", *map(str, args)], env=env, text=True,
+                          capture_output=True, preexec_fn=_limited(memory_mb))
+
+
+def test_a_stray_cell_in_the_last_row_costs_nothing(tmp_path):
+    """One note in row 1,048,576 of an input sheet and one of the Instructions: read and written back bounded."""
+    path = copy_reference(tmp_path)
+    make_cheap(path)
+    wb = load_workbook(path)
+    wb["Hinges"].cell(1, 30, "# remarks")
+    wb["Hinges"].cell(1048576, 30, "stray note")
+    wb["Instructions"].cell(1048576, 12, "stray note")
+    wb.save(path)
+    checked = _mountwb("check", path, memory_mb=1200)
+    assert checked.returncode == 0, checked.stderr
+    ran = _mountwb("run", path, "--no-progress", "--run", "LP rotor", memory_mb=1500)
+    assert ran.returncode == 0, ran.stderr
+    with zipfile.ZipFile(path) as archive:
+        rows = {name: archive.read(name).count(b"<row ") for name in archive.namelist()
+                if name.startswith("xl/worksheets/sheet")}
+    assert max(rows.values()) < 1000
+    wb = load_workbook(path)
+    assert wb["Hinges"].cell(1048576, 30).value == "stray note" and "Result efficiency" in wb.sheetnames
+
+
+def test_a_workbook_too_large_to_read_is_refused(tmp_path):
+    path = copy_reference(tmp_path)
+    with zipfile.ZipFile(path, "a", zipfile.ZIP_DEFLATED) as archive, archive.open("xl/media/filler.bin", "w",
+                                                                                    force_zip64=True) as member:
+        for _ in range(MAX_UNPACKED_BYTES // 2**24 + 1):
+            member.write(bytes(2**24))
+    assert path.stat().st_size < 2_000_000
+    checked = _mountwb("check", path, memory_mb=1200)
+    assert checked.returncode == 2
+    assert "parts that unpack to" in checked.stderr and "at most 250,000,000 bytes" in checked.stderr
+
+
+def test_a_refusal_is_printed_once(cheap_ran, tmp_path):
+    path = _copy(cheap_ran, tmp_path)
+    (tmp_path / "~$case.xlsx").write_bytes(b"engineer")
+    ran = _mountwb("run", path, "--no-progress", "--run", "LP rotor")
+    assert ran.returncode == 0, ran.stderr
+    assert (ran.stdout + ran.stderr).count("open in Excel (lock file ~$case.xlsx present)") == 1

@@ -30,7 +30,7 @@ from openpyxl.utils.datetime import to_excel
 from flexbodies.atomic import replacing
 
 __all__ = ["save_atomic", "lock_file", "lock_message", "unsupported_content", "restore_formula_values",
-           "name_beside", "workbook_bytes", "new_file_target"]
+           "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem"]
 
 log = logging.getLogger(__name__)
 
@@ -124,6 +124,22 @@ def name_beside(path: Union[str, Path], label: str) -> Path:
         number += 1
         candidate = path.with_name(f"{path.stem}-{label}-{stamp}-{number}.xlsx")
     return candidate
+
+
+def bounded_file_problem(path: Path, limit: int) -> Union[str, None]:
+    """Why the file a workbook names at *path* is not read (None: it may be read).
+
+    Only a regular file of at most *limit* bytes is read: a device
+    (``/dev/zero``), a pipe or a folder never ends or is not a file.
+    """
+    if not path.exists():
+        return f"{path} does not exist"
+    if not path.is_file():
+        return f"{path} is not a regular file (a device, a pipe or a folder)"
+    size = path.stat().st_size
+    if size > limit:
+        return f"{path} has {size:,} bytes; at most {limit:,} are read"
+    return None
 
 
 def new_file_target(path: Union[str, Path], label: str, replaceable: Callable[[Path], bool]):

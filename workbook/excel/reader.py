@@ -18,6 +18,7 @@ from typing import Any, Callable, Union
 import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import WorkbookError
+from workbook.excel.files import bounded_file_problem
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import Record, SheetReader, open_workbook
 from workbook.model import case as cm
@@ -25,6 +26,9 @@ from workbook.model import case as cm
 __all__ = ["CaseBook", "read_workbook"]
 
 log = logging.getLogger(__name__)
+
+#: Largest mesh file read, bytes.
+MAX_MESH_BYTES = 500_000_000
 
 
 @dataclass(frozen=True)
@@ -167,9 +171,10 @@ class _CaseReader(SheetReader):
         import flexbodies
 
         path = self.path.parent / record.get("mesh_file")
-        if not path.is_file():
+        problem = bounded_file_problem(path, MAX_MESH_BYTES)
+        if problem is not None:
             self.record_problem(record, ("mesh_file",), record.get("mesh_file"),
-                                f"a mesh file (relative to the workbook's folder; {path} does not exist)")
+                                f"a mesh file (relative to the workbook's folder; {problem})")
             return None
         bores = []
         for eye in ("a", "b"):
@@ -430,6 +435,8 @@ def read_workbook(path: Union[str, Path]) -> CaseBook:
     formulas, values = open_workbook(path)
     reader = _CaseReader(path, formulas, values)
     tables = {table.sheet: reader.table(table) for table in L.TABLES}
+    if reader.merged_found:
+        raise WorkbookError(reader.problems)
     case = reader.case(tables)
     if case is None:
         reader.unique(tables["Runs"])

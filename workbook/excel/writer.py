@@ -40,7 +40,7 @@ import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.excel.files import lock_file, lock_message, name_beside, restore_formula_values, save_atomic, unsupported_content
 from workbook.excel.runs import RunSpec, TestPoint
-from workbook.excel.sheets import peek
+from workbook.excel.sheets import peek, stored_cells
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
@@ -261,10 +261,10 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     for number, ws in enumerate(workbook.worksheets, start=1):
         if ws.title not in values.sheetnames:
             continue
-        for row in ws.iter_rows():
-            for cell in row:
-                if cell.data_type == "f" and values[ws.title][cell.coordinate].value is not None:
-                    cached.setdefault(number, {})[cell.coordinate] = values[ws.title][cell.coordinate].value
+        for cell in stored_cells(ws):
+            value = peek(values[ws.title], cell.coordinate) if cell.data_type == "f" else None
+            if value is not None:
+                cached.setdefault(number, {})[cell.coordinate] = value
     return cached
 
 
