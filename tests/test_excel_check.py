@@ -215,6 +215,23 @@ def _formula_error(path):
     give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", "#VALUE!", error=True)
 
 
+def _link_without_hinges(wb):
+    """Delete the rows of the Hinges sheet that hold link 'rear-right' (row 6 of the Links sheet)."""
+    ws = wb["Hinges"]
+    assert wb["Links"]["A6"].value == "rear-right"
+    for row in range(ws.max_row, 2, -1):
+        if "rear-right" in (ws.cell(row, 2).value, ws.cell(row, 3).value):
+            ws.delete_rows(row)
+
+
+def _no_pylon(wb):
+    ws = wb["Hinges"]
+    for row in range(3, ws.max_row + 1):
+        for col in (2, 3):
+            if ws.cell(row, col).value == "pylon":
+                ws.cell(row, col).value = "engine"
+
+
 BAD_INPUTS = {
     "missing sheet": (_edit_wb(lambda wb: wb.remove(wb["Hinges"])), ["sheet 'Hinges'"]),
     "missing column": (_edit_wb(lambda wb: wb["Hinges"].delete_cols(column_of(wb["Hinges"], "stiffness"))),
@@ -312,6 +329,15 @@ BAD_INPUTS = {
                                       ["case.xlsx", "encrypted with a password", "without a password"]),
     "a rig record naming a device": (_edit({("Test data", "run", 3): "LP rotor", ("Test data", "rig record", 3): "/dev/zero"}),
                                      ["sheet 'Test data'", "'/dev/zero'", "not a regular file"]),
+    "absurd hinge stiffness": (_edit({("Hinges", "stiffness", 4): 1e300}),
+                               ["sheet 'Hinges'", "cell G4", "found 1e+300", "at most 1e+14 N/m"]),
+    "absurd length in the wrong unit": (_edit({("Links", "end A x", 2): "km"}),
+                                        ["sheet 'Links'", "cell B5", "found -1600 m", "at most 1000 m"]),
+    "a link without hinges": (_edit_wb(_link_without_hinges),
+                              ["sheet 'Links'", "cell B6:D6", "a hinge at end A of link 'rear-right'",
+                               "cell E6:G6", "a hinge at end B of link 'rear-right'", "mechanism"]),
+    "no hinge to the pylon": (_edit_wb(_no_pylon),
+                              ["sheet 'Hinges'", "at least one hinge to the pylon"]),
     "bad rig sensors switch": (_edit({("Case", "rig sensors", 3): "sometimes"}),
                                ["sheet 'Case'", "cell V3", "yes or no"]),
 }

@@ -285,6 +285,7 @@ class _CaseReader(SheetReader):
         for record, link in items["Links"]:
             first_links.setdefault(record.get("name"), link)
         self.hinge_bodies(items["Hinges"], tables["Links"], first_links)
+        self.loose_eyes(items["Hinges"], items["Links"])
         if self.problems or not engine or None in engine or not settings or None in settings[0]:
             return None
         (analysis, effects), record = settings[0], tables["Case"][0]
@@ -316,6 +317,30 @@ class _CaseReader(SheetReader):
                     self.record_problem(record, L.HINGES.vector_keys("position"),
                                         record.typed(L.HINGES.vector_keys("position"), None),
                                         f"an eye centre of link '{body}' (the nearest is {gap * 1e3:.4g} mm away)")
+
+    def loose_eyes(self, hinges: list, links: list) -> None:
+        """Report each link eye no hinge holds, and a mount with no hinge to the engine or the pylon.
+
+        A link eye without a hinge swings free: the mount is a mechanism,
+        which the run would find only after building the model.
+        """
+        if any(hinge is None for _, hinge in hinges) or any(p.sheet == L.HINGES.sheet for p in self.problems):
+            return    # a bad or misplaced hinge is reported already
+        built = [hinge for _, hinge in hinges]
+        for record, link in links:
+            if link is None:
+                continue
+            held = {link.eye_at(h.position) for h in built if link.name in (h.body_a, h.body_b)}
+            for eye in ("a", "b"):
+                if eye not in held:
+                    keys = L.LINKS.vector_keys(f"end_{eye}")
+                    self.record_problem(record, keys, record.typed(keys, None),
+                                        f"a hinge at end {eye.upper()} of link '{link.name}' (no row of the Hinges "
+                                        "sheet joins the link there: it would swing free, a mechanism)")
+        for body in (cm.ENGINE, cm.PYLON):
+            if hinges and not any(body in (h.body_a, h.body_b) for h in built):
+                self.problem(L.HINGES.sheet, None, "body A", None,
+                             f"at least one hinge to the {body} (body A or body B '{body}')")
 
     def case_error(self, exc: cm.CaseError, items: dict) -> None:
         """Report a CaseError of the Case constructor at the row of the item it names."""

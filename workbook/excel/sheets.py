@@ -265,6 +265,12 @@ class SheetReader:
                     usable = False    # the unit cell is reported
                     continue
                 converted = converted * factors[key] if column.kind == "number" else converted
+                limit = L.MAGNITUDE_LIMITS.get(column.si_unit)
+                if column.kind == "number" and limit is not None and abs(converted) > limit:
+                    self.problem(table.sheet, cells[key], column.header, value,
+                                 f"a magnitude of at most {limit:g} {column.si_unit} (found {converted:g} "
+                                 f"{column.si_unit}: check the number and the unit in row {L.UNIT_ROW})")
+                    continue
             values[key] = converted
         raw = {key: value for key, value in raw.items() if value is not _FORMULA_WITHOUT_VALUE}
         return Record(table, row, values, cells, raw, usable and len(self.problems) == known)
