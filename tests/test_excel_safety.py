@@ -5,6 +5,7 @@ Excel and LibreOffice write them) and runs the real commands on them.
 """
 from __future__ import annotations
 
+import datetime
 import os
 import resource
 import shutil
@@ -16,11 +17,15 @@ import time
 import zipfile
 
 import pytest
-from excel_helpers import ROOT, copy_reference, make_cheap, sha256
+from excel_helpers import ROOT, copy_reference, give_cached_value, make_cheap, sha256
 from openpyxl import Workbook, load_workbook
+from openpyxl.cell.rich_text import CellRichText, TextBlock
+from openpyxl.cell.text import InlineFont
+from openpyxl.comments import Comment
 
 from workbook.cli.main import main
 from workbook.errors import WorkbookError
+from workbook.excel.files import lost_parts, unsupported_content, workbook_bytes
 from workbook.excel.reader import read_workbook
 from workbook.excel.sheets import MAX_UNPACKED_BYTES
 
@@ -224,3 +229,90 @@ def test_a_refusal_is_printed_once(cheap_ran, tmp_path):
     ran = _mountwb("run", path, "--no-progress", "--run", "LP rotor")
     assert ran.returncode == 0, ran.stderr
     assert (ran.stdout + ran.stderr).count("open in Excel (lock file ~$case.xlsx present)") == 1
+
+
+# -- what a write-back keeps, and what makes it refuse -------------------------------------------------------------
+
+
+def test_rich_text_and_the_cached_values_of_date_formulas_are_kept(cheap_ran, tmp_path):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    hinges = wb["Hinges"]
+    hinges.cell(1, 30, "# checked on")
+    hinges.cell(3, 30, "=DATE(2026,11,1)").number_format = "yyyy-mm-dd"
+    hinges.cell(4, 30, CellRichText(["bearing ", TextBlock(InlineFont(b=True), "replaced"), " in 2025"]))
+    wb.save(path)
+    sheet = f"xl/worksheets/sheet{wb.sheetnames.index('Hinges') + 1}.xml"
+    give_cached_value(path, sheet, "AD3", 46327)
+    assert load_workbook(path, data_only=True)["Hinges"]["AD3"].value == datetime.datetime(2026, 11, 1)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]
+    assert load_workbook(path, data_only=True)["Hinges"]["AD3"].value == datetime.datetime(2026, 11, 1)
+    rich = load_workbook(path, rich_text=True)["Hinges"]["AD4"].value
+    assert isinstance(rich, CellRichText) and str(rich) == "bearing replaced in 2025"
+    assert [block.font.b for block in rich if isinstance(block, TextBlock)] == [True]
+
+
+def _add_part(path, name, content_type, data=b"<x/>"):
+    """Add a zip part with its content type, as Excel writes a feature openpyxl does not know."""
+    _rezip(path, lambda member, text: text.replace(
+        "</Types>", f'<Override PartName="/{name}" ContentType="{content_type}"/></Types>')
+        if member == "[Content_Types].xml" else text)
+    with zipfile.ZipFile(path, "a") as archive:
+        archive.writestr(name, data)
+
+
+def _company(path):
+    _rezip(path, lambda name, text: text.replace("</Properties>", "<Company>Acme Aero</Company></Properties>")
+           if name == "docProps/app.xml" else text)
+
+
+def _resized_comment(path):
+    wb = load_workbook(path)
+    wb["Hinges"]["A5"].comment = Comment("see the supplier's drawing", "J. Doe", height=200, width=400)
+    wb.save(path)
+
+
+def _shown_comment(path):
+    _rezip(path, lambda name, text: text.replace("visibility:hidden", "visibility:visible")
+           if name.endswith(".vml") else text)
+
+
+@pytest.mark.parametrize("change, found", [
+    (lambda p: _add_part(p, "xl/threadedComments/threadedComment1.xml",
+                         "application/vnd.ms-excel.threadedcomments+xml"), "threaded comments"),
+    (lambda p: _add_part(p, "xl/metadata.xml", "application/vnd.openxmlformats-officedocument.spreadsheetml."
+                                               "sheetMetadata+xml"), "dynamic-array formulas (cell metadata)"),
+    (_company, "document properties (Company)"),
+    (_resized_comment, "comment boxes resized or always shown"),
+    (lambda p: (_resized_comment(p), _shown_comment(p)), "comment boxes resized or always shown"),
+])
+def test_content_openpyxl_would_drop_is_detected(tmp_path, change, found):
+    path = copy_reference(tmp_path)
+    wb = load_workbook(path)
+    wb["Hinges"]["A4"].comment = Comment("a comment of the default size is kept", "J. Doe")
+    wb.save(path)
+    assert unsupported_content(path) == []
+    change(path)
+    assert unsupported_content(path) == [found]
+
+
+def test_any_kind_of_part_a_rewrite_would_lose_is_found(tmp_path):
+    path = copy_reference(tmp_path)
+    before = path.read_bytes()
+    assert lost_parts(before, workbook_bytes(load_workbook(path), path)) == []
+    _add_part(path, "xl/feature/part1.xml", "application/vnd.example.feature+xml")
+    assert unsupported_content(path) == []
+    assert lost_parts(path.read_bytes(), workbook_bytes(load_workbook(path), path)) == [
+        "xl/feature/part1.xml (application/vnd.example.feature+xml)"]
+
+
+def test_a_part_the_rewrite_would_lose_sends_the_results_beside(cheap_ran, tmp_path, capsys):
+    path = _copy(cheap_ran, tmp_path)
+    _add_part(path, "xl/feature/part1.xml", "application/vnd.example.feature+xml")
+    digest = sha256(path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    out = capsys.readouterr().out
+    assert "cannot keep (xl/feature/part1.xml (application/vnd.example.feature+xml))" in out
+    assert sha256(path) == digest
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith("case-results-")]) == 1

@@ -30,7 +30,7 @@ from openpyxl.utils.datetime import to_excel
 from flexbodies.atomic import replacing
 
 __all__ = ["save_atomic", "lock_file", "lock_message", "unsupported_content", "restore_formula_values",
-           "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem"]
+           "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem", "lost_parts", "write_atomic"]
 
 log = logging.getLogger(__name__)
 
@@ -53,7 +53,23 @@ _MEMBERS = (
     ("xl/queryTables/", "queries"),
     ("xl/connections.xml", "data connections"),
     ("customXml/", "custom XML parts"),
+    ("xl/threadedComments/", "threaded comments"),
+    ("xl/persons/", "threaded comments"),
+    ("xl/metadata.xml", "dynamic-array formulas (cell metadata)"),
+    ("xl/richData/", "pictures or data types in cells"),
+    ("xl/webextensions/", "add-ins"),
+    ("xl/namedSheetViews/", "sheet views"),
 )
+#: Document properties (docProps/app.xml) openpyxl does not keep, when they hold text.
+_APP_PROPERTIES = ("Company", "Manager", "HyperlinkBase")
+_APP_PROPERTY = re.compile(rb"<(?:\w+:)?(" + b"|".join(p.encode() for p in _APP_PROPERTIES) + rb")>([^<]+)</")
+#: A comment box in a legacy drawing: its style (size, visibility).
+_NOTE = re.compile(rb'<(?:\w+:)?shape\b[^>]*?style="([^"]*)"[^>]*>(?:(?!</(?:\w+:)?shape>).)*?ObjectType="Note"', re.S)
+#: Box of a comment as openpyxl writes it (Excel's default too): 144 x 79 px = 108 x 59.25 pt, hidden.
+_NOTE_BOX_PT = (108.0, 59.25)
+#: Parts whose loss is harmless: Excel rebuilds the calculation chain and the thumbnail, and the
+#: printer-driver settings are device data (the page setup itself is kept).
+_REBUILT_TYPES = ("calcChain+xml", "printerSettings", "image/jpeg")
 #: Worksheet extensions (extLst) openpyxl drops.
 _EXTENSIONS = (
     (re.compile(rb"<x14:dataValidations?\b"), "data-validation extensions (lists from other sheets)"),
@@ -93,7 +109,60 @@ def unsupported_content(path: Union[str, Path]) -> list[str]:
                 for pattern, what in _EXTENSIONS:
                     if what not in found and pattern.search(data):
                         found.append(what)
+            if name.endswith(".vml") and "comment boxes resized or always shown" not in found:
+                if any(_custom_note(style) for style in _NOTE.findall(archive.read(name))):
+                    found.append("comment boxes resized or always shown")
+        if "docProps/app.xml" in names:
+            given = [key.decode() for key, text in _APP_PROPERTY.findall(archive.read("docProps/app.xml"))
+                     if text.strip()]
+            if given:
+                found.append(f"document properties ({', '.join(given)})")
     return found
+
+
+def _custom_note(style: bytes) -> bool:
+    """True if a comment box's VML style is not the default size, or the comment is always shown."""
+    fields = dict(item.split(":", 1) for item in style.decode().replace(" ", "").split(";") if ":" in item)
+    if fields.get("visibility", "hidden") != "hidden":
+        return True
+    for key, default in zip(("width", "height"), _NOTE_BOX_PT):
+        text = fields.get(key, "")
+        match = re.fullmatch(r"([0-9.]+)(pt|px|in|cm|mm)?", text)
+        if not match:
+            return True
+        scale = {"pt": 1.0, "px": 0.75, "in": 72.0, "cm": 72 / 2.54, "mm": 72 / 25.4, None: 1.0}[match.group(2)]
+        if abs(float(match.group(1)) * scale - default) > 0.5:
+            return True
+    return False
+
+
+def _content_types(data: bytes) -> dict[str, str]:
+    """Content type of each part of the zip archive *data*, by part name."""
+    with zipfile.ZipFile(io.BytesIO(data)) as archive:
+        names = [name for name in archive.namelist() if not name.endswith("/")]
+        xml = archive.read("[Content_Types].xml").decode("utf-8")
+    defaults = dict(re.findall(r'<Default\s+Extension="([^"]+)"\s+ContentType="([^"]+)"', xml))
+    defaults = {key.lower(): value for key, value in defaults.items()}
+    overrides = {name.lstrip("/"): kind for name, kind in
+                 re.findall(r'<Override\s+PartName="([^"]+)"\s+ContentType="([^"]+)"', xml)}
+    return {name: overrides.get(name) or defaults.get(name.rsplit(".", 1)[-1].lower(), "unknown")
+            for name in names if name != "[Content_Types].xml"}
+
+
+def lost_parts(before: bytes, after: bytes) -> list[str]:
+    """Parts of the workbook *before* of a kind the rewritten workbook *after* no longer has.
+
+    A safety net under :func:`unsupported_content`: any kind of part (by
+    content type) that the rewrite dropped, except those Excel rebuilds.
+
+    Returns
+    -------
+    list of str
+        ``"<part name> (<content type>)"`` for each part lost.
+    """
+    kept = set(_content_types(after).values())
+    return [f"{name} ({kind})" for name, kind in _content_types(before).items()
+            if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)]
 
 
 def lock_file(path: Union[str, Path]) -> Union[Path, None]:
@@ -278,6 +347,23 @@ def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
     return True
 
 
+def write_atomic(path: Union[str, Path], data: bytes) -> Path:
+    """Write *data* to *path* all at once, with the permissions of the file it replaces.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    mode = _mode(path)
+    if not _replace_unnamed(path, data, mode):
+        with replacing(path, suffix=".saving") as temporary:
+            temporary.write_bytes(data)
+    log.info("saved %s", path)
+    return path
+
+
 def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[bytes], bytes], None] = None) -> Path:
     """Save an openpyxl workbook to *path* atomically.
 
@@ -300,10 +386,4 @@ def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[bytes]
     data = workbook_bytes(workbook, path)
     if finish is not None:
         data = finish(data)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    mode = _mode(path)
-    if not _replace_unnamed(path, data, mode):
-        with replacing(path, suffix=".saving") as temporary:
-            temporary.write_bytes(data)
-    log.info("saved %s", path)
-    return path
+    return write_atomic(path, data)

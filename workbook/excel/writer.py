@@ -15,7 +15,10 @@ workbook beside it, and the reason is given) when:
 - it is open in Excel or LibreOffice (the lock file ``~$<name>`` or
   ``.~lock.<name>#`` is present);
 - it holds content openpyxl would drop (charts, images, pivot tables,
-  macros, external links, data-validation extensions, ...);
+  macros, external links, data-validation extensions, threaded comments,
+  dynamic-array formulas, resized or always-shown comment boxes, company
+  and manager properties, ...), or the rewritten file would lack any kind
+  of part the original has (:func:`~workbook.excel.files.lost_parts`);
 - a sheet named like a result sheet exists that is not ours;
 - it changed on disk while the runs were computed.
 
@@ -38,7 +41,17 @@ from openpyxl.utils import get_column_letter
 
 import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
-from workbook.excel.files import lock_file, lock_message, name_beside, restore_formula_values, save_atomic, unsupported_content
+from workbook.excel.files import (
+    lock_file,
+    lock_message,
+    lost_parts,
+    name_beside,
+    restore_formula_values,
+    save_atomic,
+    unsupported_content,
+    workbook_bytes,
+    write_atomic,
+)
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.sheets import peek, stored_cells
 from workbook.model.case import DIRECTIONS
@@ -244,7 +257,7 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
         return f"it holds content this program cannot keep ({', '.join(dropped)})", None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        workbook = load_workbook(path)
+        workbook = load_workbook(path, rich_text=True)
     conflicts = _conflicts(workbook, titles)
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
@@ -290,8 +303,11 @@ def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], te
     reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
     if reason is None:
         add_result_sheets(workbook, runs, tests, stamp)
-        cached = _cached_formula_values(path, workbook)
-        return WriteOutcome(save_atomic(workbook, path, lambda data: restore_formula_values(data, cached)), None)
+        data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
+        lost = lost_parts(path.read_bytes(), data)
+        if not lost:
+            return WriteOutcome(write_atomic(path, data), None)
+        reason = f"it holds content this program cannot keep ({', '.join(lost)})"
     separate = Workbook()
     separate.remove(separate.active)
     add_result_sheets(separate, runs, tests, stamp)
