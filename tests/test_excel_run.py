@@ -156,24 +156,35 @@ def test_test_data_error(ran):
 def test_report_workbook(ran):
     path, _, digest, report = ran
     wb = load_workbook(report)
-    assert wb.sheetnames == ["Summary", "Validation", "Transmissibility", "Plots", "Model card", "Metadata"]
+    assert wb.sheetnames == ["Summary", "Validation", "Transmissibility", "Modes", "Warnings", "Plots", "Model card",
+                             "Metadata"]
     validation = _sheet_rows(wb["Validation"], header_row=3)   # the pylon-sum test point only
     assert [(r["run"], r["direction"]) for r in validation] == [("LP rotor", "y")]
     lp_y = validation[0]
-    assert lp_y["T test"] == pytest.approx(TEST_LP_Y / 1000.0, rel=1e-12)
-    assert lp_y["error %"] == pytest.approx((lp_y["T sim"] - lp_y["T test"]) / lp_y["T test"] * 100, rel=1e-9)
+    assert lp_y["T test (-)"] == pytest.approx(TEST_LP_Y / 1000.0, rel=1e-12)
+    assert lp_y["error (%)"] == pytest.approx((lp_y["T sim (-)"] - lp_y["T test (-)"]) / lp_y["T test (-)"] * 100,
+                                              rel=1e-9)
+    assert lp_y["level test (dB)"] == pytest.approx(20 * np.log10(lp_y["T test (-)"]), rel=1e-12)
     assert len(wb["Summary"]._charts) == 1 and len(wb["Transmissibility"]._charts) == 1
+    assert len(wb["Modes"]._charts) == 1
     chart = wb["Transmissibility"]._charts[0]
     assert len(chart.series) == 6 and chart.x_axis.delete is False      # sweep and single runs, x y z each
     assert len(wb["Plots"]._images) == 3
-    summary = _sheet_rows(wb["Summary"], header_row=3)
-    efficiency = {(r["run"], r["direction"]): r["eta %"] for r in _sheet_rows(load_workbook(path)["Result efficiency"])}
+    summary = _sheet_rows(wb["Summary"], header_row=4)[:2]
+    efficiency = {(r["run"], r["direction"]): r for r in _sheet_rows(load_workbook(path)["Result efficiency"])}
     assert [r["run"] for r in summary] == ["LP rotor", "HP rotor"]
     for row in summary:
         for d in "xyz":
-            assert row[f"eta % {d}"] == pytest.approx(efficiency[(row["run"], d)], rel=1e-12)
-    meta = {r["item"]: r["value"] for r in _sheet_rows(wb["Metadata"], header_row=1)}
-    assert meta["input SHA-256"] == digest
+            answer = efficiency[(row["run"], d)]
+            assert [row[f"eta (%) {d}"], row[f"T (-) {d}"], row[f"level (dB) {d}"]] == pytest.approx(
+                [answer["eta %"], answer["T"], answer["dB"]], rel=1e-12)
+    modes = _sheet_rows(wb["Modes"], header_row=3)
+    card = [str(c.value) for c in load_workbook(path)["Result model card"]["A"]]
+    lp_modes = [r["frequency (Hz)"] for r in modes if r["run"] == "LP rotor"]
+    assert lp_modes and all(f"{f:7.2f} Hz" in "\n".join(card) for f in lp_modes)
+    meta = {r["item"]: r["value"] for r in _sheet_rows(wb["Metadata"], header_row=3)}
+    assert meta["input SHA-256 as read"] == digest
+    assert meta["case workbook with the results: SHA-256"] == sha256(path)
     assert meta["version openpyxl"] and meta["version exudyn"] != "not installed"
     assert any(str(c.value).startswith("Model card: reference mount / LP rotor") for c in wb["Model card"]["A"])
 

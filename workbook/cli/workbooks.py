@@ -127,7 +127,7 @@ def run_workbook(args) -> int:
     _print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
-            report = write_report(args.report, book, runs)
+            report = write_report(args.report, book, runs, outcome)
         except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE

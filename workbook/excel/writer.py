@@ -54,6 +54,7 @@ from workbook.excel.files import (
 )
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.sheets import peek, stored_cells
+from workbook.excel.styling import FORMATS, print_setup, quantity_of
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
@@ -151,11 +152,27 @@ def result_frames(runs: list[RunResult], tests: tuple = ()) -> dict[str, pd.Data
     return frames
 
 
+def _model_part(card) -> tuple:
+    """What a model card says about the model itself (not the solver's steps or the wall time)."""
+    return card.bodies, card.effects, card.mounted_modes
+
+
 def card_lines(runs: list[RunResult]) -> list[str]:
+    """The model cards of *runs* as text lines: each run's first card in full; the other points of a sweep
+    in one line each (step and wall time) when their model is the same, else in full."""
     lines = []
     for run in runs:
-        for card in run.result.model_cards.values():
-            lines += [f"Run '{run.spec.name}'", *card.to_text().splitlines(), ""]
+        cards = list(run.result.model_cards.values())
+        lines += [f"Run '{run.spec.name}'", *cards[0].to_text().splitlines(), ""]
+        same = [card for card in cards[1:] if _model_part(card) == _model_part(cards[0])]
+        if same:
+            lines.append(f"Other points of run '{run.spec.name}' (the same bodies, effects and mounted modes):")
+            lines += [f"  {card.run_name}: time step {card.solver.get('time step', '-')}; wall time "
+                      f"{sum(card.timings.values()):.3f} s" for card in same]
+            lines.append("")
+        for card in cards[1:]:
+            if card not in same:
+                lines += [*card.to_text().splitlines(), ""]
     return lines
 
 
@@ -187,18 +204,23 @@ def is_result_sheet(ws) -> bool:
 
 def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
     ws.cell(1, 1, note).font = Font(italic=True)
+    formats = [FORMATS.get(quantity_of(name)) for name in frame.columns]
     for col, name in enumerate(frame.columns, start=1):
         cell = ws.cell(2, col, name)
         cell.font, cell.fill = Font(bold=True), _HEADER_FILL
-        ws.column_dimensions[get_column_letter(col)].width = max(10, len(str(name)) + 2)
+        texts = [str(v) for v in frame[name] if isinstance(v, str)]
+        ws.column_dimensions[get_column_letter(col)].width = max([11, len(str(name)) + 2,
+                                                                  *(len(t) + 2 for t in texts)])
     for row, values in enumerate(frame.itertuples(index=False), start=3):
         for col, value in enumerate(values, start=1):
             if isinstance(value, float) and not pd.notna(value):
                 value = None
             elif hasattr(value, "item"):
                 value = value.item()
-            ws.cell(row, col, value)
-    ws.freeze_panes = "A3"
+            cell = ws.cell(row, col, value)
+            if formats[col - 1] is not None and isinstance(value, (int, float)):
+                cell.number_format = formats[col - 1]
+    print_setup(ws, header_rows=2)
     _mark(ws)
 
 
@@ -237,6 +259,8 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
     for row, line in enumerate(card_lines(runs), start=2):
         ws.cell(row, 1, line).font = Font(name="Consolas", bold=line.startswith("Run '"))
     ws.cell(1, 1, stamp).font = Font(italic=True)
+    ws.column_dimensions["A"].width = 120
+    print_setup(ws)
     _mark(ws)
     return result_sheet_names(frames)
 
