@@ -316,3 +316,13 @@ def test_a_part_the_rewrite_would_lose_sends_the_results_beside(cheap_ran, tmp_p
     assert "cannot keep (xl/feature/part1.xml (application/vnd.example.feature+xml))" in out
     assert sha256(path) == digest
     assert len([p for p in tmp_path.iterdir() if p.name.startswith("case-results-")]) == 1
+
+
+def test_a_workbook_named_through_a_link_stays_linked(cheap_ran, tmp_path):
+    target = _copy(cheap_ran, tmp_path, "stored.xlsx")
+    link = tmp_path / "case.xlsx"
+    link.symlink_to(target.name)
+    assert main(["run", str(link), "--no-progress", "--run", "HP rotor"]) == 0
+    assert link.is_symlink() and sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx", "stored.xlsx"]
+    rows = load_workbook(target)["Result efficiency"].iter_rows(min_row=3, values_only=True)
+    assert {row[0] for row in rows} == {"HP rotor"}

@@ -350,11 +350,13 @@ def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
 def write_atomic(path: Union[str, Path], data: bytes) -> Path:
     """Write *data* to *path* all at once, with the permissions of the file it replaces.
 
+    A symbolic link stays a link: the file it points to is replaced.
+
     Returns
     -------
     Path
     """
-    path = Path(path)
+    path = Path(path).resolve()
     path.parent.mkdir(parents=True, exist_ok=True)
     mode = _mode(path)
     if not _replace_unnamed(path, data, mode):
