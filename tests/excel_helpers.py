@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import hashlib
 import shutil
+import zipfile
 from pathlib import Path
 
 from openpyxl import load_workbook
@@ -57,5 +58,62 @@ def make_cheap(path: Path, sweep_points: int = 4) -> None:
     wb.save(path)
 
 
+def give_cached_value(path: Path, member: str, cell: str, value, error: bool = False) -> None:
+    """Store *value* as the cached result of the formula in *cell* of zip *member* (as Excel would).
+
+    *error*: the value is a formula error such as ``#VALUE!`` (cell type ``e``).
+    """
+    with zipfile.ZipFile(path) as archive:
+        contents = {name: archive.read(name) for name in archive.namelist()}
+    xml = contents[member].decode()
+    start = xml.index(f'<c r="{cell}"')
+    end = xml.index("</c>", start)
+    cell_xml = xml[start:end].replace("<v></v>", "").replace("<v />", "")
+    if error:
+        cell_xml = cell_xml.replace(f'<c r="{cell}"', f'<c r="{cell}" t="e"', 1)
+    contents[member] = (xml[:start] + cell_xml + f"<v>{value}</v>" + xml[end:]).encode()
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, data in contents.items():
+            archive.writestr(name, data)
+
+
 def sha256(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def compound_file(streams: dict) -> bytes:
+    """A Microsoft compound file (OLE2, the container of .xls and of password-protected workbooks).
+
+    Parameters
+    ----------
+    streams : dict of str to int
+        Stream name -> size in bytes (a multiple of 512, at least 4096: kept
+        out of the mini stream). At most three streams.
+    """
+    import struct
+
+    end, free, fat_sector, no_stream = 0xFFFFFFFE, 0xFFFFFFFF, 0xFFFFFFFD, 0xFFFFFFFF
+    fat = [fat_sector, end]             # sector 0: the FAT, sector 1: the directory
+    starts, data = [], b""
+    for size in streams.values():
+        starts.append(len(fat))
+        count = size // 512
+        fat += [len(fat) + i + 1 for i in range(count - 1)] + [end]
+        data += bytes(size)
+    fat += [free] * (128 - len(fat))
+    header = struct.pack("<8s16sHHHHH6sIIIIIIIII", bytes.fromhex("d0cf11e0a1b11ae1"), bytes(16), 0x3E, 3, 0xFFFE,
+                         9, 6, bytes(6), 0, 1, 1, 0, 4096, end, 0, end, 0)
+    header += struct.pack("<I", 0) + struct.pack("<I", free) * 108
+
+    def entry(name, kind, left, right, child, start, size):
+        encoded = (name + "\0").encode("utf-16-le")
+        return struct.pack("<64sHBBIII16sIQQIQ", encoded, len(encoded), kind, 1, left, right, child, bytes(16), 0,
+                           0, 0, start, size)
+
+    names = list(streams)
+    entries = [entry("Root Entry", 5, no_stream, no_stream, 1, end, 0)]
+    for i, name in enumerate(names, start=1):
+        entries.append(entry(name, 2, no_stream, i + 1 if i < len(names) else no_stream, no_stream,
+                             starts[i - 1], streams[name]))
+    directory = b"".join(entries) + bytes(128) * (4 - len(entries))
+    return header + struct.pack("<128I", *fat) + directory + data

@@ -7,7 +7,7 @@ import re
 import zipfile
 
 import pytest
-from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference, set_cells, sha256
+from excel_helpers import REFERENCE, TEMPLATE, column_of, compound_file, copy_reference, give_cached_value, set_cells, sha256
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
@@ -58,9 +58,9 @@ def _members(path):
 
 @pytest.mark.parametrize("make, committed", [(template_workbook, TEMPLATE), (reference_workbook, REFERENCE)])
 def test_committed_workbooks_are_what_the_code_generates(tmp_path, make, committed):
-    generated = write_workbook(make(), tmp_path / committed.name)
+    generated, _ = write_workbook(make(), tmp_path / committed.name)
     assert _members(generated) == _members(committed), \
-        f"{committed.name} is stale: regenerate it with `mountwb template {committed} [--reference]`"
+        f"{committed.name} is stale: regenerate it with `mountwb template {committed} [--reference] --replace`"
 
 
 def test_reference_workbook_is_the_python_default():
@@ -206,6 +206,32 @@ def _zip_of_text(path):
     return buffer.getvalue()
 
 
+def _date_formatted_mass(wb):
+    wb["Engine"]["A3"].number_format = "yyyy-mm-dd"
+
+
+def _formula_error(path):
+    set_cells(path, {("Engine", "mass", 3): '=1+"a"'})
+    give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", "#VALUE!", error=True)
+
+
+def _link_without_hinges(wb):
+    """Delete the rows of the Hinges sheet that hold link 'rear-right' (row 6 of the Links sheet)."""
+    ws = wb["Hinges"]
+    assert wb["Links"]["A6"].value == "rear-right"
+    for row in range(ws.max_row, 2, -1):
+        if "rear-right" in (ws.cell(row, 2).value, ws.cell(row, 3).value):
+            ws.delete_rows(row)
+
+
+def _no_pylon(wb):
+    ws = wb["Hinges"]
+    for row in range(3, ws.max_row + 1):
+        for col in (2, 3):
+            if ws.cell(row, col).value == "pylon":
+                ws.cell(row, col).value = "engine"
+
+
 BAD_INPUTS = {
     "missing sheet": (_edit_wb(lambda wb: wb.remove(wb["Hinges"])), ["sheet 'Hinges'"]),
     "missing column": (_edit_wb(lambda wb: wb["Hinges"].delete_cols(column_of(wb["Hinges"], "stiffness"))),
@@ -280,6 +306,38 @@ BAD_INPUTS = {
     "two rows in the Test rig sheet": (_edit({**RIG_ROW, **{(sheet, header, 4): value for (sheet, header, _), value
                                                              in RIG_ROW.items()}}),
                                        ["sheet 'Test rig'", "row 4", "exactly one row"]),
+    "ambiguous text number": (_edit({("Engine", "mass", 3): "3,568"}),
+                              ["sheet 'Engine'", "cell A3", "'3,568'", "3568 (',' separating thousands)",
+                               "3.568 (',' as the decimal separator)"]),
+    "ambiguous text number with a dot": (_edit({("Hinges", "stiffness", 4): "2.500"}),
+                                         ["sheet 'Hinges'", "cell G4", "2500", "2.5"]),
+    "merged cells": (_edit_wb(lambda wb: wb["Hinges"].merge_cells("B3:C5")),
+                     ["sheet 'Hinges'", "cell B3:C5", "not merged"]),
+    "number formatted as a date": (_edit_wb(_date_formatted_mass),
+                                   ["sheet 'Engine'", "cell A3", "'3568 formatted as the date 1909-10-07'",
+                                    "format it as a number"]),
+    "formula error": (_formula_error, ["sheet 'Engine'", "cell A3", "'#VALUE!'", "formula error #VALUE!"]),
+    "RPM": (_edit({("Excitations", "frequency", 2): "RPM"}), ["cell F2", "'RPM'", "did you mean 'rpm'?"]),
+    "U/min": (_edit({("Excitations", "frequency", 2): "U/min"}), ["cell F2", "'U/min'", "did you mean 'rpm'?"]),
+    "Ns/m": (_edit({("Hinges", "damping", 2): "Ns/m"}), ["cell H2", "'Ns/m'", "did you mean 'N*s/m'?"]),
+    "a stray value in the last row": (_edit_wb(lambda wb: wb["Hinges"].cell(1048576, 1, "x")),
+                                      ["sheet 'Hinges'", "cell A1048576", "'x'", "at most 10000 rows are read"]),
+    "an .xls workbook": (_write_bytes(lambda p: compound_file({"Workbook": 4096})),
+                         ["case.xlsx", "Excel 97-2003 workbook (.xls)", "save it as Excel Workbook .xlsx"]),
+    "a password-protected workbook": (_write_bytes(lambda p: compound_file({"EncryptionInfo": 4096,
+                                                                             "EncryptedPackage": 8192})),
+                                      ["case.xlsx", "encrypted with a password", "without a password"]),
+    "a rig record naming a device": (_edit({("Test data", "run", 3): "LP rotor", ("Test data", "rig record", 3): "/dev/zero"}),
+                                     ["sheet 'Test data'", "'/dev/zero'", "not a regular file"]),
+    "absurd hinge stiffness": (_edit({("Hinges", "stiffness", 4): 1e300}),
+                               ["sheet 'Hinges'", "cell G4", "found 1e+300", "at most 1e+14 N/m"]),
+    "absurd length in the wrong unit": (_edit({("Links", "end A x", 2): "km"}),
+                                        ["sheet 'Links'", "cell B5", "found -1600 m", "at most 1000 m"]),
+    "a link without hinges": (_edit_wb(_link_without_hinges),
+                              ["sheet 'Links'", "cell B6:D6", "a hinge at end A of link 'rear-right'",
+                               "cell E6:G6", "a hinge at end B of link 'rear-right'", "mechanism"]),
+    "no hinge to the pylon": (_edit_wb(_no_pylon),
+                              ["sheet 'Hinges'", "at least one hinge to the pylon"]),
     "bad rig sensors switch": (_edit({("Case", "rig sensors", 3): "sometimes"}),
                                ["sheet 'Case'", "cell V3", "yes or no"]),
 }
@@ -373,3 +431,11 @@ def test_the_case_sheet_chooses_the_analysis_method(tmp_path):
     assert read_workbook(path).case.analysis.method == "time"
     set_cells(path, {("Case", "method", 3): "auto"})
     assert read_workbook(path).case.analysis.method == "auto"
+
+
+@pytest.mark.parametrize("text, mass", [("3568", 3568.0), ("3 568", 3568.0), ("3568,5", 3568.5), ("3.568,5", 3568.5),
+                                        ("3,568.5", 3568.5), ("0,5", 0.5), ("1,234,567", 1234567.0)])
+def test_text_numbers_with_one_reading_are_read(tmp_path, text, mass):
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Engine", "mass", 3): text})
+    assert read_workbook(path).case.engine.mass == mass

@@ -11,7 +11,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, make_cheap, set_cells, sha256
+from excel_helpers import CHEAP_SETTINGS, column_of, copy_reference, give_cached_value, make_cheap, set_cells, sha256
 from openpyxl import Workbook, load_workbook
 from openpyxl.chart import BarChart, Reference
 from openpyxl.comments import Comment
@@ -107,7 +107,7 @@ def test_results_written_back_match_a_python_run(ran):
     wb = load_workbook(path)
     assert [n for n in wb.sheetnames if n.startswith(L.RESULT_PREFIX)] == [
         "Result efficiency", "Result hinges", "Result sweep", "Result model card"]
-    assert all(wb[n][MARKER_CELL].value == MARKER and wb[n].column_dimensions["Z"].hidden
+    assert all(wb[n][MARKER_CELL].value == f"{MARKER}: {n}" and wb[n].column_dimensions["Z"].hidden
                for n in wb.sheetnames if n.startswith(L.RESULT_PREFIX))
     rows = _sheet_rows(wb["Result efficiency"])
     assert len(rows) == 3 * (1 + 1 + 4)          # LP, HP, 4 sweep points x 3 directions
@@ -160,24 +160,35 @@ def test_test_data_error(ran):
 def test_report_workbook(ran):
     path, _, digest, report = ran
     wb = load_workbook(report)
-    assert wb.sheetnames == ["Summary", "Validation", "Transmissibility", "Plots", "Model card", "Metadata"]
+    assert wb.sheetnames == ["Summary", "Validation", "Transmissibility", "Modes", "Warnings", "Plots", "Model card",
+                             "Metadata"]
     validation = _sheet_rows(wb["Validation"], header_row=3)   # the pylon-sum test point only
     assert [(r["run"], r["direction"]) for r in validation] == [("LP rotor", "y")]
     lp_y = validation[0]
-    assert lp_y["T test"] == pytest.approx(TEST_LP_Y / 1000.0, rel=1e-12)
-    assert lp_y["error %"] == pytest.approx((lp_y["T sim"] - lp_y["T test"]) / lp_y["T test"] * 100, rel=1e-9)
+    assert lp_y["T test (-)"] == pytest.approx(TEST_LP_Y / 1000.0, rel=1e-12)
+    assert lp_y["error (%)"] == pytest.approx((lp_y["T sim (-)"] - lp_y["T test (-)"]) / lp_y["T test (-)"] * 100,
+                                              rel=1e-9)
+    assert lp_y["level test (dB)"] == pytest.approx(20 * np.log10(lp_y["T test (-)"]), rel=1e-12)
     assert len(wb["Summary"]._charts) == 1 and len(wb["Transmissibility"]._charts) == 1
+    assert len(wb["Modes"]._charts) == 1
     chart = wb["Transmissibility"]._charts[0]
     assert len(chart.series) == 6 and chart.x_axis.delete is False      # sweep and single runs, x y z each
     assert len(wb["Plots"]._images) == 3
-    summary = _sheet_rows(wb["Summary"], header_row=3)
-    efficiency = {(r["run"], r["direction"]): r["eta %"] for r in _sheet_rows(load_workbook(path)["Result efficiency"])}
+    summary = _sheet_rows(wb["Summary"], header_row=4)[:2]
+    efficiency = {(r["run"], r["direction"]): r for r in _sheet_rows(load_workbook(path)["Result efficiency"])}
     assert [r["run"] for r in summary] == ["LP rotor", "HP rotor"]
     for row in summary:
         for d in "xyz":
-            assert row[f"eta % {d}"] == pytest.approx(efficiency[(row["run"], d)], rel=1e-12)
-    meta = {r["item"]: r["value"] for r in _sheet_rows(wb["Metadata"], header_row=1)}
-    assert meta["input SHA-256"] == digest
+            answer = efficiency[(row["run"], d)]
+            assert [row[f"eta (%) {d}"], row[f"T (-) {d}"], row[f"level (dB) {d}"]] == pytest.approx(
+                [answer["eta %"], answer["T"], answer["dB"]], rel=1e-12)
+    modes = _sheet_rows(wb["Modes"], header_row=3)
+    card = [str(c.value) for c in load_workbook(path)["Result model card"]["A"]]
+    lp_modes = [r["frequency (Hz)"] for r in modes if r["run"] == "LP rotor"]
+    assert lp_modes and all(f"{f:7.2f} Hz" in "\n".join(card) for f in lp_modes)
+    meta = {r["item"]: r["value"] for r in _sheet_rows(wb["Metadata"], header_row=3)}
+    assert meta["input SHA-256 as read"] == digest
+    assert meta["case workbook with the results: SHA-256"] == sha256(path)
     assert meta["version openpyxl"] and meta["version exudyn"] != "not installed"
     assert any(str(c.value).startswith("Model card: reference mount / LP rotor") for c in wb["Model card"]["A"])
 
@@ -186,7 +197,7 @@ def test_rerun_replaces_our_sheets_and_keeps_formula_values(cheap, tmp_path, cap
     path = tmp_path / "case.xlsx"
     shutil.copyfile(cheap, path)
     set_cells(path, {("Engine", "mass", 3): "=3000+568"})
-    _give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", 3568)
+    give_cached_value(path, "xl/worksheets/sheet3.xml", "A3", 3568)
     for _ in range(2):
         assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
     wb = load_workbook(path)
@@ -196,19 +207,6 @@ def test_rerun_replaces_our_sheets_and_keeps_formula_values(cheap, tmp_path, cap
     assert wb["Engine"]["A3"].value == "=3000+568"
     assert load_workbook(path, data_only=True)["Engine"]["A3"].value == 3568
     assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]      # no temporary files left
-
-
-def _give_cached_value(path, member, cell, value):
-    with zipfile.ZipFile(path) as archive:
-        contents = {name: archive.read(name) for name in archive.namelist()}
-    xml = contents[member].decode()
-    start = xml.index(f'<c r="{cell}"')
-    end = xml.index("</c>", start)
-    contents[member] = (xml[:start] + xml[start:end].replace("<v></v>", "").replace("<v />", "")
-                        + f"<v>{value}</v>" + xml[end:]).encode()
-    with zipfile.ZipFile(path, "w") as archive:
-        for name, data in contents.items():
-            archive.writestr(name, data)
 
 
 def _user_sheet(path):
@@ -297,9 +295,14 @@ def test_unknown_run_name_is_bad_input(cheap, capsys):
     assert sha256(cheap) == digest
 
 
-def test_report_cannot_overwrite_the_case(cheap, tmp_path, capsys):
+def test_report_never_replaces_the_case(cheap, tmp_path, capsys):
     path = tmp_path / "case.xlsx"
     shutil.copyfile(cheap, path)
-    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(path)]) == 1
-    assert "cannot overwrite the case workbook" in capsys.readouterr().err
-    assert "Result efficiency" in load_workbook(path).sheetnames       # the results were written first
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "is not a report this program wrote; it is kept" in out
+    wb = load_workbook(path)
+    assert "Result efficiency" in wb.sheetnames and "Summary" not in wb.sheetnames   # the results only
+    reports = [p for p in tmp_path.iterdir() if p.name.startswith("case-report-")]
+    assert len(reports) == 1 and f"report written to {reports[0]}" in out
+    assert load_workbook(reports[0]).sheetnames[0] == "Summary"

@@ -24,6 +24,14 @@ def _report_problems(error) -> int:
     return EXIT_BAD_INPUT
 
 
+def _print_written(named, what: str, target, reason) -> None:
+    """Where a workbook went: the file named, or beside it with the reason."""
+    if reason is None:
+        print(f"{what} written to {target}")
+    else:
+        print(f"{named} was not overwritten: {reason}.\n{what} written to {target}")
+
+
 def check_arguments(parser: argparse.ArgumentParser) -> Callable:
     """``mountwb check CASE.xlsx``: validate a case workbook; nothing is run or written."""
     parser.add_argument("workbook", help="case workbook (.xlsx)")
@@ -49,15 +57,16 @@ def template_arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("output", help="workbook to write, e.g. templates/case-template.xlsx")
     parser.add_argument("--reference", action="store_true",
                         help="write the reference case with the seed study's runs (cases/reference.xlsx)")
+    parser.add_argument("--replace", action="store_true",
+                        help="replace OUT if it exists (default: an existing file is kept and the workbook "
+                             "is written beside it under a new name)")
 
     def template(args) -> int:
-        from workbook.excel.files import lock_file
         from workbook.excel.template import reference_workbook, template_workbook, write_workbook
 
-        if lock_file(args.output) is not None:
-            print(f"{args.output} is open in Excel; close it and run again", file=sys.stderr)
-            return EXIT_TROUBLE
-        print(write_workbook(reference_workbook() if args.reference else template_workbook(), args.output))
+        target, reason = write_workbook(reference_workbook() if args.reference else template_workbook(),
+                                        args.output, args.replace)
+        _print_written(args.output, "template", target, reason)
         return EXIT_OK
 
     return template
@@ -115,14 +124,12 @@ def run_workbook(args) -> int:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)
         return EXIT_TROUBLE
-    if outcome.reason is None:
-        print(f"results written into {outcome.path}")
-    else:
-        print(f"{book.path.name} was not overwritten: {outcome.reason}.\nresults written to {outcome.path}")
+    _print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
-            print(f"report written to {write_report(args.report, book, runs)}")
-        except (ValueError, OSError) as error:
+            report = write_report(args.report, book, runs, outcome)
+        except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE
+        _print_written(args.report, "report", report.path, report.reason)
     return EXIT_OK

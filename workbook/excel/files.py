@@ -1,5 +1,12 @@
 """Workbook files on disk: atomic saves and the checks made before overwriting one.
 
+A save writes the whole new file, with the type (``.xlsx`` or macro-enabled
+``.xlsm``) and the permissions of the file it replaces, and then renames it
+over the old one in one step: a reader, or a kill at any moment, sees the
+old file or the new one. Where the system allows (Linux), the new file has
+no name until it is complete, so a kill during the save leaves nothing
+behind.
+
 openpyxl rewrites a whole workbook from what it understood; content it does
 not understand is dropped silently. :func:`unsupported_content` looks inside
 the .xlsx (a zip archive) for such content, so that a run can refuse to
@@ -7,16 +14,23 @@ overwrite the file and write its results elsewhere instead.
 """
 from __future__ import annotations
 
+import datetime
+import io
 import logging
+import os
 import re
+import stat
 import zipfile
 from pathlib import Path
 from typing import Callable, Union
 from xml.sax.saxutils import escape
 
+from openpyxl.utils.datetime import to_excel
+
 from flexbodies.atomic import replacing
 
-__all__ = ["save_atomic", "lock_file", "unsupported_content", "restore_formula_values"]
+__all__ = ["save_atomic", "lock_file", "lock_message", "unsupported_content", "restore_formula_values",
+           "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem", "lost_parts", "write_atomic"]
 
 log = logging.getLogger(__name__)
 
@@ -39,7 +53,23 @@ _MEMBERS = (
     ("xl/queryTables/", "queries"),
     ("xl/connections.xml", "data connections"),
     ("customXml/", "custom XML parts"),
+    ("xl/threadedComments/", "threaded comments"),
+    ("xl/persons/", "threaded comments"),
+    ("xl/metadata.xml", "dynamic-array formulas (cell metadata)"),
+    ("xl/richData/", "pictures or data types in cells"),
+    ("xl/webextensions/", "add-ins"),
+    ("xl/namedSheetViews/", "sheet views"),
 )
+#: Document properties (docProps/app.xml) openpyxl does not keep, when they hold text.
+_APP_PROPERTIES = ("Company", "Manager", "HyperlinkBase")
+_APP_PROPERTY = re.compile(rb"<(?:\w+:)?(" + b"|".join(p.encode() for p in _APP_PROPERTIES) + rb")>([^<]+)</")
+#: A comment box in a legacy drawing: its style (size, visibility).
+_NOTE = re.compile(rb'<(?:\w+:)?shape\b[^>]*?style="([^"]*)"[^>]*>(?:(?!</(?:\w+:)?shape>).)*?ObjectType="Note"', re.S)
+#: Box of a comment as openpyxl writes it (Excel's default too): 144 x 79 px = 108 x 59.25 pt, hidden.
+_NOTE_BOX_PT = (108.0, 59.25)
+#: Parts whose loss is harmless: Excel rebuilds the calculation chain and the thumbnail, and the
+#: printer-driver settings are device data (the page setup itself is kept).
+_REBUILT_TYPES = ("calcChain+xml", "printerSettings", "image/jpeg")
 #: Worksheet extensions (extLst) openpyxl drops.
 _EXTENSIONS = (
     (re.compile(rb"<x14:dataValidations?\b"), "data-validation extensions (lists from other sheets)"),
@@ -79,14 +109,127 @@ def unsupported_content(path: Union[str, Path]) -> list[str]:
                 for pattern, what in _EXTENSIONS:
                     if what not in found and pattern.search(data):
                         found.append(what)
+            if name.endswith(".vml") and "comment boxes resized or always shown" not in found:
+                if any(_custom_note(style) for style in _NOTE.findall(archive.read(name))):
+                    found.append("comment boxes resized or always shown")
+        if "docProps/app.xml" in names:
+            given = [key.decode() for key, text in _APP_PROPERTY.findall(archive.read("docProps/app.xml"))
+                     if text.strip()]
+            if given:
+                found.append(f"document properties ({', '.join(given)})")
     return found
 
 
+def _custom_note(style: bytes) -> bool:
+    """True if a comment box's VML style is not the default size, or the comment is always shown."""
+    fields = dict(item.split(":", 1) for item in style.decode().replace(" ", "").split(";") if ":" in item)
+    if fields.get("visibility", "hidden") != "hidden":
+        return True
+    for key, default in zip(("width", "height"), _NOTE_BOX_PT):
+        text = fields.get(key, "")
+        match = re.fullmatch(r"([0-9.]+)(pt|px|in|cm|mm)?", text)
+        if not match:
+            return True
+        scale = {"pt": 1.0, "px": 0.75, "in": 72.0, "cm": 72 / 2.54, "mm": 72 / 25.4, None: 1.0}[match.group(2)]
+        if abs(float(match.group(1)) * scale - default) > 0.5:
+            return True
+    return False
+
+
+def _content_types(data: bytes) -> dict[str, str]:
+    """Content type of each part of the zip archive *data*, by part name."""
+    with zipfile.ZipFile(io.BytesIO(data)) as archive:
+        names = [name for name in archive.namelist() if not name.endswith("/")]
+        xml = archive.read("[Content_Types].xml").decode("utf-8")
+    defaults = dict(re.findall(r'<Default\s+Extension="([^"]+)"\s+ContentType="([^"]+)"', xml))
+    defaults = {key.lower(): value for key, value in defaults.items()}
+    overrides = {name.lstrip("/"): kind for name, kind in
+                 re.findall(r'<Override\s+PartName="([^"]+)"\s+ContentType="([^"]+)"', xml)}
+    return {name: overrides.get(name) or defaults.get(name.rsplit(".", 1)[-1].lower(), "unknown")
+            for name in names if name != "[Content_Types].xml"}
+
+
+def lost_parts(before: bytes, after: bytes) -> list[str]:
+    """Parts of the workbook *before* of a kind the rewritten workbook *after* no longer has.
+
+    A safety net under :func:`unsupported_content`: any kind of part (by
+    content type) that the rewrite dropped, except those Excel rebuilds.
+
+    Returns
+    -------
+    list of str
+        ``"<part name> (<content type>)"`` for each part lost.
+    """
+    kept = set(_content_types(after).values())
+    return [f"{name} ({kind})" for name, kind in _content_types(before).items()
+            if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)]
+
+
 def lock_file(path: Union[str, Path]) -> Union[Path, None]:
-    """Excel's lock file ``~$<name>`` beside *path* if present (the workbook is open in Excel)."""
+    """The lock file beside *path* if present: the workbook is open in Excel or LibreOffice.
+
+    Excel writes ``~$<name>``, LibreOffice ``.~lock.<name>#``.
+    """
     path = Path(path)
-    lock = path.with_name("~$" + path.name)
-    return lock if lock.exists() else None
+    for lock in (path.with_name("~$" + path.name), path.with_name(f".~lock.{path.name}#")):
+        if lock.exists():
+            return lock
+    return None
+
+
+def lock_message(lock: Path) -> str:
+    """Plain words for a lock file found by :func:`lock_file`."""
+    application = "LibreOffice" if lock.name.startswith(".~lock.") else "Excel"
+    return f"it is open in {application} (lock file {lock.name} present); close it and run again to write into it"
+
+
+def name_beside(path: Union[str, Path], label: str) -> Path:
+    """A new file name beside *path*: ``<stem>-<label>-<date-time>.xlsx`` (``-2``, ``-3``... if taken)."""
+    path = Path(path)
+    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+    candidate = path.with_name(f"{path.stem}-{label}-{stamp}.xlsx")
+    number = 1
+    while candidate.exists():
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{label}-{stamp}-{number}.xlsx")
+    return candidate
+
+
+def bounded_file_problem(path: Path, limit: int) -> Union[str, None]:
+    """Why the file a workbook names at *path* is not read (None: it may be read).
+
+    Only a regular file of at most *limit* bytes is read: a device
+    (``/dev/zero``), a pipe or a folder never ends or is not a file.
+    """
+    if not path.exists():
+        return f"{path} does not exist"
+    if not path.is_file():
+        return f"{path} is not a regular file (a device, a pipe or a folder)"
+    size = path.stat().st_size
+    if size > limit:
+        return f"{path} has {size:,} bytes; at most {limit:,} are read"
+    return None
+
+
+def new_file_target(path: Union[str, Path], label: str, replaceable: Callable[[Path], bool]):
+    """Where a new workbook the user named goes: *path*, or a new name beside it, and why.
+
+    An existing file is replaced only when ``replaceable(path)`` says it may
+    be (a report this package wrote) and it is not open in Excel or
+    LibreOffice; otherwise the new workbook goes to :func:`name_beside`.
+
+    Returns
+    -------
+    (Path, str or None)
+        The file to write and the reason it is not *path* (None: it is).
+    """
+    path = Path(path)
+    lock = lock_file(path)
+    if lock is not None:
+        return name_beside(path, label), lock_message(lock)
+    if path.exists() and not replaceable(path):
+        return name_beside(path, label), f"{path.name} exists and is not a {label} this program wrote; it is kept"
+    return path, None
 
 
 def _cached(value) -> Union[tuple[str, str], None]:
@@ -97,10 +240,12 @@ def _cached(value) -> Union[tuple[str, str], None]:
         return "", repr(float(value)) if isinstance(value, float) else str(value)
     if isinstance(value, str):
         return ' t="str"', escape(value)
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        return "", repr(float(to_excel(value)))
     return None
 
 
-def restore_formula_values(path: Union[str, Path], cached: dict[int, dict[str, object]]) -> None:
+def restore_formula_values(data: bytes, cached: dict[int, dict[str, object]]) -> bytes:
     """Put the cached values of formula cells back into an .xlsx openpyxl wrote.
 
     openpyxl keeps formulas but writes them without the value Excel last
@@ -109,55 +254,138 @@ def restore_formula_values(path: Union[str, Path], cached: dict[int, dict[str, o
 
     Parameters
     ----------
-    path : str or Path
-        The .xlsx written by openpyxl (rewritten in place).
+    data : bytes
+        The .xlsx written by openpyxl.
     cached : dict of int to dict of str to value
         Per sheet number (1-based position in the workbook), cell -> value.
+
+    Returns
+    -------
+    bytes
+        The .xlsx with the values.
     """
-    with zipfile.ZipFile(path) as archive:
-        members = [(info, archive.read(info.filename)) for info in archive.infolist()]
-    changed = False
-    for i, (info, data) in enumerate(members):
-        match = re.match(r"^xl/worksheets/sheet(\d+)\.xml$", info.filename)
+    def edit(name: str, xml: bytes) -> bytes:
+        match = re.match(r"^xl/worksheets/sheet(\d+)\.xml$", name)
         if not match or int(match.group(1)) not in cached:
-            continue
-        xml = data.decode("utf-8")
+            return xml
+        text = xml.decode("utf-8")
         for cell, value in cached[int(match.group(1))].items():
             typed = _cached(value)
             if typed is None:
                 continue
             pattern = re.compile(rf'<c r="{cell}"([^>]*)>(<f\b[^>]*/>|<f\b[^>]*>.*?</f>)<v\s*/>(</c>)', re.S)
-            xml = pattern.sub(lambda m: f'<c r="{cell}"{m.group(1)}{typed[0]}>{m.group(2)}<v>{typed[1]}</v></c>', xml)
-        members[i] = (info, xml.encode("utf-8"))
-        changed = True
-    if changed:
-        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
-            for info, data in members:
-                archive.writestr(info, data)
+            text = pattern.sub(lambda m: f'<c r="{cell}"{m.group(1)}{typed[0]}>{m.group(2)}<v>{typed[1]}</v></c>',
+                               text)
+        return text.encode("utf-8")
+
+    return _edit_members(data, edit)
 
 
-def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[Path], None], None] = None) -> Path:
+def _edit_members(data: bytes, edit: Callable[[str, bytes], bytes]) -> bytes:
+    """The zip archive *data* with each member replaced by ``edit(name, content)``."""
+    output = io.BytesIO()
+    with zipfile.ZipFile(io.BytesIO(data)) as source, zipfile.ZipFile(output, "w", zipfile.ZIP_DEFLATED) as target:
+        for info in source.infolist():
+            target.writestr(info, edit(info.filename, source.read(info.filename)))
+    return output.getvalue()
+
+
+_XLSX_MAIN = b"application/vnd.openxmlformats-officedocument.spreadsheetml.sheet.main+xml"
+_XLSM_MAIN = b"application/vnd.ms-excel.sheet.macroEnabled.main+xml"
+
+
+def _macro_enabled(name: str, xml: bytes) -> bytes:
+    """The content types of a macro-enabled workbook (.xlsm), which openpyxl writes as .xlsx."""
+    return xml.replace(_XLSX_MAIN, _XLSM_MAIN) if name == "[Content_Types].xml" else xml
+
+
+def workbook_bytes(workbook, path: Union[str, Path]) -> bytes:
+    """The file openpyxl writes for *workbook*, typed by the ending of *path* (.xlsx or .xlsm)."""
+    buffer = io.BytesIO()
+    workbook.save(buffer)
+    data = buffer.getvalue()
+    return _edit_members(data, _macro_enabled) if Path(path).suffix.lower() == ".xlsm" else data
+
+
+def _mode(path: Path) -> int:
+    """Permissions of the file at *path*, or those a new file gets under the umask."""
+    try:
+        return stat.S_IMODE(path.stat().st_mode)
+    except FileNotFoundError:
+        umask = os.umask(0)
+        os.umask(umask)
+        return 0o666 & ~umask
+
+
+def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
+    """Write *data* to a file without a name, then name it *path* (False: the system cannot)."""
+    flag = getattr(os, "O_TMPFILE", None)
+    if flag is None:
+        return False
+    folder = os.open(path.parent, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        try:
+            handle = os.open(path.parent, flag | os.O_WRONLY, mode)
+        except OSError:
+            return False
+        try:
+            with os.fdopen(handle, "wb", closefd=False) as stream:
+                stream.write(data)
+            os.fchmod(handle, mode)
+            os.fsync(handle)
+            linked = f".~{path.name}.{os.getpid()}.saving"
+            os.link(f"/proc/self/fd/{handle}", linked, dst_dir_fd=folder, follow_symlinks=True)
+        finally:
+            os.close(handle)
+        try:
+            os.replace(linked, path.name, src_dir_fd=folder, dst_dir_fd=folder)
+        except BaseException:
+            os.unlink(linked, dir_fd=folder)
+            raise
+    finally:
+        os.close(folder)
+    return True
+
+
+def write_atomic(path: Union[str, Path], data: bytes) -> Path:
+    """Write *data* to *path* all at once, with the permissions of the file it replaces.
+
+    A symbolic link stays a link: the file it points to is replaced.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path).resolve()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    mode = _mode(path)
+    if not _replace_unnamed(path, data, mode):
+        with replacing(path, suffix=".saving") as temporary:
+            temporary.write_bytes(data)
+    log.info("saved %s", path)
+    return path
+
+
+def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[bytes], bytes], None] = None) -> Path:
     """Save an openpyxl workbook to *path* atomically.
 
-    The workbook is written to a temporary file in the same folder and then
-    renamed over *path*, so *path* is never half-written; it keeps the
-    permissions of the workbook it replaces.
+    The file is built in memory, written whole beside *path* and renamed
+    over it, so *path* is never half-written; it keeps the permissions of
+    the workbook it replaces, and an .xlsm stays a macro-enabled workbook.
 
     Parameters
     ----------
     workbook : openpyxl.Workbook
     path : str or Path
     finish : callable, optional
-        Called with the temporary file's path before the rename (to post-process it).
+        Post-processes the file's bytes before they are written.
 
     Returns
     -------
     Path
     """
     path = Path(path)
-    with replacing(path, suffix=".xlsx.tmp") as temporary:
-        workbook.save(temporary)
-        if finish is not None:
-            finish(temporary)
-    log.info("saved %s", path)
-    return path
+    data = workbook_bytes(workbook, path)
+    if finish is not None:
+        data = finish(data)
+    return write_atomic(path, data)

@@ -23,7 +23,7 @@ from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
            "EXCITATIONS", "ROTORS", "TEST_RIG", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
-           "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES"]
+           "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES", "MAGNITUDE_LIMITS"]
 
 HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
 INSTRUCTIONS_SHEET = "Instructions"
@@ -33,6 +33,12 @@ YES, NO = "yes", "no"
 
 #: Unit vector of each axis letter (the Rotors sheet's spin axis).
 AXES = {axis: tuple(float(axis == other) for other in DIRECTIONS) for axis in DIRECTIONS}
+
+#: Largest magnitude a number of each SI unit may have in a case workbook. A larger value is a
+#: typing or unit mistake (1e300 N/m, a length in metres typed in millimetres twice) that the
+#: solver would meet only as a failed run; the limits are orders of magnitude beyond any mount.
+MAGNITUDE_LIMITS = {"m": 1e3, "kg": 1e7, "N": 1e10, "N/m": 1e14, "N*s/m": 1e10, "Hz": 1e6, "s": 1e6,
+                    "kg*m^2": 1e8, "Pa": 1e14, "kg/m^3": 1e6, "m/s^2": 1e5, "N*m": 1e11, "kg*m": 1e4}
 
 #: Column kinds: how a cell is read.
 KINDS = ("number", "integer", "text", "choice", "yesno", "modes", "fidelity", "unit")

@@ -18,6 +18,7 @@ from typing import Any, Callable, Union
 import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import WorkbookError
+from workbook.excel.files import bounded_file_problem
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import Record, SheetReader, open_workbook
 from workbook.model import case as cm
@@ -25,6 +26,9 @@ from workbook.model import case as cm
 __all__ = ["CaseBook", "read_workbook"]
 
 log = logging.getLogger(__name__)
+
+#: Largest mesh file read, bytes.
+MAX_MESH_BYTES = 500_000_000
 
 
 @dataclass(frozen=True)
@@ -167,9 +171,10 @@ class _CaseReader(SheetReader):
         import flexbodies
 
         path = self.path.parent / record.get("mesh_file")
-        if not path.is_file():
+        problem = bounded_file_problem(path, MAX_MESH_BYTES)
+        if problem is not None:
             self.record_problem(record, ("mesh_file",), record.get("mesh_file"),
-                                f"a mesh file (relative to the workbook's folder; {path} does not exist)")
+                                f"a mesh file (relative to the workbook's folder; {problem})")
             return None
         bores = []
         for eye in ("a", "b"):
@@ -280,6 +285,7 @@ class _CaseReader(SheetReader):
         for record, link in items["Links"]:
             first_links.setdefault(record.get("name"), link)
         self.hinge_bodies(items["Hinges"], tables["Links"], first_links)
+        self.loose_eyes(items["Hinges"], items["Links"])
         if self.problems or not engine or None in engine or not settings or None in settings[0]:
             return None
         (analysis, effects), record = settings[0], tables["Case"][0]
@@ -311,6 +317,30 @@ class _CaseReader(SheetReader):
                     self.record_problem(record, L.HINGES.vector_keys("position"),
                                         record.typed(L.HINGES.vector_keys("position"), None),
                                         f"an eye centre of link '{body}' (the nearest is {gap * 1e3:.4g} mm away)")
+
+    def loose_eyes(self, hinges: list, links: list) -> None:
+        """Report each link eye no hinge holds, and a mount with no hinge to the engine or the pylon.
+
+        A link eye without a hinge swings free: the mount is a mechanism,
+        which the run would find only after building the model.
+        """
+        if any(hinge is None for _, hinge in hinges) or any(p.sheet == L.HINGES.sheet for p in self.problems):
+            return    # a bad or misplaced hinge is reported already
+        built = [hinge for _, hinge in hinges]
+        for record, link in links:
+            if link is None:
+                continue
+            held = {link.eye_at(h.position) for h in built if link.name in (h.body_a, h.body_b)}
+            for eye in ("a", "b"):
+                if eye not in held:
+                    keys = L.LINKS.vector_keys(f"end_{eye}")
+                    self.record_problem(record, keys, record.typed(keys, None),
+                                        f"a hinge at end {eye.upper()} of link '{link.name}' (no row of the Hinges "
+                                        "sheet joins the link there: it would swing free, a mechanism)")
+        for body in (cm.ENGINE, cm.PYLON):
+            if hinges and not any(body in (h.body_a, h.body_b) for h in built):
+                self.problem(L.HINGES.sheet, None, "body A", None,
+                             f"at least one hinge to the {body} (body A or body B '{body}')")
 
     def case_error(self, exc: cm.CaseError, items: dict) -> None:
         """Report a CaseError of the Case constructor at the row of the item it names."""
@@ -430,6 +460,8 @@ def read_workbook(path: Union[str, Path]) -> CaseBook:
     formulas, values = open_workbook(path)
     reader = _CaseReader(path, formulas, values)
     tables = {table.sheet: reader.table(table) for table in L.TABLES}
+    if reader.merged_found:
+        raise WorkbookError(reader.problems)
     case = reader.case(tables)
     if case is None:
         reader.unique(tables["Runs"])

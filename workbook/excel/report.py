@@ -1,25 +1,32 @@
-"""The report workbook of a run: summary, native charts, plots, model cards, metadata.
+"""The report workbook of a run: a summary, native charts, plots, warnings, model cards, provenance.
 
-Sheets:
+Sheets, each printed landscape and one page wide, headers frozen and
+repeated on every printed page, every number formatted by its quantity
+(:data:`~workbook.excel.styling.FORMATS`) and every header with its unit:
 
-- ``Summary``: pylon isolation efficiency per run and direction (single
-  frequencies) with a native bar chart;
-- ``Validation`` (with test data): the seed study's validation table, pylon
-  T and eta simulated and measured per run and direction, error =
-  (sim - test) / test x 100 %;
-- ``Transmissibility``: pylon T per direction against frequency with a
-  native scatter chart (one curve per sweep run and direction; the single
-  frequency runs as points);
-- ``Plots``: one PNG per run (force histories, or T against frequency for a
-  sweep);
+- ``Summary`` (one printed page): pylon isolation efficiency eta,
+  transmissibility T and level 20 log10 T per run and direction at the
+  single frequencies, the sweeps, the number of warnings, a native bar chart;
+- ``Validation`` (with test data): pylon T and eta simulated and measured
+  per run and direction, error = (sim - test) / test x 100 %;
+- ``Transmissibility``: pylon T (and dB, eta) per direction against
+  frequency, with a native log-log scatter chart (one curve per sweep run
+  and direction; the single-frequency runs as points);
+- ``Modes``: the mounted modes of each run (frequency, damping ratio,
+  motion) with a native bar chart;
+- ``Warnings``: every warning of the runs (e.g. a response not steady);
+- ``Plots``: one picture per run (force histories, or T against frequency);
 - ``Model card``: the model card of every run;
-- ``Metadata``: input file and its SHA-256, package versions, date.
+- ``Metadata``: the input file and its SHA-256 as read, the files written
+  and their SHA-256 as they are on disk after the write, versions, date.
 """
 from __future__ import annotations
 
 import datetime
+import hashlib
 import io
 import platform
+import zipfile
 from importlib import metadata
 from pathlib import Path
 from typing import Union
@@ -27,27 +34,70 @@ from typing import Union
 from openpyxl import Workbook
 from openpyxl.chart import BarChart, Reference, ScatterChart, Series
 from openpyxl.drawing.image import Image
-from openpyxl.styles import Font
+from openpyxl.styles import Alignment, Font, PatternFill
+from openpyxl.utils import get_column_letter
 
-from workbook.answers.isolation import efficiency
-from workbook.excel.files import lock_file, save_atomic
+from workbook.answers.isolation import efficiency, level_db
+from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.reader import CaseBook
-from workbook.excel.writer import RunResult, card_lines, result_frames
+from workbook.excel.styling import FORMATS, print_setup
+from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["write_report", "PACKAGES"]
+__all__ = ["write_report", "is_report", "PACKAGES", "REPORT_KEYWORDS"]
+
+#: Document keywords that mark a report workbook (an existing report may be replaced).
+REPORT_KEYWORDS = "mountwb report"
 
 #: Distributions whose versions the metadata sheet records.
 PACKAGES = ("engine-mount-workbook", "exudyn", "scikit-fem", "numpy", "scipy", "pandas", "openpyxl", "pint",
             "matplotlib")
 
+_HEADER_FILL = PatternFill("solid", fgColor="DDEBF7")
+#: Printed characters per unit of column width, and the widest column, characters.
+_MAX_WIDTH = 60
 
-def _rows(ws, header: list, rows: list, start: int = 1) -> None:
-    for col, name in enumerate(header, start=1):
-        ws.cell(start, col, name).font = Font(bold=True)
-    for r, values in enumerate(rows, start=start + 1):
-        for col, value in enumerate(values, start=1):
-            ws.cell(r, col, value)
+
+def _value(value):
+    return value.item() if hasattr(value, "item") else value
+
+
+def _table(ws, top: int, columns: list[tuple[str, str]], rows: list, left: int = 1) -> int:
+    """Write a table at row *top*: a bold header row, then *rows*, each column formatted by its quantity.
+
+    Parameters
+    ----------
+    columns : list of (header, quantity)
+        Header text (with its unit) and a key of :data:`FORMATS`.
+
+    Returns
+    -------
+    int
+        The last row written.
+    """
+    for col, (header, _) in enumerate(columns, start=left):
+        cell = ws.cell(top, col, header)
+        cell.font, cell.fill = Font(bold=True), _HEADER_FILL
+        cell.alignment = Alignment(horizontal="center", vertical="center", wrap_text=True)
+    for r, values in enumerate(rows, start=top + 1):
+        for col, (value, (_, quantity)) in enumerate(zip(values, columns), start=left):
+            cell = ws.cell(r, col, _value(value))
+            if quantity in FORMATS:
+                cell.number_format = FORMATS[quantity]
+    for col, (header, quantity) in enumerate(columns, start=left):
+        texts = [str(_value(v[col - left])) for v in rows if v[col - left] is not None] if quantity == "text" else []
+        width = max([len(w) for w in header.split()] + [len(t) for t in texts] + [9 if quantity != "text" else 6])
+        letter = get_column_letter(col)
+        ws.column_dimensions[letter].width = max(ws.column_dimensions[letter].width or 0, min(width + 2, _MAX_WIDTH))
+    return top + len(rows)
+
+
+def _title(ws, text: str, note: Union[str, None] = None) -> None:
+    ws["A1"] = text
+    ws["A1"].font = Font(bold=True, size=13)
+    if note:
+        ws["A2"] = note
+        ws["A2"].font = Font(italic=True)
 
 
 def _show_axes(chart) -> None:
@@ -56,65 +106,134 @@ def _show_axes(chart) -> None:
     chart.y_axis.delete = False
 
 
-def _summary(ws, case_name: str, runs: list[RunResult]) -> None:
-    ws["A1"] = f"{case_name}: pylon isolation efficiency eta = (1 - T) x 100 %"
-    ws["A1"].font = Font(bold=True, size=13)
-    rows = [[run.spec.name, point.frequency_hz, *point.efficiency, *point.transmissibility]
-            for run in runs if len(run.result.runs) == 1 for point in run.result.runs]
-    _rows(ws, ["run", "frequency Hz", *(f"eta % {d}" for d in DIRECTIONS), *(f"T {d}" for d in DIRECTIONS)],
-          rows, start=3)
-    ws.column_dimensions["A"].width = 28
-    if not rows:
-        return
-    chart = BarChart()
-    chart.title, chart.y_axis.title, chart.x_axis.title = "Pylon isolation efficiency", "eta %", "run"
-    chart.add_data(Reference(ws, min_col=3, max_col=5, min_row=3, max_row=3 + len(rows)), titles_from_data=True)
-    chart.set_categories(Reference(ws, min_col=1, min_row=4, max_row=3 + len(rows)))
-    chart.width, chart.height = 18, 9
-    _show_axes(chart)
-    ws.add_chart(chart, "J3")
+def _directions(label: str, quantity: str) -> list[tuple[str, str]]:
+    return [(f"{label} {d}", quantity) for d in DIRECTIONS]
+
+
+def _singles(runs: list[RunResult]) -> list:
+    return [(run, point) for run in runs if len(run.result.runs) == 1 for point in run.result.runs]
+
+
+def _summary(ws, book: CaseBook, runs: list[RunResult]) -> None:
+    _title(ws, f"{book.case.name}: pylon isolation", "eta = (1 - T) x 100 %; T = |F_pylon| / |F_exc|; "
+           "level = 20 log10 T (negative: isolation)")
+    columns = [("run", "text"), ("frequency (Hz)", "Hz"), *_directions("eta (%)", "eta"),
+               *_directions("T (-)", "T"), *_directions("level (dB)", "dB")]
+    rows = [[run.spec.name, point.frequency_hz, *point.efficiency, *point.transmissibility,
+             *level_db(point.transmissibility)] for run, point in _singles(runs)]
+    top = 4
+    last = _table(ws, top, columns, rows)
+    sweeps = [run for run in runs if len(run.result.runs) > 1]
+    row = last + 2
+    if sweeps:
+        sweep_columns = [("sweep run", "text"), ("from (Hz)", "Hz"), ("to (Hz)", "Hz"),
+                         *_directions("max T (-)", "T"), *_directions("at (Hz)", "Hz")]
+        sweep_rows = []
+        for run in sweeps:
+            points = run.result.runs
+            peaks = [max(points, key=lambda p, i=i: p.transmissibility[i]) for i in range(len(DIRECTIONS))]
+            sweep_rows.append([run.spec.name, points[0].frequency_hz, points[-1].frequency_hz,
+                               *(p.transmissibility[i] for i, p in enumerate(peaks)), *(p.frequency_hz for p in peaks)])
+        row = _table(ws, row, sweep_columns, sweep_rows) + 2
+    warnings = sum(len(point.warnings) for run in runs for point in run.result.runs)
+    ws.cell(row, 1, f"{warnings} warning{'s' if warnings != 1 else ''} (sheet Warnings); curves: sheet "
+                    "Transmissibility; mounted modes: sheet Modes; model cards and provenance: sheets Model card "
+                    "and Metadata").font = Font(italic=True)
+    if rows:
+        chart = BarChart()
+        chart.title, chart.y_axis.title, chart.x_axis.title = "Pylon isolation efficiency", "eta (%)", "run"
+        chart.add_data(Reference(ws, min_col=3, max_col=5, min_row=top, max_row=top + len(rows)),
+                       titles_from_data=True)
+        chart.set_categories(Reference(ws, min_col=1, min_row=top + 1, max_row=top + len(rows)))
+        chart.width, chart.height = 16, 7.5
+        _show_axes(chart)
+        ws.add_chart(chart, f"A{row + 2}")
+    print_setup(ws, one_page=True)
 
 
 def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
-    ws["A1"] = "Validation: pylon transmissibility, simulation against test; error = (sim - test) / test x 100 %"
-    ws["A1"].font = Font(bold=True, size=13)
+    _title(ws, "Validation: pylon transmissibility, simulation against test",
+           "error = (sim - test) / test x 100 %")
     frame = result_frames(runs, tests)["efficiency"]
     frame = frame[frame["test amplitude N"].notna()]
     t_test = frame["T"] * frame["test amplitude N"] / frame["amplitude N"]
     rows = [[row["run"], row["frequency Hz"], row["direction"], row["T"], t, row["error %"], row["eta %"],
-             efficiency(t)] for (_, row), t in zip(frame.iterrows(), t_test)]
-    _rows(ws, ["run", "frequency Hz", "direction", "T sim", "T test", "error %", "eta sim %", "eta test %"], rows,
-          start=3)
+             efficiency(t), row["dB"], float(level_db(t))] for (_, row), t in zip(frame.iterrows(), t_test)]
+    _table(ws, 3, [("run", "text"), ("frequency (Hz)", "Hz"), ("direction", "text"), ("T sim (-)", "T"),
+                   ("T test (-)", "T"), ("error (%)", "error"), ("eta sim (%)", "eta"), ("eta test (%)", "eta"),
+                   ("level sim (dB)", "dB"), ("level test (dB)", "dB")], rows)
+    print_setup(ws, header_rows=3)
 
 
 def _transmissibility(ws, runs: list[RunResult]) -> None:
-    ws["A1"] = "Pylon transmissibility T = |F_pylon| / |F_exc| against frequency"
-    ws["A1"].font = Font(bold=True, size=13)
+    _title(ws, "Pylon transmissibility T = |F_pylon| / |F_exc| against frequency",
+           "level = 20 log10 T; eta = (1 - T) x 100 %")
     groups = [(run.spec.name, run.result.runs) for run in runs if len(run.result.runs) > 1]
-    singles = sorted((p for run in runs if len(run.result.runs) == 1 for p in run.result.runs),
-                     key=lambda p: p.frequency_hz)
+    singles = sorted((p for _, p in _singles(runs)), key=lambda p: p.frequency_hz)
     if singles:
         groups.append(("single-frequency runs", singles))
     chart = ScatterChart()
-    chart.title, chart.x_axis.title, chart.y_axis.title = "Transmissibility", "frequency Hz", "T"
+    chart.title, chart.x_axis.title, chart.y_axis.title = "Pylon transmissibility", "frequency (Hz)", "T (-)"
     chart.x_axis.scaling.logBase = 10
     chart.y_axis.scaling.logBase = 10
-    chart.width, chart.height = 18, 10
-    row = 3
+    chart.style = 13
+    chart.width, chart.height = 24, 12
+    ws.add_chart(chart, "A4")
+    row = 30
     for name, points in groups:
-        _rows(ws, ["frequency Hz", *(f"{name}: T {d}" for d in DIRECTIONS)],
-              [[p.frequency_hz, *p.transmissibility] for p in points], start=row)
+        ws.cell(row - 1, 1, name).font = Font(bold=True)
+        columns = [("frequency (Hz)", "Hz"), *_directions("T (-)", "T"), *_directions("level (dB)", "dB"),
+                   *_directions("eta (%)", "eta")]
+        _table(ws, row, columns, [[p.frequency_hz, *p.transmissibility, *level_db(p.transmissibility),
+                                   *p.efficiency] for p in points])
         x = Reference(ws, min_col=1, min_row=row + 1, max_row=row + len(points))
-        for i, _ in enumerate(DIRECTIONS):
-            series = Series(Reference(ws, min_col=2 + i, min_row=row, max_row=row + len(points)), x,
-                            title_from_data=True)
+        for i, d in enumerate(DIRECTIONS):
+            series = Series(Reference(ws, min_col=2 + i, min_row=row + 1, max_row=row + len(points)), x,
+                            title=f"{name}: {d}")
             if name == "single-frequency runs":
                 series.marker.symbol, series.graphicalProperties.line.noFill = "circle", True
+            else:
+                series.marker.symbol = "none"
             chart.series.append(series)
         row += len(points) + 3
-    ws.column_dimensions["A"].width = 14
     _show_axes(chart)
-    ws.add_chart(chart, "G3")
+    print_setup(ws)
+
+
+def _modes(ws, runs: list[RunResult]) -> None:
+    _title(ws, "Mounted modes: the engine on its mount", "linearised about the static preload; "
+           "zeta = damping ratio")
+    rows = []
+    for run in runs:
+        card = next(iter(run.result.model_cards.values()))    # the points of a sweep share the model
+        rows += [[run.spec.name, number, frequency, 100 * zeta, description]
+                 for number, (frequency, zeta, description) in enumerate(card.mounted_modes, start=1)]
+    _table(ws, 3, [("run", "text"), ("mode", "text"), ("frequency (Hz)", "Hz"), ("zeta (%)", "zeta"),
+                   ("engine motion", "text")], rows)
+    first = runs[0].spec.name if runs else None
+    count = sum(row[0] == first for row in rows)
+    if count:
+        chart = BarChart()
+        chart.type = "bar"
+        chart.title, chart.y_axis.title, chart.x_axis.title = f"Mounted modes ({first})", "frequency (Hz)", "mode"
+        chart.add_data(Reference(ws, min_col=3, min_row=3, max_row=3 + count), titles_from_data=True)
+        chart.set_categories(Reference(ws, min_col=2, min_row=4, max_row=3 + count))
+        chart.width, chart.height, chart.legend = 16, 7.5, None
+        _show_axes(chart)
+        ws.add_chart(chart, "G3")
+    print_setup(ws, header_rows=3)
+
+
+def _warnings(ws, runs: list[RunResult]) -> None:
+    _title(ws, "Warnings of the runs", "a warning names a result to read with care; none: nothing to report")
+    rows = [[run.spec.name, point.name, warning] for run in runs for point in run.result.runs
+            for warning in point.warnings]
+    _table(ws, 3, [("run", "text"), ("point", "text"), ("warning", "text")],
+           rows or [["(none)", "", "no run gave a warning"]])
+    ws.column_dimensions["C"].width = 110
+    for row in ws.iter_rows(min_row=4, min_col=3, max_col=3):
+        row[0].alignment = Alignment(wrap_text=True, vertical="top")
+    print_setup(ws, header_rows=3)
 
 
 def _figure(run: RunResult):
@@ -141,59 +260,100 @@ def _plots(ws, runs: list[RunResult]) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    row = 1
-    for run in runs:
-        ws.cell(row, 1, f"Run '{run.spec.name}'").font = Font(bold=True)
+    row, height = 1, 0
+    for number, run in enumerate(runs):
+        column = 1 if number % 2 == 0 else 12      # two pictures side by side (10 default columns each)
+        ws.cell(row, column, f"Run '{run.spec.name}'").font = Font(bold=True)
         fig = _figure(run)
         buffer = io.BytesIO()
         fig.savefig(buffer, format="png", dpi=80)
         plt.close(fig)
         image = Image(io.BytesIO(buffer.getvalue()))
-        ws.add_image(image, f"A{row + 1}")
-        row += int(image.height / 20) + 4
+        ws.add_image(image, f"{get_column_letter(column)}{row + 1}")
+        height = max(height, int(image.height / 20) + 3)
+        if number % 2 == 1:
+            row, height = row + height, 0
+    print_setup(ws)
 
 
-def _metadata(ws, book: CaseBook, runs: list[RunResult]) -> None:
+def _model_cards(ws, runs: list[RunResult]) -> None:
+    for row, line in enumerate(card_lines(runs), start=1):
+        ws.cell(row, 1, line).font = Font(name="Consolas", size=9, bold=line.startswith("Run '"))
+    ws.column_dimensions["A"].width = 120
+    print_setup(ws)
+
+
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def _metadata(ws, book: CaseBook, runs: list[RunResult], written: Union[WriteOutcome, None]) -> None:
     def version(name: str) -> str:
         try:
             return metadata.version(name)
         except metadata.PackageNotFoundError:
             return "not installed"
 
-    rows = [["input file", str(book.path.resolve())], ["input SHA-256", book.sha256],
-            ["case", book.case.name], ["runs", ", ".join(run.spec.name for run in runs)],
-            ["date", datetime.datetime.now().astimezone().isoformat(timespec="seconds")],
-            ["python", platform.python_version()], ["platform", platform.platform()]]
+    _title(ws, "Provenance", "SHA-256 of each file as it is on disk after this run wrote it")
+    rows = [["input file", str(book.path.resolve())], ["input SHA-256 as read", book.sha256]]
+    if written is not None:
+        label = "case workbook with the results" if written.reason is None else "results workbook (beside the input)"
+        rows += [[label, str(written.path.resolve())], [f"{label}: SHA-256", _sha256(written.path)]]
+        if written.reason is not None:
+            rows += [["input not overwritten because", written.reason],
+                     ["input SHA-256 now", _sha256(book.path)]]
+    rows += [["case", book.case.name], ["runs", ", ".join(run.spec.name for run in runs)],
+             ["date", datetime.datetime.now().astimezone().isoformat(timespec="seconds")],
+             ["python", platform.python_version()], ["platform", platform.platform()]]
     rows += [[f"version {name}", version(name)] for name in PACKAGES]
-    _rows(ws, ["item", "value"], rows)
-    ws.column_dimensions["A"].width, ws.column_dimensions["B"].width = 28, 80
+    _table(ws, 3, [("item", "text"), ("value", "text")], rows)
+    ws.column_dimensions["B"].width = 100
+    print_setup(ws, header_rows=3)
 
 
-def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult]) -> Path:
-    """Write the report workbook of *runs* to *path* (atomically).
+def is_report(path: Path) -> bool:
+    """True if the file at *path* is a report workbook this module wrote (its keywords say so)."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            core = archive.read("docProps/core.xml")
+    except (OSError, KeyError, zipfile.BadZipFile):
+        return False
+    return f"<cp:keywords>{REPORT_KEYWORDS}</cp:keywords>".encode() in core
 
-    Raises
-    ------
-    ValueError
-        *path* is the case workbook itself.
-    PermissionError
-        *path* is open in Excel (its lock file is present).
+
+def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult],
+                 written: Union[WriteOutcome, None] = None) -> WriteOutcome:
+    """Write the report workbook of *runs* to *path* (atomically), or beside it.
+
+    An existing *path* is replaced only if it is a report this module wrote
+    and not open in Excel or LibreOffice; otherwise (the case workbook
+    itself, any other file) the report goes to a new name beside it.
+
+    Parameters
+    ----------
+    path : str or Path
+    book : CaseBook
+        The case workbook as read.
+    runs : list of RunResult
+    written : WriteOutcome, optional
+        Where the results were written (:func:`~workbook.excel.writer.write_results`):
+        the metadata records that file's SHA-256 as it is now.
+
+    Returns
+    -------
+    WriteOutcome
     """
-    path = Path(path)
-    if path.resolve() == book.path.resolve():
-        raise ValueError(f"the report cannot overwrite the case workbook {path.name}; choose another file")
-    lock = lock_file(path)
-    if lock is not None:
-        raise PermissionError(f"{path.name} is open in Excel (lock file {lock.name}); close it and run again")
+    target, reason = new_file_target(path, "report", is_report)
     workbook = Workbook()
+    workbook.properties.creator, workbook.properties.keywords = "mountwb", REPORT_KEYWORDS
     workbook.active.title = "Summary"
-    _summary(workbook.active, book.case.name, runs)
+    _summary(workbook.active, book, runs)
     if book.tests:
         _validation(workbook.create_sheet("Validation"), runs, book.tests)
     _transmissibility(workbook.create_sheet("Transmissibility"), runs)
+    _modes(workbook.create_sheet("Modes"), runs)
+    _warnings(workbook.create_sheet("Warnings"), runs)
     _plots(workbook.create_sheet("Plots"), runs)
-    cards = workbook.create_sheet("Model card")
-    for row, line in enumerate(card_lines(runs), start=1):
-        cards.cell(row, 1, line).font = Font(name="Consolas", bold=line.startswith("Run '"))
-    _metadata(workbook.create_sheet("Metadata"), book, runs)
-    return save_atomic(workbook, path)
+    _model_cards(workbook.create_sheet("Model card"), runs)
+    _metadata(workbook.create_sheet("Metadata"), book, runs, written)
+    return WriteOutcome(save_atomic(workbook, target), reason)

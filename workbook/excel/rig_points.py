@@ -13,12 +13,16 @@ from pathlib import Path
 
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import RecordError
+from workbook.excel.files import bounded_file_problem
 from workbook.excel.runs import TestPoint
 from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.rig.correlation import measure
 from workbook.rig.records import read_record
 
-__all__ = ["record_test_points"]
+__all__ = ["record_test_points", "MAX_RECORD_BYTES"]
+
+#: Largest rig record read, bytes.
+MAX_RECORD_BYTES = 200_000_000
 
 
 def record_test_points(path: Path, run_name: str, case: Case) -> list[TestPoint]:
@@ -36,12 +40,16 @@ def record_test_points(path: Path, run_name: str, case: Case) -> list[TestPoint]
     Raises
     ------
     RecordError
-        A bad record, transducers that do not match the case's pylon-side
+        A bad record, a path that is not a regular file of at most
+        :data:`MAX_RECORD_BYTES`, transducers that do not match the case's pylon-side
         hinges, a sweep run, or a record of another rotor frequency.
     """
     if len(case.excitations) != 1 or isinstance(case.excitations[0], Sweep):
         raise RecordError(path, f"run {run_name!r} is not a single-frequency run; a record measures one frequency")
     excitation = case.excitations[0]
+    problem = bounded_file_problem(path, MAX_RECORD_BYTES)
+    if problem is not None:
+        raise RecordError(path, problem)
     record = read_record(path)
     record.check_hinges([h.name for h in case.pylon_hinges])
     if abs(record.nominal_hz - excitation.frequency) > 0.02 * excitation.frequency:

@@ -6,6 +6,7 @@ as the values Excel cached when it last saved the file.
 """
 from __future__ import annotations
 
+import datetime
 import math
 import re
 import warnings
@@ -15,6 +16,8 @@ from pathlib import Path
 from typing import Any, Callable, Union
 
 from openpyxl.utils import get_column_letter
+from openpyxl.utils.cell import coordinate_to_tuple
+from openpyxl.utils.datetime import to_excel
 
 import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
@@ -22,7 +25,54 @@ from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
 from workbook.model.units import si_factor
 
-__all__ = ["Record", "SheetReader", "open_workbook"]
+__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "MAX_DATA_ROWS", "MAX_FILE_BYTES",
+           "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
+
+
+def peek(ws, coordinate: str) -> Any:
+    """The value of cell *coordinate* of *ws*, without creating the cell (None if it is not stored).
+
+    ``ws[coordinate]`` and ``ws.cell()`` add an empty cell to the sheet,
+    which a later save would write.
+    """
+    cell = ws._cells.get(coordinate_to_tuple(coordinate))
+    return None if cell is None else cell.value
+
+
+def stored_cells(ws) -> list:
+    """The cells stored in *ws* (those in the file), by row then column; no empty cell is created."""
+    return [ws._cells[key] for key in sorted(ws._cells)]
+
+
+#: Data rows read per table at most.
+MAX_DATA_ROWS = 10_000
+
+
+class _Cells:
+    """The stored cells of one sheet (values as cached, and formulas), looked up without creating cells."""
+
+    def __init__(self, ws_values, ws_formulas):
+        self._values = {(c.row, c.column): c.value for c in stored_cells(ws_values)}
+        self._formulas = {(c.row, c.column): c.value for c in stored_cells(ws_formulas) if c.data_type == "f"}
+        self.merged = list(ws_values.merged_cells.ranges)
+
+    def value(self, row: int, col: int) -> Any:
+        return self._values.get((row, col))
+
+    def formula(self, row: int, col: int) -> Any:
+        return self._formulas.get((row, col))
+
+    def has(self, row: int, col: int) -> bool:
+        return self._values.get((row, col)) is not None or (row, col) in self._formulas
+
+    def columns(self, row: int) -> list[int]:
+        """Columns of the stored cells of *row*."""
+        return sorted(c for r, c in self._values if r == row)
+
+    def rows(self, columns: set) -> list[int]:
+        """Data rows with a value or a formula in one of *columns*, in order."""
+        found = {r for r, c in (*self._values, *self._formulas) if c in columns and self.has(r, c)}
+        return sorted(r for r in found if r >= L.FIRST_DATA_ROW)
 
 
 @dataclass
@@ -66,6 +116,8 @@ class SheetReader:
     def __init__(self, path: Path, formulas, values):
         self.path, self.formulas, self.values = path, formulas, values
         self.problems: list[Problem] = []
+        #: True once merged cells were found in a table (its rows are incomplete: the case is not built).
+        self.merged_found = False
 
     def problem(self, sheet, cell, column, value, expected) -> None:
         problem = Problem(self.path.name, sheet, cell, column, value, expected)
@@ -85,22 +137,36 @@ class SheetReader:
     # -- tables -------------------------------------------------------------------------------------------
 
     def table(self, table: L.Table) -> list[Record]:
-        """The data rows of *table* (empty if the sheet is unusable)."""
+        """The data rows of *table* (empty if the sheet is unusable).
+
+        Only the cells stored in the file are looked at (a stray cell in the
+        last row of the sheet costs nothing), and only the first
+        :data:`MAX_DATA_ROWS` data rows are read: a value below them is a
+        problem.
+        """
         if table.sheet not in self.values.sheetnames:
             if not table.optional:
                 self.problem(table.sheet, None, None, None,
                              f"a sheet named '{table.sheet}' (sheets: {', '.join(self.values.sheetnames)})")
             return []
-        ws_values, ws_formulas = self.values[table.sheet], self.formulas[table.sheet]
-        positions = self._headers(table, ws_values)
+        sheet = _Cells(self.values[table.sheet], self.formulas[table.sheet])
+        positions = self._headers(table, sheet)
         if positions is None:
             return []
-        factors = self._units(table, ws_values, positions)
+        merged = self._merged(table, sheet, positions)
+        factors = self._units(table, sheet, positions)
         records = []
-        for row in range(L.FIRST_DATA_ROW, ws_values.max_row + 1):
-            raw = {}
-            for key, col in positions.items():
-                raw[key] = self._cell(ws_values, ws_formulas, row, col, table)
+        for row in sheet.rows(set(positions.values())):
+            if row in merged:
+                continue
+            if row >= L.FIRST_DATA_ROW + MAX_DATA_ROWS:
+                col = min(c for c in positions.values() if sheet.has(row, c))
+                self.problem(table.sheet, f"{get_column_letter(col)}{row}", sheet.value(L.HEADER_ROW, col),
+                             sheet.value(row, col), f"data in rows {L.FIRST_DATA_ROW} to "
+                             f"{L.FIRST_DATA_ROW + MAX_DATA_ROWS - 1} (at most {MAX_DATA_ROWS} rows are read; "
+                             "delete the stray cell or move the data up)")
+                break
+            raw = {key: self._cell(sheet, row, col, table) for key, col in positions.items()}
             if all(v is None for v in raw.values()):
                 continue
             records.append(self._record(table, row, raw, positions, factors))
@@ -112,11 +178,25 @@ class SheetReader:
             records = records[:1]
         return records
 
-    def _headers(self, table: L.Table, ws) -> Union[dict, None]:
+    def _merged(self, table: L.Table, sheet: "_Cells", positions: dict) -> set:
+        """Report merged cells over the columns read; the data rows they cover (not read further)."""
+        columns, rows = set(positions.values()), set()
+        for merged in sheet.merged:
+            if not any(merged.min_col <= col <= merged.max_col for col in columns):
+                continue
+            self.problem(table.sheet, merged.coord, sheet.value(L.HEADER_ROW, merged.min_col),
+                         sheet.value(merged.min_row, merged.min_col),
+                         "cells that are not merged (merged cells hold one value for all of them: unmerge them "
+                         "and give every cell its own value)")
+            rows.update(range(merged.min_row, merged.max_row + 1))
+            self.merged_found = True
+        return rows
+
+    def _headers(self, table: L.Table, sheet: "_Cells") -> Union[dict, None]:
         by_header = {c.header.lower(): c for c in table.columns}
         positions: dict[str, int] = {}
-        for col in range(1, ws.max_column + 1):
-            text = ws.cell(L.HEADER_ROW, col).value
+        for col in sheet.columns(L.HEADER_ROW):
+            text = sheet.value(L.HEADER_ROW, col)
             if text is None or (isinstance(text, str) and (not text.strip() or text.strip().startswith("#"))):
                 continue
             cell = f"{get_column_letter(col)}{L.HEADER_ROW}"
@@ -135,27 +215,27 @@ class SheetReader:
                              f"a column headed '{column.header}'")
         return None if any(c.required for c in missing) else positions
 
-    def _units(self, table: L.Table, ws, positions: dict) -> dict:
+    def _units(self, table: L.Table, sheet: "_Cells", positions: dict) -> dict:
         """Factor to SI of each number column (None where the unit cell is bad)."""
         factors = {}
         for key, col in positions.items():
             column = table.column(key)
             if not column.has_unit:
                 continue
-            text = ws.cell(L.UNIT_ROW, col).value
+            text = sheet.value(L.UNIT_ROW, col)
             try:
                 factors[key] = si_factor("" if text is None else str(text), column.si_unit)
             except UnitProblem as exc:
                 factors[key] = None
                 self.problem(table.sheet, f"{get_column_letter(col)}{L.UNIT_ROW}", f"{column.header} (unit)",
-                             text, exc.expected)
+                             text, exc.expected + _unit_suggestion(text, column.si_unit))
         return factors
 
-    def _cell(self, ws_values, ws_formulas, row: int, col: int, table: L.Table) -> Any:
-        value = ws_values.cell(row, col).value
-        if value is None and ws_formulas.cell(row, col).data_type == "f":
-            self.problem(table.sheet, f"{get_column_letter(col)}{row}", ws_values.cell(L.HEADER_ROW, col).value,
-                         ws_formulas.cell(row, col).value,
+    def _cell(self, sheet: "_Cells", row: int, col: int, table: L.Table) -> Any:
+        value = sheet.value(row, col)
+        formula = sheet.formula(row, col)
+        if value is None and formula is not None:
+            self.problem(table.sheet, f"{get_column_letter(col)}{row}", sheet.value(L.HEADER_ROW, col), formula,
                          "a formula with a calculated value (the file was saved without one: open it in "
                          "Excel or LibreOffice, recalculate and save)")
             return _FORMULA_WITHOUT_VALUE
@@ -179,13 +259,19 @@ class SheetReader:
             try:
                 converted = _PARSERS[column.kind](value, column)
             except _Bad as exc:
-                self.problem(table.sheet, cells[key], column.header, value, exc.expected)
+                self.problem(table.sheet, cells[key], column.header, exc.shown or value, exc.expected)
                 continue
             if column.has_unit:
                 if factors.get(key) is None:
                     usable = False    # the unit cell is reported
                     continue
                 converted = converted * factors[key] if column.kind == "number" else converted
+                limit = L.MAGNITUDE_LIMITS.get(column.si_unit)
+                if column.kind == "number" and limit is not None and abs(converted) > limit:
+                    self.problem(table.sheet, cells[key], column.header, value,
+                                 f"a magnitude of at most {limit:g} {column.si_unit} (found {converted:g} "
+                                 f"{column.si_unit}: check the number and the unit in row {L.UNIT_ROW})")
+                    continue
             values[key] = converted
         raw = {key: value for key, value in raw.items() if value is not _FORMULA_WITHOUT_VALUE}
         return Record(table, row, values, cells, raw, usable and len(self.problems) == known)
@@ -195,24 +281,104 @@ _FORMULA_WITHOUT_VALUE = object()
 
 
 class _Bad(ValueError):
-    def __init__(self, expected: str):
-        self.expected = expected
+    """A cell that cannot be read: what was expected, and the value as the user sees it (if not the cell's)."""
+
+    def __init__(self, expected: str, shown: Any = None):
+        self.expected, self.shown = expected, shown
         super().__init__(expected)
 
 
+#: What a formula shows when it fails.
+FORMULA_ERRORS = ("#NULL!", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#N/A", "#SPILL!", "#CALC!",
+                  "#GETTING_DATA")
+
+
+def _not_a_value(value: Any) -> None:
+    """Refuse a formula error or a date where a number or text is read."""
+    if isinstance(value, str) and value.strip().upper() in FORMULA_ERRORS:
+        raise _Bad(f"a value (the cell shows the formula error {value.strip()}: correct the formula or the cells "
+                   "it uses)")
+    if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
+        number = float(to_excel(value))
+        raise _Bad(f"a number, not a date (the cell is formatted as a date: format it as a number; it holds "
+                   f"{number:.10g})", f"{number:.10g} formatted as the date {_shown_date(value)}")
+
+
+def _shown_date(value) -> str:
+    """A date as ISO text, without a midnight time."""
+    if isinstance(value, datetime.datetime) and value.time() == datetime.time():
+        value = value.date()
+    return value.isoformat()
+
+
+def _unit_suggestion(text: Any, si_unit: str) -> str:
+    """'; did you mean ...?' for a unit cell spelt unlike the accepted spelling ('RPM', 'U/min', 'Ns/m'), or ''."""
+    if text is None:
+        return ""
+    text = str(text).strip()
+    for spelling in _UNIT_SPELLINGS:
+        candidate = spelling(text)
+        if candidate == text:
+            continue
+        try:
+            si_factor(candidate, si_unit)
+        except UnitProblem:
+            continue
+        return f"; did you mean '{candidate}'?"
+    return ""
+
+
+#: Rewrites of common unit spellings into the accepted one, tried in turn.
+_UNIT_SPELLINGS = (
+    lambda t: "rpm" if t.lower().replace(" ", "") in ("rpm", "u/min", "upm", "r/min", "rev/min") else t,
+    str.lower,
+    lambda t: re.sub(r"(?<=N)(?=[sm])", "*", t),
+    lambda t: re.sub(r"(?<=N)(?=[sm])", "*", t.replace("KN", "kN")),
+)
+
+
 def _as_number(value: Any, column: L.Column) -> float:
+    _not_a_value(value)
     if isinstance(value, bool):
         raise _Bad("a number")
-    if isinstance(value, (int, float)):
-        number = float(value)
-    else:
-        try:
-            number = float(str(value).strip().replace(",", "."))
-        except ValueError:
-            raise _Bad("a number") from None
+    number = float(value) if isinstance(value, (int, float)) else _text_number(str(value))
     if not math.isfinite(number):
         raise _Bad("a finite number")
     return number
+
+
+#: Digits grouped in threes by a separator: 1,234 or 12.345.678.
+_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$")
+_PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
+
+
+def _text_number(text: str) -> float:
+    """A number typed as text, read only when its separators leave one reading.
+
+    ``3,5`` is 3.5, ``1.234,5`` and ``1,234.5`` are 1234.5, ``1,234,567`` is
+    1234567; but ``3,568`` (or ``3.568``) may be 3568 (a thousands
+    separator) or 3.568 (a decimal separator) and is refused with both
+    readings. A number entered as a number is never ambiguous.
+    """
+    compact = text.strip().replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
+    grouped = _GROUPED.match(compact)
+    separator = grouped.group("sep") if grouped else None
+    if grouped and compact.count(separator) == 1:
+        thousands, decimal = compact.replace(separator, ""), compact.replace(separator, ".")
+        raise _Bad(f"a number whose separators can be read one way only: {text.strip()!r} reads as "
+                   f"{thousands} ({separator!r} separating thousands) or as {decimal} ({separator!r} as the "
+                   f"decimal separator); type {thousands} or {decimal}, or enter the cell as a number")
+    if grouped:
+        return float(compact.replace(grouped.group("sep"), ""))
+    if "," in compact and "." in compact:
+        decimal = "," if compact.rindex(",") > compact.rindex(".") else "."
+        whole, _, fraction = compact.rpartition(decimal)
+        if _GROUPED.match(whole) and _GROUPED.match(whole).group("sep") != decimal and fraction.isdigit():
+            return float(whole.replace("," if decimal == "." else ".", "") + "." + fraction)
+        raise _Bad("a number")
+    if not _PLAIN.match(compact) and compact.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
+        raise _Bad("a number")
+    return float(compact.replace(",", "."))
 
 
 def _as_integer(value: Any, column: L.Column) -> int:
@@ -223,6 +389,7 @@ def _as_integer(value: Any, column: L.Column) -> int:
 
 
 def _as_text(value: Any, column: L.Column) -> str:
+    _not_a_value(value)
     if isinstance(value, float) and value.is_integer():
         value = int(value)
     return str(value).strip()
@@ -295,6 +462,44 @@ _PARSERS: dict[str, Callable] = {"number": _as_number, "integer": _as_integer, "
                                  "fidelity": _as_fidelity, "unit": _as_length_unit}
 
 
+#: Largest workbook file read, bytes, and the most its parts may unpack to (a case workbook is ~50 kB).
+MAX_FILE_BYTES, MAX_UNPACKED_BYTES = 50_000_000, 250_000_000
+_OLE = bytes.fromhex("d0cf11e0a1b11ae1")
+
+
+def _not_a_workbook(path: Path) -> Problem:
+    """What a file that is not a zip archive is, in words a user recognises."""
+    with open(path, "rb") as stream:
+        head = stream.read(min(MAX_FILE_BYTES, 4_000_000))
+    size = path.stat().st_size
+    if head.startswith(_OLE):
+        if "EncryptedPackage".encode("utf-16-le") in head:
+            return Problem(path.name, None, None, None, "a workbook encrypted with a password",
+                           "a workbook without a password (save a copy without one: in Excel File > Info > "
+                           "Protect Workbook > Encrypt with Password, clear the password)")
+        return Problem(path.name, None, None, None, "an Excel 97-2003 workbook (.xls)",
+                       "an Excel .xlsx workbook (save it as Excel Workbook .xlsx)")
+    return Problem(path.name, None, None, None, f"{size} bytes that are not a zip archive", "an Excel .xlsx workbook")
+
+
+def _too_large(path: Path) -> Union[Problem, None]:
+    """A problem if the file, or what its parts unpack to, exceeds the limits read."""
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        return Problem(path.name, None, None, None, f"a file of {size:,} bytes",
+                       f"a case workbook of at most {MAX_FILE_BYTES:,} bytes (the limit read)")
+    try:
+        with zipfile.ZipFile(path) as archive:
+            unpacked = sum(info.file_size for info in archive.infolist())
+    except zipfile.BadZipFile:
+        return None    # reported by the reader below
+    if unpacked > MAX_UNPACKED_BYTES:
+        return Problem(path.name, None, None, None, f"parts that unpack to {unpacked:,} bytes",
+                       f"a case workbook whose parts unpack to at most {MAX_UNPACKED_BYTES:,} bytes (the limit "
+                       "read; a sheet filled to its last row or column is the usual cause)")
+    return None
+
+
 def open_workbook(path: Union[str, Path]):
     """Open a workbook twice: with formulas and with the cached values.
 
@@ -305,7 +510,9 @@ def open_workbook(path: Union[str, Path]):
     Raises
     ------
     WorkbookError
-        The file is missing, not an .xlsx workbook or corrupt.
+        The file is missing, not an .xlsx workbook (an .xls or a
+        password-protected one, named as such), corrupt, or larger than
+        :data:`MAX_FILE_BYTES` (:data:`MAX_UNPACKED_BYTES` unpacked).
     """
     from openpyxl import load_workbook
 
@@ -313,8 +520,10 @@ def open_workbook(path: Union[str, Path]):
     if not path.is_file():
         raise WorkbookError([Problem(path.name, None, None, None, str(path), "an existing workbook file")])
     if not zipfile.is_zipfile(path):
-        raise WorkbookError([Problem(path.name, None, None, None, f"{path.stat().st_size} bytes that are not "
-                                     "a zip archive", "an Excel .xlsx workbook")])
+        raise WorkbookError([_not_a_workbook(path)])
+    problem = _too_large(path)
+    if problem is not None:
+        raise WorkbookError([problem])
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")

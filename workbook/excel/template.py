@@ -20,8 +20,9 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.datavalidation import DataValidation
 
 import workbook.excel.layout as L
-from workbook.excel.files import save_atomic
+from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.runs import RunSpec, TestPoint
+from workbook.excel.styling import print_setup
 from workbook.model import case as cm
 from workbook.model.units import si_factor
 
@@ -217,6 +218,7 @@ def _write_table(ws, table: L.Table, rows: list[dict]) -> None:
             validation.add(f"{letter}{L.FIRST_DATA_ROW}:{letter}{_VALIDATED_ROWS}")
             ws.add_data_validation(validation)
     ws.freeze_panes = ws.cell(L.FIRST_DATA_ROW, 2)
+    print_setup(ws, header_rows=L.UNIT_ROW, freeze=False)
 
 
 def _write_instructions(ws) -> None:
@@ -238,6 +240,7 @@ def _write_instructions(ws) -> None:
     for letter, width in zip("ABCDEF", (14, 22, 10, 22, 9, 90)):
         ws.column_dimensions[letter].width = width
     ws.cell(1, 1).alignment = Alignment(vertical="top")
+    print_setup(ws)
 
 
 def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> Workbook:
@@ -279,6 +282,14 @@ def reference_workbook() -> Workbook:
     return case_workbook(reference_case(sweep=True), REFERENCE_RUNS)
 
 
-def write_workbook(workbook: Workbook, path: Union[str, Path]) -> Path:
-    """Save a generated workbook (atomically)."""
-    return save_atomic(workbook, path)
+def write_workbook(workbook: Workbook, path: Union[str, Path], replace: bool = False):
+    """Save a generated workbook (atomically); an existing file is replaced only if *replace*.
+
+    Returns
+    -------
+    (Path, str or None)
+        The file written (*path*, or a new name beside an existing *path*)
+        and the reason it is not *path* (None: it is).
+    """
+    target, reason = new_file_target(path, "template", lambda _: replace)
+    return save_atomic(workbook, target), reason

@@ -1,16 +1,24 @@
 """Write run results back into the case workbook, safely.
 
-Result sheets are named ``Result ...`` and carry a marker in a hidden cell,
-so a later run replaces them and never a sheet of the user's that happens to
-share a name. The input sheets are left as openpyxl read them (values,
+Result sheets are named ``Result efficiency``, ``Result hinges``, ``Result
+sweep`` and ``Result model card``; each carries, in a hidden cell, a marker
+naming the sheet it was written as. A later run replaces a sheet only when
+its name is one of these and its marker names that same sheet: a copy of a
+result sheet (``Result efficiency (2)``) or a renamed one (``Result LP
+baseline``) is the user's and is kept, like any sheet of the user's that
+happens to share a name. The input sheets are left as openpyxl read them (values,
 styles, drop-downs, comments).
 
 The case workbook is not overwritten (the results go to a separate, new
 workbook beside it, and the reason is given) when:
 
-- it is open in Excel (the lock file ``~$<name>`` is present);
+- it is open in Excel or LibreOffice (the lock file ``~$<name>`` or
+  ``.~lock.<name>#`` is present);
 - it holds content openpyxl would drop (charts, images, pivot tables,
-  macros, external links, data-validation extensions, ...);
+  macros, external links, data-validation extensions, threaded comments,
+  dynamic-array formulas, resized or always-shown comment boxes, company
+  and manager properties, ...), or the rewritten file would lack any kind
+  of part the original has (:func:`~workbook.excel.files.lost_parts`);
 - a sheet named like a result sheet exists that is not ours;
 - it changed on disk while the runs were computed.
 
@@ -34,8 +42,20 @@ from openpyxl.utils import get_column_letter
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
 from workbook.answers.results import PYLON_SUM, MountResult
-from workbook.excel.files import lock_file, restore_formula_values, save_atomic, unsupported_content
+from workbook.excel.files import (
+    lock_file,
+    lock_message,
+    lost_parts,
+    name_beside,
+    restore_formula_values,
+    save_atomic,
+    unsupported_content,
+    workbook_bytes,
+    write_atomic,
+)
 from workbook.excel.runs import RunSpec, TestPoint
+from workbook.excel.sheets import peek, stored_cells
+from workbook.excel.styling import FORMATS, print_setup, quantity_of
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
@@ -43,7 +63,7 @@ __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_r
 
 log = logging.getLogger(__name__)
 
-#: Text of the hidden marker cell of every result sheet.
+#: Text of the hidden marker cell of every result sheet, followed by ": <sheet title>".
 MARKER = "mountwb result sheet"
 #: Marker cell (its column is hidden).
 MARKER_CELL = "Z1"
@@ -133,11 +153,27 @@ def result_frames(runs: list[RunResult], tests: tuple = ()) -> dict[str, pd.Data
     return frames
 
 
+def _model_part(card) -> tuple:
+    """What a model card says about the model itself (not the solver's steps or the wall time)."""
+    return card.bodies, card.effects, card.mounted_modes
+
+
 def card_lines(runs: list[RunResult]) -> list[str]:
+    """The model cards of *runs* as text lines: each run's first card in full; the other points of a sweep
+    in one line each (step and wall time) when their model is the same, else in full."""
     lines = []
     for run in runs:
-        for card in run.result.model_cards.values():
-            lines += [f"Run '{run.spec.name}'", *card.to_text().splitlines(), ""]
+        cards = list(run.result.model_cards.values())
+        lines += [f"Run '{run.spec.name}'", *cards[0].to_text().splitlines(), ""]
+        same = [card for card in cards[1:] if _model_part(card) == _model_part(cards[0])]
+        if same:
+            lines.append(f"Other points of run '{run.spec.name}' (the same bodies, effects and mounted modes):")
+            lines += [f"  {card.run_name}: time step {card.solver.get('time step', '-')}; wall time "
+                      f"{sum(card.timings.values()):.3f} s" for card in same]
+            lines.append("")
+        for card in cards[1:]:
+            if card not in same:
+                lines += [*card.to_text().splitlines(), ""]
     return lines
 
 
@@ -145,30 +181,47 @@ def _sheet_title(name: str) -> str:
     return f"{L.RESULT_PREFIX}{name}"
 
 
+def _marker(title: str) -> str:
+    return f"{MARKER}: {title}"
+
+
 def _mark(ws) -> None:
-    ws[MARKER_CELL] = MARKER
+    ws[MARKER_CELL] = _marker(ws.title)
     ws.column_dimensions[MARKER_CELL.rstrip("0123456789")].hidden = True
 
 
 def is_result_sheet(ws) -> bool:
-    """True if *ws* is a result sheet written by this module."""
-    return ws[MARKER_CELL].value == MARKER
+    """True if *ws* is a result sheet this package wrote, under the name it has now.
+
+    A copy or a renamed result sheet keeps the marker of the sheet it came
+    from, so its name and marker differ: it is the user's. (Workbooks written
+    before the marker named its sheet carry the bare :data:`MARKER`.)
+    """
+    if ws.title not in RESULT_SHEETS:
+        return False
+    value = peek(ws, MARKER_CELL)
+    return value == _marker(ws.title) or value == MARKER
 
 
 def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
     ws.cell(1, 1, note).font = Font(italic=True)
+    formats = [FORMATS.get(quantity_of(name)) for name in frame.columns]
     for col, name in enumerate(frame.columns, start=1):
         cell = ws.cell(2, col, name)
         cell.font, cell.fill = Font(bold=True), _HEADER_FILL
-        ws.column_dimensions[get_column_letter(col)].width = max(10, len(str(name)) + 2)
+        texts = [str(v) for v in frame[name] if isinstance(v, str)]
+        ws.column_dimensions[get_column_letter(col)].width = max([11, len(str(name)) + 2,
+                                                                  *(len(t) + 2 for t in texts)])
     for row, values in enumerate(frame.itertuples(index=False), start=3):
         for col, value in enumerate(values, start=1):
             if isinstance(value, float) and not pd.notna(value):
                 value = None
             elif hasattr(value, "item"):
                 value = value.item()
-            ws.cell(row, col, value)
-    ws.freeze_panes = "A3"
+            cell = ws.cell(row, col, value)
+            if formats[col - 1] is not None and isinstance(value, (int, float)):
+                cell.number_format = formats[col - 1]
+    print_setup(ws, header_rows=2)
     _mark(ws)
 
 
@@ -180,13 +233,17 @@ _NOTES = {
 }
 
 
+#: Every sheet title a write may create (and so may replace).
+RESULT_SHEETS = tuple(_sheet_title(name) for name in (*_NOTES, "model card"))
+
+
 def result_sheet_names(frames: dict) -> list[str]:
     """Titles of the result sheets a write creates."""
     return [_sheet_title(name) for name in frames] + [_sheet_title("model card")]
 
 
 def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str) -> list[str]:
-    """Add the result sheets to an openpyxl *workbook* (our old ones are removed first).
+    """Add the result sheets to an openpyxl *workbook* (the ones it wrote before are removed first).
 
     Returns
     -------
@@ -194,7 +251,7 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
         The sheet titles written.
     """
     for ws in list(workbook.worksheets):
-        if ws.title.startswith(L.RESULT_PREFIX) and is_result_sheet(ws):
+        if is_result_sheet(ws):
             workbook.remove(ws)
     frames = result_frames(runs, tests)
     for name, frame in frames.items():
@@ -203,6 +260,8 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
     for row, line in enumerate(card_lines(runs), start=2):
         ws.cell(row, 1, line).font = Font(name="Consolas", bold=line.startswith("Run '"))
     ws.cell(1, 1, stamp).font = Font(italic=True)
+    ws.column_dimensions["A"].width = 120
+    print_setup(ws)
     _mark(ws)
     return result_sheet_names(frames)
 
@@ -215,7 +274,7 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
     """(reason or None, the loaded workbook or None)."""
     lock = lock_file(path)
     if lock is not None:
-        return f"it is open in Excel (lock file {lock.name} present); close it and run again to write into it", None
+        return lock_message(lock), None
     if hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
         return "it changed on disk while the runs were computed", None
     dropped = unsupported_content(path)
@@ -223,7 +282,7 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
         return f"it holds content this program cannot keep ({', '.join(dropped)})", None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        workbook = load_workbook(path)
+        workbook = load_workbook(path, rich_text=True)
     conflicts = _conflicts(workbook, titles)
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
@@ -240,21 +299,11 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     for number, ws in enumerate(workbook.worksheets, start=1):
         if ws.title not in values.sheetnames:
             continue
-        for row in ws.iter_rows():
-            for cell in row:
-                if cell.data_type == "f" and values[ws.title][cell.coordinate].value is not None:
-                    cached.setdefault(number, {})[cell.coordinate] = values[ws.title][cell.coordinate].value
+        for cell in stored_cells(ws):
+            value = peek(values[ws.title], cell.coordinate) if cell.data_type == "f" else None
+            if value is not None:
+                cached.setdefault(number, {})[cell.coordinate] = value
     return cached
-
-
-def _separate_path(path: Path) -> Path:
-    stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    candidate = path.with_name(f"{path.stem}-results-{stamp}.xlsx")
-    number = 1
-    while candidate.exists():
-        number += 1
-        candidate = path.with_name(f"{path.stem}-results-{stamp}-{number}.xlsx")
-    return candidate
 
 
 def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], tests: tuple = ()) -> WriteOutcome:
@@ -279,11 +328,14 @@ def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], te
     reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
     if reason is None:
         add_result_sheets(workbook, runs, tests, stamp)
-        cached = _cached_formula_values(path, workbook)
-        return WriteOutcome(save_atomic(workbook, path, lambda saved: restore_formula_values(saved, cached)), None)
+        data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
+        lost = lost_parts(path.read_bytes(), data)
+        if not lost:
+            return WriteOutcome(write_atomic(path, data), None)
+        reason = f"it holds content this program cannot keep ({', '.join(lost)})"
     separate = Workbook()
     separate.remove(separate.active)
     add_result_sheets(separate, runs, tests, stamp)
-    target = save_atomic(separate, _separate_path(path))
-    log.warning("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
+    target = save_atomic(separate, name_beside(path, "results"))
+    log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)
