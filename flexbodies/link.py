@@ -30,10 +30,11 @@ import numpy as np
 from .assembly import FEModel, assemble
 from .cache import LinkCache, default_cache_dir
 from .geometry import LinkGeometry
+from .interior import InteriorSolver
 from .materials import STEEL, Material
 from .meshing import default_element_size, load_mesh, mesh_link
 from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
-from .reduction import couple, reduce_coupled, reference_frequencies
+from .reduction import couple, reduce_for_decisions
 from .selection import decide_modes
 
 __all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "build_fe_model", "default_cache_dir"]
@@ -240,21 +241,22 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
             return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
         fe, timings = build_fe_model(model)
         coupled = couple(fe, model.interface)
+        start = time.perf_counter()
+        solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+        timings["factorisation_seconds"] = time.perf_counter() - start
         if frequencies is None:
             start = time.perf_counter()
-            frequencies = reference_frequencies(coupled)
+            frequencies = solver.reference_frequencies()
             timings["frequency_seconds"] = time.perf_counter() - start
             cache.write_summary(fe_hash, frequencies)
             decisions = [decide_modes(modes, frequencies["mounted_hz"][0], f) for f in excitations_hz]
             keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
             links = [None] * len(decisions)
-        result = []
-        for link, decision, key in zip(links, decisions, keys):
-            if link is not None:
-                result.append(with_decision(link, decision, cache_hit=True))
-                continue
-            info = {"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
-            link = reduce_coupled(coupled, decision, frequencies, info)
+        missing = {key: decision for key, decision, link in zip(keys, decisions, links) if link is None}
+        infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
+                 for key in missing]
+        made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos)))
+        for key, link in made.items():
             cache.save_link(key, link)
-            result.append(link)
-        return tuple(result)
+        return tuple(with_decision(link, d, cache_hit=True) if link is not None else with_decision(made[key], d, False)
+                     for link, d, key in zip(links, decisions, keys))
