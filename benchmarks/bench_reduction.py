@@ -12,10 +12,20 @@ reduction with 12 modes (static modes, eigen-solve, orthonormalisation,
 Exudyn's floating-frame invariants). ``--exudyn`` adds Exudyn's own
 ``ComputeHurtyCraigBamptonModes`` (RBE2, 12 modes) on the same matrices.
 
+``--reference`` instead reduces the links of the reference mount cold (no
+cache), for every excitation of the case, in two ways side by side: as
+before (per excitation, each link's reference frequencies and its
+Craig-Bampton basis each with a factorisation of their own) and as now
+(:func:`flexbodies.link.reduce_link_set`: one factorisation per unique link
+serving the reference frequencies, the static modes and one fixed-interface
+eigen-solve for all excitations). It prints the median times of the
+repeats and the largest relative difference of every frequency.
+
 Run::
 
     python benchmarks/bench_reduction.py                 # 14, 10 and 7 mm
     python benchmarks/bench_reduction.py --sizes 10 5 --repeats 3 --exudyn
+    python benchmarks/bench_reduction.py --reference --repeats 3
 """
 from __future__ import annotations
 
@@ -95,13 +105,87 @@ def measure(size_mm: float, repeats: int, with_exudyn: bool) -> dict:
     return row
 
 
+def _before(case, frequencies_hz):
+    """The reduction chain as it was: per excitation, per link not yet reduced for that decision."""
+    from flexbodies.craig_bampton import craig_bampton
+    from flexbodies.link import build_fe_model
+    from flexbodies.reduction import couple, reduce_coupled, reference_frequencies
+    from flexbodies.selection import decide_modes
+
+    summaries, done, links = {}, set(), {}
+    for f in frequencies_hz:
+        for link in case.links:
+            key = link.model.key()
+            decision = decide_modes(link.modes, summaries[key]["mounted_hz"][0], f) if key in summaries else None
+            if decision is not None and (key, decision.key) in done:
+                continue  # a cache hit
+            fe, _ = build_fe_model(link.model)
+            coupled = couple(fe, link.model.interface)
+            if key not in summaries:
+                summaries[key] = reference_frequencies(coupled)
+                decision = decide_modes(link.modes, summaries[key]["mounted_hz"][0], f)
+                if (key, decision.key) in done:
+                    continue
+            cb = craig_bampton(coupled.stiffness, coupled.mass, coupled.coupling.boundary,
+                               count=decision.count, cutoff_hz=decision.cutoff_hz)
+            links[(link.name, f)] = reduce_coupled(coupled, cb, decision, summaries[key], {})
+            done.add((key, decision.key))
+    return links
+
+
+def _now(case, frequencies_hz):
+    """The reduction chain as it is: one call per unique link for every excitation."""
+    from flexbodies.link import reduce_link_set
+
+    links, seen = {}, set()
+    for link in case.links:
+        if link.model.key() in seen:
+            continue
+        seen.add(link.model.key())
+        for f, reduced in zip(frequencies_hz, reduce_link_set(link.model, link.modes, frequencies_hz, use_cache=False)):
+            links[(link.name, f)] = reduced
+    return links
+
+
+def reference_links(repeats: int) -> None:
+    """Cold reduction of the reference mount's links, before and now, with the largest frequency difference."""
+    import numpy as np
+
+    from workbook.model.reference import reference_case
+
+    case = reference_case()
+    frequencies_hz = sorted({e.frequency for e in case.excitations})
+    before_s, before = _timed(lambda: _before(case, frequencies_hz), repeats)
+    now_s, now = _timed(lambda: _now(case, frequencies_hz), repeats)
+    worst = 0.0
+    for key, old in before.items():
+        new = now[key]
+        assert old.decision.key == new.decision.key, key
+        for name in ("free_free_hz", "mounted_hz", "fixed_interface_hz", "reduced_hz"):
+            a, b = np.asarray(old.frequencies[name]), np.asarray(new.frequencies[name])
+            assert a.shape == b.shape, (key, name)
+            if a.size:
+                worst = max(worst, float(np.max(np.abs(b / a - 1))))
+    unique = len({link.model.key() for link in case.links})
+    print(f"Cold reduction of the {len(case.links)} reference links ({unique} unique) for "
+          f"{', '.join(f'{f:g}' for f in frequencies_hz)} Hz, median of {repeats}, 1 BLAS thread")
+    print(f"  before: {before_s:7.2f} s   ({len(before)} reductions)")
+    print(f"  now:    {now_s:7.2f} s   (one per unique link)")
+    print(f"  speed-up {before_s / now_s:.2f}x; largest relative frequency difference {worst:.1e}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=float, nargs="+", default=[14.0, 10.0, 7.0], help="element sizes, mm")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--exudyn", action="store_true", help="also time Exudyn's ComputeHurtyCraigBamptonModes")
+    parser.add_argument("--reference", action="store_true",
+                        help="cold reduction of the reference mount's links, before and now")
     parser.add_argument("--one", type=float, help=argparse.SUPPRESS)  # a single size, in this process
     args = parser.parse_args(argv)
+    if args.reference:
+        reference_links(args.repeats)
+        return
     if args.one is not None:
         print(json.dumps(measure(args.one, args.repeats, args.exudyn)))
         return

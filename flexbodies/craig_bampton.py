@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from .eigen import factorize, lowest_modes
 
-__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes"]
+__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "fixed_interface_set", "kept_count"]
 
 #: Frequencies below this fraction of the first elastic one count as rigid-body modes.
 _RIGID_FRACTION = 1e-3
@@ -54,28 +54,44 @@ class CraigBamptonBasis:
         return 0.5 * (reduced + reduced.T)
 
 
-def _fixed_interface_modes(K_ii, M_ii, factor, count=None, cutoff_hz=None):
+def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: float | None = None):
     """Lowest fixed-interface modes, by count or up to (and one past) a cut-off.
 
     With a cut-off the modes are computed in growing batches until the
     highest one reaches ``cutoff_hz``, so the kept set spans at least up to it.
+
+    Parameters
+    ----------
+    modes_of : callable
+        ``modes_of(k)`` gives the lowest ``k`` frequencies (Hz) and mode shapes.
+    n : int
+        Size of the fixed-interface problem.
+    count, cutoff_hz
+        As in :func:`craig_bampton`.
     """
-    n = K_ii.shape[0]
     if count == 0:
-        return np.zeros(0), np.zeros((n, 0))
+        return np.zeros(0), None
     k = count if count is not None else 8
     while True:
         k_eff = min(k, n - 2)
-        freqs, vec = lowest_modes(K_ii, M_ii, k_eff, 0.0, factor)
+        freqs, vec = modes_of(k_eff)
         if count is not None:
             return freqs, vec
-        reached = np.flatnonzero(freqs >= cutoff_hz)
-        if reached.size:
-            keep = reached[0] + 1
-            return freqs[:keep], vec[:, :keep]
-        if k_eff == n - 2:
+        if np.any(freqs >= cutoff_hz) or k_eff == n - 2:
             return freqs, vec
         k *= 2
+
+
+def kept_count(frequencies_hz, count: int | None = None, cutoff_hz: float | None = None) -> int:
+    """How many of the lowest fixed-interface modes a count or a cut-off keeps.
+
+    A cut-off keeps the modes up to it and the first one above it (all of
+    them when none reaches it).
+    """
+    if count is not None:
+        return min(count, len(frequencies_hz))
+    reached = np.flatnonzero(np.asarray(frequencies_hz) >= cutoff_hz)
+    return int(reached[0]) + 1 if reached.size else len(frequencies_hz)
 
 
 def craig_bampton(stiffness, mass, boundary, *, count: int | None = None, cutoff_hz: float | None = None):
@@ -111,10 +127,13 @@ def craig_bampton(stiffness, mass, boundary, *, count: int | None = None, cutoff
     vectors[interior] = -factor.solve(K_ib)
     vectors[boundary, np.arange(len(boundary))] = 1.0
     M_ii = M[interior][:, interior].tocsc()
-    freqs, phi = _fixed_interface_modes(K_ii, M_ii, factor, count=count, cutoff_hz=cutoff_hz)
-    fixed = np.zeros((n, phi.shape[1]))
-    fixed[interior] = phi
-    return CraigBamptonBasis(np.hstack([vectors, fixed]), boundary, freqs)
+    freqs, phi = fixed_interface_set(lambda k: lowest_modes(K_ii, M_ii, k, 0.0, factor), len(interior),
+                                     count=count, cutoff_hz=cutoff_hz)
+    keep = kept_count(freqs, count, cutoff_hz)
+    fixed = np.zeros((n, keep))
+    if keep:
+        fixed[interior] = phi[:, :keep]
+    return CraigBamptonBasis(np.hstack([vectors, fixed]), boundary, freqs[:keep])
 
 
 def elastic_modes(cb: CraigBamptonBasis, stiffness, mass):

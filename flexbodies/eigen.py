@@ -10,7 +10,11 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["factorize", "natural_frequencies", "free_dofs", "lowest_modes"]
+__all__ = ["factorize", "natural_frequencies", "free_dofs", "lowest_modes", "start_vector"]
+
+
+#: Relative residual below which a solve is not refined.
+_ROUND_OFF = 1e-13
 
 
 class _Factor:
@@ -27,9 +31,13 @@ class _Factor:
 
     def _refined(self, rhs: np.ndarray) -> np.ndarray:
         # One step of iterative refinement recovers the digits that the
-        # ill-conditioning of coupled (RBE3) matrices costs.
+        # ill-conditioning of coupled (RBE3) matrices costs; it is skipped
+        # when the residual is already at round-off.
         x = self._lu.solve(rhs)
-        return x + self._lu.solve(rhs - self._matrix @ x)
+        residual = rhs - self._matrix @ x
+        if np.linalg.norm(residual) <= _ROUND_OFF * np.linalg.norm(rhs):
+            return x
+        return x + self._lu.solve(residual)
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve for a vector or for each column of a matrix, with one refinement step."""
@@ -39,8 +47,12 @@ class _Factor:
         # SuperLU on a 2-D right-hand side is slower than a loop over columns.
         return np.column_stack([self._refined(np.ascontiguousarray(c)) for c in rhs.T])
 
+    def solve_plain(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve for one vector, without refinement (what an eigen-solver's operator needs)."""
+        return self._lu.solve(np.ascontiguousarray(rhs, dtype=float))
+
     def as_operator(self) -> spla.LinearOperator:
-        return spla.LinearOperator(self.shape, matvec=self._lu.solve, dtype=float)
+        return spla.LinearOperator(self.shape, matvec=self.solve_plain, dtype=float)
 
 
 def factorize(matrix: sp.spmatrix) -> _Factor:
@@ -68,6 +80,11 @@ def free_dofs(ndof: int, fixed) -> np.ndarray:
     return np.flatnonzero(mask)
 
 
+def start_vector(n: int) -> np.ndarray:
+    """Lanczos start vector: fixed, so that the modes, and every file made from them, are reproducible."""
+    return np.random.default_rng(0).standard_normal(n)
+
+
 def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None):
     """Eigenpairs of ``K x = lambda M x`` nearest to ``sigma``, by shift-invert Lanczos.
 
@@ -91,11 +108,9 @@ def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None):
     n = stiffness.shape[0]
     if factor is None:
         factor = factorize((stiffness - sigma * mass).tocsc())
-    # A fixed start vector makes the modes, and every file made from them, reproducible.
-    start = np.random.default_rng(0).standard_normal(n)
     lam, vec = spla.eigsh(
         stiffness, k=min(count, n - 2), M=mass, sigma=sigma, which="LM",
-        OPinv=factor.as_operator(), v0=start,
+        OPinv=factor.as_operator(), v0=start_vector(n),
     )
     order = np.argsort(lam)
     return np.sqrt(np.clip(lam[order], 0.0, None)) / (2 * np.pi), vec[:, order]

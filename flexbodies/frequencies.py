@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from .eigen import natural_frequencies
 
-__all__ = ["free_free_frequencies", "mounted_frequencies", "clamped_frequencies"]
+__all__ = ["free_free_frequencies", "mounted_frequencies", "clamped_frequencies", "mounted_constraint_basis"]
 
 
 def free_free_frequencies(stiffness, mass, count: int = 6) -> np.ndarray:
@@ -32,22 +32,29 @@ def clamped_frequencies(stiffness, mass, coupling, interfaces=(0,), count: int =
     return freqs
 
 
-def _mounted_transform(coupling) -> sp.csr_matrix:
-    """Basis of the coordinates left when both masters are pinned and spin is held.
+def mounted_constraint_basis(coupling) -> np.ndarray:
+    """Master motions left when both masters are pinned and spin is held, shape (n_master_dof, n_master_dof - 7).
 
     Master translations of every interface are held; the rotation of the first
-    master about the line through the first two master nodes is held.
+    master about the line through the first two master nodes is held. Rows
+    follow ``coupling.boundary``; the columns are orthonormal.
     """
-    n_q = coupling.n_q
     masters = coupling.master_dofs
     axis = coupling.centres[1] - coupling.centres[0]
     axis = axis / np.linalg.norm(axis)
-    n_m = masters.size
-    constraints = np.zeros((3 * len(masters) + 1, n_m))
+    constraints = np.zeros((3 * len(masters) + 1, masters.size))
     for i in range(len(masters)):
         constraints[3 * i: 3 * i + 3, 6 * i: 6 * i + 3] = np.eye(3)
     constraints[-1, 3:6] = axis
-    null = sla.null_space(constraints)  # (n_m, n_m - 7)
+    return sla.null_space(constraints)
+
+
+def _mounted_transform(coupling) -> sp.csr_matrix:
+    """Basis of the coordinates left when both masters are pinned and spin is held (:func:`mounted_constraint_basis`)."""
+    n_q = coupling.n_q
+    masters = coupling.master_dofs
+    n_m = masters.size
+    null = mounted_constraint_basis(coupling)  # (n_m, n_m - 7)
     others = np.setdiff1d(np.arange(n_q), masters.ravel())
     n_free = len(others) + null.shape[1]
     identity = sp.csr_matrix((np.ones(len(others)), (others, np.arange(len(others)))), shape=(n_q, n_free))

@@ -13,16 +13,14 @@ result on disk under the hash of its inputs:
   mode decision.
 
 A changed geometry, mesh file, material, mesh size, coupling or mode
-selection changes the hash and recomputes. A cache file that fails its
-checks is reported, recomputed and replaced, never used.
+selection changes the hash and recomputes. The store itself (verified
+entries, the lock per link, cache trouble) is :mod:`flexbodies.cache`.
 """
 from __future__ import annotations
 
 import dataclasses
 import hashlib
 import json
-import logging
-import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,18 +28,16 @@ from pathlib import Path
 import numpy as np
 
 from .assembly import FEModel, assemble
-from .atomic import replacing
+from .cache import LinkCache, default_cache_dir
 from .geometry import LinkGeometry
+from .interior import InteriorSolver
 from .materials import STEEL, Material
 from .meshing import default_element_size, load_mesh, mesh_link
-from .reduced import SCHEMA_VERSION, ReducedLink, ReducedLinkFileError, load_reduced_link, package_version, save_reduced_link, with_decision
-from .reduction import couple, reduce_coupled, reference_frequencies
+from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
+from .reduction import couple, reduce_for_decisions
 from .selection import decide_modes
 
-__all__ = ["MeshSource", "LinkModel", "reduce_link", "build_fe_model", "default_cache_dir"]
-
-log = logging.getLogger(__name__)
-
+__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "build_fe_model", "default_cache_dir"]
 
 @dataclass(frozen=True)
 class MeshSource:
@@ -118,15 +114,15 @@ class LinkModel:
             "interface": self.interface.upper(),
         }
 
+    def key(self) -> str:
+        """Hash of :meth:`fingerprint`: the key of the link's cache entries and of its lock."""
+        return _hash(self.fingerprint())
+
 
 def _hash(record: dict) -> str:
+    """Short SHA-256 of a JSON-able record (the key of a cache entry)."""
     text = json.dumps(record, sort_keys=True, default=lambda v: np.asarray(v).tolist())
     return hashlib.sha256(text.encode()).hexdigest()[:24]
-
-
-def default_cache_dir() -> Path:
-    """Cache folder: ``$MOUNTWB_CACHE``, else ``~/.cache/mountwb``."""
-    return Path(os.environ.get("MOUNTWB_CACHE") or Path.home() / ".cache" / "mountwb")
 
 
 def _in_link_frame(fe: FEModel) -> FEModel:
@@ -174,23 +170,8 @@ def build_fe_model(model: LinkModel) -> tuple[FEModel, dict]:
     return fe, {"mesh_seconds": meshed - start, "assembly_seconds": time.perf_counter() - meshed}
 
 
-def _read_summary(path: Path) -> dict | None:
-    try:
-        summary = json.loads(path.read_text())
-        return {key: np.asarray(summary[key], dtype=float) for key in ("free_free_hz", "mounted_hz")}
-    except FileNotFoundError:
-        return None
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        log.warning("%s: unreadable frequency summary (%s); recomputing", path, exc)
-        return None
-
-
-def _write_summary(path: Path, frequencies: dict) -> None:
-    with replacing(path) as temporary:
-        temporary.write_text(json.dumps({key: np.asarray(v).tolist() for key, v in frequencies.items()}))
-
-
-def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = None, *, cache_dir=None, use_cache: bool = True) -> ReducedLink:
+def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = None, *, cache_dir=None,
+                use_cache: bool = True) -> ReducedLink:
     """Reduce a link for a mode request, reusing the cache where the inputs match.
 
     Parameters
@@ -211,42 +192,71 @@ def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = No
         ``cache_hit`` tells whether it was loaded; ``info`` holds the inputs,
         their hash and the time of each stage in s.
     """
-    cache = Path(cache_dir) if cache_dir is not None else default_cache_dir()
-    fingerprint = model.fingerprint()
-    fe_hash = _hash(fingerprint)
-    summary_path = cache / f"fe-{fe_hash}.json"
-    frequencies = _read_summary(summary_path) if use_cache else None
-    fe_state = None
+    (link,) = reduce_link_set(model, modes, [excitation_hz], cache_dir=cache_dir, use_cache=use_cache)
+    return link
+
+
+def _cached(cache: LinkCache, fe_hash: str, modes, excitations_hz) -> tuple:
+    """The stored frequencies, the decisions, their keys and the stored links (None where missing)."""
+    frequencies = cache.read_summary(fe_hash)
     if frequencies is None:
+        return None, None, None, None
+    decisions = [decide_modes(modes, frequencies["mounted_hz"][0], f) for f in excitations_hz]
+    keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+    return frequencies, decisions, keys, [cache.load_link(key) for key in keys]
+
+
+def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
+                    use_cache: bool = True) -> tuple:
+    """Reduce a link for several excitations at once: one FE model, every decision served from it.
+
+    Parameters
+    ----------
+    model : LinkModel
+    modes : {"auto", "static"} or int or float
+        See :func:`flexbodies.selection.decide_modes`.
+    excitations_hz : sequence of float or None
+        The highest excitation frequency of each run that needs the link, Hz.
+    cache_dir : str or Path, optional
+        Default :func:`default_cache_dir`.
+    use_cache : bool
+        False recomputes and does not read or write the cache.
+
+    Returns
+    -------
+    tuple of ReducedLink
+        One per excitation, in order, each carrying its own decision.
+    """
+    excitations_hz = list(excitations_hz)
+    cache = LinkCache(cache_dir, enabled=use_cache)
+    fingerprint = model.fingerprint()
+    fe_hash = _hash(fingerprint)  # model.key(), without reading a mesh file twice
+    frequencies, decisions, keys, links = _cached(cache, fe_hash, modes, excitations_hz)
+    if links is not None and all(link is not None for link in links):
+        return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
+    with cache.lock(fe_hash):
+        # another process may have computed the entries while this one waited
+        frequencies, decisions, keys, links = _cached(cache, fe_hash, modes, excitations_hz)
+        if links is not None and all(link is not None for link in links):
+            return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
         fe, timings = build_fe_model(model)
         coupled = couple(fe, model.interface)
         start = time.perf_counter()
-        frequencies = reference_frequencies(coupled)
-        timings["frequency_seconds"] = time.perf_counter() - start
-        fe_state = (coupled, timings)
-        if use_cache:
-            _write_summary(summary_path, frequencies)
-
-    decision = decide_modes(modes, frequencies["mounted_hz"][0], excitation_hz)
-    link_hash = _hash({"fe": fe_hash, "modes": decision.key})
-    link_path = cache / f"link-{link_hash}.npz"
-    if use_cache and link_path.exists():
-        try:
-            return with_decision(load_reduced_link(link_path), decision, cache_hit=True)
-        except ReducedLinkFileError as exc:
-            log.warning("%s; recomputing it", exc)
-
-    if fe_state is None:
-        fe, timings = build_fe_model(model)
-        fe_state = (couple(fe, model.interface), timings)
-    coupled, timings = fe_state
-    info = {
-        "inputs": fingerprint,
-        "input_hash": link_hash,
-        "package_version": package_version(),
-        **timings,
-    }
-    link = reduce_coupled(coupled, decision, frequencies, info)
-    if use_cache:
-        save_reduced_link(link, link_path)
-    return link
+        solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+        timings["factorisation_seconds"] = time.perf_counter() - start
+        if frequencies is None:
+            start = time.perf_counter()
+            frequencies = solver.reference_frequencies()
+            timings["frequency_seconds"] = time.perf_counter() - start
+            cache.write_summary(fe_hash, frequencies)
+            decisions = [decide_modes(modes, frequencies["mounted_hz"][0], f) for f in excitations_hz]
+            keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+            links = [None] * len(decisions)
+        missing = {key: decision for key, decision, link in zip(keys, decisions, links) if link is None}
+        infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
+                 for key in missing]
+        made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos)))
+        for key, link in made.items():
+            cache.save_link(key, link)
+        return tuple(with_decision(link, d, cache_hit=True) if link is not None else with_decision(made[key], d, False)
+                     for link, d, key in zip(links, decisions, keys))

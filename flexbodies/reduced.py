@@ -5,10 +5,11 @@ A :class:`ReducedLink` holds what Exudyn's ``ObjectFFRFreducedOrder`` needs
 invariants) plus what an engineer needs to trust it (frequencies, the mode
 decision and its reason, the inputs and their hash, versions, timings).
 
-The file is a NumPy ``.npz`` archive: one array per quantity and a JSON
-``meta`` record holding the schema name and version, the package version,
-the input hash and a SHA-256 checksum over every array. A file that fails
-any of these checks raises :class:`ReducedLinkFileError`; it is never used.
+The file is an uncompressed NumPy ``.npz`` archive (loading it costs no
+decompression): one array per quantity and a JSON ``meta`` record holding
+the schema name and version, the package version, the input hash (the
+entry's key) and a SHA-256 checksum over every array. A file that fails any
+of these checks raises :class:`ReducedLinkFileError`; it is never used.
 Lengths are in m, masses in kg, frequencies in Hz, stiffness in N/m.
 """
 from __future__ import annotations
@@ -28,7 +29,7 @@ from .selection import ModeDecision
 __all__ = ["ReducedLink", "ReducedLinkFileError", "save_reduced_link", "load_reduced_link", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "mountwb-reduced-link"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 #: Floating-frame invariants, named as Exudyn's ObjectFFRFreducedOrder names them.
 FFRF_KEYS = (
@@ -199,18 +200,24 @@ def save_reduced_link(link: ReducedLink, path) -> Path:
         "checksum": _checksum(arrays),
     }
     with replacing(path) as temporary, open(temporary, "wb") as handle:
-        np.savez_compressed(handle, meta=np.array(json.dumps(meta)), **arrays)
+        np.savez(handle, meta=np.array(json.dumps(meta)), **arrays)
     return path
 
 
-def load_reduced_link(path) -> ReducedLink:
+def load_reduced_link(path, key: str | None = None) -> ReducedLink:
     """Read and verify a reduced-link file.
+
+    Parameters
+    ----------
+    path : str or Path
+    key : str, optional
+        The input hash the file must carry (a cache entry's key).
 
     Raises
     ------
     ReducedLinkFileError
         The file is missing, not an archive, damaged, of another schema or
-        version, or its checksum does not match its contents.
+        version, of another key, or its checksum does not match its contents.
     """
     path = Path(path)
     try:
@@ -230,6 +237,9 @@ def load_reduced_link(path) -> ReducedLink:
         raise ReducedLinkFileError(
             f"{path}: schema version {meta.get('schema_version')}, this package reads version {SCHEMA_VERSION}"
         )
+    stored_key = (meta.get("info") or {}).get("input_hash")
+    if key is not None and stored_key != key:
+        raise ReducedLinkFileError(f"{path}: holds the entry of key {stored_key}, not of {key}")
     if _checksum(arrays) != meta.get("checksum"):
         raise ReducedLinkFileError(f"{path}: checksum mismatch, the file was altered or damaged")
     try:

@@ -14,13 +14,14 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from .craig_bampton import craig_bampton, elastic_modes
+from .craig_bampton import CraigBamptonBasis, elastic_modes, fixed_interface_set, kept_count
 from .frequencies import free_free_frequencies, mounted_frequencies
 from .interfaces import InterfaceCoupling, couple_interfaces
+from .interior import InteriorSolver
 from .reduced import FFRF_KEYS, ReducedLink
 from .selection import ModeDecision
 
-__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "ffrf_invariants"]
+__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions", "ffrf_invariants"]
 
 
 @dataclass(frozen=True)
@@ -93,16 +94,18 @@ def ffrf_invariants(nodes, mass, stiffness, mode_basis, triangles) -> dict:
     return {key: np.asarray(data[key], dtype=float) for key in FFRF_KEYS}
 
 
-def reduce_coupled(coupled: CoupledModel, decision: ModeDecision, frequencies: dict, info: dict) -> ReducedLink:
-    """Craig-Bampton reduction of a coupled link for a resolved mode decision.
+def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeDecision, frequencies: dict,
+                   info: dict) -> ReducedLink:
+    """The reduced link of a Craig-Bampton basis: elastic modes, node-wise basis, floating-frame invariants.
 
     Parameters
     ----------
     coupled : CoupledModel
+    cb : CraigBamptonBasis
+        The static modes and the fixed-interface modes ``decision`` keeps.
     decision : ModeDecision
-        Gives the count or cut-off of fixed-interface modes.
     frequencies : dict
-        Reference frequencies of the coupled model (:func:`reference_frequencies`).
+        Reference frequencies of the coupled model (:func:`reference_frequencies`), Hz.
     info : dict
         JSON-able facts about the inputs, stored with the link; reduction
         timings and sizes are added.
@@ -113,10 +116,6 @@ def reduce_coupled(coupled: CoupledModel, decision: ModeDecision, frequencies: d
     """
     start = time.perf_counter()
     coupling = coupled.coupling
-    cb = craig_bampton(
-        coupled.stiffness, coupled.mass, coupling.boundary,
-        count=decision.count, cutoff_hz=decision.cutoff_hz,
-    )
     modes_q, reduced_hz = elastic_modes(cb, coupled.stiffness, coupled.mass)
     fe = coupled.fe_model
     n_fe = len(fe.nodes)
@@ -134,7 +133,7 @@ def reduce_coupled(coupled: CoupledModel, decision: ModeDecision, frequencies: d
         fe_dof=int(fe.ndof),
         coupled_dof=int(coupling.n_q),
         fe_description=fe.description,
-        reduction_seconds=time.perf_counter() - start,
+        reduction_seconds=info.get("reduction_seconds", 0.0) + time.perf_counter() - start,
     )
     return ReducedLink(
         nodes=nodes,
@@ -148,3 +147,49 @@ def reduce_coupled(coupled: CoupledModel, decision: ModeDecision, frequencies: d
         decision=decision,
         info=info,
     )
+
+
+def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decisions, frequencies: dict, infos) -> list:
+    """Reduce a coupled link for several mode decisions from one factorisation.
+
+    The fixed-interface modes are nested (the lowest ``k`` of one solve), so
+    one eigen-solve up to the highest need of all decisions serves each of
+    them, truncated to what it keeps; the same factorisation gives the
+    static modes.
+
+    Parameters
+    ----------
+    coupled : CoupledModel
+    solver : InteriorSolver
+        The factorisation of ``coupled``'s interior stiffness.
+    decisions : sequence of ModeDecision
+    frequencies : dict
+        Reference frequencies of the coupled model, Hz.
+    infos : sequence of dict
+        What :func:`reduce_coupled` stores with each link.
+
+    Returns
+    -------
+    list of ReducedLink
+        One per decision.
+    """
+    start = time.perf_counter()
+    counts = [d.count for d in decisions if d.count is not None]
+    cutoffs = [d.cutoff_hz for d in decisions if d.count is None]
+    need_count = max(counts, default=0)
+    fixed_hz, fixed = np.zeros(0), np.zeros((solver.n_q, 0))
+    if cutoffs or need_count:
+        fixed_hz, fixed = fixed_interface_set(
+            solver.fixed_interface_modes, len(solver.interior),
+            count=None if cutoffs else need_count, cutoff_hz=max(cutoffs, default=None),
+        )
+        if need_count > len(fixed_hz):
+            fixed_hz, fixed = solver.fixed_interface_modes(need_count)
+    static = solver.static_modes()
+    shared = time.perf_counter() - start
+    links = []
+    for decision, info in zip(decisions, infos):
+        keep = kept_count(fixed_hz, decision.count, decision.cutoff_hz)
+        cb = CraigBamptonBasis(np.hstack([static, fixed[:, :keep]]), solver.masters, fixed_hz[:keep])
+        links.append(reduce_coupled(coupled, cb, decision, frequencies, {**info, "reduction_seconds": shared}))
+    return links

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from flexbodies import STEEL, TITANIUM, LinkGeometry, LinkModel, ReducedLinkFileError, load_reduced_link, reduce_link, save_reduced_link
+from flexbodies.reduced import SCHEMA_VERSION
 
 #: A small, coarse link: these tests are about files, not accuracy.
 SMALL = LinkGeometry(length=0.20, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020, shank_width=0.030, shank_thickness=0.020)
@@ -147,7 +148,41 @@ def test_the_file_holds_what_the_issue_lists(tmp_path):
         names = set(data.files)
     assert {"nodes", "master_nodes", "interface_nodes_0", "interface_nodes_1", "mode_basis",
             "ffrf_massMatrixReduced", "ffrf_stiffnessMatrixReduced", "freq_mounted_hz", "freq_free_free_hz"} <= names
-    assert meta["units"]["length"] == "m" and meta["schema_version"] == 1
+    assert meta["units"]["length"] == "m" and meta["schema_version"] == SCHEMA_VERSION
     assert meta["info"]["input_hash"] == link.input_hash and "package_version" in meta
     assert meta["info"]["inputs"]["material"]["name"] == "steel"
     assert "low-frequency rule met" in meta["decision"]["reason"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["fe-{key}.json", "link-*.npz"], ids=["frequency summary", "reduced link"])
+def test_another_keys_entry_is_recomputed_with_one_warning(tmp_path, caplog, kind):
+    steel, titanium = _model(), _model(material=TITANIUM)
+    dirty = tmp_path / "dirty"
+    reduce_link(steel, 6, cache_dir=dirty)
+    clean = reduce_link(titanium, 6, cache_dir=tmp_path / "clean")
+    reduce_link(titanium, 6, cache_dir=dirty)
+
+    def entry(model):
+        if kind.startswith("fe-"):
+            return dirty / kind.format(key=model.key())
+        (path,) = [p for p in _link_files(dirty) if load_reduced_link(p).info["inputs"] == model.fingerprint()]
+        return path
+
+    target = entry(titanium)
+    # the steel link's entry copied over the titanium link's, as a folder copied between projects might
+    target.write_bytes(entry(steel).read_bytes())
+    with caplog.at_level(logging.WARNING, logger="flexbodies.cache"):
+        again = reduce_link(titanium, 6, cache_dir=dirty)
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    assert len(warnings) == 1 and target.name in warnings[0] and "not of" in warnings[0], warnings
+    assert not again.cache_hit
+    np.testing.assert_allclose(again.frequencies["mounted_hz"], clean.frequencies["mounted_hz"], rtol=1e-12)
+    np.testing.assert_allclose(again.frequencies["reduced_hz"], clean.frequencies["reduced_hz"], rtol=1e-12)
+    np.testing.assert_allclose(again.ffrf["massMatrixReduced"], clean.ffrf["massMatrixReduced"], rtol=1e-9, atol=1e-12)
+    # the copied entry would have been another link: titanium is much lighter than steel
+    assert again.mass < 0.7 * reduce_link(steel, 6, cache_dir=dirty).mass
+    # the entry was replaced by the right one: the next run loads it without a word
+    caplog.clear()
+    assert reduce_link(titanium, 6, cache_dir=dirty).cache_hit
+    assert not [r for r in caplog.records if r.levelno == logging.WARNING]

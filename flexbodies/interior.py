@@ -1,0 +1,149 @@
+"""Every solve a link's reduction needs, from one factorisation of its interior stiffness.
+
+In coupled coordinates ``q = [interior, masters]`` the interior stiffness
+``K_ii`` (every master DOF held) is regular. Its one factorisation serves:
+
+- the static (constraint) modes ``psi = -K_ii^-1 K_ib``;
+- the fixed-interface eigenproblem (``K_ii``, ``M_ii``, shift 0);
+- the mounted eigenproblem (masters pinned, spin held) and the free-free one,
+  whose stiffness borders ``K_ii`` with a few master coordinates ``r``
+  (master motion ``N r``). A solve with the bordered matrix is one ``K_ii``
+  solve plus a small dense one with the condensed boundary stiffness
+  ``S = N^T (K_bb + K_bi psi) N``. The free body is held statically
+  determinate at the first master, and its rigid-body motion is projected
+  out (inertia relief), so the operator's eigenvalues are those of the
+  elastic modes.
+
+Each eigenproblem then runs shift-invert Lanczos on the full coupled model:
+the frequencies are those of the FE model, not of a reduced one.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from .eigen import factorize, lowest_modes, start_vector
+from .frequencies import mounted_constraint_basis
+from .interfaces import rigid_motion_rows
+
+__all__ = ["InteriorSolver"]
+
+
+class InteriorSolver:
+    """One factorisation of a coupled link's interior stiffness, and what it solves.
+
+    Parameters
+    ----------
+    stiffness, mass : scipy.sparse matrix, shape (n_q, n_q)
+        Coupled stiffness (N/m) and mass (kg).
+    coupling : InterfaceCoupling
+        Gives the master DOF (the last coordinates of ``q``) and the bore centres.
+    """
+
+    def __init__(self, stiffness, mass, coupling):
+        K = sp.csr_matrix(stiffness)
+        self.mass = sp.csr_matrix(mass)
+        self.stiffness = K
+        self.coupling = coupling
+        self.masters = np.asarray(coupling.boundary, dtype=int)
+        self.interior = np.setdiff1d(np.arange(K.shape[0]), self.masters)
+        if not np.array_equal(self.masters, np.arange(len(self.interior), K.shape[0])):
+            raise ValueError("the master DOF must be the last coordinates of the coupled model")
+        K_i = K[self.interior]
+        self.K_ii = K_i[:, self.interior].tocsc()
+        self.K_ib = K_i[:, self.masters].toarray()
+        self.M_ii = self.mass[self.interior][:, self.interior].tocsc()
+        self.factor = factorize(self.K_ii)
+        #: Interior part of the static modes, one column per master DOF.
+        self.psi = -self.factor.solve(self.K_ib)
+        K_bb = K[self.masters][:, self.masters].toarray()
+        condensed = K_bb + self.K_ib.T @ self.psi
+        #: Condensed (Guyan) boundary stiffness, symmetrised.
+        self.condensed = 0.5 * (condensed + condensed.T)
+
+    @property
+    def n_q(self) -> int:
+        return self.stiffness.shape[0]
+
+    def reference_frequencies(self) -> dict:
+        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz."""
+        return {"free_free_hz": self.free_free_frequencies(6), "mounted_hz": self.mounted_frequencies(3)}
+
+    def static_modes(self) -> np.ndarray:
+        """Static modes in coupled coordinates, shape (n_q, n_masters): unit value at one master DOF."""
+        vectors = np.zeros((self.n_q, len(self.masters)))
+        vectors[self.interior] = self.psi
+        vectors[self.masters, np.arange(len(self.masters))] = 1.0
+        return vectors
+
+    def fixed_interface_modes(self, count: int):
+        """The lowest ``count`` fixed-interface modes: frequencies (Hz) and mass-normalised shapes in ``q``."""
+        freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, self.factor)
+        vectors = np.zeros((self.n_q, phi.shape[1]))
+        vectors[self.interior] = phi
+        return freqs, vectors
+
+    def _bordered(self, basis: np.ndarray):
+        """Solver of the stiffness with master motion ``basis @ r``, in ``[interior, r]`` coordinates."""
+        n_i = len(self.interior)
+        coupling = self.K_ib @ basis            # K_ib N
+        psi_n = self.psi @ basis                # -K_ii^-1 K_ib N
+        schur = sla.cho_factor(basis.T @ self.condensed @ basis)
+
+        def solve(f):
+            f = np.asarray(f, dtype=float)
+            y = self.factor.solve_plain(f[:n_i])
+            r = sla.cho_solve(schur, f[n_i:] - coupling.T @ y)
+            return np.concatenate([y + psi_n @ r, r])
+
+        return solve
+
+    def _bordered_matrices(self, basis: np.ndarray):
+        """Stiffness and mass in ``[interior, r]`` coordinates with master motion ``basis @ r``."""
+        n_i = len(self.interior)
+        lift = sp.bmat([[sp.identity(n_i, format="csr"), None], [None, sp.csr_matrix(basis)]], format="csr")
+        return (lift.T @ self.stiffness @ lift).tocsr(), (lift.T @ self.mass @ lift).tocsr()
+
+    def mounted_frequencies(self, count: int = 3) -> np.ndarray:
+        """Frequencies with both bore centres pinned and the spin about the link axis held, Hz."""
+        basis = mounted_constraint_basis(self.coupling)
+        K, M = self._bordered_matrices(basis)
+        solve = self._bordered(basis)
+        operator = spla.LinearOperator(K.shape, matvec=solve, dtype=float)
+        lam, _ = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", OPinv=operator, v0=start_vector(K.shape[0]))
+        return np.sort(np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi))
+
+    def _rigid_masters(self) -> np.ndarray:
+        """Master DOF of the six rigid-body motions about the first master, shape (n_masters, 6)."""
+        centres = self.coupling.centres
+        blocks = []
+        for rows in rigid_motion_rows(centres - centres[0]):
+            blocks.append(rows)
+            blocks.append(np.hstack([np.zeros((3, 3)), np.eye(3)]))
+        return np.vstack(blocks)
+
+    def free_free_frequencies(self, count: int = 6) -> np.ndarray:
+        """First elastic frequencies of the free link, Hz (its six rigid-body modes skipped)."""
+        n_i, n_q = len(self.interior), self.n_q
+        held, others = self.masters[:6], self.masters[6:]
+        solve = self._bordered(np.eye(len(self.masters))[:, 6:])  # held at the first master
+        rigid = self.static_modes() @ self._rigid_masters()
+        rigid = rigid @ np.linalg.inv(np.linalg.cholesky(rigid.T @ (self.mass @ rigid))).T
+        mass_rigid = self.mass @ rigid
+
+        def relieved(f):
+            # P^T F P f with P = I - M R R^T: loads balanced by inertia, flexibility with the first master
+            # held, rigid motion removed; the rigid-body modes map to 0 and the elastic ones to 1/lambda
+            f = f - mass_rigid @ (rigid.T @ f)
+            z = solve(np.concatenate([f[self.interior], f[others]]))
+            x = np.zeros(n_q)
+            x[self.interior], x[others] = z[:n_i], z[n_i:]
+            assert not x[held].any()
+            return x - rigid @ (mass_rigid.T @ x)
+
+        operator = spla.LinearOperator((n_q, n_q), matvec=relieved, dtype=float)
+        lam, _ = spla.eigsh(self.stiffness, k=count, M=self.mass, sigma=0.0, which="LM", OPinv=operator,
+                            v0=start_vector(n_q))
+        return np.sort(np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi))
