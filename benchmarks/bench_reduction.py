@@ -21,11 +21,16 @@ serving the reference frequencies, the static modes and one fixed-interface
 eigen-solve for all excitations). It prints the median times of the
 repeats and the largest relative difference of every frequency.
 
+``--warm`` times what a warm run pays per reference link: loading and
+verifying its file (uncompressed, as stored, and the same arrays
+compressed, as before) and a reload from the process's memory.
+
 Run::
 
     python benchmarks/bench_reduction.py                 # 14, 10 and 7 mm
     python benchmarks/bench_reduction.py --sizes 10 5 --repeats 3 --exudyn
     python benchmarks/bench_reduction.py --reference --repeats 3
+    python benchmarks/bench_reduction.py --warm --repeats 5
 """
 from __future__ import annotations
 
@@ -174,6 +179,48 @@ def reference_links(repeats: int) -> None:
     print(f"  speed-up {before_s / now_s:.2f}x; largest relative frequency difference {worst:.1e}")
 
 
+def warm_links(repeats: int) -> None:
+    """Loading the reference mount's reduced links: file as stored, the same compressed, from memory."""
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    import numpy as np
+
+    from flexbodies.cache import LinkCache
+    from flexbodies.link import reduce_link_set
+    from flexbodies.reduced import load_reduced_link
+    from workbook.model.reference import reference_case
+
+    case = reference_case()
+    frequencies_hz = sorted({e.frequency for e in case.excitations})
+    folder = Path(tempfile.mkdtemp(prefix="bench-warm-"))
+    for link in {link.model.key(): link for link in case.links}.values():
+        reduce_link_set(link.model, link.modes, frequencies_hz, cache_dir=folder)
+    files = sorted(folder.glob("link-*.npz"))
+    compressed = []
+    for path in files:
+        with np.load(path) as data:
+            arrays = {key: data[key] for key in data.files}
+        target = folder / f"z{path.name}"
+        np.savez_compressed(target, **arrays)
+        compressed.append(target)
+    store = LinkCache(folder)
+    keys = [path.stem.split("-", 1)[1] for path in files]
+    stored_s, _ = _timed(lambda: [load_reduced_link(path) for path in files], repeats)
+    zipped_s, _ = _timed(lambda: [load_reduced_link(path) for path in compressed], repeats)
+    for key in keys:
+        store.load_link(key)
+    memory_s, _ = _timed(lambda: [store.load_link(key) for key in keys], repeats)
+    size = sum(p.stat().st_size for p in files) / 1e6
+    size_z = sum(p.stat().st_size for p in compressed) / 1e6
+    shutil.rmtree(folder)
+    print(f"Loading the {len(files)} reduced links of the reference mount (both rotors), median of {repeats}")
+    print(f"  uncompressed file (as stored): {stored_s:.3f} s, {size:.1f} MB")
+    print(f"  compressed file (as before):   {zipped_s:.3f} s, {size_z:.1f} MB")
+    print(f"  from the process's memory:     {memory_s:.4f} s")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=float, nargs="+", default=[14.0, 10.0, 7.0], help="element sizes, mm")
@@ -181,8 +228,12 @@ def main(argv=None):
     parser.add_argument("--exudyn", action="store_true", help="also time Exudyn's ComputeHurtyCraigBamptonModes")
     parser.add_argument("--reference", action="store_true",
                         help="cold reduction of the reference mount's links, before and now")
+    parser.add_argument("--warm", action="store_true", help="loading the reference mount's reduced links")
     parser.add_argument("--one", type=float, help=argparse.SUPPRESS)  # a single size, in this process
     args = parser.parse_args(argv)
+    if args.warm:
+        warm_links(args.repeats)
+        return
     if args.reference:
         reference_links(args.repeats)
         return

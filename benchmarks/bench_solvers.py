@@ -18,8 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import statistics
-import time
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 os.environ.setdefault("OMP_NUM_THREADS", "1")
@@ -28,6 +26,7 @@ os.environ.setdefault("MKL_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 import scipy.sparse as sp  # noqa: E402
 import scipy.sparse.linalg as spla  # noqa: E402
+from bench_reduction import _timed  # noqa: E402  (this folder is on the path of a script run from it)
 
 
 def _superlu(ordering):
@@ -80,15 +79,6 @@ SOLVERS = {
 }
 
 
-def _median(function, repeats):
-    times, result = [], None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = function()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times), result
-
-
 def link_matrices():
     """(name, interior stiffness) of each unique link of the reference case."""
     from flexbodies.link import build_fe_model
@@ -118,13 +108,13 @@ def main(argv=None):
         for solver, make in SOLVERS.items():
             row = {"link": f"{name} ({A.shape[0]} DOF)", "solver": solver}
             try:
-                row["factorise [s]"], solve = _median(lambda: make(A), args.repeats)
+                row["factorise [s]"], solve = _timed(lambda: make(A), args.repeats)
             except Exception as error:  # an optional solver that is missing or broken here
                 row["note"] = f"{type(error).__name__}: {str(error).splitlines()[0][:60]}"
                 rows.append(row)
                 continue
-            row["1 solve [s]"], _ = _median(lambda: solve(rhs[:, 0].copy()), args.repeats)
-            row["12 solves [s]"], X = _median(lambda: solve(rhs), args.repeats)
+            row["1 solve [s]"], _ = _timed(lambda: solve(rhs[:, 0].copy()), args.repeats)
+            row["12 solves [s]"], X = _timed(lambda: solve(rhs), args.repeats)
             row["residual"] = float(np.abs(A @ X - rhs).max() / np.abs(rhs).max())
             rows.append(row)
     table = pd.DataFrame(rows).set_index(["link", "solver"])

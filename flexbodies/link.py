@@ -243,7 +243,7 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         coupled = couple(fe, model.interface)
         start = time.perf_counter()
         solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
-        timings["factorisation_seconds"] = time.perf_counter() - start
+        timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
         if frequencies is None:
             start = time.perf_counter()
             frequencies = solver.reference_frequencies()

@@ -191,5 +191,6 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     for decision, info in zip(decisions, infos):
         keep = kept_count(fixed_hz, decision.count, decision.cutoff_hz)
         cb = CraigBamptonBasis(np.hstack([static, fixed[:, :keep]]), solver.masters, fixed_hz[:keep])
-        links.append(reduce_coupled(coupled, cb, decision, frequencies, {**info, "reduction_seconds": shared}))
+        links.append(reduce_coupled(coupled, cb, decision, frequencies,
+                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared}))
     return links
