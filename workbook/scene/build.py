@@ -301,11 +301,14 @@ def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | Non
 
 def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None,
                  progress: Callable[[int], None] | None = None) -> dict:
-    """Reduce every link of *case* (cached on disk by :mod:`flexbodies`).
+    """Reduce every link of *case* (cached on disk and in memory by :mod:`flexbodies`).
 
     Flexible links keep the modes their ``modes`` field asks for, judged at the
     excitation's frequency (default: the case's highest); rigid links need
-    only their mass properties and take the static reduction.
+    only their mass properties and take the static reduction. Each link is
+    reduced once for every excitation of the case (fixed-interface modes are
+    nested: one eigen-solve up to the highest need, truncated per
+    excitation), so the other excitations' runs load it.
 
     Parameters
     ----------
@@ -318,12 +321,14 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None
     -------
     dict of str to flexbodies.ReducedLink
     """
-    from flexbodies import reduce_link
+    from flexbodies import reduce_link_set
 
     frequency = _reduction_frequency(case, excitation)
+    frequencies = sorted({e.frequency for e in case.excitations} | {frequency})
     reduced = {}
     for link in case.links:
-        reduced[link.name] = reduce_link(link.model, modes=case.link_modes(link.name), excitation_hz=frequency)
+        per_frequency = reduce_link_set(link.model, case.link_modes(link.name), frequencies)
+        reduced[link.name] = per_frequency[frequencies.index(frequency)]
         if progress is not None:
             progress(len(reduced))
     return reduced
