@@ -370,6 +370,6 @@ def test_the_case_sheet_chooses_the_analysis_method(tmp_path):
     from workbook.excel.reader import read_workbook
 
     path = copy_reference(tmp_path)
-    assert read_workbook(path).case.analysis.method == "time"
-    set_cells(path, {("Case", "method", 3): "auto"})
     assert read_workbook(path).case.analysis.method == "auto"
+    set_cells(path, {("Case", "method", 3): "time"})
+    assert read_workbook(path).case.analysis.method == "time"
