@@ -37,7 +37,7 @@ def copy_reference(folder: Path, name: str = "case.xlsx") -> Path:
 
 #: Short settings that make a run take about a second (answers within tens of %).
 CHEAP_SETTINGS = {"steps per period": 20, "ramp periods": 2, "settle time": 0.05, "measured periods": 4,
-                  "steady tolerance": 0.5}
+                  "steady tolerance": 0.5, "method": "time"}
 
 
 def make_cheap(path: Path, sweep_points: int = 4) -> None:

@@ -428,9 +428,9 @@ def test_the_case_sheet_chooses_the_analysis_method(tmp_path):
     from workbook.excel.reader import read_workbook
 
     path = copy_reference(tmp_path)
-    assert read_workbook(path).case.analysis.method == "time"
-    set_cells(path, {("Case", "method", 3): "auto"})
     assert read_workbook(path).case.analysis.method == "auto"
+    set_cells(path, {("Case", "method", 3): "time"})
+    assert read_workbook(path).case.analysis.method == "time"
 
 
 @pytest.mark.parametrize("text, mass", [("3568", 3568.0), ("3 568", 3568.0), ("3568,5", 3568.5), ("3.568,5", 3568.5),

@@ -30,7 +30,7 @@ def _with_method(case, method):
 
 @pytest.mark.slow
 def test_frequency_domain_matches_time_domain_on_the_reference_mount(reference):
-    time_result = run_case(reference)
+    time_result = run_case(_with_method(reference, "time"))
     frequency_result = run_case(_with_method(reference, "frequency"))
     for name in ("LP rotor", "HP rotor"):
         td, fd = time_result.run(name), frequency_result.run(name)
@@ -76,6 +76,32 @@ def test_auto_takes_the_time_domain_when_clearance_makes_the_scene_nonlinear():
     assert choose_method(no_gaps).method == "frequency"
     forced = dataclasses.replace(gapped, analysis=AnalysisSettings(method="frequency"))
     assert choose_method(forced).method == "frequency" and "approximation" in choose_method(forced).reason
+
+
+def test_auto_is_the_default_and_a_linear_sweep_takes_one_linearisation_whatever_is_asked():
+    """The default answers a linear scene in the frequency domain and says so on the card and in the JSON; a
+    sweep asked for in the time domain on a linear scene still takes one linearisation (its T is the closed
+    form, which a time run per point would give only to the time-step error)."""
+    import json
+
+    case = sdof_case((3.0,))
+    assert AnalysisSettings().method == "auto"
+    result = run_case(dataclasses.replace(case, analysis=AnalysisSettings()))
+    card = result.model_cards["r = 3"]
+    assert card.method == "frequency" and card.method_reason.startswith("auto: the scene is linear")
+    assert f"Method: frequency domain ({card.method_reason})" in card.to_text()
+    answer = json.loads(result.to_json())["runs"][0]["model_card"]["method"]
+    assert answer == {"analysis": "frequency domain", "reason": card.method_reason}
+    assert result.run("r = 3").transmissibility[2] == pytest.approx(closed_form(3.0), rel=1e-6)
+    sweep = Sweep.band("sweep", case.excitations[0], 0.5 * NATURAL_HZ, 3 * NATURAL_HZ, 5)
+    timed = dataclasses.replace(case, excitations=(sweep,), analysis=AnalysisSettings(method="time"))
+    swept = run_case(timed)
+    assert {c.method for c in swept.model_cards.values()} == {"frequency"}
+    assert all("a sweep on a linear scene" in c.method_reason for c in swept.model_cards.values())
+    for run in swept.runs:
+        assert run.transmissibility[2] == pytest.approx(closed_form(run.frequency_hz / NATURAL_HZ), rel=1e-6)
+    gapped = dataclasses.replace(timed, hinges=tuple(dataclasses.replace(h, radial_clearance=1e-4) for h in case.hinges))
+    assert choose_method(gapped, sweep=True).method == "time"
 
 
 def _spectral_peak(time, signal):

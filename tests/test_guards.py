@@ -73,7 +73,7 @@ def test_guard_settings_are_validated(field, value):
 def test_the_command_line_reports_an_exhausted_time_budget_as_numerical_trouble(cache_dir, capsys):
     from workbook.cli.main import main
 
-    assert main(["run", "--rigid", "--no-progress", "--time-budget", "0.01"]) == 1
+    assert main(["run", "--rigid", "--method", "time", "--no-progress", "--time-budget", "0.01"]) == 1
     error = capsys.readouterr().err
     assert "mountwb run: numerical trouble: case 'reference mount', run 'LP rotor': stopped after" in error
     assert "time budget 0.01 s" in error

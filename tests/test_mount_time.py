@@ -18,7 +18,7 @@ matplotlib.use("Agg")
 
 @pytest.fixture(scope="module")
 def reference(coarse_reference):
-    return coarse_reference
+    return dataclasses.replace(coarse_reference, analysis=dataclasses.replace(coarse_reference.analysis, method="time"))
 
 
 @pytest.fixture(scope="module")

@@ -66,6 +66,10 @@ class ModelCard:
         Frequency (Hz), damping ratio and description of each mounted mode.
     timings : dict of str to float
         Wall time per stage, s.
+    method : str
+        The analysis that answered: ``"time"`` or ``"frequency"``.
+    method_reason : str
+        Why that analysis answered.
     """
 
     case_name: str
@@ -75,6 +79,8 @@ class ModelCard:
     solver: dict
     mounted_modes: list
     timings: dict = field(default_factory=dict)
+    method: str = ""
+    method_reason: str = ""
 
     @property
     def total_dof(self) -> int:
@@ -82,7 +88,9 @@ class ModelCard:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready data."""
-        return {"case": self.case_name, "run": self.run_name, "total_dof": self.total_dof,
+        return {"case": self.case_name, "run": self.run_name,
+                "method": {"analysis": f"{self.method} domain", "reason": self.method_reason},
+                "total_dof": self.total_dof,
                 "bodies": [asdict(b) for b in self.bodies], "effects": [asdict(e) for e in self.effects],
                 "solver": dict(self.solver),
                 "mounted_modes": [{"frequency_hz": f, "damping_ratio": z, "description": d}
@@ -92,6 +100,7 @@ class ModelCard:
     def to_text(self) -> str:
         """A plain-text card for the console."""
         lines = [f"Model card: {self.case_name} / {self.run_name}", "",
+                 f"Method: {self.method} domain ({self.method_reason})", "",
                  f"Bodies ({self.total_dof} DOF):"]
         width = max(len(b.name) for b in self.bodies)
         for b in self.bodies:
@@ -111,7 +120,7 @@ class ModelCard:
         return "\n".join(lines)
 
 
-def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, float], method=None,
+def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, float], method,
                solver: dict | None = None) -> ModelCard:
     """Fill the model card of a run.
 
@@ -123,8 +132,8 @@ def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, fl
     plan : workbook.solve.time_domain.TimePlan or None
         The time-domain plan (None for a frequency-domain run).
     timings : dict of str to float
-    method : workbook.solve.method.MethodChoice, optional
-        The analysis method and why (default: the time domain, no reason recorded).
+    method : workbook.solve.method.MethodChoice
+        The analysis method and why.
     solver : dict, optional
         Solver settings to record instead of those of *plan*.
     """
@@ -146,11 +155,12 @@ def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, fl
                                 "test-rig transducer under a pylon pin: moving half on its spring to ground"))
     card = ModelCard(case.name, scene.excitation.name, bodies, _effects(scene, preload, method),
                      _solver(scene, plan) if solver is None else dict(solver),
-                     [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings))
+                     [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings),
+                     method.method, method.reason)
     return card
 
 
-def _effects(scene, preload, method=None) -> list[EffectEntry]:
+def _effects(scene, preload, method) -> list[EffectEntry]:
     case, effects = scene.case, scene.case.effects
     flexible = [link.name for link in case.links if case.link_is_flexible(link.name)]
     damped_links = [link.name for link in case.links
@@ -179,16 +189,11 @@ def _effects(scene, preload, method=None) -> list[EffectEntry]:
         _rig_sensors(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
-    if method is None:
-        entries += [EffectEntry("time domain", True, time_detail),
-                    EffectEntry("frequency domain", False, "not used")]
-    else:
-        frequency_detail = "harmonic solution of the scene linearised about the preload"
-        entries += [EffectEntry("time domain", method.method == "time",
-                                f"{time_detail}: {method.reason}" if method.method == "time" else "not used"),
-                    EffectEntry("frequency domain", method.method == "frequency",
-                                f"{frequency_detail}: {method.reason}" if method.method == "frequency"
-                                else "not used")]
+    frequency_detail = "harmonic solution of the scene linearised about the preload"
+    entries += [EffectEntry("time domain", method.method == "time",
+                            f"{time_detail}: {method.reason}" if method.method == "time" else "not used"),
+                EffectEntry("frequency domain", method.method == "frequency",
+                            f"{frequency_detail}: {method.reason}" if method.method == "frequency" else "not used")]
     return entries
 
 

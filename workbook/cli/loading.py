@@ -42,7 +42,7 @@ def _json_case(path: str) -> Case:
 
 
 def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = False,
-              time_budget: float | None = None) -> Case:
+              time_budget: float | None = None, method: str | None = None) -> Case:
     """The case a command works on.
 
     Parameters
@@ -56,6 +56,8 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         Make every link rigid.
     time_budget : float or None
         Wall-time budget of one run, s (None: as the case says).
+    method : {"auto", "time", "frequency"} or None
+        Analysis method (None: as the case says).
 
     Raises
     ------
@@ -75,6 +77,8 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         case = reference_case() if path is None else _json_case(path)
     if time_budget is not None:
         case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, time_budget=time_budget))
+    if method is not None:
+        case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method=method))
     return case.with_rigid_links() if rigid else case
 
 

@@ -1,4 +1,4 @@
-"""``mountwb run [CASE] [--json] [--rigid] [--time-budget S]``: run a case.
+"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--time-budget S]``: run a case.
 
 Prints the three-way isolation-efficiency table, the dB table and the model
 card of each run, or the answers as JSON. A case workbook runs the rows of
@@ -11,6 +11,7 @@ from typing import Callable
 
 from workbook.cli import workbooks
 from workbook.cli.loading import is_workbook, load_case, progress_factory
+from workbook.model.case import ANALYSIS_METHODS
 
 __all__ = ["arguments"]
 
@@ -19,6 +20,10 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     parser.add_argument("--json", action="store_true", help="print the answers as JSON")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+    parser.add_argument("--method", choices=ANALYSIS_METHODS,
+                        help="analysis: auto (frequency domain for a linear scene, time domain when a clearance "
+                             "law is built), time or frequency; default: as the case says (auto unless it says "
+                             "otherwise)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--time-budget", type=float, metavar="SECONDS",
                         help="wall time one run may take before it stops with an estimate of the time it needs")
@@ -31,7 +36,7 @@ def run(args) -> int:
 
     if is_workbook(args.case):
         return workbooks.run_workbook(args)
-    case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget)
+    case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget, method=args.method)
     result = run_case(case, progress=None if args.no_progress else progress_factory())
     if args.json:
         print(result.to_json(indent=2))

@@ -102,9 +102,10 @@ def run_workbook(args) -> int:
     from workbook.excel.report import write_report
     from workbook.excel.writer import write_results
 
-    if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None):
-        print("mountwb run: --json, --rigid and --time-budget are for JSON cases; a workbook sets its runs' "
-              "fidelity in its Runs sheet and its time budget in its Case sheet", file=sys.stderr)
+    if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None) \
+            or getattr(args, "method", None):
+        print("mountwb run: --json, --rigid, --method and --time-budget are for JSON cases; a workbook sets its "
+              "runs' fidelity in its Runs sheet and its method and time budget in its Case sheet", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         book = read_workbook(args.case)

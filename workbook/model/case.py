@@ -699,11 +699,13 @@ class AnalysisSettings:
     equilibrium_tolerance : float
         Largest relative mismatch between the pylon-side hinge forces and the
         applied static loads.
-    method : {"time", "frequency", "auto"}
-        The analysis answering the case: time domain, frequency domain
-        (harmonic solution of the scene linearised about the preload), or
-        ``"auto"`` (frequency domain when no clearance law makes the scene
-        nonlinear, see :mod:`workbook.solve.method`).
+    method : {"auto", "time", "frequency"}
+        The analysis answering the case: ``"auto"`` (the default: frequency
+        domain when the scene is linear, time domain when a clearance law
+        makes it nonlinear, see :mod:`workbook.solve.method`), time domain,
+        or frequency domain (harmonic solution of the scene linearised about
+        the preload). A sweep on a linear scene always takes one
+        linearisation for all its frequencies.
     step_halvings : int
         When Newton's method fails in a segment of the time integration, the
         segment is run again with the step halved, at most this many times
@@ -725,7 +727,7 @@ class AnalysisSettings:
     spectral_radius: float = 0.9
     newton_tolerance: float = 1e-6
     equilibrium_tolerance: float = 1e-6
-    method: str = "time"
+    method: str = "auto"
     step_halvings: int = 4
     time_budget: float | None = None
     divergence_displacement: float = 0.05

@@ -2,13 +2,17 @@
 
 ``AnalysisSettings.method``:
 
-- ``"auto"``: the frequency domain when the scene is linear (no hinge
-  clearance law is built), since the harmonic solution of the linearised
-  scene is then exact and costs no transient; the time domain when a
-  clearance law makes the scene nonlinear;
+- ``"auto"`` (the default): the frequency domain when the scene is linear
+  (no hinge clearance law is built), since the harmonic solution of the
+  linearised scene is then exact and costs no transient; the time domain
+  when a clearance law makes the scene nonlinear;
 - ``"time"`` or ``"frequency"``: forced by the user. Forcing the frequency
   domain on a scene with clearance linearises the clearance laws about the
   preloaded state (gaps frozen open or closed): the card says so.
+
+A sweep on a linear scene always takes the frequency domain, whatever the
+case asks: one linearisation serves every frequency, where the time domain
+would run every point from rest.
 """
 from __future__ import annotations
 
@@ -45,12 +49,23 @@ def _clearance_hinges(case: Case) -> list[str]:
     return [h.name for h in case.hinges if h.radial_clearance > 0]
 
 
-def choose_method(case: Case) -> MethodChoice:
-    """Choose the analysis method of *case* from ``case.analysis.method``."""
+def choose_method(case: Case, *, sweep: bool = False) -> MethodChoice:
+    """Choose the analysis method of *case* from ``case.analysis.method``.
+
+    Parameters
+    ----------
+    case : Case
+    sweep : bool
+        The choice is for a sweep: on a linear scene the frequency domain
+        answers it whatever the case asks.
+    """
     asked = case.analysis.method
     gaps = _clearance_hinges(case)
     nonlinear = (f"hinge clearance on {', '.join(repr(g) for g in gaps)} makes the scene nonlinear"
                  if gaps else "")
+    if sweep and not gaps:
+        return MethodChoice(FREQUENCY, f"a sweep on a linear scene (no hinge clearance): one linearisation "
+                            f"serves every frequency (the case asks for method {asked!r})")
     if asked == TIME:
         return MethodChoice(TIME, "the case asks for it (method 'time')"
                             + (f"; {nonlinear}" if gaps else "; the scene is linear, so the frequency domain "

@@ -30,7 +30,7 @@ from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
 from workbook.solve.guards import check_undamped_resonance, run_label
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
-from workbook.solve.method import FREQUENCY, MethodChoice, choose_method
+from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
 from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
 from workbook.solve.preload import Preload, solve_preload
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
@@ -138,7 +138,8 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
     progress : callable, optional
         Progress factory for the long stages (see :data:`ProgressFactory`).
     method : MethodChoice, optional
-        Why the time domain answers this run, for the model card.
+        Why the time domain answers this run, for the model card (default:
+        asked for directly).
 
     Returns
     -------
@@ -153,6 +154,7 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         an undamped mode, a failed or diverging integration, or an exhausted
         time budget; the message says when and why.
     """
+    method = method or MethodChoice(TIME, "asked for directly (run_excitation)")
     prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
@@ -244,30 +246,31 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
         Progress factory for the long stages (see :data:`ProgressFactory`).
     method : MethodChoice, optional
         The method and why (default: :func:`workbook.solve.method.choose_method`
-        of the case).
+        of the case, per excitation: a sweep on a linear scene always takes
+        the frequency domain).
 
     Returns
     -------
     MountResult
     """
-    method = method or choose_method(case)
     runs, cards, preloads = [], {}, {}
     for item in case.excitations:
         points = item.expand() if isinstance(item, Sweep) else (item,)
-        if method.method == FREQUENCY:
+        chosen = method or choose_method(case, sweep=isinstance(item, Sweep))
+        if chosen.method == FREQUENCY:
             prepared = prepare(case, points[0], reduce_for=points[-1], progress=progress)
-            item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, method,
+            item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
                                                                      progress=progress)
         else:
             item_runs, item_cards, item_preloads = [], {}, {}
             for excitation in points:
                 result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress,
-                                                       method=method)
+                                                       method=chosen)
                 item_runs.append(result)
                 item_cards[result.name] = card
                 item_preloads[result.name] = preload
         runs += item_runs
         cards.update(item_cards)
         preloads.update(item_preloads)
-    log.info("%s: %d %s runs", case.name, len(runs), method.label)
+    log.info("%s: %d runs", case.name, len(runs))
     return MountResult(case.name, runs, cards, preloads)
