@@ -19,10 +19,10 @@ from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
 from flexbodies.meshing import LinkMesh
 from workbook.errors import MechanismError, ResonanceError, SimulationError
-from workbook.model.case import HarmonicForce
-from workbook.model.reference import HINGE_DAMPING_TIME, LP_ROTOR, reference_case
+from workbook.model.case import HarmonicForce, Rotor
+from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
 from workbook.solve.frequency_pipeline import prepare, run_case_frequency
-from workbook.solve.modes import mounted_modes
+from workbook.solve.modes import FREE_FREQUENCY_HZ, modes_of, mounted_modes
 from workbook.solve.pipeline import run_excitation
 
 
@@ -204,3 +204,20 @@ def test_an_unrestrained_mechanism_stops_before_any_integration(rigid, run):
     with pytest.raises(MechanismError, match=r"free motion.*heading translation \(x\)") as caught:
         run(without)
     assert isinstance(caught.value, SimulationError)
+
+
+# --- 9. a very fast heavy rotor -----------------------------------------------------------------------------
+
+
+def test_a_heavy_fast_rotor_is_no_mechanism_and_keeps_the_stiffness_determinant(rigid):
+    """Ip = 1e5 kg m^2 at 248.5 Hz drives the backward whirl towards 0 Hz;
+    nothing is free, so the mechanism check (on K and M alone) passes. The
+    gyroscopic coupling cannot change det(K) / det(M), the product of the
+    squared natural frequencies: it must be the same with and without it."""
+    heavy = dataclasses.replace(rigid, rotors=(Rotor("heavy", polar_inertia=1e5, frequency_hz=248.5),),
+                                effects=dataclasses.replace(rigid.effects, gyroscopics=True))
+    prepared = prepare(heavy, HP_ROTOR)
+    whirl = [m.omega_squared for m in prepared.modes]
+    still = [m.omega_squared for m in modes_of(prepared.model.linearization, gyroscopic=False)]
+    assert min(m.frequency_hz for m in prepared.modes) < FREE_FREQUENCY_HZ < still[0]
+    assert np.sum(np.log(whirl)) == pytest.approx(np.sum(np.log(still)), rel=1e-6)

@@ -35,13 +35,13 @@ from typing import Any, Callable, Union
 
 import numpy as np
 
-from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, PointForce, PointMoment, SingleFrequencyExcitation
+from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, SingleFrequencyExcitation
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "link_is_flexible", "rig_sensors_built", "TRANSDUCER_PREFIX"]
+           "link_is_flexible", "marker_bodies", "rig_sensors_built", "TRANSDUCER_PREFIX"]
 
 log = logging.getLogger(__name__)
 
@@ -291,6 +291,12 @@ class Scene:
                 for name, items in self.force_channels.items()}
 
 
+def marker_bodies(hinge: Hinge) -> tuple[str, str]:
+    """The bodies on a hinge connector's markers 0 and 1: the pylon first
+    when it is one of them, else ``(body_a, body_b)``."""
+    return hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
+
+
 def link_is_flexible(case: Case, name: str) -> bool:
     """True if link *name* is built as a flexible body in *case*."""
     return case.effects.flexible_links and case.link_map[name].flexible
@@ -413,7 +419,7 @@ def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] =
     clearance_functions = {}
     hinges = {}
     for hinge in case.hinges:
-        first, second = hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
+        first, second = marker_bodies(hinge)
         markers = (marker(first, hinge.position), marker(second, hinge.position))
         damping = hinge.damping if case.effects.hinge_damping else 0.0
         clearance = case.effects.clearance and hinge.radial_clearance > 0
