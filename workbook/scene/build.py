@@ -22,6 +22,10 @@ rig measures). Hinges and transducers are the scene's *force channels*
 (:attr:`Scene.force_channels`), each with a force sensor;
 :attr:`Scene.pylon_channels` names those summed into the pylon force.
 
+Every Exudyn item is named within its kind (:func:`exudyn_name`, e.g.
+``"hinge: front-up-left"``), so the case's names never collide with the
+scene's own items.
+
 For Exudyn users, :func:`build_scene` is the entry point: it returns the
 ``mbs`` with every item number, ready to extend and to solve with Exudyn's
 own solvers (see ``docs/example_exudyn_script.py``).
@@ -41,7 +45,7 @@ from workbook.scene.hinge_law import exudyn_clearance_function
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "link_is_flexible", "marker_bodies", "rig_sensors_built", "TRANSDUCER_PREFIX"]
+           "exudyn_name", "link_is_flexible", "marker_bodies", "rig_sensors_built", "TRANSDUCER_PREFIX"]
 
 log = logging.getLogger(__name__)
 
@@ -291,6 +295,18 @@ class Scene:
                 for name, items in self.force_channels.items()}
 
 
+def exudyn_name(kind: str, name: str) -> str:
+    """The Exudyn name of a scene item: ``"KIND: NAME"``.
+
+    Every item is named within its kind (``"hinge"``, ``"link"``,
+    ``"static load"``, ``"excitation"``, ``"rig"``, and ``"scene"`` for the
+    scene's own items such as the engine), so a user's name can never clash
+    with the scene's own or with another kind's; within a kind,
+    :class:`~workbook.model.case.Case` keeps the names unique.
+    """
+    return f"{kind}: {name}"
+
+
 def marker_bodies(hinge: Hinge) -> tuple[str, str]:
     """The bodies on a hinge connector's markers 0 and 1: the pylon first
     when it is one of them, else ``(body_a, body_b)``."""
@@ -400,7 +416,7 @@ def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] =
             mbs, reduced[link.name], link.end_a, link.end_b,
             flexible=link_is_flexible(case, link.name), bore_axis=link.bore_axis,
             stiffness_damping=link.stiffness_damping if damping else 0.0,
-            mass_damping=link.mass_damping if damping else 0.0, name=link.name, **optional)
+            mass_damping=link.mass_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
 
     transducers = _add_transducers(mbs, case, ground) if rig_sensors_built(case) else {}
 
@@ -425,7 +441,7 @@ def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] =
         clearance = case.effects.clearance and hinge.radial_clearance > 0
         stiffness = hinge.gap_contact_stiffness if clearance else hinge.stiffness
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=hinge.name, markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
+            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
             visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         law = None
         if clearance:
@@ -435,7 +451,7 @@ def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] =
             law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
             mbs.SetObjectParameter(connector, "springForceUserFunction", law)
         sensor = mbs.AddSensor(eii.SensorObject(
-            name=f"force {hinge.name}", objectNumber=connector, storeInternal=True, writeToFile=False,
+            name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,
             outputVariableType=exu.OutputVariableType.Force))
         hinges[hinge.name] = HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
 
@@ -447,7 +463,7 @@ def build_scene(case: Case, excitation: Union[SingleFrequencyExcitation, None] =
         signal = ExcitationSignal.of(excitation, case.analysis.ramp_periods)
         point = mbs.AddMarker(eii.MarkerBodyPosition(
             bodyNumber=engine.body, localPosition=list(np.subtract(excitation.point, case.engine.center_of_mass))))
-        load = mbs.AddLoad(eii.LoadForceVector(name=excitation.name, markerNumber=point, loadVector=[0.0] * 3))
+        load = mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", excitation.name), markerNumber=point, loadVector=[0.0] * 3))
         function = CreateSymbolicUserFunction(mbs, signal.exudyn_user_function(), "loadVectorUserFunction", load)
         mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
         excitation_items = ExcitationItems(excitation.name, point, load, signal, function)
@@ -485,17 +501,18 @@ def _add_transducers(mbs, case: Case, ground: int) -> dict[str, TransducerItems]
     transducers = {}
     for position, carried in pins:
         name = TRANSDUCER_PREFIX + " + ".join(carried)
-        node = mbs.AddNode(eii.NodePoint(name=name, referenceCoordinates=list(position),
+        node = mbs.AddNode(eii.NodePoint(name=exudyn_name("rig", name), referenceCoordinates=list(position),
                                          visualization=eii.VNodePoint(show=False)))
-        body = mbs.AddObject(eii.ObjectMassPoint(name=f"{name} mass", mass=rig.mass, nodeNumber=node,
+        body = mbs.AddObject(eii.ObjectMassPoint(name=exudyn_name("rig", f"{name} mass"), mass=rig.mass, nodeNumber=node,
                                                  visualization=eii.VObjectMassPoint(show=False)))
         markers = (mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=ground, localPosition=list(position))),
                    mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=name, markerNumbers=list(markers), stiffness=list(rig.stiffness), damping=list(rig.damping),
+            name=exudyn_name("rig", name), markerNumbers=list(markers), stiffness=list(rig.stiffness),
+            damping=list(rig.damping),
             visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         sensor = mbs.AddSensor(eii.SensorObject(
-            name=f"force {name}", objectNumber=connector, storeInternal=True, writeToFile=False,
+            name=exudyn_name("rig force", name), objectNumber=connector, storeInternal=True, writeToFile=False,
             outputVariableType=exu.OutputVariableType.Force))
         transducers[name] = TransducerItems(node, body, connector, sensor, markers, position, tuple(carried))
     return transducers
@@ -507,10 +524,10 @@ def _add_engine(mbs, case: Case) -> EngineItems:
     eii = exu.itemInterface
     inertia = case.engine.inertia_matrix
     node = mbs.AddNode(eii.NodeRigidBodyRxyz(
-        name="engine", referenceCoordinates=list(case.engine.center_of_mass) + [0.0, 0.0, 0.0],
+        name=exudyn_name("scene", "engine"), referenceCoordinates=list(case.engine.center_of_mass) + [0.0, 0.0, 0.0],
         visualization=eii.VNodeRigidBodyRxyz(show=False)))
     body = mbs.AddObject(eii.ObjectRigidBody(
-        name="engine", nodeNumber=node, mass=case.engine.mass,
+        name=exudyn_name("scene", "engine"), nodeNumber=node, mass=case.engine.mass,
         inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[1, 2], inertia[0, 2], inertia[0, 1]],
         visualization=eii.VObjectRigidBody(show=False)))
     marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
@@ -527,10 +544,11 @@ def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict
         if isinstance(load, PointForce):
             local = np.subtract(load.point, case.engine.center_of_mass)
             point = mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=engine.body, localPosition=list(local)))
-            loads[load.name] = [mbs.AddLoad(eii.LoadForceVector(name=load.name, markerNumber=point,
+            loads[load.name] = [mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("static load", load.name), markerNumber=point,
                                                                loadVector=list(load.force)))]
         elif isinstance(load, PointMoment):
-            loads[load.name] = [mbs.AddLoad(eii.LoadTorqueVector(name=load.name, markerNumber=engine.marker_rigid,
+            loads[load.name] = [mbs.AddLoad(eii.LoadTorqueVector(name=exudyn_name("static load", load.name),
+                                                                markerNumber=engine.marker_rigid,
                                                                 loadVector=list(load.moment)))]
         else:
             bodies = [engine.body] + [link.body for link in links.values()]
@@ -606,7 +624,7 @@ def _add_gyroscopics(mbs, case: Case, engine: EngineItems) -> GyroscopicItems:
 
     eii = exu.itemInterface
     momentum = sum(rotor.angular_momentum for rotor in case.rotors)
-    item = mbs.AddObject(eii.ObjectGenericODE2(name="rotor gyroscopics", nodeNumbers=[engine.node],
+    item = mbs.AddObject(eii.ObjectGenericODE2(name=exudyn_name("scene", "rotor gyroscopics"), nodeNumbers=[engine.node],
                                                massMatrix=np.zeros((6, 6)),
                                                visualization=eii.VObjectGenericODE2(show=False)))
     function = CreateSymbolicUserFunction(mbs, exudyn_gyroscopic_function(momentum), "forceUserFunction", item)
