@@ -21,7 +21,8 @@ from flexbodies.meshing import LinkMesh
 from workbook.errors import MechanismError, ResonanceError, SimulationError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
-from workbook.solve.frequency_pipeline import prepare, run_case_frequency
+from workbook.solve.frequency_pipeline import prepare, results_of, run_case_frequency
+from workbook.solve.method import choose_method
 from workbook.solve.modes import FREE_FREQUENCY_HZ, modes_of, mounted_modes
 from workbook.solve.pipeline import run_excitation
 
@@ -221,3 +222,26 @@ def test_a_heavy_fast_rotor_is_no_mechanism_and_keeps_the_stiffness_determinant(
     still = [m.omega_squared for m in modes_of(prepared.model.linearization, gyroscopic=False)]
     assert min(m.frequency_hz for m in prepared.modes) < FREE_FREQUENCY_HZ < still[0]
     assert np.sum(np.log(whirl)) == pytest.approx(np.sum(np.log(still)), rel=1e-6)
+
+
+# --- 10. an undamped link mode -------------------------------------------------------------------------------
+
+
+def test_an_excitation_on_an_undamped_link_mode_is_refused_naming_the_links(cache_dir):
+    """Hinge and link damping off, flexible links: the thrust rods' own
+    bending modes (engine still) are undamped. On one of them the harmonic
+    matrix is singular to round-off (T of 1e8 was reported before);
+    1 % beside it the answer is finite and bounded by the undamped modal
+    amplification."""
+    case = reference_case()
+    bare = dataclasses.replace(case, effects=dataclasses.replace(case.effects, hinge_damping=False,
+                                                                 link_damping=False))
+    prepared = prepare(bare, LP_ROTOR, reduce_for=HP_ROTOR)
+    rod = next(m for m in prepared.modes if m.engine_share < 0.01 and m.body_shares["thrust-left"] > 0.3)
+    on_mode = dataclasses.replace(LP_ROTOR, frequency_hz=rod.frequency_hz)
+    with pytest.raises(ResonanceError, match=r"undamped mode at [\d.]+ Hz \(motion of 'thrust-(left|right)'.*"
+                                             r"with the engine still"):
+        results_of(bare, prepared, (on_mode,), choose_method(bare))
+    beside = dataclasses.replace(LP_ROTOR, frequency_hz=1.01 * rod.frequency_hz)
+    result = results_of(bare, prepared, (beside,), choose_method(bare))[0][0]
+    assert np.all(np.isfinite(result.transmissibility)) and result.transmissibility.max() < 1e3

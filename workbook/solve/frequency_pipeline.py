@@ -31,7 +31,7 @@ __all__ = ["prepare", "PreparedScene", "results_of", "run_case_frequency"]
 
 log = logging.getLogger(__name__)
 
-#: Relative distance from an undamped mounted mode at which the harmonic
+#: Relative distance from an undamped mode at which the harmonic
 #: solution is refused (the dynamic matrix is singular on the mode).
 RESONANCE_BAND = 1e-6
 
@@ -121,7 +121,7 @@ def results_of(case: Case, prepared: PreparedScene, points: tuple, method: Metho
     runs, cards, preloads = [], {}, {}
     try:
         for done, excitation in enumerate(points, start=1):
-            check_undamped_resonance(run_label(case.name, excitation.name), excitation.frequency, mounted,
+            check_undamped_resonance(run_label(case.name, excitation.name), excitation.frequency, prepared.modes,
                                      RESONANCE_BAND, "the response grows without bound: no steady state exists")
             start = time.perf_counter()
             result = prepared.model.result(excitation, case.analysis.steady_tolerance)

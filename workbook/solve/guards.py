@@ -10,7 +10,8 @@ change, never in NaN or a silently wrong number:
 - :class:`DivergenceError`: the engine ran away from its preloaded position,
   or a coordinate became NaN or infinite;
 - :class:`TimeBudgetExceeded`: the run used up its wall-time budget;
-- :class:`ResonanceError`: the excitation sits on an undamped mounted mode,
+- :class:`ResonanceError`: the excitation sits on an undamped mode (of the
+  engine on its mount or of a link),
   where no steady state exists;
 - :class:`RunTooLong`: the planned run is too long to be meant (a mounted
   mode so lightly damped that its transient would take days to decay).
@@ -21,6 +22,7 @@ The mechanism and equilibrium errors of :mod:`workbook.solve.preload` are
 from __future__ import annotations
 
 from workbook.errors import ResonanceError
+from workbook.solve.modes import ENGINE_SHARE
 
 __all__ = ["run_label", "newton_cause", "check_undamped_resonance", "UNDAMPED_RATIO", "MAX_STEPS"]
 
@@ -62,11 +64,13 @@ def newton_cause(convergence) -> str:
 
 
 def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float, consequence: str) -> None:
-    """Stop if *frequency_hz* lies on (or, within *band*, next to) an undamped mounted mode.
+    """Stop if *frequency_hz* lies on (or, within *band*, next to) an undamped mode.
 
     Without damping the response at a natural frequency grows without bound,
     and next to it the free vibration never decays: there is no steady state
-    to report.
+    to report. Every mode counts, the engine's and the links' own alike: on
+    an undamped link mode the harmonic matrix is singular to round-off and
+    its solution is noise (measured: T of 1e5 to 1e11).
 
     Parameters
     ----------
@@ -75,7 +79,7 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
     frequency_hz : float
         Excitation frequency, Hz.
     modes : list of workbook.solve.modes.Mode
-        The mounted modes.
+        Every mode of the preloaded scene.
     band : float
         Relative distance ``|f / f_n - 1|`` within which the excitation counts
         as on the mode.
@@ -87,9 +91,11 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
     ResonanceError
     """
     for mode in modes:
-        if mode.damping_ratio < UNDAMPED_RATIO and abs(frequency_hz / mode.frequency_hz - 1.0) < band:
+        if (mode.frequency_hz > 0 and mode.damping_ratio < UNDAMPED_RATIO
+                and abs(frequency_hz / mode.frequency_hz - 1.0) < band):
+            kind = "mounted mode" if mode.engine_share >= ENGINE_SHARE else "mode"
             raise ResonanceError(
                 f"{where}: the excitation at {frequency_hz:.6g} Hz is within {100 * band:.3g} % of the undamped "
-                f"mounted mode at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
+                f"{kind} at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
                 f"{mode.damping_ratio:.1e}): {consequence}. Give the hinges or links damping, or move the "
                 f"excitation frequency.")
