@@ -195,7 +195,10 @@ def _simulation_settings(scene: Scene, plan: TimePlan):
     analysis = scene.case.analysis
     settings = exu.SimulationSettings()
     settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = plan.step
+    # one sample per step: a write period of exactly one step skips a sample
+    # when the accumulated time falls a round-off short of the next write
+    # (measured: once in 320000 steps at 248.5 Hz); half a step never does
+    settings.solution.sensors.writePeriod = 0.5 * plan.step
     integration = settings.timeIntegration
     integration.verboseMode = 0
     # a failed segment is re-run by integrate() with a halved step; Exudyn's own
