@@ -45,7 +45,8 @@ from workbook.scene.hinge_law import exudyn_clearance_function
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "exudyn_name", "link_is_flexible", "marker_bodies", "rig_sensors_built", "TRANSDUCER_PREFIX"]
+           "exudyn_name", "ignored_contact_stiffness", "link_is_flexible", "marker_bodies", "net_angular_momentum",
+           "scene_warnings", "rig_sensors_built", "TRANSDUCER_PREFIX", "CANCELLED_MOMENTUM"]
 
 log = logging.getLogger(__name__)
 
@@ -313,6 +314,27 @@ def marker_bodies(hinge: Hinge) -> tuple[str, str]:
     return hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
 
 
+def ignored_contact_stiffness(case: Case) -> list[Hinge]:
+    """Hinges that give a contact stiffness (other than their stiffness) but
+    no gap: no clearance law is built, so the contact stiffness never acts."""
+    return [h for h in case.hinges if h.contact_stiffness is not None and h.radial_clearance == 0
+            and h.contact_stiffness != h.stiffness]
+
+
+def scene_warnings(case: Case) -> list[str]:
+    """What the case gives that the scene does not build, in words: a
+    contact stiffness on a hinge without a gap, and rotors whose spin
+    angular momenta cancel (no gyroscopic moment)."""
+    warnings = [f"hinge {h.name!r}: contact_stiffness {h.contact_stiffness:g} N/m is ignored: the hinge has no gap "
+                f"(radial_clearance 0), so its stiffness {h.stiffness:g} N/m acts"
+                for h in ignored_contact_stiffness(case)]
+    if case.rotors and case.effects.gyroscopics and not gyroscopics_built(case):
+        warnings.append(f"rotors {', '.join(repr(r.name) for r in case.rotors)}: their spin angular momenta cancel "
+                        f"(net {np.linalg.norm(net_angular_momentum(case)):.3g} kg m^2/s), so they exert no "
+                        f"gyroscopic moment and none is built")
+    return warnings
+
+
 def link_is_flexible(case: Case, name: str) -> bool:
     """True if link *name* is built as a flexible body in *case*."""
     return case.effects.flexible_links and case.link_map[name].flexible
@@ -560,9 +582,24 @@ def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict
     return loads
 
 
+#: Net spin angular momentum, relative to the largest rotor's, below which
+#: the rotors' gyroscopic moments cancel and are not built.
+CANCELLED_MOMENTUM = 1e-9
+
+
+def net_angular_momentum(case: Case) -> np.ndarray:
+    """Total spin angular momentum of the case's rotors in engine coordinates, kg m^2/s."""
+    return sum((np.asarray(rotor.angular_momentum, dtype=float) for rotor in case.rotors), np.zeros(3))
+
+
 def gyroscopics_built(case: Case) -> bool:
-    """True if *case* gives rotors and asks for their gyroscopic moments."""
-    return bool(case.rotors) and case.effects.gyroscopics
+    """True if *case* gives rotors, asks for their gyroscopic moments, and
+    their net spin angular momentum does not cancel (the moment is linear in
+    it: counter-rotating rotors of equal momentum exert none)."""
+    if not (case.rotors and case.effects.gyroscopics):
+        return False
+    largest = max(float(np.linalg.norm(rotor.angular_momentum)) for rotor in case.rotors)
+    return float(np.linalg.norm(net_angular_momentum(case))) > CANCELLED_MOMENTUM * largest
 
 
 def exudyn_gyroscopic_function(momentum):
@@ -623,7 +660,7 @@ def _add_gyroscopics(mbs, case: Case, engine: EngineItems) -> GyroscopicItems:
     from exudyn.advancedUtilities import CreateSymbolicUserFunction
 
     eii = exu.itemInterface
-    momentum = sum(rotor.angular_momentum for rotor in case.rotors)
+    momentum = net_angular_momentum(case)
     item = mbs.AddObject(eii.ObjectGenericODE2(name=exudyn_name("scene", "rotor gyroscopics"), nodeNumbers=[engine.node],
                                                massMatrix=np.zeros((6, 6)),
                                                visualization=eii.VObjectGenericODE2(show=False)))

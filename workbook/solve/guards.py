@@ -21,10 +21,15 @@ The mechanism and equilibrium errors of :mod:`workbook.solve.preload` are
 """
 from __future__ import annotations
 
-from workbook.errors import ResonanceError
-from workbook.solve.modes import ENGINE_SHARE
+import contextlib
+import io
+import logging
 
-__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "UNDAMPED_RATIO", "MAX_STEPS"]
+from workbook.errors import ResonanceError
+
+__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
+
+log = logging.getLogger(__name__)
 
 #: A mounted mode with a damping ratio below this counts as undamped (the
 #: linearisation of a scene without damping gives ratios of about 1e-15).
@@ -37,6 +42,27 @@ MAX_STEPS = 50_000_000
 def run_label(case_name: str, run_name: str) -> str:
     """How the messages name a run: ``case 'NAME', run 'NAME'``."""
     return f"case {case_name!r}, run {run_name!r}"
+
+
+@contextlib.contextmanager
+def solver_output():
+    """Capture what Exudyn prints (its banners, "SOLVER FAILED" boxes and
+    hints) instead of letting it reach stdout, where it would break
+    ``mountwb run --json``; the text goes to the debug log.
+
+    Yields
+    ------
+    io.StringIO
+        The captured text (complete once the ``with`` block has ended), for
+        an error's detail.
+    """
+    buffer = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buffer):
+            yield buffer
+    finally:
+        if buffer.getvalue().strip():
+            log.debug("Exudyn said:\n%s", buffer.getvalue().rstrip())
 
 
 def newton_cause(convergence) -> str:
@@ -93,7 +119,7 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
     for mode in modes:
         if (mode.frequency_hz > 0 and mode.damping_ratio < UNDAMPED_RATIO
                 and abs(frequency_hz / mode.frequency_hz - 1.0) < band):
-            kind = "mounted mode" if mode.engine_share >= ENGINE_SHARE else "mode"
+            kind = "mounted mode" if mode.mounted else "mode"
             raise ResonanceError(
                 f"{where}: the excitation at {frequency_hz:.6g} Hz is within {100 * band:.3g} % of the undamped "
                 f"{kind} at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "

@@ -33,6 +33,7 @@ import scipy.linalg as sla
 
 from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
+from workbook.solve.guards import solver_output
 
 __all__ = ["Linearization", "Mode", "linearize", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
            "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
@@ -106,6 +107,11 @@ class Mode:
     omega_squared: float = 0.0
 
     @property
+    def mounted(self) -> bool:
+        """Most of the kinetic energy in the engine (:data:`ENGINE_SHARE`)."""
+        return self.engine_share >= ENGINE_SHARE
+
+    @property
     def damping_ratio(self) -> float:
         """Modal damping ratio zeta = sigma / w."""
         omega = 2 * np.pi * self.frequency_hz
@@ -150,8 +156,9 @@ def linearize(scene: Scene) -> Linearization:
     settings = exu.SimulationSettings()
     settings.solution.file.write = False
     mbs = scene.mbs
-    matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
-                                           returnConstraintJacobian=True)
+    with solver_output():
+        matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
+                                               returnConstraintJacobian=True)
     mass, stiffness, damping = (np.asarray(m) for m in matrices[:3])
     size = mass.shape[0]
     if mbs.systemData.AEsize() > 0:
@@ -273,4 +280,4 @@ def unstable_modes(modes: list[Mode]) -> list[Mode]:
 
 def mounted_modes(modes: list[Mode]) -> list[Mode]:
     """The engine's modes on its mount (most kinetic energy in the engine)."""
-    return [mode for mode in modes if mode.engine_share >= ENGINE_SHARE and mode.frequency_hz >= FREE_FREQUENCY_HZ]
+    return [mode for mode in modes if mode.mounted and mode.frequency_hz >= FREE_FREQUENCY_HZ]

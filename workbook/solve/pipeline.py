@@ -69,8 +69,9 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
     with timed(timings, "static preload"):
         preload = solve_preload(scene)
     with timed(timings, "mounted modes"):
-        mounted = mounted_modes(modes_of(linearize(scene)))
-    plan = plan_run(case.analysis, scene.excitation.signal, mounted,
+        modes = modes_of(linearize(scene))
+        mounted = mounted_modes(modes)
+    plan = plan_run(case.analysis, scene.excitation.signal, modes,
                     where=run_label(case.name, excitation.name))
     log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
     with timed(timings, "time integration"):

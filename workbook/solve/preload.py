@@ -24,6 +24,7 @@
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -31,9 +32,11 @@ import numpy as np
 from workbook.errors import EquilibriumError, MechanismError, UnstablePreloadError
 from workbook.model.case import ENGINE, Gravity, PointForce, PointMoment
 from workbook.scene.build import Scene, marker_bodies
+from workbook.solve.guards import solver_output
 from workbook.solve.modes import Mode, free_motions, linearize, modes_of, unstable_modes
 
 __all__ = ["Preload", "applied_static_force", "check_mechanism", "check_preloaded_stability", "link_compression",
+           "static_failure_message", "LOAD_STEPS",
            "check_equilibrium", "solve_preload", "spring_roundoff_force", "ROUNDOFF_MARGIN"]
 
 log = logging.getLogger(__name__)
@@ -41,6 +44,12 @@ log = logging.getLogger(__name__)
 #: Newton tolerances stay this many times above the round-off of the stiffest
 #: spring's force (:func:`spring_roundoff_force`).
 ROUNDOFF_MARGIN = 10.0
+#: A static solve that fails in one step is tried again in this many
+#: (adaptive) load steps.
+LOAD_STEPS = 20
+#: A stepped static solve that failed beyond this share of the loads met a
+#: limit load (buckling or tipping); below it, Newton could not converge at all.
+LIMIT_LOAD_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -276,14 +285,7 @@ def solve_preload(scene: Scene) -> Preload:
         # overshoots (a closed clearance gap) must not loosen it
         settings.staticSolver.newton.adaptInitialResidual = False
         settings.staticSolver.verboseMode = 0
-        try:
-            with scene.excitation_paused():
-                converged = scene.mbs.SolveStatic(settings, updateInitialValues=True)
-        except exu.SolverError as error:
-            raise EquilibriumError(f"case {case.name!r}: the static solve failed: {error}") from error
-        if not converged:
-            raise EquilibriumError(f"case {case.name!r}: the static solve did not converge "
-                                   f"(load scale {scene.load_scale:.4g} N)")
+        _solve_static(scene, settings)
     forces = scene.hinge_forces()
     if case.effects.preload and scene.static_loads:
         check_preloaded_stability(scene, forces)
@@ -292,6 +294,64 @@ def solve_preload(scene: Scene) -> Preload:
     mismatch = check_equilibrium(case.name, pylon, applied, tolerance, scene.load_scale)
     log.info("preload of %r: pylon force %s N, relative mismatch %.1e", case.name, np.round(pylon, 1), mismatch)
     return Preload(forces, pylon, applied, mismatch, bool(case.effects.preload and scene.static_loads))
+
+
+def _attempt(scene: Scene, settings) -> tuple[bool, str]:
+    """One static solve; whether it converged, and what Exudyn printed."""
+    import exudyn as exu
+
+    with solver_output() as output, scene.excitation_paused():
+        try:
+            converged = bool(scene.mbs.SolveStatic(settings, updateInitialValues=True))
+        except exu.SolverError:
+            converged = False
+    return converged, output.getvalue()
+
+
+def _solve_static(scene: Scene, settings) -> None:
+    """Solve the static loads: in one step, else in up to :data:`LOAD_STEPS`
+    adaptive load steps; if that fails too, say why in plain words."""
+    converged, said = _attempt(scene, settings)
+    if converged:
+        return
+    settings.staticSolver.numberOfLoadSteps = LOAD_STEPS
+    settings.staticSolver.verboseMode = 1        # reports the load factor reached
+    converged, stepped = _attempt(scene, settings)
+    if converged:
+        log.info("case %r: the static loads needed %d load steps", scene.case.name, LOAD_STEPS)
+        return
+    factors = re.findall(r"load factor = ([-+0-9.eE]+)", stepped)
+    reached = float(factors[-1]) if factors else 0.0
+    raise EquilibriumError(static_failure_message(scene, reached, settings.staticSolver.newton.absoluteTolerance),
+                           detail=said + stepped)
+
+
+def static_failure_message(scene: Scene, reached: float, tolerance: float) -> str:
+    """Why the static solve failed, in plain words, with advice.
+
+    Parameters
+    ----------
+    scene : Scene
+    reached : float
+        Largest share of the static loads for which Newton still converged
+        when they were applied in steps (0 to 1).
+    tolerance : float
+        Newton's absolute tolerance, N.
+    """
+    case = scene.case
+    stiffest = max(max(h.stiffness, h.gap_contact_stiffness) for h in case.hinges)
+    where = f"case {case.name!r}: the static solve failed"
+    if reached >= LIMIT_LOAD_SHARE:
+        return (f"{where}: applied in steps, the static loads ({_load_listing(scene)}) could be carried up to "
+                f"{100 * reached:.3g} % of their value and no further: there the mount reaches its limit load, "
+                f"where the preload buckles a compressed link or tips the mount. Reduce or redirect the loads, "
+                f"or stiffen or rearrange the links that carry them in compression.")
+    return (f"{where}: Newton's iteration did not converge even on {100 * reached:.2g} % of the static loads. "
+            f"Likely cause: a stiffness too large for double precision: the stiffest hinge has {stiffest:.3g} N/m, "
+            f"whose force is known only to {spring_roundoff_force(scene) / ROUNDOFF_MARGIN:.2g} N at these "
+            f"coordinates; summed over the mount this noise keeps the residual above Newton's tolerance "
+            f"({tolerance:.2g} N). Lower the stiffest hinge stiffnesses: a hinge far stiffer than the link it "
+            f"holds acts as rigid anyway (on the reference mount 1e12 N/m still solves, 1e13 N/m does not).")
 
 
 def check_equilibrium(case_name: str, pylon_force, applied_force, tolerance: float, load_scale: float) -> float:
