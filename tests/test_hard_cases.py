@@ -97,7 +97,8 @@ def test_clearance_closed_by_the_preload_agrees_with_the_linear_answer(rigid):
     gapped = _hinges(rigid, radial_clearance=30e-6)
     small = dataclasses.replace(LP_ROTOR, amplitude=100.0)
     result, linear = _time(gapped, small), _frequency(gapped, small)
-    assert result.steady and not linear.warnings
+    # rigid links at 59 Hz are warned (the thrust rods' fundamental is 100 Hz); no gap is
+    assert result.steady and all("is rigid although" in w for w in linear.warnings)
     # measured 0.42 %: the integrator's period error at 40 steps per period, as without clearance
     assert result.transmissibility == pytest.approx(linear.transmissibility, rel=0.01)
 
