@@ -22,6 +22,7 @@ from workbook.errors import MechanismError, ResonanceError, SimulationError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
 from workbook.solve.frequency_pipeline import prepare, results_of, run_case_frequency
+from workbook.solve.guards import singular_solve_guard
 from workbook.solve.method import choose_method
 from workbook.solve.modes import FREE_FREQUENCY_HZ, modes_of, mounted_modes
 from workbook.solve.pipeline import run_excitation
@@ -243,6 +244,11 @@ def test_an_excitation_on_an_undamped_link_mode_is_refused_naming_the_links(cach
     with pytest.raises(ResonanceError, match=r"undamped mode at [\d.]+ Hz \(motion of 'thrust-(left|right)'.*"
                                              r"with the engine still"):
         results_of(bare, prepared, (on_mode,), choose_method(bare))
+    # the safety net behind that check: a solve singular to round-off is refused, naming the nearest mode
+    with pytest.raises(ResonanceError, match=r"singular to round-off.*from the mode at [\d.]+ Hz \(motion of "
+                                             r"'thrust-(left|right)'"):
+        with singular_solve_guard("the rods", rod.frequency_hz, prepared.modes):
+            prepared.model.result(on_mode, bare.analysis.steady_tolerance)
     beside = dataclasses.replace(LP_ROTOR, frequency_hz=1.01 * rod.frequency_hz)
     result = results_of(bare, prepared, (beside,), choose_method(bare))[0][0]
     assert np.all(np.isfinite(result.transmissibility)) and result.transmissibility.max() < 1e3

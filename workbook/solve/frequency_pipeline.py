@@ -20,7 +20,7 @@ from workbook.answers.results import MountResult
 from workbook.model.case import Case, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
-from workbook.solve.guards import check_undamped_resonance, run_label
+from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import MethodChoice, choose_method
 from workbook.solve.modes import modes_of, mounted_modes
@@ -124,7 +124,8 @@ def results_of(case: Case, prepared: PreparedScene, points: tuple, method: Metho
             check_undamped_resonance(run_label(case.name, excitation.name), excitation.frequency, prepared.modes,
                                      RESONANCE_BAND, "the response grows without bound: no steady state exists")
             start = time.perf_counter()
-            result = prepared.model.result(excitation, case.analysis.steady_tolerance)
+            with singular_solve_guard(run_label(case.name, excitation.name), excitation.frequency, prepared.modes):
+                result = prepared.model.result(excitation, case.analysis.steady_tolerance)
             result.warnings.extend(link_warnings(case, prepared.scene.reduced))
             result.warnings.extend(linearised_gap_warnings(gaps, prepared.preload.hinge_forces,
                                                            result.hinge_amplitudes))

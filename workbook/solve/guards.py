@@ -24,10 +24,14 @@ from __future__ import annotations
 import contextlib
 import io
 import logging
+import math
+import warnings
+
+from scipy.linalg import LinAlgWarning
 
 from workbook.errors import ResonanceError
 
-__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
+__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "singular_solve_guard", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
 
 log = logging.getLogger(__name__)
 
@@ -125,3 +129,38 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
                 f"{kind} at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
                 f"{mode.damping_ratio:.1e}): {consequence}. Give the hinges or links damping, or move the "
                 f"excitation frequency.")
+
+
+@contextlib.contextmanager
+def singular_solve_guard(where: str, frequency_hz: float, modes):
+    """Turn a harmonic solve that is singular to round-off (scipy's
+    ``LinAlgWarning``) into a :class:`ResonanceError` naming the mode nearest
+    to the excitation, instead of an answer that is noise.
+
+    Parameters
+    ----------
+    where : str
+        Case and run, for the message.
+    frequency_hz : float
+        Excitation frequency, Hz.
+    modes : list of workbook.solve.modes.Mode
+        Every mode of the preloaded scene.
+
+    Raises
+    ------
+    ResonanceError
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LinAlgWarning)
+        try:
+            yield
+        except LinAlgWarning as warning:
+            def distance(mode) -> float:
+                return abs(frequency_hz / mode.frequency_hz - 1.0) if mode.frequency_hz > 0 else math.inf
+
+            nearest = min(modes, key=distance)
+            raise ResonanceError(
+                f"{where}: the harmonic solve at {frequency_hz:.6g} Hz is singular to round-off ({warning}): the "
+                f"excitation is {100 * distance(nearest):.2g} % from the mode at {nearest.frequency_hz:.6g} Hz "
+                f"({nearest.description}; damping ratio {nearest.damping_ratio:.1e}), and the answer would be "
+                f"noise. Give the hinges or links damping, or move the excitation frequency.") from None
