@@ -223,6 +223,8 @@ def test_a_heavy_fast_rotor_is_no_mechanism_and_keeps_the_stiffness_determinant(
     whirl = [m.omega_squared for m in prepared.modes]
     still = [m.omega_squared for m in modes_of(prepared.model.linearization, gyroscopic=False)]
     assert min(m.frequency_hz for m in prepared.modes) < FREE_FREQUENCY_HZ < still[0]
+    # the slow backward whirl is a real mounted mode: listed, not dropped as if it were free
+    assert mounted_modes(prepared.modes)[0].frequency_hz < FREE_FREQUENCY_HZ
     assert np.sum(np.log(whirl)) == pytest.approx(np.sum(np.log(still)), rel=1e-6)
 
 

@@ -279,5 +279,11 @@ def unstable_modes(modes: list[Mode]) -> list[Mode]:
 
 
 def mounted_modes(modes: list[Mode]) -> list[Mode]:
-    """The engine's modes on its mount (most kinetic energy in the engine)."""
-    return [mode for mode in modes if mode.mounted and mode.frequency_hz >= FREE_FREQUENCY_HZ]
+    """The engine's modes on its mount (most kinetic energy in the engine).
+
+    Every one with ``w^2 > 0``, however slow: free motions and negative
+    stiffness have stopped the run before (:mod:`workbook.solve.preload`,
+    judged without the gyroscopic coupling), so a slow mode here is real,
+    e.g. the backward whirl of a heavy fast rotor (0.016 Hz for
+    1e5 kg m^2 at 248.5 Hz on the reference mount)."""
+    return [mode for mode in modes if mode.mounted and mode.omega_squared > 0]
