@@ -7,7 +7,12 @@
    forces). Only stiffness restrains a motion, so the check solves
    ``K x = w^2 M x`` without the rotors' gyroscopic coupling.
 2. The static loads are solved for (Newton, tolerance scaled to the loads),
-   and the solution becomes the initial state of the dynamic run.
+   and the solution becomes the initial state of the dynamic run. A solve
+   that fails is tried again in :data:`LOAD_STEPS` adaptive load steps; if
+   that fails too, :class:`EquilibriumError` says how much of the loads was
+   carried (a limit load: buckling or tipping) or that even a small share
+   was not (a stiffness beyond double precision), with Exudyn's own output
+   as its ``detail``.
 3. The scene is linearised again about the preloaded equilibrium, where the
    loads add geometric stiffness (a compressed link pushes sideways as it
    turns). A negative stiffness there stops the run with
