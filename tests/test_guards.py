@@ -77,3 +77,16 @@ def test_the_command_line_reports_an_exhausted_time_budget_as_numerical_trouble(
     error = capsys.readouterr().err
     assert "mountwb run: numerical trouble: case 'reference mount', run 'LP rotor': stopped after" in error
     assert "time budget 0.01 s" in error
+
+
+def test_a_long_measured_window_is_sampled_once_per_step():
+    """4000 measured periods at 248.5 Hz: 320 000 stored steps. A sensor
+    write period of exactly one step once skipped a sample there (t = 24.17 s)
+    and the run failed with 'time must be uniformly sampled'."""
+    shake = dataclasses.replace(SHAKE, frequency_hz=248.5, amplitude=1e3)
+    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(measured_periods=4000, settle_time=0.1))
+    result, _, _ = run_excitation(case, shake)
+    step = 1 / (40 * 248.5)
+    assert len(result.time) == 2 * 4000 * 40 + 1
+    assert np.abs(np.diff(result.time) - step).max() < 1e-9 * step
+    assert np.all(np.isfinite(result.transmissibility))

@@ -20,7 +20,7 @@ from typing import Any
 
 __all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
-           "MechanismError", "EquilibriumError", "UsageError", "BAD_INPUT", "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
+           "MechanismError", "EquilibriumError", "UnstablePreloadError", "UsageError", "BAD_INPUT", "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
            "EXIT_INTERRUPTED", "exit_code"]
 
 #: Exit codes of the command line.
@@ -202,8 +202,32 @@ class MechanismError(SimulationError):
 
 
 class EquilibriumError(SimulationError):
-    """The static solve failed or its hinge forces do not balance the loads."""
+    """The static solve failed or its hinge forces do not balance the loads.
 
+    Attributes
+    ----------
+    detail : str
+        What the solver itself reported (its console output), for the log.
+    """
+
+    def __init__(self, message: str, detail: str = ""):
+        self.detail = detail
+        super().__init__(message)
+
+
+class UnstablePreloadError(SimulationError):
+    """The preloaded equilibrium is unstable: its stiffness is negative in
+    some direction (the preload buckles a link or tips the mount).
+
+    Attributes
+    ----------
+    omega_squared : list of float
+        The negative squared circular frequencies, rad^2/s^2.
+    """
+
+    def __init__(self, message: str, omega_squared: list[float]):
+        self.omega_squared = list(omega_squared)
+        super().__init__(message)
 
 
 class UsageError(ValueError):

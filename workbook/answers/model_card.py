@@ -9,7 +9,10 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+import numpy as np
+
 from workbook.scene.build import Scene
+from workbook.solve.step_accuracy import ACCURACY_TARGET
 
 __all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
 
@@ -184,7 +187,9 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         EffectEntry("hinge clearance", effects.clearance and bool(gaps),
                     f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
                     if effects.clearance and gaps else
-                    ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")),
+                    ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")
+                    + _ignored_contact(case)),
+        _spin_restraints(scene),
         _gyroscopics(scene),
         _rig_sensors(scene),
     ]
@@ -197,10 +202,37 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
     return entries
 
 
+def _ignored_contact(case) -> str:
+    from workbook.scene.build import ignored_contact_stiffness
+
+    ignored = [h.name for h in ignored_contact_stiffness(case)]
+    return f"; contact_stiffness ignored on {', '.join(ignored)} (no gap)" if ignored else ""
+
+
+def _spin_restraints(scene) -> EffectEntry:
+    """The links' torsional spin restraints: what they are and the mode each adds."""
+    name, links = "link spin restraints", scene.links
+    if not links:
+        return EffectEntry(name, False, "no links")
+    stiffness = [item.spin_stiffness for item in links.values()]
+    frequencies = sorted({round(item.spin_frequency_hz, 6) for item in links.values()})
+    return EffectEntry(name, True, f"{len(links)} torsional springs, one per link from its eye A to a ground "
+                       f"point, about the link's axis (k = {min(stiffness):.3g} to {max(stiffness):.3g} N m/rad): "
+                       f"they stop the free spin of a link on two ball hinges, move no hinge point and each add "
+                       f"one spin mode at {', '.join(f'{f:g}' for f in frequencies)} Hz")
+
+
 def _gyroscopics(scene) -> EffectEntry:
     """The rotors' gyroscopic moment: built or not, and why."""
+    from workbook.scene.build import net_angular_momentum
+
     name, rotors = "gyroscopic rotor", scene.case.rotors
     if scene.gyroscopics is None:
+        if rotors and scene.case.effects.gyroscopics:
+            return EffectEntry(name, False, f"not built: the spin angular momenta of "
+                               f"{', '.join(r.name for r in rotors)} cancel (net "
+                               f"{np.linalg.norm(net_angular_momentum(scene.case)):.3g} kg m^2/s), so their "
+                               f"gyroscopic moments cancel too")
         return EffectEntry(name, False, "switched off: rotor inertia lumped in the engine" if rotors
                            else "no rotors given: rotor inertia lumped in the engine")
     listing = ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in rotors)
@@ -231,6 +263,10 @@ def _solver(scene, plan) -> dict[str, Any]:
                   f"{plan.settle_reason}",
         "measured": f"2 windows of {plan.measured_periods} periods, steady if within "
                     f"{100 * analysis.steady_tolerance:g} %",
+        "integrator accuracy": (f"estimated amplitude error {100 * plan.amplitude_error:.2g} %, largest on "
+                                f"{plan.error_source}; {plan.steps_needed} steps per period keep it below "
+                                f"{100 * ACCURACY_TARGET:g} %"
+                                if plan.error_source else "no modes to estimate it on"),
         "steps": plan.steps,
         "end time": f"{plan.end_time:.4g} s",
         "Newton absolute tolerance": f"{analysis.newton_tolerance * scene.load_scale:.3g} "

@@ -863,12 +863,7 @@ class Case:
                 if not isinstance(item, kinds):
                     raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
             _set(self, name, items)
-            seen = set()
-            for item in items:
-                if item.name in seen:
-                    raise CaseError(f"{name[:-1].replace('_', ' ')} {item.name!r}", "name",
-                                    item.name, "a name not used before")
-                seen.add(item.name)
+        self._check_names(groups)
         links = self.link_map
         for hinge in self.hinges:
             for name in ("body_a", "body_b"):
@@ -882,6 +877,21 @@ class Case:
                     raise CaseError(f"hinge {hinge.name!r}", "position", hinge.position,
                                     f"an eye centre of link {body!r}: {links[body].end_a} or "
                                     f"{links[body].end_b}")
+
+    def _check_names(self, groups) -> None:
+        """Every item's name unique across all kinds of items (links, hinges,
+        static loads, excitations and the points of each sweep, rotors), and
+        none of them ``"pylon"`` or ``"engine"``."""
+        owners = {reserved: f"the scene's own {reserved}" for reserved in _RESERVED}
+        for group, _ in groups:
+            kind = group[:-1].replace("_", " ")
+            for item in getattr(self, group):
+                names = [item.name] + ([point.name for point in item.expand()] if isinstance(item, Sweep) else [])
+                for name in names:
+                    if name in owners:
+                        raise CaseError(f"{kind} {item.name!r}", "name", name,
+                                        f"a name not used before (it already names {owners[name]})")
+                    owners[name] = f"{kind} {item.name!r}"
 
     @property
     def link_map(self) -> dict[str, Link]:

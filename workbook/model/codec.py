@@ -51,7 +51,8 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
     Raises
     ------
     ValueError
-        For an unknown ``"type"`` or fields that class does not have; the case
+        For an unknown ``"type"``, fields that class does not have, or
+        required fields it lacks; the case
         classes raise :class:`~workbook.model.case.CaseError` for invalid values.
     """
     classes = _registry() if _classes is None else _classes
@@ -68,10 +69,18 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
         unknown = set(data) - known - {"type"}
         if unknown:
             raise ValueError(f"{kind}: unknown fields {sorted(unknown)}; expected {sorted(known)}")
+        missing = sorted(f.name for f in dataclasses.fields(cls) if f.name not in data
+                         and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
+        if missing:
+            raise ValueError(f"{kind}: fields {missing} missing; expected {sorted(known)}")
         fields = {key: from_dict(value, classes) for key, value in data.items() if key != "type"}
         if cls is _case.Link and isinstance(fields.get("modes"), float):
             fields["modes"] = _case.ModeCutoff(fields["modes"])     # a number with a fraction: a cut-off, Hz
-        return cls(**fields)
+        try:
+            return cls(**fields)
+        except (TypeError, AttributeError) as error:
+            # a value of the wrong kind (a list where a number belongs, ...)
+            raise ValueError(f"{kind}: a field holds a value of the wrong kind ({error})") from None
     return data
 
 

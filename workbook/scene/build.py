@@ -22,6 +22,10 @@ rig measures). Hinges and transducers are the scene's *force channels*
 (:attr:`Scene.force_channels`), each with a force sensor;
 :attr:`Scene.pylon_channels` names those summed into the pylon force.
 
+Every Exudyn item is named within its kind (:func:`exudyn_name`, e.g.
+``"hinge: front-up-left"``), so the case's names never collide with the
+scene's own items.
+
 For Exudyn users, :func:`build_scene` is the entry point: it returns the
 ``mbs`` with every item number, ready to extend and to solve with Exudyn's
 own solvers (see ``docs/example_exudyn_script.py``).
@@ -35,13 +39,14 @@ from typing import Any, Callable
 
 import numpy as np
 
-from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, PointForce, PointMoment, SingleFrequencyExcitation
+from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, SingleFrequencyExcitation
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "TRANSDUCER_PREFIX"]
+           "exudyn_name", "ignored_contact_stiffness", "marker_bodies", "net_angular_momentum",
+           "scene_warnings", "TRANSDUCER_PREFIX", "CANCELLED_MOMENTUM"]
 
 log = logging.getLogger(__name__)
 
@@ -291,6 +296,45 @@ class Scene:
                 for name, items in self.force_channels.items()}
 
 
+def exudyn_name(kind: str, name: str) -> str:
+    """The Exudyn name of a scene item: ``"KIND: NAME"``.
+
+    Every item is named within its kind (``"hinge"``, ``"link"``,
+    ``"static load"``, ``"excitation"``, ``"rig"``, and ``"scene"`` for the
+    scene's own items such as the engine), so a user's name can never clash
+    with the scene's own or with another kind's; within a kind,
+    :class:`~workbook.model.case.Case` keeps the names unique.
+    """
+    return f"{kind}: {name}"
+
+
+def marker_bodies(hinge: Hinge) -> tuple[str, str]:
+    """The bodies on a hinge connector's markers 0 and 1: the pylon first
+    when it is one of them, else ``(body_a, body_b)``."""
+    return hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
+
+
+def ignored_contact_stiffness(case: Case) -> list[Hinge]:
+    """Hinges that give a contact stiffness (other than their stiffness) but
+    no gap: no clearance law is built, so the contact stiffness never acts."""
+    return [h for h in case.hinges if h.contact_stiffness is not None and h.radial_clearance == 0
+            and h.contact_stiffness != h.stiffness]
+
+
+def scene_warnings(case: Case) -> list[str]:
+    """What the case gives that the scene does not build, in words: a
+    contact stiffness on a hinge without a gap, and rotors whose spin
+    angular momenta cancel (no gyroscopic moment)."""
+    warnings = [f"hinge {h.name!r}: contact_stiffness {h.contact_stiffness:g} N/m is ignored: the hinge has no gap "
+                f"(radial_clearance 0), so its stiffness {h.stiffness:g} N/m acts"
+                for h in ignored_contact_stiffness(case)]
+    if case.rotors and case.effects.gyroscopics and not gyroscopics_built(case):
+        warnings.append(f"rotors {', '.join(repr(r.name) for r in case.rotors)}: their spin angular momenta cancel "
+                        f"(net {np.linalg.norm(net_angular_momentum(case)):.3g} kg m^2/s), so they exert no "
+                        f"gyroscopic moment and none is built")
+    return warnings
+
+
 def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | None) -> float:
     """Highest excitation frequency a reduction must serve, Hz."""
     if excitation is not None:
@@ -388,7 +432,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
             mbs, reduced[link.name], link.end_a, link.end_b,
             flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
             stiffness_damping=link.stiffness_damping if damping else 0.0,
-            mass_damping=link.mass_damping if damping else 0.0, name=link.name, **optional)
+            mass_damping=link.mass_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
 
     transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
 
@@ -407,13 +451,13 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     clearance_functions = {}
     hinges = {}
     for hinge in case.hinges:
-        first, second = hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
+        first, second = marker_bodies(hinge)
         markers = (marker(first, hinge.position), marker(second, hinge.position))
         damping = hinge.damping if case.effects.hinge_damping else 0.0
         clearance = case.effects.clearance and hinge.radial_clearance > 0
         stiffness = hinge.gap_contact_stiffness if clearance else hinge.stiffness
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=hinge.name, markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
+            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
             visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         law = None
         if clearance:
@@ -423,7 +467,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
             law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
             mbs.SetObjectParameter(connector, "springForceUserFunction", law)
         sensor = mbs.AddSensor(eii.SensorObject(
-            name=f"force {hinge.name}", objectNumber=connector, storeInternal=True, writeToFile=False,
+            name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,
             outputVariableType=exu.OutputVariableType.Force))
         hinges[hinge.name] = HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
 
@@ -435,7 +479,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         signal = ExcitationSignal.of(excitation, case.analysis.ramp_periods)
         point = mbs.AddMarker(eii.MarkerBodyPosition(
             bodyNumber=engine.body, localPosition=list(np.subtract(excitation.point, case.engine.center_of_mass))))
-        load = mbs.AddLoad(eii.LoadForceVector(name=excitation.name, markerNumber=point, loadVector=[0.0] * 3))
+        load = mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", excitation.name), markerNumber=point, loadVector=[0.0] * 3))
         function = CreateSymbolicUserFunction(mbs, signal.exudyn_user_function(), "loadVectorUserFunction", load)
         mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
         excitation_items = ExcitationItems(excitation.name, point, load, signal, function)
@@ -473,17 +517,18 @@ def _add_transducers(mbs, case: Case, ground: int) -> dict[str, TransducerItems]
     transducers = {}
     for position, carried in pins:
         name = TRANSDUCER_PREFIX + " + ".join(carried)
-        node = mbs.AddNode(eii.NodePoint(name=name, referenceCoordinates=list(position),
+        node = mbs.AddNode(eii.NodePoint(name=exudyn_name("rig", name), referenceCoordinates=list(position),
                                          visualization=eii.VNodePoint(show=False)))
-        body = mbs.AddObject(eii.ObjectMassPoint(name=f"{name} mass", mass=rig.mass, nodeNumber=node,
+        body = mbs.AddObject(eii.ObjectMassPoint(name=exudyn_name("rig", f"{name} mass"), mass=rig.mass, nodeNumber=node,
                                                  visualization=eii.VObjectMassPoint(show=False)))
         markers = (mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=ground, localPosition=list(position))),
                    mbs.AddMarker(eii.MarkerNodePosition(nodeNumber=node)))
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=name, markerNumbers=list(markers), stiffness=list(rig.stiffness), damping=list(rig.damping),
+            name=exudyn_name("rig", name), markerNumbers=list(markers), stiffness=list(rig.stiffness),
+            damping=list(rig.damping),
             visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         sensor = mbs.AddSensor(eii.SensorObject(
-            name=f"force {name}", objectNumber=connector, storeInternal=True, writeToFile=False,
+            name=exudyn_name("rig force", name), objectNumber=connector, storeInternal=True, writeToFile=False,
             outputVariableType=exu.OutputVariableType.Force))
         transducers[name] = TransducerItems(node, body, connector, sensor, markers, position, tuple(carried))
     return transducers
@@ -495,10 +540,10 @@ def _add_engine(mbs, case: Case) -> EngineItems:
     eii = exu.itemInterface
     inertia = case.engine.inertia_matrix
     node = mbs.AddNode(eii.NodeRigidBodyRxyz(
-        name="engine", referenceCoordinates=list(case.engine.center_of_mass) + [0.0, 0.0, 0.0],
+        name=exudyn_name("scene", "engine"), referenceCoordinates=list(case.engine.center_of_mass) + [0.0, 0.0, 0.0],
         visualization=eii.VNodeRigidBodyRxyz(show=False)))
     body = mbs.AddObject(eii.ObjectRigidBody(
-        name="engine", nodeNumber=node, mass=case.engine.mass,
+        name=exudyn_name("scene", "engine"), nodeNumber=node, mass=case.engine.mass,
         inertia=[inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[1, 2], inertia[0, 2], inertia[0, 1]],
         visualization=eii.VObjectRigidBody(show=False)))
     marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
@@ -515,10 +560,11 @@ def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict
         if isinstance(load, PointForce):
             local = np.subtract(load.point, case.engine.center_of_mass)
             point = mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=engine.body, localPosition=list(local)))
-            loads[load.name] = [mbs.AddLoad(eii.LoadForceVector(name=load.name, markerNumber=point,
+            loads[load.name] = [mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("static load", load.name), markerNumber=point,
                                                                loadVector=list(load.force)))]
         elif isinstance(load, PointMoment):
-            loads[load.name] = [mbs.AddLoad(eii.LoadTorqueVector(name=load.name, markerNumber=engine.marker_rigid,
+            loads[load.name] = [mbs.AddLoad(eii.LoadTorqueVector(name=exudyn_name("static load", load.name),
+                                                                markerNumber=engine.marker_rigid,
                                                                 loadVector=list(load.moment)))]
         else:
             bodies = [engine.body] + [link.body for link in links.values()]
@@ -530,9 +576,24 @@ def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict
     return loads
 
 
+#: Net spin angular momentum, relative to the largest rotor's, below which
+#: the rotors' gyroscopic moments cancel and are not built.
+CANCELLED_MOMENTUM = 1e-9
+
+
+def net_angular_momentum(case: Case) -> np.ndarray:
+    """Total spin angular momentum of the case's rotors in engine coordinates, kg m^2/s."""
+    return sum((np.asarray(rotor.angular_momentum, dtype=float) for rotor in case.rotors), np.zeros(3))
+
+
 def gyroscopics_built(case: Case) -> bool:
-    """True if *case* gives rotors and asks for their gyroscopic moments."""
-    return bool(case.rotors) and case.effects.gyroscopics
+    """True if *case* gives rotors, asks for their gyroscopic moments, and
+    their net spin angular momentum does not cancel (the moment is linear in
+    it: counter-rotating rotors of equal momentum exert none)."""
+    if not (case.rotors and case.effects.gyroscopics):
+        return False
+    largest = max(float(np.linalg.norm(rotor.angular_momentum)) for rotor in case.rotors)
+    return float(np.linalg.norm(net_angular_momentum(case))) > CANCELLED_MOMENTUM * largest
 
 
 def exudyn_gyroscopic_function(momentum):
@@ -593,8 +654,8 @@ def _add_gyroscopics(mbs, case: Case, engine: EngineItems) -> GyroscopicItems:
     from exudyn.advancedUtilities import CreateSymbolicUserFunction
 
     eii = exu.itemInterface
-    momentum = sum(rotor.angular_momentum for rotor in case.rotors)
-    item = mbs.AddObject(eii.ObjectGenericODE2(name="rotor gyroscopics", nodeNumbers=[engine.node],
+    momentum = net_angular_momentum(case)
+    item = mbs.AddObject(eii.ObjectGenericODE2(name=exudyn_name("scene", "rotor gyroscopics"), nodeNumbers=[engine.node],
                                                massMatrix=np.zeros((6, 6)),
                                                visualization=eii.VObjectGenericODE2(show=False)))
     function = CreateSymbolicUserFunction(mbs, exudyn_gyroscopic_function(momentum), "forceUserFunction", item)

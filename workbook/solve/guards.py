@@ -10,7 +10,8 @@ change, never in NaN or a silently wrong number:
 - :class:`DivergenceError`: the engine ran away from its preloaded position,
   or a coordinate became NaN or infinite;
 - :class:`TimeBudgetExceeded`: the run used up its wall-time budget;
-- :class:`ResonanceError`: the excitation sits on an undamped mounted mode,
+- :class:`ResonanceError`: the excitation sits on an undamped mode (of the
+  engine on its mount or of a link),
   where no steady state exists;
 - :class:`RunTooLong`: the planned run is too long to be meant (a mounted
   mode so lightly damped that its transient would take days to decay).
@@ -20,9 +21,19 @@ The mechanism and equilibrium errors of :mod:`workbook.solve.preload` are
 """
 from __future__ import annotations
 
+import contextlib
+import io
+import logging
+import math
+import warnings
+
+from scipy.linalg import LinAlgWarning
+
 from workbook.errors import ResonanceError
 
-__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "UNDAMPED_RATIO", "MAX_STEPS"]
+__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "singular_solve_guard", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
+
+log = logging.getLogger(__name__)
 
 #: A mounted mode with a damping ratio below this counts as undamped (the
 #: linearisation of a scene without damping gives ratios of about 1e-15).
@@ -35,6 +46,27 @@ MAX_STEPS = 50_000_000
 def run_label(case_name: str, run_name: str) -> str:
     """How the messages name a run: ``case 'NAME', run 'NAME'``."""
     return f"case {case_name!r}, run {run_name!r}"
+
+
+@contextlib.contextmanager
+def solver_output():
+    """Capture what Exudyn prints (its banners, "SOLVER FAILED" boxes and
+    hints) instead of letting it reach stdout, where it would break
+    ``mountwb run --json``; the text goes to the debug log.
+
+    Yields
+    ------
+    io.StringIO
+        The captured text (complete once the ``with`` block has ended), for
+        an error's detail.
+    """
+    buffer = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buffer):
+            yield buffer
+    finally:
+        if buffer.getvalue().strip():
+            log.debug("Exudyn said:\n%s", buffer.getvalue().rstrip())
 
 
 def newton_cause(convergence) -> str:
@@ -62,11 +94,13 @@ def newton_cause(convergence) -> str:
 
 
 def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float, consequence: str) -> None:
-    """Stop if *frequency_hz* lies on (or, within *band*, next to) an undamped mounted mode.
+    """Stop if *frequency_hz* lies on (or, within *band*, next to) an undamped mode.
 
     Without damping the response at a natural frequency grows without bound,
     and next to it the free vibration never decays: there is no steady state
-    to report.
+    to report. Every mode counts, the engine's and the links' own alike: on
+    an undamped link mode the harmonic matrix is singular to round-off and
+    its solution is noise (measured: T of 1e5 to 1e11).
 
     Parameters
     ----------
@@ -75,7 +109,7 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
     frequency_hz : float
         Excitation frequency, Hz.
     modes : list of workbook.solve.modes.Mode
-        The mounted modes.
+        Every mode of the preloaded scene.
     band : float
         Relative distance ``|f / f_n - 1|`` within which the excitation counts
         as on the mode.
@@ -87,9 +121,46 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
     ResonanceError
     """
     for mode in modes:
-        if mode.damping_ratio < UNDAMPED_RATIO and abs(frequency_hz / mode.frequency_hz - 1.0) < band:
+        if (mode.frequency_hz > 0 and mode.damping_ratio < UNDAMPED_RATIO
+                and abs(frequency_hz / mode.frequency_hz - 1.0) < band):
+            kind = "mounted mode" if mode.mounted else "mode"
             raise ResonanceError(
                 f"{where}: the excitation at {frequency_hz:.6g} Hz is within {100 * band:.3g} % of the undamped "
-                f"mounted mode at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
+                f"{kind} at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
                 f"{mode.damping_ratio:.1e}): {consequence}. Give the hinges or links damping, or move the "
                 f"excitation frequency.")
+
+
+@contextlib.contextmanager
+def singular_solve_guard(where: str, frequency_hz: float, modes):
+    """Turn a harmonic solve that is singular to round-off (scipy's
+    ``LinAlgWarning``) into a :class:`ResonanceError` naming the mode nearest
+    to the excitation, instead of an answer that is noise.
+
+    Parameters
+    ----------
+    where : str
+        Case and run, for the message.
+    frequency_hz : float
+        Excitation frequency, Hz.
+    modes : list of workbook.solve.modes.Mode
+        Every mode of the preloaded scene.
+
+    Raises
+    ------
+    ResonanceError
+    """
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", LinAlgWarning)
+        try:
+            yield
+        except LinAlgWarning as warning:
+            def distance(mode) -> float:
+                return abs(frequency_hz / mode.frequency_hz - 1.0) if mode.frequency_hz > 0 else math.inf
+
+            nearest = min(modes, key=distance)
+            raise ResonanceError(
+                f"{where}: the harmonic solve at {frequency_hz:.6g} Hz is singular to round-off ({warning}): the "
+                f"excitation is {100 * distance(nearest):.2g} % from the mode at {nearest.frequency_hz:.6g} Hz "
+                f"({nearest.description}; damping ratio {nearest.damping_ratio:.1e}), and the answer would be "
+                f"noise. Give the hinges or links damping, or move the excitation frequency.") from None

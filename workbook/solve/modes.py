@@ -25,6 +25,7 @@ undamped gyroscopic system ``M x'' + G x' + K x = 0``: eigenvalues
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,8 +33,9 @@ import scipy.linalg as sla
 
 from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
+from workbook.solve.guards import solver_output
 
-__all__ = ["Linearization", "Mode", "linearize", "modes_of", "free_motions", "mounted_modes",
+__all__ = ["Linearization", "Mode", "linearize", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
            "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
 
 #: Modes below this frequency count as free motions (mechanisms), Hz. The
@@ -91,6 +93,10 @@ class Mode:
         largest component 1 in magnitude.
     body_shares : dict of str to float
         Share of the modal kinetic energy per body.
+    omega_squared : float
+        Signed squared circular frequency, rad^2/s^2: negative for a
+        direction in which the stiffness is negative (a buckling or tipping
+        mount), whose *frequency_hz* is then 0.
     """
 
     frequency_hz: float
@@ -98,6 +104,12 @@ class Mode:
     engine_share: float
     engine_shape: np.ndarray
     body_shares: dict
+    omega_squared: float = 0.0
+
+    @property
+    def mounted(self) -> bool:
+        """Most of the kinetic energy in the engine (:data:`ENGINE_SHARE`)."""
+        return self.engine_share >= ENGINE_SHARE
 
     @property
     def damping_ratio(self) -> float:
@@ -144,8 +156,9 @@ def linearize(scene: Scene) -> Linearization:
     settings = exu.SimulationSettings()
     settings.solution.file.write = False
     mbs = scene.mbs
-    matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
-                                           returnConstraintJacobian=True)
+    with solver_output():
+        matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
+                                               returnConstraintJacobian=True)
     mass, stiffness, damping = (np.asarray(m) for m in matrices[:3])
     size = mass.shape[0]
     if mbs.systemData.AEsize() > 0:
@@ -193,9 +206,19 @@ def _eigen(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
     return squared[order], vectors[:size, keep[order]]
 
 
-def modes_of(linearization: Linearization) -> list[Mode]:
-    """All modes of a linearisation, by ascending frequency."""
-    lin = linearization
+def modes_of(linearization: Linearization, *, gyroscopic: bool = True) -> list[Mode]:
+    """All modes of a linearisation, by ascending frequency.
+
+    Parameters
+    ----------
+    linearization : Linearization
+    gyroscopic : bool
+        False: the modes of ``K x = w^2 M x`` even with rotors built. Only
+        stiffness restrains a motion, so mechanisms and instabilities are
+        judged on these (a fast rotor drives its backward whirl towards
+        0 Hz although nothing is free).
+    """
+    lin = linearization if gyroscopic else dataclasses.replace(linearization, gyroscopic=None)
     squared_frequencies, vectors = _eigen(lin)
     modes = []
     for index, omega_squared in enumerate(squared_frequencies):
@@ -210,7 +233,7 @@ def modes_of(linearization: Linearization) -> list[Mode]:
         engine = _real_shape(full[lin.body_coordinates[ENGINE]])
         decay = float(np.real(np.conj(vector) @ lin.damping @ vector)) / (2 * kinetic)
         modes.append(Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), decay, shares[ENGINE],
-                          engine, {b: s for b, s in shares.items() if b != ENGINE}))
+                          engine, {b: s for b, s in shares.items() if b != ENGINE}, float(omega_squared)))
     return modes
 
 
@@ -240,11 +263,27 @@ def describe_engine_motion(shape: np.ndarray, length_scale: float = 1.0) -> str:
     return "engine " + " with ".join(parts)
 
 
+def _free_omega_squared() -> float:
+    return (2 * np.pi * FREE_FREQUENCY_HZ) ** 2
+
+
 def free_motions(modes: list[Mode]) -> list[Mode]:
-    """The modes below :data:`FREE_FREQUENCY_HZ`: free motions of a mechanism."""
-    return [mode for mode in modes if mode.frequency_hz < FREE_FREQUENCY_HZ]
+    """The modes with ``|w| < 2 pi`` :data:`FREE_FREQUENCY_HZ`: free motions of a mechanism."""
+    return [mode for mode in modes if abs(mode.omega_squared) < _free_omega_squared()]
+
+
+def unstable_modes(modes: list[Mode]) -> list[Mode]:
+    """The modes with negative stiffness beyond the free-motion limit
+    (``w^2 <= -(2 pi`` :data:`FREE_FREQUENCY_HZ` ``)^2``): the static state is unstable."""
+    return [mode for mode in modes if mode.omega_squared <= -_free_omega_squared()]
 
 
 def mounted_modes(modes: list[Mode]) -> list[Mode]:
-    """The engine's modes on its mount (most kinetic energy in the engine)."""
-    return [mode for mode in modes if mode.engine_share >= ENGINE_SHARE and mode.frequency_hz >= FREE_FREQUENCY_HZ]
+    """The engine's modes on its mount (most kinetic energy in the engine).
+
+    Every one with ``w^2 > 0``, however slow: free motions and negative
+    stiffness have stopped the run before (:mod:`workbook.solve.preload`,
+    judged without the gyroscopic coupling), so a slow mode here is real,
+    e.g. the backward whirl of a heavy fast rotor (0.016 Hz for
+    1e5 kg m^2 at 248.5 Hz on the reference mount)."""
+    return [mode for mode in modes if mode.mounted and mode.omega_squared > 0]

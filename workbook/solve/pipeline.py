@@ -28,7 +28,7 @@ from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
-from workbook.solve.guards import check_undamped_resonance, run_label
+from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
 from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
@@ -40,7 +40,7 @@ __all__ = ["PreparedScene", "prepare", "run_excitation", "solve_frequencies", "r
 
 log = logging.getLogger(__name__)
 
-#: Relative distance from an undamped mounted mode at which the harmonic
+#: Relative distance from an undamped mode at which the harmonic
 #: solution is refused (the dynamic matrix is singular on the mode).
 RESONANCE_BAND = 1e-6
 
@@ -158,7 +158,7 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
     prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
-    plan = plan_run(case.analysis, scene.excitation.signal, mounted, where=run_label(case.name, excitation.name))
+    plan = plan_run(case.analysis, scene.excitation.signal, prepared.modes, where=run_label(case.name, excitation.name))
     log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
     with timed(timings, "time integration"):
         if progress is None:
@@ -214,10 +214,12 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
     runs, cards, preloads = [], {}, {}
     try:
         for done, excitation in enumerate(points, start=1):
-            check_undamped_resonance(run_label(case.name, excitation.name), excitation.frequency, mounted,
+            where = run_label(case.name, excitation.name)
+            check_undamped_resonance(where, excitation.frequency, prepared.modes,
                                      RESONANCE_BAND, "the response grows without bound: no steady state exists")
             start = time.perf_counter()
-            result = model.result(excitation, case.analysis.steady_tolerance)
+            with singular_solve_guard(where, excitation.frequency, prepared.modes):
+                result = model.result(excitation, case.analysis.steady_tolerance)
             result.warnings.extend(link_warnings(case, prepared.scene.reduced))
             result.warnings.extend(linearised_gap_warnings(gaps, prepared.preload.hinge_forces,
                                                            result.hinge_amplitudes))

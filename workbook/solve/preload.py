@@ -4,10 +4,22 @@
    (near) zero frequency is a free motion and the run stops with
    :class:`MechanismError` naming it (a ball-jointed mount with a link
    missing is a mechanism, and a static solve would fail or return absurd
-   forces).
+   forces). Only stiffness restrains a motion, so the check solves
+   ``K x = w^2 M x`` without the rotors' gyroscopic coupling.
 2. The static loads are solved for (Newton, tolerance scaled to the loads),
-   and the solution becomes the initial state of the dynamic run.
-3. The pylon force - the vector sum of the pylon-side hinge forces, or of
+   and the solution becomes the initial state of the dynamic run. A solve
+   that fails is tried again in :data:`LOAD_STEPS` adaptive load steps; if
+   that fails too, :class:`EquilibriumError` says how much of the loads was
+   carried (a limit load: buckling or tipping) or that even a small share
+   was not (a stiffness beyond double precision), with Exudyn's own output
+   as its ``detail``.
+3. The scene is linearised again about the preloaded equilibrium, where the
+   loads add geometric stiffness (a compressed link pushes sideways as it
+   turns). A negative stiffness there stops the run with
+   :class:`UnstablePreloadError` (the preload buckles a link or tips the
+   mount) naming the motion, the loads and the compressed links; a free
+   motion there is a :class:`MechanismError` as in 1.
+4. The pylon force - the vector sum of the pylon-side hinge forces, or of
    the test-rig transducer forces when they are built - must equal the
    applied static loads (forces on the engine plus the weight of every body;
    the transducers carry no weight, see
@@ -17,16 +29,20 @@
 from __future__ import annotations
 
 import logging
+import re
 from dataclasses import dataclass
 
 import numpy as np
 
 from workbook.answers.isolation import pylon_sum
-from workbook.errors import EquilibriumError, MechanismError
-from workbook.scene.build import Scene
-from workbook.solve.modes import Mode, free_motions, linearize, modes_of
+from workbook.errors import EquilibriumError, MechanismError, UnstablePreloadError
+from workbook.model.case import ENGINE, Gravity, PointForce, PointMoment
+from workbook.scene.build import Scene, marker_bodies
+from workbook.solve.guards import solver_output
+from workbook.solve.modes import Mode, free_motions, linearize, modes_of, unstable_modes
 
-__all__ = ["Preload", "applied_static_force", "check_mechanism",
+__all__ = ["Preload", "applied_static_force", "check_mechanism", "check_preloaded_stability", "link_compression",
+           "static_failure_message", "LOAD_STEPS",
            "check_equilibrium", "solve_preload", "spring_roundoff_force", "ROUNDOFF_MARGIN"]
 
 log = logging.getLogger(__name__)
@@ -34,6 +50,12 @@ log = logging.getLogger(__name__)
 #: Newton tolerances stay this many times above the round-off of the stiffest
 #: spring's force (:func:`spring_roundoff_force`).
 ROUNDOFF_MARGIN = 10.0
+#: A static solve that fails in one step is tried again in this many
+#: (adaptive) load steps.
+LOAD_STEPS = 20
+#: A stepped static solve that failed beyond this share of the loads met a
+#: limit load (buckling or tipping); below it, Newton could not converge at all.
+LIMIT_LOAD_SHARE = 0.5
 
 
 @dataclass(frozen=True)
@@ -130,7 +152,12 @@ def check_mechanism(scene: Scene) -> list[Mode]:
     """
     # a clearance restrains once its gap closes: check with the gaps closed
     with scene.gaps_closed():
-        modes = modes_of(linearize(scene))
+        modes = modes_of(linearize(scene), gyroscopic=False)
+    _stop_on_free_motions(scene, modes)
+    return modes
+
+
+def _stop_on_free_motions(scene: Scene, modes: list[Mode]) -> None:
     free = free_motions(modes)
     if free:
         case = scene.case
@@ -139,6 +166,92 @@ def check_mechanism(scene: Scene) -> list[Mode]:
         loose = [f"link {link.name!r} eye {eye.upper()} at {getattr(link, 'end_' + eye)} m"
                  for link in case.links for eye in ("a", "b") if (link.name, eye) not in hinged]
         raise MechanismError(case.name, [mode.description for mode in free], loose)
+
+
+def link_compression(scene: Scene, forces: dict) -> dict[str, float]:
+    """Axial compression of every link from the hinge forces on its eyes, N
+    (negative: tension).
+
+    Parameters
+    ----------
+    scene : Scene
+    forces : dict of str to ndarray, shape (3,)
+        Force of each hinge on its marker-0 body (:meth:`Scene.hinge_forces`), N.
+    """
+    case = scene.case
+    compression = {link.name: 0.0 for link in case.links}
+    for hinge in case.hinges:
+        first = marker_bodies(hinge)[0]
+        for body in hinge.bodies:
+            if body not in compression:
+                continue
+            link = case.link_map[body]
+            axis = np.subtract(link.end_b, link.end_a) / np.linalg.norm(np.subtract(link.end_b, link.end_a))
+            on_link = forces[hinge.name] if body == first else -forces[hinge.name]
+            # eye a pushed towards b, or eye b towards a: compression (half from each eye)
+            sign = 1.0 if link.eye_at(hinge.position) == "a" else -1.0
+            compression[body] += 0.5 * sign * float(on_link @ axis)
+    return compression
+
+
+def _load_listing(scene: Scene) -> str:
+    parts = []
+    for load in scene.case.static_loads:
+        if isinstance(load, PointForce):
+            parts.append(f"{load.name!r} {np.linalg.norm(load.force):.4g} N along "
+                         f"{np.round(np.asarray(load.force) / np.linalg.norm(load.force), 3).tolist()}")
+        elif isinstance(load, PointMoment):
+            parts.append(f"{load.name!r} {np.linalg.norm(load.moment):.4g} N m")
+        elif isinstance(load, Gravity):
+            parts.append(f"{load.name!r} {np.linalg.norm(load.acceleration):.4g} m/s^2")
+    return ", ".join(parts)
+
+
+def check_preloaded_stability(scene: Scene, forces: dict) -> list[Mode]:
+    """Linearise the scene about its preloaded state (geometric stiffness of
+    the loads included) and stop if it is unstable or free there.
+
+    Parameters
+    ----------
+    scene : Scene
+        Solved for its preload (the initial state is the equilibrium).
+    forces : dict of str to ndarray
+        Its hinge forces (:meth:`Scene.hinge_forces`), N.
+
+    Returns
+    -------
+    list of Mode
+        The modes of ``K x = w^2 M x`` at the preload.
+
+    Raises
+    ------
+    UnstablePreloadError
+        A direction with negative stiffness: the preload buckles a link or
+        tips the mount.
+    MechanismError
+        A free motion at the preload.
+    """
+    modes = modes_of(linearize(scene), gyroscopic=False)
+    unstable = unstable_modes(modes)
+    if unstable:
+        case = scene.case
+        compressed = sorted(((force, name) for name, force in link_compression(scene, forces).items()
+                             if force > 0), reverse=True)
+        listing = "; ".join(
+            f"{mode.description} (w^2 = {mode.omega_squared:.4g} 1/s^2; kinetic energy in "
+            + ", ".join(f"{body} {100 * share:.0f} %" for body, share in
+                        sorted({ENGINE: mode.engine_share, **mode.body_shares}.items(),
+                               key=lambda item: -item[1]) if share >= 0.05) + ")"
+            for mode in unstable)
+        links = (", ".join(f"{name!r} {force / 1e3:.4g} kN" for force, name in compressed[:4])
+                 if compressed else "none")
+        raise UnstablePreloadError(
+            f"case {case.name!r}: the preload makes the mount unstable: at the preloaded equilibrium the "
+            f"stiffness is negative in {len(unstable)} direction(s): {listing}. The static loads "
+            f"({_load_listing(scene)}) buckle a compressed link or tip the mount; links in compression: "
+            f"{links}. Reduce or redirect the load, or stiffen or rearrange the links that carry it in "
+            f"compression.", [mode.omega_squared for mode in unstable])
+    _stop_on_free_motions(scene, modes)
     return modes
 
 
@@ -151,7 +264,9 @@ def solve_preload(scene: Scene) -> Preload:
     Raises
     ------
     MechanismError
-        The mount has a free motion.
+        The mount has a free motion, unloaded or at the preload.
+    UnstablePreloadError
+        The preloaded equilibrium is unstable.
     EquilibriumError
         The static solve failed, or the pylon force (pylon-side hinges or
         rig transducers) differs from the applied static loads by more than
@@ -176,20 +291,73 @@ def solve_preload(scene: Scene) -> Preload:
         # overshoots (a closed clearance gap) must not loosen it
         settings.staticSolver.newton.adaptInitialResidual = False
         settings.staticSolver.verboseMode = 0
-        try:
-            with scene.excitation_paused():
-                converged = scene.mbs.SolveStatic(settings, updateInitialValues=True)
-        except exu.SolverError as error:
-            raise EquilibriumError(f"case {case.name!r}: the static solve failed: {error}") from error
-        if not converged:
-            raise EquilibriumError(f"case {case.name!r}: the static solve did not converge "
-                                   f"(load scale {scene.load_scale:.4g} N)")
+        _solve_static(scene, settings)
     forces = scene.hinge_forces()
+    if case.effects.preload and scene.static_loads:
+        check_preloaded_stability(scene, forces)
     pylon = pylon_sum(forces, scene.pylon_channels)
     applied = applied_static_force(scene)
     mismatch = check_equilibrium(case.name, pylon, applied, tolerance, scene.load_scale)
     log.info("preload of %r: pylon force %s N, relative mismatch %.1e", case.name, np.round(pylon, 1), mismatch)
     return Preload(forces, pylon, applied, mismatch, bool(case.effects.preload and scene.static_loads))
+
+
+def _attempt(scene: Scene, settings) -> tuple[bool, str]:
+    """One static solve; whether it converged, and what Exudyn printed."""
+    import exudyn as exu
+
+    with solver_output() as output, scene.excitation_paused():
+        try:
+            converged = bool(scene.mbs.SolveStatic(settings, updateInitialValues=True))
+        except exu.SolverError:
+            converged = False
+    return converged, output.getvalue()
+
+
+def _solve_static(scene: Scene, settings) -> None:
+    """Solve the static loads: in one step, else in up to :data:`LOAD_STEPS`
+    adaptive load steps; if that fails too, say why in plain words."""
+    converged, said = _attempt(scene, settings)
+    if converged:
+        return
+    settings.staticSolver.numberOfLoadSteps = LOAD_STEPS
+    settings.staticSolver.verboseMode = 1        # reports the load factor reached
+    converged, stepped = _attempt(scene, settings)
+    if converged:
+        log.info("case %r: the static loads needed %d load steps", scene.case.name, LOAD_STEPS)
+        return
+    factors = re.findall(r"load factor = ([-+0-9.eE]+)", stepped)
+    reached = float(factors[-1]) if factors else 0.0
+    raise EquilibriumError(static_failure_message(scene, reached, settings.staticSolver.newton.absoluteTolerance),
+                           detail=said + stepped)
+
+
+def static_failure_message(scene: Scene, reached: float, tolerance: float) -> str:
+    """Why the static solve failed, in plain words, with advice.
+
+    Parameters
+    ----------
+    scene : Scene
+    reached : float
+        Largest share of the static loads for which Newton still converged
+        when they were applied in steps (0 to 1).
+    tolerance : float
+        Newton's absolute tolerance, N.
+    """
+    case = scene.case
+    stiffest = max(max(h.stiffness, h.gap_contact_stiffness) for h in case.hinges)
+    where = f"case {case.name!r}: the static solve failed"
+    if reached >= LIMIT_LOAD_SHARE:
+        return (f"{where}: applied in steps, the static loads ({_load_listing(scene)}) could be carried up to "
+                f"{100 * reached:.3g} % of their value and no further: there the mount reaches its limit load, "
+                f"where the preload buckles a compressed link or tips the mount. Reduce or redirect the loads, "
+                f"or stiffen or rearrange the links that carry them in compression.")
+    return (f"{where}: Newton's iteration did not converge even on {100 * reached:.2g} % of the static loads. "
+            f"Likely cause: a stiffness too large for double precision: the stiffest hinge has {stiffest:.3g} N/m, "
+            f"whose force is known only to {spring_roundoff_force(scene) / ROUNDOFF_MARGIN:.2g} N at these "
+            f"coordinates; summed over the mount this noise keeps the residual above Newton's tolerance "
+            f"({tolerance:.2g} N). Lower the stiffest hinge stiffnesses: a hinge far stiffer than the link it "
+            f"holds acts as rigid anyway (on the reference mount 1e12 N/m still solves, 1e13 N/m does not).")
 
 
 def check_equilibrium(case_name: str, pylon_force, applied_force, tolerance: float, load_scale: float) -> float:

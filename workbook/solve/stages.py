@@ -6,7 +6,9 @@ import time
 from contextlib import contextmanager
 from typing import Callable
 
+from flexbodies.selection import LOW_FREQUENCY_RATIO
 from workbook.model.case import Case
+from workbook.scene.build import scene_warnings
 
 __all__ = ["ProgressFactory", "timed", "link_warnings"]
 
@@ -26,7 +28,20 @@ def timed(timings: dict, stage: str):
 
 
 def link_warnings(case: Case, reduced: dict) -> list[str]:
-    """Warnings of the flexible links whose mode selection is unsafe at the
-    run's excitation (``flexbodies.ModeDecision.warning``)."""
-    return [f"link {name!r}: {link.decision.warning}" for name, link in reduced.items()
-            if case.link_is_flexible(name) and link.decision.warning]
+    """Warnings of the links whose model is unsafe at the run's excitation:
+    flexible links whose mode selection is (``flexbodies.ModeDecision.warning``),
+    and rigid links excited as high as that (their own dynamics are missing
+    as well), plus the scene's own warnings (:func:`workbook.scene.build.scene_warnings`)."""
+    warnings = []
+    for name, link in reduced.items():
+        decision = link.decision
+        if not decision.warning:
+            continue
+        if case.link_is_flexible(name):
+            warnings.append(f"link {name!r}: {decision.warning}")
+        else:
+            warnings.append(f"link {name!r} is rigid although the excitation {decision.excitation_hz:g} Hz is "
+                            f"{decision.ratio:.2f} of its mounted fundamental {decision.fundamental_hz:.0f} Hz "
+                            f"(a link without its own modes needs < {LOW_FREQUENCY_RATIO}): its own dynamics are "
+                            f"missing; make it flexible")
+    return warnings + scene_warnings(case)

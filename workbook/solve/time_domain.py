@@ -3,7 +3,11 @@
 The plan (all whole excitation periods):
 
 - step: one period / ``steps_per_period`` (the highest excitation frequency of
-  the run sets it; 40 steps per period or more);
+  the run sets it; 40 steps per period or more). Its accuracy is known, not
+  hoped for: :mod:`workbook.solve.step_accuracy` gives the integrator's
+  steady amplitude error on every mode of the preloaded scene; the largest
+  is on the model card, and above :data:`~workbook.solve.step_accuracy.ACCURACY_LIMIT` the result warns
+  with the steps per period that would meet it;
 - ramp: the excitation rises smoothly over ``ramp_periods`` periods;
 - settle: ``settle_time_constants`` decay time constants ``1 / (zeta w)`` of
   the least damped mounted mode (or a fixed ``settle_time``); undamped modes
@@ -47,8 +51,9 @@ from workbook.errors import DivergenceError, NewtonFailure, RunTooLong, TimeBudg
 from workbook.model.case import AnalysisSettings
 from workbook.scene.build import Scene
 from workbook.scene.excitation import ExcitationSignal
-from workbook.solve.guards import MAX_STEPS, UNDAMPED_RATIO, check_undamped_resonance, newton_cause, run_label
-from workbook.solve.modes import Mode
+from workbook.solve.guards import MAX_STEPS, UNDAMPED_RATIO, check_undamped_resonance, newton_cause, run_label, solver_output
+from workbook.solve.modes import Mode, mounted_modes
+from workbook.solve.step_accuracy import ACCURACY_LIMIT, ACCURACY_TARGET, amplitude_error, steps_for_accuracy
 
 __all__ = ["TimePlan", "plan_run", "integrate", "extract", "TimeHistories", "TRANSIENT_SEGMENTS"]
 
@@ -78,6 +83,14 @@ class TimePlan:
     undamped_hz : tuple of float
         Mounted modes without damping, Hz: their free vibration started by
         the ramp never decays.
+    amplitude_error : float
+        The integrator's estimated steady amplitude error, relative
+        (:func:`workbook.solve.step_accuracy.amplitude_error`).
+    error_source : str
+        The mode it is largest on.
+    steps_needed : int
+        Steps per period that keep it within
+        :data:`~workbook.solve.step_accuracy.ACCURACY_TARGET`.
     """
 
     frequency_hz: float
@@ -88,6 +101,9 @@ class TimePlan:
     measured_periods: int
     settle_reason: str
     undamped_hz: tuple = ()
+    amplitude_error: float = 0.0
+    error_source: str = ""
+    steps_needed: int = 0
 
     @property
     def periods(self) -> int:
@@ -118,7 +134,7 @@ class TimePlan:
         return segments + [(transient * self.steps_per_period, self.steps, True)]
 
 
-def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, mounted: list[Mode], where: str = "run"
+def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, modes: list[Mode], where: str = "run"
              ) -> TimePlan:
     """Choose the step and the durations of a run.
 
@@ -126,24 +142,26 @@ def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, mounted: list
     ----------
     analysis : AnalysisSettings
     signal : ExcitationSignal
-    mounted : list of Mode
-        The mounted modes of the preloaded scene; the least damped one sets
-        the settle time unless the settings fix it.
+    modes : list of Mode
+        The modes of the preloaded scene: the least damped mounted one sets
+        the settle time unless the settings fix it; every one counts for the
+        resonance check and the integrator's accuracy.
     where : str
         Case and run, for error messages.
 
     Raises
     ------
     ResonanceError
-        The excitation lies on an undamped mounted mode, closer than the
+        The excitation lies on an undamped mode, closer than the
         measured window can tell apart (1 / ``measured_periods``).
     RunTooLong
         The plan has more than :data:`workbook.solve.guards.MAX_STEPS` steps.
     """
     frequency = signal.frequency_hz
     period = 1.0 / frequency
+    mounted = mounted_modes(modes)
     check_undamped_resonance(
-        where, frequency, mounted, 1.0 / analysis.measured_periods,
+        where, frequency, modes, 1.0 / analysis.measured_periods,
         f"the free vibration started by the ramp never decays, and a {analysis.measured_periods}-period window "
         f"cannot tell it from the response (on the mode itself the response grows without bound)")
     damped = [m for m in mounted if m.damping_ratio >= UNDAMPED_RATIO]
@@ -159,9 +177,14 @@ def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, mounted: list
         settle = analysis.settle_time_constants / slowest.decay_rate
         reason = (f"{analysis.settle_time_constants:g} x 1/(zeta w) = {settle:.3g} s of the least damped "
                   f"mounted mode ({slowest.frequency_hz:.3g} Hz, zeta {slowest.damping_ratio:.3g})")
+    error, worst = amplitude_error(modes, frequency, analysis.steps_per_period, analysis.spectral_radius)
+    source = "" if worst is None else (f"the mode at {worst.frequency_hz:.4g} Hz, zeta {worst.damping_ratio:.3g} "
+                                       f"({worst.description})")
+    needed = steps_for_accuracy(modes, frequency, analysis.steps_per_period, analysis.spectral_radius,
+                                ACCURACY_TARGET)
     plan = TimePlan(frequency, period / analysis.steps_per_period, analysis.steps_per_period,
                     math.ceil(analysis.ramp_periods - 1e-9), math.ceil(settle * frequency - 1e-9),
-                    analysis.measured_periods, reason, undamped)
+                    analysis.measured_periods, reason, undamped, error, source, needed)
     if plan.steps > MAX_STEPS:
         raise RunTooLong(f"{where}: the plan needs {plan.steps:.3g} time steps ({plan.end_time:.3g} s simulated; "
                          f"settle time: {reason}), more than {MAX_STEPS:.0e}. Add damping, set a fixed settle time "
@@ -196,7 +219,10 @@ def _simulation_settings(scene: Scene, plan: TimePlan):
     analysis = scene.case.analysis
     settings = exu.SimulationSettings()
     settings.solution.file.write = False
-    settings.solution.sensors.writePeriod = plan.step
+    # one sample per step: a write period of exactly one step skips a sample
+    # when the accumulated time falls a round-off short of the next write
+    # (measured: once in 320000 steps at 248.5 Hz); half a step never does
+    settings.solution.sensors.writePeriod = 0.5 * plan.step
     integration = settings.timeIntegration
     integration.verboseMode = 0
     # a failed segment is re-run by integrate() with a halved step; Exudyn's own
@@ -230,7 +256,9 @@ def _solve_segment(scene: Scene, settings, plan: TimePlan, first: int, last: int
         integration.startTime, integration.endTime = start, end
         integration.numberOfSteps = (last - first) * 2 ** halving
         solver = exu.MainSolverImplicitSecondOrder()
-        if solver.SolveSystem(scene.mbs, settings):
+        with solver_output():
+            solved = solver.SolveSystem(scene.mbs, settings)
+        if solved:
             _advance_initial_state(scene.mbs)
             if halving:
                 retries.append(f"{start:.6g} to {end:.6g} s: step halved {halving} time(s) to "
@@ -326,6 +354,13 @@ def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> Excitatio
             f"not steady: the pylon-force amplitudes of the last two {plan.measured_periods}-period windows "
             f"differ by {100 * steady.relative_change:.2f} % (> {100 * analysis.steady_tolerance:.2g} %); "
             f"lengthen the settle time or check the damping")
+        log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
+    if plan.amplitude_error > ACCURACY_LIMIT:
+        warnings.append(
+            f"time step too coarse: at {plan.steps_per_period} steps per period the integrator's period error "
+            f"puts the answer about {100 * plan.amplitude_error:.3g} % off on {plan.error_source}; "
+            f"{plan.steps_needed} steps per period keep it below {100 * ACCURACY_TARGET:g} % (or answer "
+            f"a linear scene in the frequency domain)")
         log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     if plan.undamped_hz:
         warnings.append(
