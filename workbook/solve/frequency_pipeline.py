@@ -70,6 +70,8 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *, reduce_for=Non
         The excitation whose frequency the link reductions must serve.
     reduced : dict, optional
         Reduced links to use (skips the reduction).
+
+    The caller closes the prepared scene (``with prepared.scene:``) when done.
     """
     timings = {}
     with timed(timings, "reduce links"):
@@ -77,12 +79,16 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *, reduce_for=Non
             reduced = reduce_links(case, reduce_for or excitation)
     with timed(timings, "build scene"):
         scene = build_scene(case, excitation, reduced=reduced)
-    with timed(timings, "static preload"):
-        preload = solve_preload(scene)
-    with timed(timings, "linearisation"):
-        model = harmonic_model(scene)
-    with timed(timings, "mounted modes"):
-        modes = modes_of(model.linearization)
+    try:
+        with timed(timings, "static preload"):
+            preload = solve_preload(scene)
+        with timed(timings, "linearisation"):
+            model = harmonic_model(scene)
+        with timed(timings, "mounted modes"):
+            modes = modes_of(model.linearization)
+    except BaseException:
+        scene.close()
+        raise
     return PreparedScene(scene, preload, model, modes, timings)
 
 
@@ -162,7 +168,8 @@ def run_case_frequency(case: Case, method: Union[MethodChoice, None] = None, *,
     for item in case.excitations:
         points = item.expand() if isinstance(item, Sweep) else (item,)
         prepared = prepare(case, points[0], reduce_for=points[-1])
-        item_runs, item_cards, item_preloads = results_of(case, prepared, points, method, progress=progress)
+        with prepared.scene:  # frees Exudyn's system, which dropping the scene does not
+            item_runs, item_cards, item_preloads = results_of(case, prepared, points, method, progress=progress)
         runs += item_runs
         cards.update(item_cards)
         preloads.update(item_preloads)

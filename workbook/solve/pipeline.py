@@ -66,26 +66,27 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 close()
     with timed(timings, "build scene"):
         scene = build_scene(case, excitation, reduced=reduced)
-    with timed(timings, "static preload"):
-        preload = solve_preload(scene)
-    with timed(timings, "mounted modes"):
-        mounted = mounted_modes(modes_of(linearize(scene)))
-    plan = plan_run(case.analysis, scene.excitation.signal, mounted,
-                    where=run_label(case.name, excitation.name))
-    log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
-    with timed(timings, "time integration"):
-        if progress is None:
-            histories = integrate(scene, plan)
-        else:
-            update, close = progress(f"{excitation.name} ({excitation.frequency:g} Hz)", plan.end_time)
-            try:
-                histories = integrate(scene, plan, update)
-            finally:
-                close()
-    with timed(timings, "amplitude extraction"):
-        result = extract(scene, plan, histories)
-    result.warnings.extend(link_warnings(case, reduced))
-    card = model_card(scene, preload, mounted, plan, timings, method)
+    with scene:  # frees Exudyn's system, which dropping the scene does not
+        with timed(timings, "static preload"):
+            preload = solve_preload(scene)
+        with timed(timings, "mounted modes"):
+            mounted = mounted_modes(modes_of(linearize(scene)))
+        plan = plan_run(case.analysis, scene.excitation.signal, mounted,
+                        where=run_label(case.name, excitation.name))
+        log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
+        with timed(timings, "time integration"):
+            if progress is None:
+                histories = integrate(scene, plan)
+            else:
+                update, close = progress(f"{excitation.name} ({excitation.frequency:g} Hz)", plan.end_time)
+                try:
+                    histories = integrate(scene, plan, update)
+                finally:
+                    close()
+        with timed(timings, "amplitude extraction"):
+            result = extract(scene, plan, histories)
+        result.warnings.extend(link_warnings(case, reduced))
+        card = model_card(scene, preload, mounted, plan, timings, method)
     card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
     return result, card, preload
 
