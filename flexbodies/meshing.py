@@ -408,12 +408,13 @@ def _gmsh_model(name: str):
 
 
 def _restore_python_signal_handlers() -> None:
-    """Put Python's handlers of SIGINT and SIGTERM back: gmsh's initialisation
-    replaces the SIGTERM handler with the default one (the process dies at
-    once, skipping every clean-up), which a program's own handler must survive."""
+    """Put Python's handlers of SIGINT, SIGTERM and SIGPIPE back: gmsh's
+    initialisation sets the default ones, so that SIGTERM killed the process at
+    once, skipping every clean-up, and a write to a closed pipe (a stopped
+    worker process's) killed it too, where Python ignores SIGPIPE."""
     if threading.current_thread() is not threading.main_thread():
         return  # handlers can only be set, and only run, in the main thread
-    for signum in (signal.SIGINT, signal.SIGTERM):
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGPIPE):
         handler = signal.getsignal(signum)
         if handler is not None:
             signal.signal(signum, handler)
