@@ -147,3 +147,17 @@ def test_resuming_from_the_table_of_another_study_is_refused(tmp_path):
     with pytest.raises(UsageError, match="its columns are"):
         read_finished(path, ({"hinge_damping": 1e3}, {"hinge_damping": 2e3}))
     assert read_finished(tmp_path / "none.csv", rows) == {}
+
+
+@pytest.mark.slow
+def test_workers_end_when_the_study_is_killed_outright(case_file, tmp_path):
+    output = tmp_path / "out"
+    process = _study(case_file, output, "--workers", "2")
+    _wait(lambda: len(_table(output)) >= 1, what="a finished row")
+    workers = [worker.pid for worker in _workers(process.pid)]
+    assert workers
+    process.kill()                                    # SIGKILL: the study cannot stop its workers itself
+    process.communicate()
+    _wait(lambda: not alive(workers), timeout=60, what="the orphaned workers to end")
+    table = _table(output)
+    assert len(table) >= 1 and set(table["status"]) == {"ok"}

@@ -17,7 +17,8 @@ Faults (local processes):
   failed with the reason. Rows not started yet simply run in a new pool.
 - An interrupt (Ctrl-C, or SIGTERM raised as :class:`workbook.errors.Terminated`)
   stops every worker process of the study before it propagates; workers
-  ignore Ctrl-C themselves, so only the parent decides.
+  ignore Ctrl-C themselves, so only the parent decides. A worker whose
+  parent was killed outright (SIGKILL) ends within :data:`PARENT_CHECK_INTERVAL`.
 
 Every finished row is handed to ``record`` at once (the study table is
 written as rows finish), so an interrupt loses only the rows in flight.
@@ -28,6 +29,7 @@ import logging
 import multiprocessing
 import os
 import signal
+import threading
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -53,6 +55,8 @@ SERIAL = 1
 ROWS_PER_WORKER = 200
 #: Seconds a worker process gets to end after SIGTERM before it is killed.
 WORKER_STOP_TIMEOUT = 5.0
+#: Seconds between a worker's checks that its parent still lives.
+PARENT_CHECK_INTERVAL = 1.0
 
 
 @dataclass
@@ -230,10 +234,18 @@ _started = None
 
 
 def _worker_init(started) -> None:
-    """Set up a worker: Ctrl-C is the parent's to handle (it stops the workers)."""
+    """Set up a worker: Ctrl-C is the parent's to handle (it stops the workers),
+    and the worker ends when its parent is gone (killed with no chance to stop it)."""
     global _started
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _started = started
+    threading.Thread(target=_end_with_parent, args=(os.getppid(),), daemon=True).start()
+
+
+def _end_with_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_CHECK_INTERVAL)
+    os._exit(1)
 
 
 def _reported_row(index: int, case: Case) -> RowOutcome:
