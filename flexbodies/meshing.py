@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import logging
 import math
+import signal
 import threading
 from dataclasses import dataclass
 from pathlib import Path
@@ -384,6 +385,7 @@ def _gmsh_model(name: str):
         owner = not gmsh.isInitialized()
         if owner:
             gmsh.initialize(readConfigFiles=False, interruptible=False)
+            _restore_python_signal_handlers()
         previous = None if owner else gmsh.model.getCurrent()
         try:
             gmsh.option.setNumber("General.Terminal", 0)
@@ -403,6 +405,19 @@ def _gmsh_model(name: str):
                 gmsh.finalize()
             elif previous:
                 gmsh.model.setCurrent(previous)
+
+
+def _restore_python_signal_handlers() -> None:
+    """Put Python's handlers of SIGINT, SIGTERM and SIGPIPE back: gmsh's
+    initialisation sets the default ones, so that SIGTERM killed the process at
+    once, skipping every clean-up, and a write to a closed pipe (a stopped
+    worker process's) killed it too, where Python ignores SIGPIPE."""
+    if threading.current_thread() is not threading.main_thread():
+        return  # handlers can only be set, and only run, in the main thread
+    for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGPIPE):
+        handler = signal.getsignal(signum)
+        if handler is not None:
+            signal.signal(signum, handler)
 
 
 def _build_link_solid(g: LinkGeometry) -> None:

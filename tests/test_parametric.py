@@ -9,7 +9,7 @@ import pytest
 
 from workbook.cli.main import main
 from workbook.cli.params import parse_vary
-from workbook.errors import CaseError
+from workbook.errors import EXIT_FAILED_ROWS, CaseError
 from workbook.model.case import AnalysisSettings
 from workbook.model.codec import to_json
 from workbook.model.reference import HINGE_STIFFNESS, LP_ROTOR, reference_case
@@ -106,7 +106,7 @@ def test_dask_cluster_equals_local(base, rows, serial, tmp_path):
     argv = ["study", "params", str(case_file), "--output", str(tmp_path / "out")]
     argv += [f"--vary=hinge_stiffness={','.join(map(str, STIFFNESS))}", f"--vary=removed_link={','.join(REMOVED)}"]
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
-        assert main(argv + ["--dask", cluster.scheduler_address]) == 0
+        assert main(argv + ["--dask", cluster.scheduler_address]) == EXIT_FAILED_ROWS  # stiffness 0, link removed
     table = pd.read_csv(tmp_path / "out" / "parameter-study.csv")
     expected = _answers(serial)
     for column in expected:

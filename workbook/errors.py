@@ -10,7 +10,9 @@ Two kinds, each with its command-line exit code (:func:`exit_code`):
   damping, a failed or diverging integration, an exhausted time budget. The
   message says when and why, in plain words.
 
-An interrupt (Ctrl-C) exits with 130.
+An interrupt exits with 130 (Ctrl-C, SIGINT) or 143 (SIGTERM,
+:class:`Terminated`); a parameter study whose every row ran but some failed
+exits with 3 (:data:`EXIT_FAILED_ROWS`).
 """
 from __future__ import annotations
 
@@ -21,10 +23,15 @@ from typing import Any
 __all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
            "MechanismError", "EquilibriumError", "UnstablePreloadError", "UsageError", "BAD_INPUT", "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
-           "EXIT_INTERRUPTED", "exit_code"]
+           "EXIT_INTERRUPTED", "EXIT_TERMINATED", "EXIT_FAILED_ROWS", "Terminated", "interruption", "exit_code"]
 
 #: Exit codes of the command line.
-EXIT_OK, EXIT_TROUBLE, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_TROUBLE, EXIT_BAD_INPUT, EXIT_FAILED_ROWS, EXIT_INTERRUPTED, EXIT_TERMINATED = 0, 1, 2, 3, 130, 143
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C's KeyboardInterrupt so that everything
+    that cleans up after Ctrl-C cleans up after it too."""
 
 
 class CaseError(ValueError):
@@ -238,18 +245,42 @@ class UsageError(ValueError):
 BAD_INPUT = (CaseError, UnitProblem, WorkbookError, RecordError, UsageError)
 
 
+def interruption(error: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt behind *error*, if any.
+
+    Exudyn turns a KeyboardInterrupt raised while it solves into an error of
+    its own (``SystemError`` "returned a result with an exception set", or
+    ``ModelError`` from a Python user function) whose cause or context is
+    the interrupt; this finds it.
+
+    Returns
+    -------
+    KeyboardInterrupt or None
+        *error* itself, the interrupt in its chain of causes, or None.
+    """
+    seen = set()
+    while error is not None and id(error) not in seen:
+        if isinstance(error, KeyboardInterrupt):
+            return error
+        seen.add(id(error))
+        error = error.__cause__ or error.__context__
+    return None
+
+
 def exit_code(error: BaseException) -> int:
     """The command-line exit code of *error*: 1 numerical trouble, 2 bad input
     (also a file that cannot be read, :class:`OSError`, and a link model
-    that :mod:`flexbodies` refuses, :class:`ValueError`), 130 interrupted.
+    that :mod:`flexbodies` refuses, :class:`ValueError`), 130 interrupted,
+    143 terminated (also when Exudyn wrapped the interrupt, :func:`interruption`).
 
     Raises
     ------
     TypeError
         *error* is none of these: a defect of the package, not of the input.
     """
-    if isinstance(error, KeyboardInterrupt):
-        return EXIT_INTERRUPTED
+    interrupt = interruption(error)
+    if interrupt is not None:
+        return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
     if isinstance(error, SimulationError):
         return EXIT_TROUBLE
     if isinstance(error, BAD_INPUT + (ValueError, OSError)):

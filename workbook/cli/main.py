@@ -2,19 +2,22 @@
 
 One module per command (``workbook.cli.<command>``); each has a function
 that adds the command's arguments to its parser and returns the handler.
-Exit codes (:mod:`workbook.errors`): 0 done, 1 numerical trouble, 2 bad
-input (nothing written), 130 interrupted (Ctrl-C).
+Exit codes (:mod:`workbook.errors`, ``docs/reliability.md``): 0 done, 1
+numerical trouble, 2 bad input (nothing written), 3 a parameter study with
+failed rows, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM). An interrupt
+or SIGTERM anywhere prints one line, no traceback.
 """
 from __future__ import annotations
 
 import argparse
 import logging
+import signal
 import sys
 
 from threadpoolctl import threadpool_limits
 
 from workbook.cli import cache, layout, links, rig, run, study, workbooks
-from workbook.errors import EXIT_INTERRUPTED, SimulationError, exit_code
+from workbook.errors import SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
 
@@ -46,8 +49,29 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _terminate(signum, frame):
+    raise Terminated()
+
+
+def _interrupted(command: str, interrupt: KeyboardInterrupt) -> int:
+    """Print the one line of an interrupt and return its exit code."""
+    how = "terminated (SIGTERM)" if isinstance(interrupt, Terminated) else "interrupted (Ctrl-C)"
+    detail = f": {interrupt}" if str(interrupt) else "; no file was changed"
+    print(f"mountwb {command}: {how}{detail}", file=sys.stderr)
+    return exit_code(interrupt)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mountwb`` console script; returns the exit code."""
+    # SIGTERM unwinds like Ctrl-C: temporary files are removed, study workers stopped.
+    previous = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        return _main(argv)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _main(argv: list[str] | None) -> int:
     # Multithreaded BLAS made the small dense solves of a run many times slower on 2 cores.
     threadpool_limits(limits=1)
     args = build_parser().parse_args(argv)
@@ -55,10 +79,12 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.handler(args)
-    except KeyboardInterrupt:
-        print(f"mountwb {args.command}: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
-    except (SimulationError, ValueError, OSError) as error:
+    except BaseException as error:
+        interrupt = interruption(error)  # also when Exudyn wrapped it into an error of its own
+        if interrupt is not None:
+            return _interrupted(args.command, interrupt)
+        if not isinstance(error, (SimulationError, ValueError, OSError)):
+            raise
         trouble = "numerical trouble: " if isinstance(error, SimulationError) else ""
         print(f"mountwb {args.command}: {trouble}{error}", file=sys.stderr)
         return exit_code(error)

@@ -8,6 +8,11 @@ bounds ``low:high`` and the rows are N samples of a Latin hypercube. Runs go
 to local processes (``--workers``, default: every core) or to the Dask
 scheduler at ``--dask ADDRESS``; the table (CSV or Parquet, and a sheet) and
 the sensitivity plot go to ``--output``.
+
+The table file is rewritten as each row finishes, so an interrupted study
+keeps every finished row; ``--resume`` runs only the rows the table does not
+hold. A study whose rows all ran but some failed exits with
+:data:`workbook.errors.EXIT_FAILED_ROWS` after a summary line.
 """
 from __future__ import annotations
 
@@ -16,7 +21,7 @@ import os
 import sys
 
 from workbook.cli.loading import load_case
-from workbook.errors import UsageError
+from workbook.errors import EXIT_FAILED_ROWS, EXIT_OK, UsageError
 
 __all__ = ["add_arguments", "run_parameter_study", "parse_vary"]
 
@@ -36,6 +41,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dask", metavar="ADDRESS", help="run on the Dask scheduler at ADDRESS instead")
     parser.add_argument("--format", choices=TABLE_FORMATS, default="csv", help="table file format (csv)")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the rows the table in --output already holds and run only the missing ones")
 
 
 def _value(text: str, numeric: bool):
@@ -79,7 +86,18 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
 
 
 def run_parameter_study(args) -> int:
-    """Run ``study params``; print the table and the files written."""
+    """Run ``study params``; print the table, a summary line and the files written.
+
+    Returns
+    -------
+    int
+        0, or :data:`workbook.errors.EXIT_FAILED_ROWS` when some rows failed.
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Ctrl-C or SIGTERM, with the number of finished rows kept in the table as its message.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -87,20 +105,30 @@ def run_parameter_study(args) -> int:
 
     from workbook.studies.parallel import run_rows
     from workbook.studies.parametric import study_cases
-    from workbook.studies.sensitivity import study_frame, write_study
+    from workbook.studies.sensitivity import StudyTable, read_finished, table_path, write_study
 
     rows = parse_vary(args.vary, args.lhs, args.seed)
     case = load_case(args.case, run=args.run, rigid=args.rigid)
+    path = table_path(args.output, args.format)
+    finished = read_finished(path, rows) if args.resume else {}
+    table = StudyTable(path, rows, finished)
     where = f"Dask scheduler {args.dask}" if args.dask else f"{args.workers} local process(es)"
-    print(f"{case.name}: {len(rows)} study rows on {where}", file=sys.stderr)
-    with tqdm(total=len(rows), desc="study rows", file=sys.stderr, disable=None) as bar:
-        outcomes = run_rows(study_cases(case, rows), workers=args.workers, dask=args.dask,
-                            progress=lambda done, total: bar.update(done - bar.n))
-    frame = study_frame(rows, outcomes)
+    kept = f" ({len(finished)} already in {path})" if args.resume else ""
+    print(f"{case.name}: {len(rows)} study rows{kept} on {where}", file=sys.stderr)
+    try:
+        with tqdm(total=len(rows), desc="study rows", file=sys.stderr, disable=None) as bar:
+            outcomes = run_rows(study_cases(case, rows), workers=args.workers, dask=args.dask, finished=finished,
+                                record=table.add, progress=lambda done, total: bar.update(done - bar.n))
+    except KeyboardInterrupt as interrupt:
+        raise type(interrupt)(f"{len(table.outcomes)} of {len(rows)} rows finished and kept in {path}; "
+                              f"--resume runs the rest") from None
+    frame = table.frame()
     print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}"))
-    for outcome in outcomes:
-        if outcome.status != "ok":
-            print(f"row {outcome.index} failed: {outcome.error}")
-    for path in write_study(frame, list(rows[0]) if rows else [], args.output, args.format):
-        print(path)
-    return 0
+    failed = [outcome for outcome in outcomes if outcome.status != "ok"]
+    for outcome in failed:
+        print(f"row {outcome.index} failed: {outcome.error}")
+    for written in write_study(frame, list(rows[0]) if rows else [], args.output, args.format):
+        print(written)
+    print(f"{len(rows) - len(failed)} of {len(rows)} rows ok, {len(failed)} failed"
+          + (f" (rows {', '.join(str(o.index) for o in failed)}; exit code {EXIT_FAILED_ROWS})" if failed else ""))
+    return EXIT_FAILED_ROWS if failed else EXIT_OK

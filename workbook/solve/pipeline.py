@@ -103,6 +103,9 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
     ------
     workbook.errors.SimulationError
         A mechanism or a failed equilibrium.
+
+    The caller closes the prepared scene (``with prepared.scene:``) when done:
+    dropping a scene does not free Exudyn's system.
     """
     timings: dict[str, float] = {}
     with timed(timings, "reduce links"):
@@ -110,14 +113,18 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
             reduced = _reduce(case, excitation, reduce_for or excitation, progress)
     with timed(timings, "build scene"):
         scene = build_scene(case, excitation, reduced=reduced)
-    with timed(timings, "static preload"):
-        preload = solve_preload(scene)
-    model = None
-    if harmonic:
-        with timed(timings, "linearisation"):
-            model = harmonic_model(scene)
-    with timed(timings, "mounted modes"):
-        modes = modes_of(model.linearization if model else linearize(scene))
+    try:
+        with timed(timings, "static preload"):
+            preload = solve_preload(scene)
+        model = None
+        if harmonic:
+            with timed(timings, "linearisation"):
+                model = harmonic_model(scene)
+        with timed(timings, "mounted modes"):
+            modes = modes_of(model.linearization if model else linearize(scene))
+    except BaseException:
+        scene.close()
+        raise
     return PreparedScene(scene, preload, modes, model, timings)
 
 
@@ -158,21 +165,23 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
     prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
-    plan = plan_run(case.analysis, scene.excitation.signal, prepared.modes, where=run_label(case.name, excitation.name))
-    log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
-    with timed(timings, "time integration"):
-        if progress is None:
-            histories = integrate(scene, plan)
-        else:
-            update, close = progress(f"{excitation.name} ({excitation.frequency:g} Hz)", plan.end_time)
-            try:
-                histories = integrate(scene, plan, update)
-            finally:
-                close()
-    with timed(timings, "amplitude extraction"):
-        result = extract(scene, plan, histories)
-    result.warnings.extend(link_warnings(case, scene.reduced))
-    card = model_card(scene, prepared.preload, mounted, plan, timings, method)
+    with scene:
+        plan = plan_run(case.analysis, scene.excitation.signal, prepared.modes,
+                        where=run_label(case.name, excitation.name))
+        log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
+        with timed(timings, "time integration"):
+            if progress is None:
+                histories = integrate(scene, plan)
+            else:
+                update, close = progress(f"{excitation.name} ({excitation.frequency:g} Hz)", plan.end_time)
+                try:
+                    histories = integrate(scene, plan, update)
+                finally:
+                    close()
+        with timed(timings, "amplitude extraction"):
+            result = extract(scene, plan, histories)
+        result.warnings.extend(link_warnings(case, scene.reduced))
+        card = model_card(scene, prepared.preload, mounted, plan, timings, method)
     card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
     return result, card, prepared.preload
 
@@ -261,8 +270,9 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
         chosen = method or choose_method(case, sweep=isinstance(item, Sweep))
         if chosen.method == FREQUENCY:
             prepared = prepare(case, points[0], reduce_for=points[-1], progress=progress)
-            item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
-                                                                     progress=progress)
+            with prepared.scene:
+                item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
+                                                                         progress=progress)
         else:
             item_runs, item_cards, item_preloads = [], {}, {}
             for excitation in points:

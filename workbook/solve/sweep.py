@@ -152,6 +152,7 @@ def run_sweep(case: Case, sweep: Sweep, *, reduced=None) -> SweepAnswer:
     prepared = prepare(case, points[0], reduce_for=points[-1], reduced=reduced)
     method = MethodChoice(FREQUENCY, "a sweep runs in the frequency domain: one linearisation serves "
                                        "every frequency")
-    runs, cards, preloads = solve_frequencies(case, prepared, points, method)
+    with prepared.scene:
+        runs, cards, preloads = solve_frequencies(case, prepared, points, method)
     return SweepAnswer(sweep, MountResult(case.name, runs, cards, preloads),
                        modes_in_band(prepared.modes, sweep.frequencies_hz[-1]))

@@ -5,34 +5,58 @@ model once (:func:`prepare`), so the disk cache of :mod:`flexbodies`
 (``$MOUNTWB_CACHE``, which workers must share) holds every reduction before
 a run starts: workers only load, and no two processes ever write the same
 cache file. The same function, :func:`run_row`, then runs one row anywhere;
-it never raises: a failing row comes back with its error while the others
-complete. Results come back in row order and are the same whichever way
-they ran (BLAS is single-threaded inside every run).
+it never raises for a row's own trouble: a failing row comes back with its
+error while the others complete. Results are the same whichever way they
+ran (BLAS is single-threaded inside every run).
+
+Faults (local processes):
+
+- A worker process that dies (killed, out of memory) takes its pool down.
+  The rows it and the other workers were running are retried once, each
+  alone in a fresh one-worker pool; a row whose worker dies again is marked
+  failed with the reason. Rows not started yet simply run in a new pool.
+- An interrupt (Ctrl-C, or SIGTERM raised as :class:`workbook.errors.Terminated`)
+  stops every worker process of the study before it propagates; workers
+  ignore Ctrl-C themselves, so only the parent decides. A worker whose
+  parent was killed outright (SIGKILL) ends within :data:`PARENT_CHECK_INTERVAL`.
+
+Every finished row is handed to ``record`` at once (the study table is
+written as rows finish), so an interrupt loses only the rows in flight.
 """
 from __future__ import annotations
 
 import logging
 import multiprocessing
 import os
+import signal
+import threading
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from typing import Callable
 
 from workbook.answers.isolation import efficiency
+from workbook.errors import interruption
 from workbook.model.case import DIRECTIONS, Case
 
-__all__ = ["RowOutcome", "prepare", "run_row", "run_rows", "SERIAL"]
+__all__ = ["RowOutcome", "prepare", "run_row", "run_rows", "SERIAL", "ROWS_PER_WORKER", "WORKER_STOP_TIMEOUT"]
 
 log = logging.getLogger(__name__)
 
 #: ``workers`` value that runs every row in this process.
 SERIAL = 1
-#: Rows a worker process runs before it is replaced: a run leaves about 11 MB
-#: of Exudyn memory behind (measured on the reference mount), which a fresh
-#: process returns.
-ROWS_PER_WORKER = 50
+#: Rows a worker process runs before a fresh process replaces it. Each
+#: row leaves 0.1 MB or less behind once scenes free Exudyn's system
+#: (``benchmarks/bench_memory.py``, study worker on the reference mount);
+#: 200 rows keep a worker within 20 MB of its start while a process start
+#: (about 3 s) costs less than 1 % of the rows' time.
+ROWS_PER_WORKER = 200
+#: Seconds a worker process gets to end after SIGTERM before it is killed.
+WORKER_STOP_TIMEOUT = 5.0
+#: Seconds between a worker's checks that its parent still lives.
+PARENT_CHECK_INTERVAL = 1.0
 
 
 @dataclass
@@ -66,26 +90,27 @@ def _failed(index: int, error: BaseException, wall_time: float = 0.0) -> RowOutc
     return RowOutcome(index, [], "failed", f"{type(error).__name__}: {error}", wall_time)
 
 
-def prepare(cases: list[Case | BaseException]) -> list[Case | RowOutcome]:
+def prepare(cases: dict[int, Case | BaseException]) -> dict[int, Case | RowOutcome]:
     """Reduce every distinct link of the cases once (filling the disk cache).
 
     Parameters
     ----------
-    cases : list of Case or exception
-        Row cases; an exception stands for a row whose case could not be built.
+    cases : dict of int to Case or exception
+        Case of each row to run, by row number; an exception stands for a
+        row whose case could not be built.
 
     Returns
     -------
-    list of Case or RowOutcome
+    dict of int to Case or RowOutcome
         The case of each row, or the failed outcome of a row whose case or
         link reduction failed.
     """
     from flexbodies import reduce_link
 
-    reduced, prepared = set(), []
-    for index, case in enumerate(cases):
+    reduced, prepared = set(), {}
+    for index, case in cases.items():
         if isinstance(case, BaseException):
-            prepared.append(_failed(index, case))
+            prepared[index] = _failed(index, case)
             continue
         try:
             for item in case.excitations:
@@ -97,15 +122,15 @@ def prepare(cases: list[Case | BaseException]) -> list[Case | RowOutcome]:
                         reduce_link(link.model, modes=modes, excitation_hz=frequency)
                         reduced.add(key)
         except Exception as error:  # a row's links may fail to mesh; the others go on
-            prepared.append(_failed(index, error))
+            prepared[index] = _failed(index, error)
             continue
-        prepared.append(case)
+        prepared[index] = case
     log.info("%d distinct link reductions for %d rows", len(reduced), len(cases))
     return prepared
 
 
 def run_row(index: int, case: Case) -> RowOutcome:
-    """Run every excitation of one row's case; never raises.
+    """Run every excitation of one row's case; never raises but for an interrupt.
 
     Parameters
     ----------
@@ -116,6 +141,11 @@ def run_row(index: int, case: Case) -> RowOutcome:
     Returns
     -------
     RowOutcome
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Ctrl-C or SIGTERM (also when Exudyn wrapped it in an error of its own).
     """
     from threadpoolctl import threadpool_limits
 
@@ -126,6 +156,9 @@ def run_row(index: int, case: Case) -> RowOutcome:
         with threadpool_limits(limits=1):
             result = run_case(case)
     except Exception as error:
+        interrupt = interruption(error)
+        if interrupt is not None:
+            raise interrupt from None
         return _failed(index, error, time.perf_counter() - start)
     runs = []
     for run in result.runs:
@@ -138,7 +171,9 @@ def run_row(index: int, case: Case) -> RowOutcome:
 
 
 def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: str | None = None,
-             progress: Callable[[int, int], None] | None = None) -> list[RowOutcome]:
+             progress: Callable[[int, int], None] | None = None,
+             finished: dict[int, RowOutcome] | None = None,
+             record: Callable[[RowOutcome], None] | None = None) -> list[RowOutcome]:
     """Run the rows' cases and return their outcomes in row order.
 
     Parameters
@@ -151,21 +186,38 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         Address of a Dask scheduler (``tcp://host:8786``) to run on instead.
     progress : callable, optional
         ``progress(done, total)`` after each row.
+    finished : dict of int to RowOutcome, optional
+        Rows already done (a resumed study): not run again, returned as they are.
+    record : callable, optional
+        ``record(outcome)`` as soon as each row finishes, in finishing order.
 
     Returns
     -------
     list of RowOutcome
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Ctrl-C or SIGTERM: every worker process has been stopped; *record*
+        has had every row finished before it.
     """
-    prepared = prepare(cases)
-    outcomes = {i: p for i, p in enumerate(prepared) if isinstance(p, RowOutcome)}
-    pending = {i: p for i, p in enumerate(prepared) if not isinstance(p, RowOutcome)}
-    total = len(prepared)
+    outcomes = dict(finished or {})
+    todo = {i: case for i, case in enumerate(cases) if i not in outcomes}
+    total = len(cases)
 
     def done(outcome: RowOutcome):
         outcomes[outcome.index] = outcome
+        if record is not None:
+            record(outcome)
         if progress is not None:
             progress(len(outcomes), total)
 
+    pending = {}
+    for index, item in prepare(todo).items():
+        if isinstance(item, RowOutcome):
+            done(item)
+        else:
+            pending[index] = item
     if dask is not None:
         _run_dask(pending, dask, done)
     elif workers <= SERIAL or len(pending) <= 1:
@@ -176,13 +228,113 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
     return [outcomes[i] for i in range(total)]
 
 
+#: In a worker process: where the worker reports the row it starts.
+_started = None
+
+
+def _worker_init(started) -> None:
+    """Set up a worker: Ctrl-C is the parent's to handle (it stops the workers),
+    and the worker ends when its parent is gone (killed with no chance to stop it)."""
+    global _started
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _started = started
+    threading.Thread(target=_end_with_parent, args=(os.getppid(),), daemon=True).start()
+
+
+def _end_with_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_CHECK_INTERVAL)
+    os._exit(1)
+
+
+def _reported_row(index: int, case: Case) -> RowOutcome:
+    _started.put((index, os.getpid()))
+    return run_row(index, case)
+
+
+def _death(exitcode: int | None) -> str:
+    """Plain words for how a worker process ended."""
+    if exitcode is None:
+        return "ended abruptly"
+    if exitcode < 0:
+        try:
+            return f"was killed by {signal.Signals(-exitcode).name}"
+        except ValueError:
+            return f"was killed by signal {-exitcode}"
+    return f"exited with code {exitcode}"
+
+
+def _stop(workers: list) -> None:
+    """SIGTERM every worker process, then SIGKILL those still alive after :data:`WORKER_STOP_TIMEOUT`."""
+    for process in workers:
+        if process.is_alive():
+            process.terminate()
+    deadline = time.monotonic() + WORKER_STOP_TIMEOUT
+    for process in workers:
+        process.join(max(0.0, deadline - time.monotonic()))
+        if process.is_alive():
+            process.kill()
+            process.join()
+
+
+def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[dict, dict, dict]:
+    """Run *pending* in a fresh pool until every row is done or the pool breaks.
+
+    Returns
+    -------
+    lost : dict of int to Case
+        Rows started but not finished when a worker process died.
+    unstarted : dict of int to Case
+        Rows the broken pool never started.
+    deaths : dict of int to str
+        How the process of each lost row ended.
+    """
+    started = context.SimpleQueue()
+    before = set(multiprocessing.active_children())
+    pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
+                               max_tasks_per_child=ROWS_PER_WORKER, initializer=_worker_init, initargs=(started,))
+    processes = set()
+    broken = {}
+    try:
+        futures = {pool.submit(_reported_row, index, case): index for index, case in pending.items()}
+        processes.update(set(multiprocessing.active_children()) - before)  # to read their exit codes later
+        for future in as_completed(futures):
+            processes.update(set(multiprocessing.active_children()) - before)
+            try:
+                done(future.result())
+            except BrokenProcessPool:
+                broken[futures[future]] = pending[futures[future]]
+    except BaseException:
+        processes.update(set(multiprocessing.active_children()) - before)
+        pool.shutdown(wait=False, cancel_futures=True)
+        _stop(list(processes))
+        raise
+    pool.shutdown(wait=True)
+    pids = {}
+    while not started.empty():
+        index, pid = started.get()
+        pids[index] = pid
+    exitcodes = {process.pid: process.exitcode for process in processes}
+    lost = {i: case for i, case in broken.items() if i in pids}
+    deaths = {i: _death(exitcodes.get(pids[i])) for i in lost}
+    return lost, {i: case for i, case in broken.items() if i not in pids}, deaths
+
+
 def _run_processes(pending: dict, workers: int, done: Callable) -> None:
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
-                             max_tasks_per_child=ROWS_PER_WORKER) as pool:
-        futures = [pool.submit(run_row, index, case) for index, case in pending.items()]
-        for future in as_completed(futures):
-            done(future.result())
+    suspects = {}
+    while pending:
+        lost, pending, _ = _pool_round(pending, workers, done, context)
+        if lost:
+            log.warning("a worker process died; rows %s, which were running, are retried one at a time",
+                        ", ".join(map(str, sorted(lost))))
+        suspects.update(lost)
+    for index, case in suspects.items():  # alone, so that a death now is the row's own
+        lost, unstarted, deaths = _pool_round({index: case}, 1, done, context)
+        if index in lost or index in unstarted:
+            how = deaths.get(index, "ended before it started the row")
+            done(RowOutcome(index, [], "failed", f"WorkerDied: the worker process running this row {how}, "
+                                                 f"also when the row was retried alone"))
 
 
 def _run_dask(pending: dict, address: str, done: Callable) -> None:
@@ -194,5 +346,9 @@ def _run_dask(pending: dict, address: str, done: Callable) -> None:
         if cache:  # the workers load the reductions made here (a shared folder on a real cluster)
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
         futures = client.map(run_row, list(pending), list(pending.values()), pure=False)
+        rows = {future.key: index for future, index in zip(futures, pending)}
         for future in dask_completed(futures):
-            done(future.result())
+            try:
+                done(future.result())
+            except Exception as error:  # e.g. KilledWorker: Dask gave up on the row's worker
+                done(_failed(rows[future.key], error))

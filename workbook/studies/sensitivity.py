@@ -4,20 +4,31 @@ One table row per study row and run (excitation): the row number, the
 parameter values, the run, its frequency, T and eta per direction, whether
 it was steady, the row's wall time, status and error (a failed row has one
 table row with its error and no answers).
+
+While a study runs, :class:`StudyTable` keeps its table file up to date:
+after each finished row the whole table is written to a temporary file and
+renamed over the old one, so the file always holds every finished row and
+never half of one, whenever the study is interrupted or killed.
+:func:`read_finished` reads such a table back to resume the study.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
-import numpy as np
-
+from flexbodies.atomic import replacing
+from workbook.errors import UsageError
 from workbook.model.case import DIRECTIONS
+from workbook.studies.parallel import RowOutcome
 from workbook.studies.parametric import PARAMETERS
 
-__all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS"]
+__all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "StudyTable", "table_path",
+           "read_finished"]
 
 #: File formats of the study table.
 TABLE_FORMATS = ("csv", "parquet")
+#: Columns of a run's answers.
+ANSWERS = ("run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS), *(f"eta % {d}" for d in DIRECTIONS), "steady")
 
 
 def study_frame(rows: tuple, outcomes: list):
@@ -28,7 +39,7 @@ def study_frame(rows: tuple, outcomes: list):
     rows : tuple of dict
         Parameter values of each study row.
     outcomes : list of RowOutcome
-        In row order.
+        In row order (all rows, or those finished so far).
 
     Returns
     -------
@@ -37,19 +48,15 @@ def study_frame(rows: tuple, outcomes: list):
     import pandas as pd
 
     records = []
-    for row, outcome in zip(rows, outcomes):
-        common = {"row": outcome.index, **row}
+    for outcome in outcomes:
+        common = {"row": outcome.index, **rows[outcome.index]}
         tail = {"wall time s": outcome.wall_time, "status": outcome.status, "error": outcome.error}
         for run in outcome.runs or [{}]:
             records.append({**common, **run, **tail})
-    frame = pd.DataFrame.from_records(records)
-    answers = ["run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS), *(f"eta % {d}" for d in DIRECTIONS),
-               "steady"]
-    for column in answers:  # a study whose rows all failed still has every column
-        if column not in frame:
-            frame[column] = np.nan
     names = list(rows[0]) if rows else []
-    return frame[["row", *names, *answers, "wall time s", "status", "error"]]
+    columns = ["row", *names, *ANSWERS, "wall time s", "status", "error"]
+    # every column, also when every row failed
+    return pd.DataFrame.from_records(records, columns=columns)
 
 
 def plot_sensitivity(frame, parameters: list[str]):
@@ -94,8 +101,119 @@ def plot_sensitivity(frame, parameters: list[str]):
     return fig
 
 
+def table_path(folder: str | Path, table_format: str = "csv") -> Path:
+    """The study table's file in *folder*: ``parameter-study.<csv|parquet>``."""
+    if table_format not in TABLE_FORMATS:
+        raise ValueError(f"table format must be one of {', '.join(TABLE_FORMATS)}, got {table_format!r}")
+    return Path(folder) / f"parameter-study.{table_format}"
+
+
+def _write_table(frame, path: Path) -> None:
+    """Write *frame* to *path* (format by its ending) all at once."""
+    with replacing(path, suffix=f".{path.suffix[1:]}.tmp") as temporary:
+        if path.suffix == ".csv":
+            frame.to_csv(temporary, index=False)
+        else:
+            frame.to_parquet(temporary, index=False)
+
+
+class StudyTable:
+    """The table file of a running study, rewritten atomically as each row finishes.
+
+    Parameters
+    ----------
+    path : Path
+        From :func:`table_path`.
+    rows : tuple of dict
+        Parameter values of every study row.
+    finished : dict of int to RowOutcome, optional
+        Rows already in the table (a resumed study).
+    """
+
+    def __init__(self, path: Path, rows: tuple, finished: dict | None = None):
+        self.path, self.rows = Path(path), rows
+        self.outcomes = dict(finished or {})
+
+    def add(self, outcome: RowOutcome) -> None:
+        """Put a finished row into the table file."""
+        self.outcomes[outcome.index] = outcome
+        _write_table(self.frame(), self.path)
+
+    def frame(self):
+        """The table of the rows finished so far, in row order."""
+        return study_frame(self.rows, [self.outcomes[i] for i in sorted(self.outcomes)])
+
+
+def _same_value(stored, value) -> bool:
+    if isinstance(value, str):
+        return str(stored) == value
+    try:
+        return math.isclose(float(stored), float(value), rel_tol=1e-12, abs_tol=0.0)
+    except (TypeError, ValueError):
+        return False
+
+
+def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
+    """The rows a study table already holds, to resume the study.
+
+    Parameters
+    ----------
+    path : str or Path
+        A table written by :class:`StudyTable` (a missing file holds no rows).
+    rows : tuple of dict
+        The study's rows: the table's must be the same study.
+
+    Returns
+    -------
+    dict of int to RowOutcome
+        Every row in the table (finished, or failed with its error).
+
+    Raises
+    ------
+    UsageError
+        The table is unreadable or belongs to another study (other
+        parameters, or other values in a row), naming the row and value.
+    """
+    import pandas as pd
+
+    path = Path(path)
+    if not path.exists():
+        return {}
+    try:
+        frame = pd.read_csv(path, keep_default_na=False, na_values=[""]) if path.suffix == ".csv" \
+            else pd.read_parquet(path)
+    except (ValueError, OSError, ImportError) as error:
+        raise UsageError(f"{path}: cannot resume from it, it is not a readable study table ({error})") from None
+    names = list(rows[0]) if rows else []
+    expected = ["row", *names, *ANSWERS, "wall time s", "status", "error"]
+    if list(frame.columns) != expected:
+        raise UsageError(f"{path}: cannot resume from it: its columns are {', '.join(map(str, frame.columns))}; "
+                         f"this study's are {', '.join(expected)}")
+    finished = {}
+    for index, table in frame.groupby("row", sort=True):
+        index = int(index)
+        if not 0 <= index < len(rows):
+            raise UsageError(f"{path}: cannot resume from it: it has row {index}; this study has rows 0 to "
+                             f"{len(rows) - 1}")
+        first = table.iloc[0]
+        for name, value in rows[index].items():
+            if not _same_value(first[name], value):
+                stored = first[name].item() if hasattr(first[name], "item") else first[name]
+                raise UsageError(f"{path}: cannot resume from it: its row {index} has {name} = {stored!r}; "
+                                 f"this study's row {index} has {value!r}")
+        status = str(first["status"])
+        runs = [] if status != "ok" else [
+            {"run": str(r["run"]), "frequency Hz": float(r["frequency Hz"]),
+             **{f"T {d}": float(r[f"T {d}"]) for d in DIRECTIONS},
+             **{f"eta % {d}": float(r[f"eta % {d}"]) for d in DIRECTIONS},
+             "steady": str(r["steady"]).lower() == "true"} for _, r in table.iterrows()]
+        error = "" if pd.isna(first["error"]) else str(first["error"])
+        finished[index] = RowOutcome(index, runs, status, error, float(first["wall time s"]))
+    return finished
+
+
 def write_study(frame, parameters: list[str], folder: str | Path, table_format: str = "csv") -> list[Path]:
-    """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot.
+    """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot, each all at once.
 
     Returns
     -------
@@ -103,20 +221,15 @@ def write_study(frame, parameters: list[str], folder: str | Path, table_format: 
         ``parameter-study.<csv|parquet>``, ``parameter-study.xlsx``,
         ``parameter-study.png`` in *folder*.
     """
-    if table_format not in TABLE_FORMATS:
-        raise ValueError(f"table format must be one of {', '.join(TABLE_FORMATS)}, got {table_format!r}")
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    table = folder / f"parameter-study.{table_format}"
-    if table_format == "csv":
-        frame.to_csv(table, index=False)
-    else:
-        frame.to_parquet(table, index=False)
-    sheet = folder / "parameter-study.xlsx"
-    frame.to_excel(sheet, sheet_name="Parameter study", index=False)
-    plot = folder / "parameter-study.png"
+    table = table_path(folder, table_format)
+    _write_table(frame, table)
+    sheet = table.with_suffix(".xlsx")
+    with replacing(sheet, suffix=".xlsx.tmp") as temporary:
+        frame.to_excel(temporary, sheet_name="Parameter study", index=False, engine="openpyxl")
+    plot = table.with_suffix(".png")
     figure = plot_sensitivity(frame, parameters)
-    figure.savefig(plot, dpi=120)
+    with replacing(plot, suffix=".png.tmp") as temporary:
+        figure.savefig(temporary, dpi=120, format="png")
     import matplotlib.pyplot as plt
 
     plt.close(figure)

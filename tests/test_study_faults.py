@@ -1,0 +1,163 @@
+"""Parameter studies keep their work: a killed worker, Ctrl-C and SIGTERM with
+real processes and signals; the table on disk holds every finished row, no
+worker outlives the study, and --resume runs only the missing rows."""
+from __future__ import annotations
+
+import dataclasses
+import signal
+import time
+
+import pandas as pd
+import psutil
+import pytest
+from cli_signals import SIGNAL_EXIT, alive, descendants, files_in, start
+
+from workbook.errors import EXIT_FAILED_ROWS, UsageError
+from workbook.model.codec import to_json
+from workbook.model.reference import LP_ROTOR, reference_case
+from workbook.studies.parallel import RowOutcome
+from workbook.studies.sensitivity import StudyTable, read_finished, table_path
+
+#: Six rows of a few seconds each (rigid links, LP rotor, the case's own settings).
+STIFFNESS = "1e7:3.5e7:6"
+#: CPU time after which a worker is surely running its row, s (its start-up took about 0.3 s).
+WORKING_CPU_S = 1.5
+
+
+@pytest.fixture()
+def case_file(tmp_path):
+    case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+    path = tmp_path / "case.json"
+    path.write_text(to_json(case))
+    return path
+
+
+def _study(case_file, output, *extra):
+    return start("study", "params", str(case_file), "--output", str(output), f"--vary=hinge_stiffness={STIFFNESS}",
+                 *extra, cwd=case_file.parent)
+
+
+def _table(output) -> pd.DataFrame:
+    path = table_path(output)
+    return pd.read_csv(path) if path.exists() else pd.DataFrame({"row": [], "status": []})
+
+
+def _wait(condition, timeout=240.0, what="condition"):
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        value = condition()
+        if value:
+            return value
+        time.sleep(0.2)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def _workers(pid: int) -> list[psutil.Process]:
+    """The study's worker processes (not multiprocessing's resource tracker)."""
+    found = []
+    for child in psutil.Process(pid).children(recursive=True):
+        try:
+            if "resource_tracker" not in " ".join(child.cmdline()):
+                found.append(child)
+        except psutil.NoSuchProcess:
+            pass
+    return found
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_an_interrupted_study_stops_its_workers_keeps_its_rows_and_resumes(case_file, tmp_path, signum, workers):
+    output = tmp_path / "out"
+    process = _study(case_file, output, "--workers", workers)
+    _wait(lambda: len(_table(output)) >= 1, what="a finished row")
+    family = descendants(process.pid)
+    process.send_signal(signum)
+    _, stderr = process.communicate(timeout=120)
+    assert process.returncode == SIGNAL_EXIT[signum]
+    assert "Traceback" not in stderr
+    assert alive(family) == []                      # no orphan workers
+    last = stderr.strip().splitlines()[-1]
+    table = _table(output)
+    kept = len(table)
+    assert 1 <= kept < 6 and set(table["status"]) == {"ok"}
+    assert f"{kept} of 6 rows finished and kept in" in last
+    assert not [name for name in files_in(output) if name.endswith(".tmp")]
+
+    resumed = _study(case_file, output, "--workers", workers, "--resume")
+    _, stderr = resumed.communicate(timeout=600)
+    assert resumed.returncode == 0, stderr
+    assert f"6 study rows ({kept} already in" in stderr
+    final = _table(output)
+    assert list(final["row"]) == list(range(6)) and set(final["status"]) == {"ok"}
+    # the kept rows were not run again: every value, their wall times too, as written before the interrupt
+    pd.testing.assert_frame_equal(final.set_index("row").loc[table["row"]], table.set_index("row"))
+
+
+def _busy(pid: int, exclude=()) -> list[psutil.Process]:
+    """Workers of *pid* not in *exclude* that have used more CPU time than their start-up takes."""
+    busy = []
+    for worker in _workers(pid):
+        try:
+            if worker.pid not in exclude and worker.cpu_times().user > WORKING_CPU_S:
+                busy.append(worker)
+        except psutil.NoSuchProcess:
+            pass
+    return busy
+
+
+@pytest.mark.slow
+def test_a_killed_worker_is_retried_and_a_twice_killed_row_is_marked_failed(tmp_path):
+    case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, steps_per_period=400))
+    case_file = tmp_path / "long.json"
+    case_file.write_text(to_json(case))
+    output = tmp_path / "out"
+    process = start("study", "params", str(case_file), "--output", str(output), "--vary=hinge_stiffness=1e7,2e7",
+                    "--workers", "2", cwd=tmp_path)
+    first = _wait(lambda: _busy(process.pid), what="a worker running a row")
+    first[0].kill()                                   # SIGKILL: both rows in flight are lost
+    lines = []
+    for line in process.stderr:                       # the lost rows are retried one at a time
+        lines.append(line)
+        if "retried one at a time" in line:
+            break
+    assert "a worker process died; rows" in lines[-1]
+    seen = {p.pid for p in _workers(process.pid)} | {first[0].pid}
+    retry = _wait(lambda: _busy(process.pid, seen), what="the retry's worker running its row")
+    retry[0].kill()                                   # killed again: the row fails with the reason
+    stdout, stderr = process.communicate(timeout=600)
+    assert process.returncode == EXIT_FAILED_ROWS
+    assert "Traceback" not in stderr + "".join(lines) and "BrokenProcessPool" not in stdout + stderr
+    table = _table(output)
+    failed = table[table["status"] == "failed"]
+    assert len(table) == 2 and len(failed) == 1      # the other row succeeded when retried alone
+    assert failed["error"].iloc[0].startswith("WorkerDied: the worker process running this row was killed by SIGKILL")
+    summary = stdout.strip().splitlines()[-1]
+    assert summary == f"1 of 2 rows ok, 1 failed (rows {failed['row'].iloc[0]}; exit code {EXIT_FAILED_ROWS})"
+
+
+def test_resuming_from_the_table_of_another_study_is_refused(tmp_path):
+    rows = ({"hinge_stiffness": 1e7}, {"hinge_stiffness": 2e7})
+    path = table_path(tmp_path)
+    StudyTable(path, rows).add(RowOutcome(1, [], "failed", "CaseError: bad", 0.5))
+    assert read_finished(path, rows) == {1: RowOutcome(1, [], "failed", "CaseError: bad", 0.5)}
+    with pytest.raises(UsageError, match="row 1 has hinge_stiffness = 20000000.0; this study's row 1 has 30000000.0"):
+        read_finished(path, ({"hinge_stiffness": 1e7}, {"hinge_stiffness": 3e7}))
+    with pytest.raises(UsageError, match="its columns are"):
+        read_finished(path, ({"hinge_damping": 1e3}, {"hinge_damping": 2e3}))
+    assert read_finished(tmp_path / "none.csv", rows) == {}
+
+
+@pytest.mark.slow
+def test_workers_end_when_the_study_is_killed_outright(case_file, tmp_path):
+    output = tmp_path / "out"
+    process = _study(case_file, output, "--workers", "2")
+    _wait(lambda: len(_table(output)) >= 1, what="a finished row")
+    workers = [worker.pid for worker in _workers(process.pid)]
+    assert workers
+    process.kill()                                    # SIGKILL: the study cannot stop its workers itself
+    process.communicate()
+    _wait(lambda: not alive(workers), timeout=60, what="the orphaned workers to end")
+    table = _table(output)
+    assert len(table) >= 1 and set(table["status"]) == {"ok"}
