@@ -166,4 +166,5 @@ def test_warnings_are_recorded(tmp_path):
     report = tmp_path / "report.xlsx"
     assert main(["run", str(case), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
     rows = list(load_workbook(report)["Warnings"].iter_rows(min_row=4, values_only=True))
-    assert rows and all(row[0] == "LP rotor" and "steady" in row[2] for row in rows)
+    assert rows and all(row[0] == "LP rotor" for row in rows)
+    assert any(row[2].startswith("not steady") for row in rows)

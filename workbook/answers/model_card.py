@@ -12,7 +12,6 @@ from typing import Any
 import numpy as np
 
 from workbook.scene.build import Scene
-from workbook.solve.step_accuracy import ACCURACY_TARGET
 
 __all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
 
@@ -265,7 +264,7 @@ def _solver(scene, plan) -> dict[str, Any]:
                     f"{100 * analysis.steady_tolerance:g} %",
         "integrator accuracy": (f"estimated amplitude error {100 * plan.amplitude_error:.2g} %, largest on "
                                 f"{plan.error_source}; {plan.steps_needed} steps per period keep it below "
-                                f"{100 * ACCURACY_TARGET:g} %"
+                                f"{100 * plan.accuracy_target:g} %"
                                 if plan.error_source else "no modes to estimate it on"),
         "steps": plan.steps,
         "end time": f"{plan.end_time:.4g} s",

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import logging
-from typing import Iterable, Union
+from typing import Iterable
 
 from workbook.errors import Problem, WorkbookError
 from workbook.excel.reader import CaseBook
@@ -14,7 +14,7 @@ __all__ = ["select_runs", "run_book"]
 log = logging.getLogger(__name__)
 
 
-def select_runs(book: CaseBook, names: Union[Iterable[str], None] = None) -> list[RunSpec]:
+def select_runs(book: CaseBook, names: Iterable[str] | None = None) -> list[RunSpec]:
     """The runs named *names* (all runs for None), in the Runs sheet's order.
 
     Raises

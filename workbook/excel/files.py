@@ -22,7 +22,7 @@ import re
 import stat
 import zipfile
 from pathlib import Path
-from typing import Callable, Union
+from typing import Callable
 from xml.sax.saxutils import escape
 
 from openpyxl.utils.datetime import to_excel
@@ -81,7 +81,7 @@ _SHEET = re.compile(r"^xl/worksheets/[^/]+\.xml$")
 _SHAPE = re.compile(rb"<xdr:sp\b")
 
 
-def unsupported_content(path: Union[str, Path]) -> list[str]:
+def unsupported_content(path: str | Path) -> list[str]:
     """What in the workbook at *path* openpyxl would drop on saving (empty: nothing).
 
     Parameters
@@ -165,7 +165,7 @@ def lost_parts(before: bytes, after: bytes) -> list[str]:
             if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)]
 
 
-def lock_file(path: Union[str, Path]) -> Union[Path, None]:
+def lock_file(path: str | Path) -> Path | None:
     """The lock file beside *path* if present: the workbook is open in Excel or LibreOffice.
 
     Excel writes ``~$<name>``, LibreOffice ``.~lock.<name>#``.
@@ -183,7 +183,7 @@ def lock_message(lock: Path) -> str:
     return f"it is open in {application} (lock file {lock.name} present); close it and run again to write into it"
 
 
-def name_beside(path: Union[str, Path], label: str) -> Path:
+def name_beside(path: str | Path, label: str) -> Path:
     """A new file name beside *path*: ``<stem>-<label>-<date-time>.xlsx`` (``-2``, ``-3``... if taken)."""
     path = Path(path)
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
@@ -195,7 +195,7 @@ def name_beside(path: Union[str, Path], label: str) -> Path:
     return candidate
 
 
-def bounded_file_problem(path: Path, limit: int) -> Union[str, None]:
+def bounded_file_problem(path: Path, limit: int) -> str | None:
     """Why the file a workbook names at *path* is not read (None: it may be read).
 
     Only a regular file of at most *limit* bytes is read: a device
@@ -211,7 +211,7 @@ def bounded_file_problem(path: Path, limit: int) -> Union[str, None]:
     return None
 
 
-def new_file_target(path: Union[str, Path], label: str, replaceable: Callable[[Path], bool]):
+def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], bool]):
     """Where a new workbook the user named goes: *path*, or a new name beside it, and why.
 
     An existing file is replaced only when ``replaceable(path)`` says it may
@@ -232,7 +232,7 @@ def new_file_target(path: Union[str, Path], label: str, replaceable: Callable[[P
     return path, None
 
 
-def _cached(value) -> Union[tuple[str, str], None]:
+def _cached(value) -> tuple[str, str] | None:
     """(type attribute, text) of a cached formula value; None for a type not restored."""
     if isinstance(value, bool):
         return ' t="b"', "1" if value else "0"
@@ -299,7 +299,7 @@ def _macro_enabled(name: str, xml: bytes) -> bytes:
     return xml.replace(_XLSX_MAIN, _XLSM_MAIN) if name == "[Content_Types].xml" else xml
 
 
-def workbook_bytes(workbook, path: Union[str, Path]) -> bytes:
+def workbook_bytes(workbook, path: str | Path) -> bytes:
     """The file openpyxl writes for *workbook*, typed by the ending of *path* (.xlsx or .xlsm)."""
     buffer = io.BytesIO()
     workbook.save(buffer)
@@ -347,7 +347,7 @@ def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
     return True
 
 
-def write_atomic(path: Union[str, Path], data: bytes) -> Path:
+def write_atomic(path: str | Path, data: bytes) -> Path:
     """Write *data* to *path* all at once, with the permissions of the file it replaces.
 
     A symbolic link stays a link: the file it points to is replaced.
@@ -366,7 +366,7 @@ def write_atomic(path: Union[str, Path], data: bytes) -> Path:
     return path
 
 
-def save_atomic(workbook, path: Union[str, Path], finish: Union[Callable[[bytes], bytes], None] = None) -> Path:
+def save_atomic(workbook, path: str | Path, finish: Callable[[bytes], bytes] | None = None) -> Path:
     """Save an openpyxl workbook to *path* atomically.
 
     The file is built in memory, written whole beside *path* and renamed

@@ -13,7 +13,7 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Union
+from typing import Any, Callable
 
 import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
@@ -127,7 +127,7 @@ class _CaseReader(SheetReader):
 
     # -- one item per row --------------------------------------------------------------------------------
 
-    def engine(self, record: Record) -> Union[cm.Engine, None]:
+    def engine(self, record: Record) -> cm.Engine | None:
         get = record.get
         inertia = ((get("ixx"), get("ixy", 0.0), get("ixz", 0.0)),
                    (get("ixy", 0.0), get("iyy"), get("iyz", 0.0)),
@@ -192,7 +192,7 @@ class _CaseReader(SheetReader):
             return None
         return flexbodies.MeshSource(str(path), tuple(bores), record.get("mesh_unit", 1.0))
 
-    def link(self, record: Record) -> Union[cm.Link, None]:
+    def link(self, record: Record) -> cm.Link | None:
         model = self.link_model(record)
         if model is None:
             return None
@@ -203,7 +203,7 @@ class _CaseReader(SheetReader):
             mass_damping=get("mass_damping", 0.0), spin_frequency_hz=get("spin_frequency_hz"),
             bore_axis=record.vector("bore_axis")))
 
-    def hinge(self, record: Record) -> Union[cm.Hinge, None]:
+    def hinge(self, record: Record) -> cm.Hinge | None:
         get = record.get
 
         def body(key: str) -> str:
@@ -249,14 +249,14 @@ class _CaseReader(SheetReader):
                                                         get("sweep_points"), get("sweep_spacing", "log")),
                           ("sweep_from", "sweep_to", "sweep_points"))
 
-    def rotor(self, record: Record) -> Union[cm.Rotor, None]:
+    def rotor(self, record: Record) -> cm.Rotor | None:
         """A Rotors row: spin axis x, y or z (empty: the Rotor default, x)."""
         get = record.get
         axis = {} if get("axis") is None else {"axis": L.AXES[get("axis")]}
         return self.build(record, lambda: cm.Rotor(get("name"), get("polar_inertia"),
                                                    frequency_hz=get("frequency_hz"), **axis))
 
-    def test_rig(self, record: Record) -> Union[cm.ForceTransducers, None]:
+    def test_rig(self, record: Record) -> cm.ForceTransducers | None:
         """The Test rig row; empty mass and damping take the ForceTransducers defaults."""
         given = {key: value for key, value in (("mass", record.get("mass")), ("damping", record.vector("damping")))
                  if value is not None}
@@ -272,7 +272,7 @@ class _CaseReader(SheetReader):
 
     # -- the case ----------------------------------------------------------------------------------------
 
-    def case(self, tables: dict) -> Union[cm.Case, None]:
+    def case(self, tables: dict) -> cm.Case | None:
         for key in ("Links", "Hinges", "Static loads", "Excitations", "Rotors"):
             self.unique(tables[key])
         engine = [self.engine(r) for r in tables["Engine"] if r.ok]
@@ -439,7 +439,7 @@ class _CaseReader(SheetReader):
             return []
 
 
-def read_workbook(path: Union[str, Path]) -> CaseBook:
+def read_workbook(path: str | Path) -> CaseBook:
     """Read and check a case workbook.
 
     Parameters

@@ -29,7 +29,6 @@ import platform
 import zipfile
 from importlib import metadata
 from pathlib import Path
-from typing import Union
 
 from openpyxl import Workbook
 from openpyxl.chart import BarChart, Reference, ScatterChart, Series
@@ -92,7 +91,7 @@ def _table(ws, top: int, columns: list[tuple[str, str]], rows: list, left: int =
     return top + len(rows)
 
 
-def _title(ws, text: str, note: Union[str, None] = None) -> None:
+def _title(ws, text: str, note: str | None = None) -> None:
     ws["A1"] = text
     ws["A1"].font = Font(bold=True, size=13)
     if note:
@@ -287,7 +286,7 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
-def _metadata(ws, book: CaseBook, runs: list[RunResult], written: Union[WriteOutcome, None]) -> None:
+def _metadata(ws, book: CaseBook, runs: list[RunResult], written: WriteOutcome | None) -> None:
     def version(name: str) -> str:
         try:
             return metadata.version(name)
@@ -321,8 +320,8 @@ def is_report(path: Path) -> bool:
     return f"<cp:keywords>{REPORT_KEYWORDS}</cp:keywords>".encode() in core
 
 
-def write_report(path: Union[str, Path], book: CaseBook, runs: list[RunResult],
-                 written: Union[WriteOutcome, None] = None) -> WriteOutcome:
+def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
+                 written: WriteOutcome | None = None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
     An existing *path* is replaced only if it is a report this module wrote

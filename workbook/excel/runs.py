@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
-from typing import Union
 
 from workbook.model.case import Case, Sweep
 
@@ -50,16 +49,16 @@ class RunSpec:
 
     name: str
     excitation: str
-    frequency: Union[float, None] = None
-    amplitude: Union[float, None] = None
-    fidelity: Union[str, int, float, None] = None
-    gap: Union[float, None] = None
-    hinge_stiffness: Union[float, None] = None
-    hinge_damping: Union[float, None] = None
-    preload: Union[bool, None] = None
-    steps_per_period: Union[int, None] = None
-    settle_time: Union[float, None] = None
-    measured_periods: Union[int, None] = None
+    frequency: float | None = None
+    amplitude: float | None = None
+    fidelity: str | int | float | None = None
+    gap: float | None = None
+    hinge_stiffness: float | None = None
+    hinge_damping: float | None = None
+    preload: bool | None = None
+    steps_per_period: int | None = None
+    settle_time: float | None = None
+    measured_periods: int | None = None
 
 
 @dataclass(frozen=True)
@@ -82,7 +81,7 @@ class TestPoint:
     run: str
     location: str
     direction: str
-    frequency: Union[float, None]
+    frequency: float | None
     amplitude: float
 
 

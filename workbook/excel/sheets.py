@@ -13,7 +13,7 @@ import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Union
+from typing import Any, Callable
 
 from openpyxl.utils import get_column_letter
 from openpyxl.utils.cell import coordinate_to_tuple
@@ -192,7 +192,7 @@ class SheetReader:
             self.merged_found = True
         return rows
 
-    def _headers(self, table: L.Table, sheet: "_Cells") -> Union[dict, None]:
+    def _headers(self, table: L.Table, sheet: "_Cells") -> dict | None:
         by_header = {c.header.lower(): c for c in table.columns}
         positions: dict[str, int] = {}
         for col in sheet.columns(L.HEADER_ROW):
@@ -417,7 +417,7 @@ def _as_yesno(value: Any, column: L.Column) -> bool:
 _CUTOFF = re.compile(r"^\s*([0-9.eE+-]+)\s*([A-Za-z/ ]+)\s*$")
 
 
-def _as_modes(value: Any, column: L.Column) -> Union[str, int, float]:
+def _as_modes(value: Any, column: L.Column) -> str | int | float:
     """auto, static, a whole number (mode count) or a frequency with its unit (cut-off, Hz)."""
     expected = "auto, static, a mode count or a cut-off frequency such as '2000 Hz'"
     if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -441,7 +441,7 @@ def _as_modes(value: Any, column: L.Column) -> Union[str, int, float]:
     raise _Bad(expected)
 
 
-def _as_fidelity(value: Any, column: L.Column) -> Union[str, int, float]:
+def _as_fidelity(value: Any, column: L.Column) -> str | int | float:
     if isinstance(value, str) and value.strip().lower() == FIDELITY_RIGID:
         return FIDELITY_RIGID
     try:
@@ -482,7 +482,7 @@ def _not_a_workbook(path: Path) -> Problem:
     return Problem(path.name, None, None, None, f"{size} bytes that are not a zip archive", "an Excel .xlsx workbook")
 
 
-def _too_large(path: Path) -> Union[Problem, None]:
+def _too_large(path: Path) -> Problem | None:
     """A problem if the file, or what its parts unpack to, exceeds the limits read."""
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
@@ -500,7 +500,7 @@ def _too_large(path: Path) -> Union[Problem, None]:
     return None
 
 
-def open_workbook(path: Union[str, Path]):
+def open_workbook(path: str | Path):
     """Open a workbook twice: with formulas and with the cached values.
 
     Returns

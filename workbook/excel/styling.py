@@ -5,8 +5,6 @@ written back into a case workbook, the report workbook and the template.
 """
 from __future__ import annotations
 
-from typing import Union
-
 from openpyxl.worksheet.properties import PageSetupProperties
 
 __all__ = ["FORMATS", "quantity_of", "print_setup"]
@@ -17,7 +15,7 @@ FORMATS = {"eta": '0.00" %"', "T": "[<0.01]0.000E+00;0.0000", "dB": "0.0", "Hz":
            "error": '0.0" %"', "zeta": '0.00" %"'}
 
 
-def quantity_of(header: str) -> Union[str, None]:
+def quantity_of(header: str) -> str | None:
     """The :data:`FORMATS` key of a result column from its header (None: text or a plain number).
 
     Headers name their unit: ``frequency Hz``, ``T x``, ``eta % y``, ``dB``,

@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import datetime
 from pathlib import Path
-from typing import Iterable, Union
+from typing import Iterable
 
 import numpy as np
 from openpyxl import Workbook
@@ -146,7 +146,7 @@ def _row_for_rotor(rotor: cm.Rotor) -> dict:
     return {"name": rotor.name, "polar_inertia": rotor.polar_inertia, "frequency_hz": rotor.frequency, "axis": axis}
 
 
-def _rows_for_test_rig(rig: Union[cm.ForceTransducers, None]) -> list[dict]:
+def _rows_for_test_rig(rig: cm.ForceTransducers | None) -> list[dict]:
     if rig is None:
         return []
     return [{**_vector("stiffness", rig.stiffness), "mass": rig.mass, **_vector("damping", rig.damping)}]
@@ -282,7 +282,7 @@ def reference_workbook() -> Workbook:
     return case_workbook(reference_case(sweep=True), REFERENCE_RUNS)
 
 
-def write_workbook(workbook: Workbook, path: Union[str, Path], replace: bool = False):
+def write_workbook(workbook: Workbook, path: str | Path, replace: bool = False):
     """Save a generated workbook (atomically); an existing file is replaced only if *replace*.
 
     Returns

@@ -32,7 +32,6 @@ import logging
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Union
 
 import pandas as pd
 from openpyxl import Workbook, load_workbook
@@ -98,7 +97,7 @@ class WriteOutcome:
     """
 
     path: Path
-    reason: Union[str, None]
+    reason: str | None
 
 
 def _match_test(tests: list[TestPoint], frequency: float):
@@ -306,7 +305,7 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     return cached
 
 
-def write_results(path: Union[str, Path], sha256: str, runs: list[RunResult], tests: tuple = ()) -> WriteOutcome:
+def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = ()) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
     Parameters

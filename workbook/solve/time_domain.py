@@ -106,6 +106,11 @@ class TimePlan:
     steps_needed: int = 0
 
     @property
+    def accuracy_target(self) -> float:
+        """The relative amplitude error :attr:`steps_needed` keeps to."""
+        return ACCURACY_TARGET
+
+    @property
     def periods(self) -> int:
         """Total periods simulated."""
         return self.ramp_periods + self.settle_periods + 2 * self.measured_periods
@@ -354,20 +359,20 @@ def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> Excitatio
             f"not steady: the pylon-force amplitudes of the last two {plan.measured_periods}-period windows "
             f"differ by {100 * steady.relative_change:.2f} % (> {100 * analysis.steady_tolerance:.2g} %); "
             f"lengthen the settle time or check the damping")
-        log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
+        log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     if plan.amplitude_error > ACCURACY_LIMIT:
         warnings.append(
             f"time step too coarse: at {plan.steps_per_period} steps per period the integrator's period error "
             f"puts the answer about {100 * plan.amplitude_error:.3g} % off on {plan.error_source}; "
             f"{plan.steps_needed} steps per period keep it below {100 * ACCURACY_TARGET:g} % (or answer "
             f"a linear scene in the frequency domain)")
-        log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
+        log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     if plan.undamped_hz:
         warnings.append(
             f"undamped mounted modes at {', '.join(f'{f:.4g}' for f in plan.undamped_hz)} Hz: the free vibration "
             f"started by the ramp never decays and is part of the measured forces; the frequency domain gives "
             f"the steady answer")
-        log.warning("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
+        log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     return ExcitationResult(
         name=scene.excitation.name, frequency_hz=plan.frequency_hz, excitation_amplitude=signal.amplitude,
         pylon_amplitude=steady.amplitude, hinge_amplitudes=hinge_amplitudes, pylon_hinges=list(scene.pylon_channels),
