@@ -20,8 +20,8 @@ EFFECTS = {"link flexibility", "static preload", "hinge damping", "link damping"
 
 
 @pytest.fixture(scope="module")
-def rigid(cache_dir):
-    return reference_case().with_rigid_links()
+def rigid(coarse_reference):
+    return coarse_reference.with_rigid_links()
 
 
 def _effects(case, **switches):
@@ -86,8 +86,8 @@ def _coordinates():
     return exu.OutputVariableType.Coordinates
 
 
-def test_no_link_damping_when_switched_off(cache_dir):
-    case = reference_case()
+def test_no_link_damping_when_switched_off(coarse_reference):
+    case = coarse_reference
     damped_links = dataclasses.replace(case, links=tuple(dataclasses.replace(link, stiffness_damping=1e-5)
                                                          for link in case.links))
     on = build_scene(damped_links, LP_ROTOR)

@@ -70,10 +70,13 @@ def test_guard_settings_are_validated(field, value):
         AnalysisSettings(**{field: value})
 
 
-def test_the_command_line_reports_an_exhausted_time_budget_as_numerical_trouble(cache_dir, capsys):
+def test_the_command_line_reports_an_exhausted_time_budget_as_numerical_trouble(coarse_reference, tmp_path, capsys):
     from workbook.cli.main import main
+    from workbook.model.codec import to_json
 
-    assert main(["run", "--rigid", "--method", "time", "--no-progress", "--time-budget", "0.01"]) == 1
+    path = tmp_path / "coarse.json"
+    path.write_text(to_json(coarse_reference))
+    assert main(["run", str(path), "--rigid", "--method", "time", "--no-progress", "--time-budget", "0.01"]) == 1
     error = capsys.readouterr().err
     assert "mountwb run: numerical trouble: case 'reference mount', run 'LP rotor': stopped after" in error
     assert "time budget 0.01 s" in error

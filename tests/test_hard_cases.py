@@ -13,6 +13,7 @@ import math
 import numpy as np
 import pytest
 import skfem
+from conftest import COARSE_ELEMENT_SIZE
 
 from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
@@ -29,7 +30,7 @@ from workbook.solve.pipeline import prepare, run_case, run_excitation, solve_fre
 
 @pytest.fixture(scope="module")
 def rigid(cache_dir):
-    return reference_case().with_rigid_links()
+    return reference_case(element_size=COARSE_ELEMENT_SIZE).with_rigid_links()
 
 
 def _with(case, **analysis):
@@ -132,7 +133,7 @@ def test_rattling_in_every_hinge_without_preload_is_periodic_and_bounded(rigid):
 def test_one_newton_on_the_58_kN_preload_gives_the_same_transmissibility(cache_dir):
     """The answer of a linear(ised) mount does not depend on the amplitude;
     1 N is 2e-5 of the static loads (flexible links, nonlinear FFRF)."""
-    case = reference_case()
+    case = reference_case(element_size=COARSE_ELEMENT_SIZE)
     one = _time(case, dataclasses.replace(LP_ROTOR, amplitude=1.0))
     full = _time(case, LP_ROTOR)
     assert one.steady and one.transmissibility == pytest.approx(full.transmissibility, rel=1e-3)

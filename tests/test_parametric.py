@@ -6,6 +6,7 @@ import dataclasses
 import numpy as np
 import pandas as pd
 import pytest
+from conftest import COARSE_ELEMENT_SIZE
 
 from workbook.cli.main import main
 from workbook.cli.params import parse_vary
@@ -26,7 +27,7 @@ REMOVED = ["none", "rear-left"]
 
 @pytest.fixture(scope="module")
 def base():
-    case = reference_case(analysis=SHORT).with_rigid_links()
+    case = reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE).with_rigid_links()
     return dataclasses.replace(case, excitations=(LP_ROTOR,))
 
 

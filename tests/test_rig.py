@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import COARSE_ELEMENT_SIZE
 
 from workbook.cli.main import main
 from workbook.errors import RecordError
@@ -23,7 +24,7 @@ SHORT = AnalysisSettings(settle_time=0.2, measured_periods=10)
 
 @pytest.fixture(scope="module")
 def lp_run(cache_dir):
-    case = reference_case(analysis=SHORT).with_rigid_links()
+    case = reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE).with_rigid_links()
     return run_excitation(case, LP_ROTOR)[0]
 
 
@@ -76,6 +77,7 @@ def test_force_amplitude_is_the_largest_magnitude_over_a_period():
     assert force_amplitude(harmonic) == pytest.approx(5.0)
 
 
+@pytest.mark.slow
 def test_committed_record_is_what_the_code_generates(tmp_path, cache_dir):
     assert main(["rig", "synthesize", str(tmp_path / "rig.csv"), "--rigid"]) == 0
     committed, made = read_record(CASES / "reference-lp-rig.csv"), read_record(tmp_path / "rig.csv")
@@ -175,7 +177,9 @@ def _workbook_with_record(folder: Path, run_row: int, periods=50) -> Path:
     shutil.copyfile(CASES / "reference-lp-rig.csv", folder / "rig.csv")
     set_cells(path, {("Case", "settle time", 3): SHORT.settle_time, ("Case", "measured periods", 3): 10,
                      ("Runs", "fidelity", 3): "rigid", ("Test data", "run", 3): ["LP rotor", "HP rotor"][run_row],
-                     ("Test data", "rig record", 3): "rig.csv", ("Test data", "record periods", 3): periods})
+                     ("Test data", "rig record", 3): "rig.csv", ("Test data", "record periods", 3): periods,
+                     # coarse link meshes: rigid links need only their mass properties
+                     **{("Links", "element size", row): COARSE_ELEMENT_SIZE * 1000 for row in range(3, 11)}})
     return path
 
 

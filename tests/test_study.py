@@ -8,7 +8,7 @@ from openpyxl import load_workbook
 
 from workbook.cli.main import main
 from workbook.model.codec import to_json
-from workbook.studies.accuracy import REFERENCE_RUNG
+from workbook.studies.accuracy import REFERENCE_RUNG, SEED_RUNG
 
 # every test reads the study the module's fixture runs once (a ladder of runs)
 pytestmark = pytest.mark.slow
@@ -42,12 +42,13 @@ def test_files_are_written_without_overwriting(study):
         assert (study / f"accuracy-study-2{suffix}").stat().st_size > 0
     assert load_workbook(study / "accuracy-study-2.xlsx").sheetnames == ["accuracy study"]
     markdown = (study / "accuracy-study-2.md").read_text()
-    assert markdown.count("\n|") == 1 + 11
-    assert "seed study's method" in markdown and f"'{REFERENCE_RUNG}'" in markdown
+    assert markdown.count("\n|") == 1 + 12
+    assert SEED_RUNG in markdown and f"'{REFERENCE_RUNG}'" in markdown
+    assert markdown.count("Low-frequency approximation (") == 2
 
 
 def test_ladder_rungs_and_their_dof(table):
-    assert len(table) == 11
+    assert len(table) == 12
     reference = f"{REFERENCE_RUNG} (reference)"
     assert table.loc[reference, "worst |error| %"] == 0
     fidelity = ["rigid links", "static modes only"] + [f"Craig-Bampton, {n} modes" for n in (2, 6, 12)] + [reference]
@@ -55,6 +56,10 @@ def test_ladder_rungs_and_their_dof(table):
     assert dof[0] == 6 + 8 * 6
     # eight flexible links, each 6 rigid-frame DOF plus 6 static modes, plus n fixed-interface modes
     np.testing.assert_array_equal(dof[1:], 6 + 8 * (12 + np.array([0, 2, 6, 12, 20])))
+    # the seed study's complete-MNF model is the reference's link model, integrated in time
+    assert table.loc[SEED_RUNG, "DOF"] == dof[-1]
+    # the low-frequency approximation drops the fixed-interface modes of the links that meet the rule
+    assert table.loc["frequency domain", "DOF"] < table.loc[SEED_RUNG, "DOF"] / 2
 
 
 def test_errors_converge(table):
@@ -70,6 +75,8 @@ def test_errors_converge(table):
         gaps.append(max(abs(_t(table, rung, a) / _t(table, "frequency domain", a) - 1) for a in "yz"))
     assert gaps[0] > gaps[1] > gaps[2]
     assert gaps[2] < 0.003
+    # the complete-MNF model in the time domain is the reference model up to the time-step error
+    assert table.loc[SEED_RUNG, "worst |error| %"] < 1.0
     assert (table["wall time s"] > 0).all()
 
 
