@@ -10,7 +10,7 @@ from workbook.model.reference import reference_case
 from workbook.solve.pipeline import run_case
 
 #: Growth allowed per run, MB (a run that kept its Exudyn system grew by ~13 MB).
-GROWTH_PER_RUN_MB = 2.0
+GROWTH_PER_RUN_MB = 1.0
 
 
 def _static_mode_case(method: str, **analysis):
