@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from workbook.model.case import Rotor
-from workbook.model.reference import HP_ROTOR, LP_ROTOR, reference_case
+from workbook.model.reference import HP_ROTOR, LP_ROTOR
 from workbook.solve.pipeline import prepare, run_case
 
 
@@ -20,8 +20,8 @@ def _run_frequency(case):
 
 
 @pytest.fixture(scope="module")
-def rigid(cache_dir):
-    return dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+def rigid(coarse_reference):
+    return dataclasses.replace(coarse_reference.with_rigid_links(), excitations=(LP_ROTOR,))
 
 
 def _entry(card, name):

@@ -86,6 +86,7 @@ def _coordinates():
     return exu.OutputVariableType.Coordinates
 
 
+@pytest.mark.slow
 def test_no_link_damping_when_switched_off(coarse_reference):
     case = coarse_reference
     damped_links = dataclasses.replace(case, links=tuple(dataclasses.replace(link, stiffness_damping=1e-5)

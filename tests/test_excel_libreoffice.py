@@ -21,8 +21,9 @@ from workbook.cli.main import main
 from workbook.excel.styling import FORMATS
 
 SOFFICE = shutil.which("soffice")
-pytestmark = pytest.mark.skipif(SOFFICE is None, reason="LibreOffice (soffice) is not on PATH: "
-                                                         "apt-get install libreoffice-calc-nogui")
+pytestmark = [pytest.mark.skipif(SOFFICE is None, reason="LibreOffice (soffice) is not on PATH: "
+                                                          "apt-get install libreoffice-calc-nogui"),
+              pytest.mark.slow]
 #: Points of the reference sweep (cases/reference.xlsx).
 REFERENCE_SWEEP_POINTS = 25
 #: Printed pages the whole reference report may take.

@@ -147,7 +147,8 @@ def _solve(case: Case, excitation: SingleFrequencyExcitation, method: str):
     if method == FREQUENCY:
         prepared = prepare(case, excitation)
         choice = MethodChoice(FREQUENCY, "accuracy study rung")
-        runs, cards, _ = solve_frequencies(case, prepared, (excitation,), choice)
+        with prepared.scene:
+            runs, cards, _ = solve_frequencies(case, prepared, (excitation,), choice)
     else:
         run, card, _ = run_excitation(case, excitation)
         runs, cards = [run], {run.name: card}
