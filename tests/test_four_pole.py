@@ -190,11 +190,20 @@ def test_command_line_writes_csv_and_plot(tmp_path, capsys):
 
     path = tmp_path / "sdof.json"
     path.write_text(to_json(sdof_case((1.5,))))
-    csv, png = tmp_path / "four-pole.csv", tmp_path / "four-pole.png"
+    csv, png, xlsx = tmp_path / "four-pole.csv", tmp_path / "four-pole.png", tmp_path / "four-pole.xlsx"
     assert main(["four-pole", str(path), "--from", "2", "--to", "50", "--points", "5", "--csv", str(csv),
-                 "--plot", str(png)]) == 0
+                 "--plot", str(png), "--xlsx", str(xlsx), "--pylon-stiffness", "3e6", "--pylon-mass", "40"]) == 0
     out = capsys.readouterr().out
     assert "K21" in out and "rigid pylon" in out
+    pole = four_pole(sdof_case(()), np.geomspace(2, 50, 5))
+    loss = pole.insertion_loss(3e6 - (2 * np.pi * pole.frequencies_hz) ** 2 * 40)
+    assert f"{loss[-1, 2]:9.2f}" in out.split("insertion loss")[1].splitlines()[-1]
+    from openpyxl import load_workbook
+
+    sheet = load_workbook(xlsx)["Four-pole"]
+    assert sheet["B30"].value == "|K11 x| (N/m)"
+    assert sheet["B31"].value == pytest.approx(4 * abs(_spring(2.0, STIFFNESS, DAMPING)), rel=1e-6)
+    assert len(sheet._charts) == 1
     import pandas as pd
 
     table = pd.read_csv(csv, index_col=0)
@@ -208,6 +217,8 @@ def test_command_line_refuses_bad_frequencies_and_reports_singular_sets(tmp_path
     csv = tmp_path / "out.csv"
     assert main(["four-pole", "--from", "50", "--to", "5", "--csv", str(csv)]) == EXIT_BAD_INPUT
     assert "'to'" in capsys.readouterr().err
+    assert main(["four-pole", "--pylon-mass", "5", "--csv", str(csv)]) == EXIT_BAD_INPUT
+    assert "--pylon-stiffness" in capsys.readouterr().err
     assert not csv.exists()
     from workbook.model.codec import to_json
 

@@ -44,7 +44,7 @@ from workbook.excel.styling import FORMATS, print_setup
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["write_report", "is_report", "PACKAGES", "REPORT_KEYWORDS"]
+__all__ = ["write_report", "is_report", "four_pole_sheet", "PACKAGES", "REPORT_KEYWORDS"]
 
 #: Document keywords that mark a report workbook (an existing report may be replaced).
 REPORT_KEYWORDS = "mountwb report"
@@ -280,6 +280,37 @@ def _model_cards(ws, runs: list[RunResult]) -> None:
     for row, line in enumerate(card_lines(runs), start=1):
         ws.cell(row, 1, line).font = Font(name="Consolas", size=9, bold=line.startswith("Run '"))
     ws.column_dimensions["A"].width = 120
+    print_setup(ws)
+
+
+def four_pole_sheet(ws, pole) -> None:
+    """Fill *ws* with the mount's four-pole parameters (a
+    :class:`~workbook.answers.four_pole.FourPole`): magnitude (N/m) and
+    phase (deg) of K11, K21 and K22 per direction against frequency, and a
+    native log-log chart of the magnitudes."""
+    table = pole.table()
+    _title(ws, f"{pole.case_name}: four-pole parameters of the mount",
+           "K11, K22: driving-point dynamic stiffness at the engine and at the pylon pins; K21: blocked transfer "
+           "dynamic stiffness (both other terminals blocked)")
+    columns = [("frequency (Hz)", "Hz")] + [(name.replace(" N/m", " (N/m)").replace(" deg", " (deg)"), "number")
+                                             for name in table.columns]
+    top = 30
+    _table(ws, top, columns, [[frequency, *row] for frequency, row in zip(table.index, table.to_numpy())])
+    chart = ScatterChart()
+    chart.title, chart.x_axis.title, chart.y_axis.title = "Dynamic stiffness", "frequency (Hz)", "|K| (N/m)"
+    chart.x_axis.scaling.logBase = 10
+    chart.y_axis.scaling.logBase = 10
+    chart.style = 13
+    chart.width, chart.height = 24, 12
+    x = Reference(ws, min_col=1, min_row=top + 1, max_row=top + len(table))
+    for col, name in enumerate(table.columns, start=2):
+        if name.startswith("|"):
+            series = Series(Reference(ws, min_col=col, min_row=top + 1, max_row=top + len(table)), x,
+                            title=name.strip("|").replace("| N/m", ""))
+            series.marker.symbol = "none"
+            chart.series.append(series)
+    _show_axes(chart)
+    ws.add_chart(chart, "A4")
     print_setup(ws)
 
 
