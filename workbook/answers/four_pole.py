@@ -257,8 +257,14 @@ class FourPole:
         return responses
 
     def transmissibility(self, force, point, pylon=None) -> np.ndarray:
-        """Pylon-force transmissibility ``|F_pylon| / |f|`` per direction, shape (f, 3)."""
-        magnitude = float(np.linalg.norm(np.abs(np.asarray(force, dtype=complex))))
+        """Pylon-force transmissibility ``|F_pylon| / |F|`` per direction, shape (f, 3).
+
+        ``|F|`` is the largest magnitude the force ``Re(f exp(i w t))``
+        takes, ``sqrt((f^H f + |f^T f|) / 2)``: the amplitude of a rotating
+        or a one-direction harmonic force alike.
+        """
+        phasor = np.asarray(force, dtype=complex)
+        magnitude = float(np.sqrt((np.vdot(phasor, phasor).real + abs(phasor @ phasor)) / 2))
         return np.array([np.abs(r.pylon_force) for r in self.respond(force, point, pylon)]) / magnitude
 
     def rigid_attachment(self, force, point, pylon) -> np.ndarray:
