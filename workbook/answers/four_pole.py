@@ -45,6 +45,7 @@ pins (the pins then move with the engine, ``x2 = T x1``).
 """
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from dataclasses import dataclass
 
@@ -364,8 +365,6 @@ def _mount_case(case: Case) -> Case:
     workbook.errors.CaseError
         A hinge with a clearance law: the four-pole set is that of a linear mount.
     """
-    import dataclasses
-
     if case.effects.clearance:
         for hinge in case.hinges:
             if hinge.radial_clearance > 0:

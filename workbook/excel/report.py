@@ -165,6 +165,17 @@ def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
     print_setup(ws, header_rows=3)
 
 
+def _log_log_chart(title: str, y_title: str) -> ScatterChart:
+    """An empty log-log scatter chart against frequency (Hz), 24 x 12 cm."""
+    chart = ScatterChart()
+    chart.title, chart.x_axis.title, chart.y_axis.title = title, "frequency (Hz)", y_title
+    chart.x_axis.scaling.logBase = 10
+    chart.y_axis.scaling.logBase = 10
+    chart.style = 13
+    chart.width, chart.height = 24, 12
+    return chart
+
+
 def _transmissibility(ws, runs: list[RunResult]) -> None:
     _title(ws, "Pylon transmissibility T = |F_pylon| / |F_exc| against frequency",
            "level = 20 log10 T; eta = (1 - T) x 100 %")
@@ -172,12 +183,7 @@ def _transmissibility(ws, runs: list[RunResult]) -> None:
     singles = sorted((p for _, p in _singles(runs)), key=lambda p: p.frequency_hz)
     if singles:
         groups.append(("single-frequency runs", singles))
-    chart = ScatterChart()
-    chart.title, chart.x_axis.title, chart.y_axis.title = "Pylon transmissibility", "frequency (Hz)", "T (-)"
-    chart.x_axis.scaling.logBase = 10
-    chart.y_axis.scaling.logBase = 10
-    chart.style = 13
-    chart.width, chart.height = 24, 12
+    chart = _log_log_chart("Pylon transmissibility", "T (-)")
     ws.add_chart(chart, "A4")
     row = 30
     for name, points in groups:
@@ -296,12 +302,7 @@ def four_pole_sheet(ws, pole) -> None:
                                              for name in table.columns]
     top = 30
     _table(ws, top, columns, [[frequency, *row] for frequency, row in zip(table.index, table.to_numpy())])
-    chart = ScatterChart()
-    chart.title, chart.x_axis.title, chart.y_axis.title = "Dynamic stiffness", "frequency (Hz)", "|K| (N/m)"
-    chart.x_axis.scaling.logBase = 10
-    chart.y_axis.scaling.logBase = 10
-    chart.style = 13
-    chart.width, chart.height = 24, 12
+    chart = _log_log_chart("Dynamic stiffness", "|K| (N/m)")
     x = Reference(ws, min_col=1, min_row=top + 1, max_row=top + len(table))
     for col, name in enumerate(table.columns, start=2):
         if name.startswith("|"):
