@@ -22,7 +22,8 @@ from typing import Any
 
 __all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
-           "MechanismError", "EquilibriumError", "UnstablePreloadError", "UsageError", "BAD_INPUT", "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
+           "MechanismError", "EquilibriumError", "FourPoleError", "UnstablePreloadError", "UsageError", "BAD_INPUT",
+           "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
            "EXIT_INTERRUPTED", "EXIT_TERMINATED", "EXIT_FAILED_ROWS", "Terminated", "interruption", "exit_code"]
 
 #: Exit codes of the command line.
@@ -286,3 +287,9 @@ def exit_code(error: BaseException) -> int:
     if isinstance(error, BAD_INPUT + (ValueError, OSError)):
         return EXIT_BAD_INPUT
     raise TypeError(f"no exit code for {type(error).__name__}")
+
+
+class FourPoleError(SimulationError):
+    """A four-pole set that cannot be formed or used: a dynamic-stiffness
+    matrix to invert is singular at a frequency (an undamped resonance of the
+    mount with its terminals blocked, or of the mount on its engine and pylon)."""

@@ -43,7 +43,7 @@ from workbook.excel.styling import FORMATS, print_setup
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["write_report", "is_report", "PACKAGES", "REPORT_KEYWORDS"]
+__all__ = ["write_report", "is_report", "four_pole_sheet", "PACKAGES", "REPORT_KEYWORDS"]
 
 #: Document keywords that mark a report workbook (an existing report may be replaced).
 REPORT_KEYWORDS = "mountwb report"
@@ -164,6 +164,17 @@ def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
     print_setup(ws, header_rows=3)
 
 
+def _log_log_chart(title: str, y_title: str) -> ScatterChart:
+    """An empty log-log scatter chart against frequency (Hz), 24 x 12 cm."""
+    chart = ScatterChart()
+    chart.title, chart.x_axis.title, chart.y_axis.title = title, "frequency (Hz)", y_title
+    chart.x_axis.scaling.logBase = 10
+    chart.y_axis.scaling.logBase = 10
+    chart.style = 13
+    chart.width, chart.height = 24, 12
+    return chart
+
+
 def _transmissibility(ws, runs: list[RunResult]) -> None:
     _title(ws, "Pylon transmissibility T = |F_pylon| / |F_exc| against frequency",
            "level = 20 log10 T; eta = (1 - T) x 100 %")
@@ -171,12 +182,7 @@ def _transmissibility(ws, runs: list[RunResult]) -> None:
     singles = sorted((p for _, p in _singles(runs)), key=lambda p: p.frequency_hz)
     if singles:
         groups.append(("single-frequency runs", singles))
-    chart = ScatterChart()
-    chart.title, chart.x_axis.title, chart.y_axis.title = "Pylon transmissibility", "frequency (Hz)", "T (-)"
-    chart.x_axis.scaling.logBase = 10
-    chart.y_axis.scaling.logBase = 10
-    chart.style = 13
-    chart.width, chart.height = 24, 12
+    chart = _log_log_chart("Pylon transmissibility", "T (-)")
     ws.add_chart(chart, "A4")
     row = 30
     for name, points in groups:
@@ -279,6 +285,32 @@ def _model_cards(ws, runs: list[RunResult]) -> None:
     for row, line in enumerate(card_lines(runs), start=1):
         ws.cell(row, 1, line).font = Font(name="Consolas", size=9, bold=line.startswith("Run '"))
     ws.column_dimensions["A"].width = 120
+    print_setup(ws)
+
+
+def four_pole_sheet(ws, pole) -> None:
+    """Fill *ws* with the mount's four-pole parameters (a
+    :class:`~workbook.answers.four_pole.FourPole`): magnitude (N/m) and
+    phase (deg) of K11, K21 and K22 per direction against frequency, and a
+    native log-log chart of the magnitudes."""
+    table = pole.table()
+    _title(ws, f"{pole.case_name}: four-pole parameters of the mount",
+           "K11, K22: driving-point dynamic stiffness at the engine and at the pylon pins; K21: blocked transfer "
+           "dynamic stiffness (both other terminals blocked)")
+    columns = [("frequency (Hz)", "Hz")] + [(name.replace(" N/m", " (N/m)").replace(" deg", " (deg)"), "number")
+                                             for name in table.columns]
+    top = 30
+    _table(ws, top, columns, [[frequency, *row] for frequency, row in zip(table.index, table.to_numpy())])
+    chart = _log_log_chart("Dynamic stiffness", "|K| (N/m)")
+    x = Reference(ws, min_col=1, min_row=top + 1, max_row=top + len(table))
+    for col, name in enumerate(table.columns, start=2):
+        if name.startswith("|"):
+            series = Series(Reference(ws, min_col=col, min_row=top + 1, max_row=top + len(table)), x,
+                            title=name.strip("|").replace("| N/m", ""))
+            series.marker.symbol = "none"
+            chart.series.append(series)
+    _show_axes(chart)
+    ws.add_chart(chart, "A4")
     print_setup(ws)
 
 

@@ -1,0 +1,103 @@
+"""``mountwb four-pole [CASE] [--from HZ --to HZ --points N] [--csv OUT] [--plot OUT.png] [--xlsx OUT]``.
+
+The mount's four-pole parameters against frequency (driving-point and
+blocked transfer dynamic stiffness per direction, see
+:mod:`workbook.answers.four_pole`), and the rigid-pylon transmissibility of
+each of the case's excitations that follows from them; with a pylon point
+stiffness per pin (``--pylon-stiffness``, ``--pylon-mass``) the insertion loss
+of the mount on that pylon. Everything is computed before a file is written.
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Callable
+
+from workbook.cli.loading import load_case
+from workbook.errors import UsageError
+
+__all__ = ["arguments"]
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    parser.add_argument("--from", dest="start", type=float, default=10.0, metavar="HZ",
+                        help="lowest frequency, Hz (default 10)")
+    parser.add_argument("--to", dest="stop", type=float, default=500.0, metavar="HZ",
+                        help="highest frequency, Hz (default 500)")
+    parser.add_argument("--points", type=int, default=41, help="frequencies, log-spaced (default 41)")
+    parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+    parser.add_argument("--csv", metavar="OUT", help="write the table as CSV")
+    parser.add_argument("--plot", metavar="OUT.png", help="write the magnitude plot as PNG")
+    parser.add_argument("--xlsx", metavar="OUT", help="write the table and a native chart as a workbook (.xlsx)")
+    parser.add_argument("--pylon-stiffness", type=float, metavar="N/M",
+                        help="pylon point stiffness at each pin in x, y and z, N/m: print the insertion loss")
+    parser.add_argument("--pylon-mass", type=float, default=0.0, metavar="KG",
+                        help="pylon mass at each pin, kg (point dynamic stiffness k - w^2 m; default 0)")
+    return run
+
+
+def run(args) -> int:
+    import numpy as np
+
+    from workbook.answers.four_pole import QUANTITIES, four_pole, frequency_grid
+    from workbook.model.case import DIRECTIONS
+    from workbook.solve.harmonic import excitation_phasor
+
+    frequencies = frequency_grid(args.start, args.stop, args.points)
+    pylon = _pylon(args, frequencies)
+    if args.xlsx and args.case and Path(args.xlsx).resolve() == Path(args.case).resolve():
+        raise UsageError(f"--xlsx {args.xlsx}: that is the case file; give a new file name")
+    case = load_case(args.case, rigid=args.rigid)
+    pole = four_pole(case, frequencies)
+    table = pole.table()
+    rigid = {x.name: pole.transmissibility(excitation_phasor(x), x.point) for x in case.single_frequency_excitations()}
+    loss = None if pylon is None else pole.insertion_loss(pylon)
+    figure = pole.plot() if args.plot else None
+    print(f"{case.name}: four-pole parameters of the mount, engine (centre of gravity) to {len(pole.pins)} pylon "
+          f"pins, about the preloaded equilibrium")
+    for quantity, meaning in QUANTITIES.items():
+        print(f"  {quantity}: {meaning}")
+    print()
+    print(table.to_string(float_format=lambda v: f"{v:10.4g}"))
+    for name, values in rigid.items():
+        print(f"\nrigid pylon, force shape of {name!r}: T = |F_pylon| / |F| from K11, K21 and the engine")
+        print("frequency Hz  " + "  ".join(f"T {axis:<7}" for axis in DIRECTIONS))
+        for frequency, row in zip(frequencies, values):
+            print(f"{frequency:12.4g}  " + "  ".join(f"{v:9.4g}" for v in np.asarray(row)))
+    if loss is not None:
+        print(f"\ninsertion loss on a pylon of {args.pylon_stiffness:g} N/m and {args.pylon_mass:g} kg per pin "
+              f"(unit force at the centre of gravity; 20 log10 |F_bolted| / |F_mount|, dB)")
+        print("frequency Hz  " + "  ".join(f"IL {axis} dB " for axis in DIRECTIONS))
+        for frequency, row in zip(frequencies, loss):
+            print(f"{frequency:12.4g}  " + "  ".join(f"{v:9.2f}" for v in row))
+    if args.csv:
+        table.to_csv(args.csv)
+    if figure is not None:
+        figure.savefig(args.plot, dpi=120)
+    if args.xlsx:
+        from openpyxl import Workbook
+
+        from workbook.excel.files import save_atomic
+        from workbook.excel.report import four_pole_sheet
+
+        book = Workbook()
+        book.active.title = "Four-pole"
+        four_pole_sheet(book.active, pole)
+        save_atomic(book, args.xlsx)
+    return 0
+
+
+def _pylon(args, frequencies):
+    """The pylon point dynamic stiffness per frequency (N/m), or None."""
+    import numpy as np
+
+    if args.pylon_stiffness is None:
+        if args.pylon_mass:
+            raise UsageError("--pylon-mass needs --pylon-stiffness (the pylon's point stiffness per pin, N/m)")
+        return None
+    if not (np.isfinite(args.pylon_stiffness) and args.pylon_stiffness > 0):
+        raise UsageError(f"--pylon-stiffness: found {args.pylon_stiffness:g}, expected a stiffness > 0 N/m")
+    if not (np.isfinite(args.pylon_mass) and args.pylon_mass >= 0):
+        raise UsageError(f"--pylon-mass: found {args.pylon_mass:g}, expected a mass >= 0 kg")
+    return args.pylon_stiffness - (2 * np.pi * frequencies) ** 2 * args.pylon_mass
