@@ -2,7 +2,7 @@
 
 The mount's four-pole parameters against frequency (driving-point and
 blocked transfer dynamic stiffness per direction, see
-:mod:`workbook.answers.four_pole`), and the rigid-pylon transmissibility of
+:mod:`workbook.solve.four_pole`), and the rigid-pylon transmissibility of
 each of the case's excitations that follows from them; with a pylon point
 stiffness per pin (``--pylon-stiffness``, ``--pylon-mass``) the insertion loss
 of the mount on that pylon. Everything is computed before a file is written.
@@ -40,8 +40,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 def run(args) -> int:
     import numpy as np
 
-    from workbook.answers.four_pole import QUANTITIES, four_pole, frequency_grid
     from workbook.model.case import DIRECTIONS
+    from workbook.solve.four_pole import QUANTITIES, four_pole, frequency_grid
     from workbook.solve.harmonic import excitation_phasor
 
     frequencies = frequency_grid(args.start, args.stop, args.points)

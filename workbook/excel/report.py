@@ -290,7 +290,7 @@ def _model_cards(ws, runs: list[RunResult]) -> None:
 
 def four_pole_sheet(ws, pole) -> None:
     """Fill *ws* with the mount's four-pole parameters (a
-    :class:`~workbook.answers.four_pole.FourPole`): magnitude (N/m) and
+    :class:`~workbook.solve.four_pole.FourPole`): magnitude (N/m) and
     phase (deg) of K11, K21 and K22 per direction against frequency, and a
     native log-log chart of the magnitudes."""
     table = pole.table()
