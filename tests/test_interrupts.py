@@ -62,7 +62,7 @@ def _one_line(rest: str, signum: int) -> str:
 @pytest.mark.slow
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_during_the_time_integration(tmp_path, signum):
-    process = start("run", "--rigid", "--no-progress", cwd=tmp_path)
+    process = start("run", "--rigid", "--method", "time", "--no-progress", cwd=tmp_path)
     code, rest = signal_at(process, "steps of", signum)
     assert code == SIGNAL_EXIT[signum]
     _one_line(rest, signum)
