@@ -306,3 +306,14 @@ def test_report_never_replaces_the_case(cheap, tmp_path, capsys):
     reports = [p for p in tmp_path.iterdir() if p.name.startswith("case-report-")]
     assert len(reports) == 1 and f"report written to {reports[0]}" in out
     assert load_workbook(reports[0]).sheetnames[0] == "Summary"
+
+
+def test_a_report_of_frequency_domain_runs_plots_their_answers(tmp_path):
+    """The default method answers the reference rows in the frequency domain:
+    no force histories, so the report plots the efficiency instead of them."""
+    path = copy_reference(tmp_path)
+    make_cheap(path)
+    set_cells(path, {("Case", "method", 3): "auto"})
+    report = tmp_path / "report.xlsx"
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
+    assert len(load_workbook(report)["Plots"]._images) == 1

@@ -91,6 +91,11 @@ class ExcitationResult(PylonAnswers):
     window: slice = field(repr=False)
 
     @property
+    def has_histories(self) -> bool:
+        """True for a time-domain answer, which keeps its force histories."""
+        return len(self.time) > 0
+
+    @property
     def steady(self) -> bool:
         return self.steady_change <= self.steady_tolerance
 
@@ -215,6 +220,9 @@ class MountResult:
         import matplotlib.pyplot as plt
 
         result = self.run(run)
+        if not result.has_histories:
+            raise ValueError(f"run {result.name!r} was answered in the frequency domain: it has no force histories "
+                             f"(ask for the time domain: method 'time')")
         histories = {**result.hinge_histories, PYLON_SUM: result.pylon_history}
         fig, axes = plt.subplots(4, 1, sharex=True, figsize=(9, 8), constrained_layout=True)
         t = result.time

@@ -246,7 +246,7 @@ def _figure(run: RunResult):
 
     result = run.result
     if len(result.runs) == 1:
-        return result.plot_time_histories()
+        return result.plot_time_histories() if result.runs[0].has_histories else result.plot_efficiency()
     fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
     frequencies = [p.frequency_hz for p in result.runs]
     for i, d in enumerate(DIRECTIONS):
