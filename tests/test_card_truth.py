@@ -28,6 +28,7 @@ def _entry(card, name):
     return next(e for e in card.effects if e.name == name)
 
 
+@pytest.mark.slow
 def test_the_spin_restraints_are_on_the_card_with_the_modes_they_add(rigid):
     result = _run_frequency(rigid)
     entry = _entry(result.model_cards[LP_ROTOR.name], "link spin restraints")

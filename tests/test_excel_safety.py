@@ -147,6 +147,7 @@ while True:
 """
 
 
+@pytest.mark.slow
 def test_a_kill_during_a_save_leaves_no_file_behind(tmp_path):
     path = copy_reference(tmp_path)
     ready = tmp_path.parent / f"{tmp_path.name}-ready"

@@ -17,8 +17,8 @@ from workbook.solve.pipeline import run_case
 
 
 @pytest.fixture(scope="module")
-def rigid(cache_dir):
-    return dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+def rigid(coarse_reference):
+    return dataclasses.replace(coarse_reference.with_rigid_links(), excitations=(LP_ROTOR,))
 
 
 def _pushed(case, newtons):
@@ -26,6 +26,7 @@ def _pushed(case, newtons):
         PointForce("push", point=case.engine.center_of_mass, force=(0.0, 0.0, newtons)),))
 
 
+@pytest.mark.slow
 def test_a_push_beyond_the_limit_load_names_the_share_carried(rigid, capsys):
     """2 MN upward: in load steps the solve stops at the limit load, which
     must lie where the preloaded stiffness changes sign (between 1.8 and

@@ -234,6 +234,7 @@ def test_a_heavy_fast_rotor_is_no_mechanism_and_keeps_the_stiffness_determinant(
 # --- 10. an undamped link mode -------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_an_excitation_on_an_undamped_link_mode_is_refused_naming_the_links(cache_dir):
     """Hinge and link damping off, flexible links: the thrust rods' own
     bending modes (engine still) are undamped. On one of them the harmonic

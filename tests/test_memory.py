@@ -43,10 +43,10 @@ def test_time_domain_runs_do_not_grow_memory():
     assert _growth_per_run(case, 5) < GROWTH_PER_RUN_MB
 
 
-def test_a_closed_scene_has_freed_its_system():
+def test_a_closed_scene_has_freed_its_system(coarse_reference):
     from workbook.scene.build import build_scene
 
-    case = reference_case().with_rigid_links()
+    case = coarse_reference.with_rigid_links()
     with build_scene(case) as scene:
         assert scene.mbs.systemData.ODE2Size() > 0
     assert scene.system.NumberOfSystems() == 0

@@ -9,13 +9,13 @@ from excel_helpers import copy_reference, set_cells
 
 from workbook.cli.main import main
 from workbook.errors import CaseError
-from workbook.model.reference import LP_SPOOL, reference_case
+from workbook.model.reference import LP_SPOOL
 from workbook.scene.build import build_scene
 
 
 @pytest.fixture(scope="module")
-def case():
-    return reference_case()
+def case(coarse_reference):
+    return coarse_reference
 
 
 def _renamed(items, index, name):

@@ -10,7 +10,7 @@ import pytest
 
 from workbook.errors import DivergenceError, SimulationError, UnstablePreloadError
 from workbook.model.case import PointForce
-from workbook.model.reference import LP_ROTOR, reference_case
+from workbook.model.reference import LP_ROTOR
 from workbook.scene.build import build_scene
 from workbook.solve.modes import linearize, modes_of
 from workbook.solve.pipeline import run_case
@@ -19,8 +19,8 @@ from workbook.solve.time_domain import integrate, plan_run
 
 
 @pytest.fixture(scope="module")
-def rigid(cache_dir):
-    return dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+def rigid(coarse_reference):
+    return dataclasses.replace(coarse_reference.with_rigid_links(), excitations=(LP_ROTOR,))
 
 
 def _pushed(case, newtons, method="frequency"):

@@ -52,6 +52,7 @@ def test_the_recommended_steps_meet_one_percent():
     assert result.transmissibility[2] == pytest.approx(EXACT, rel=0.01)
 
 
+@pytest.mark.slow
 def test_eight_steps_per_period_on_the_reference_mount_warn(cache_dir):
     """Eight steps per period at 59 Hz put T_x about 10 % off the frequency
     domain: the run must say so; 40 steps (estimated 0.5 %) do not warn."""
