@@ -921,6 +921,19 @@ class Case:
         """The pylon-side hinges, whose forces sum to the pylon force."""
         return tuple(h for h in self.hinges if h.on_pylon)
 
+    def pylon_pins(self) -> list[tuple[Vector3, list[str]]]:
+        """The pylon pins: each position (m) with the names of the pylon-side
+        hinges on it (hinges closer than the point tolerance share a pin)."""
+        pins: list[tuple[Vector3, list[str]]] = []
+        for hinge in self.pylon_hinges:
+            pin = next((pin for pin in pins
+                        if np.linalg.norm(np.subtract(pin[0], hinge.position)) <= POINT_TOLERANCE), None)
+            if pin is None:
+                pins.append((hinge.position, [hinge.name]))
+            else:
+                pin[1].append(hinge.name)
+        return pins
+
     def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
         """Every run of the case: single excitations and expanded sweeps."""
         runs = []

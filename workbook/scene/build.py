@@ -520,15 +520,8 @@ def _add_transducers(mbs, case: Case, ground: int) -> dict[str, TransducerItems]
 
     eii = exu.itemInterface
     rig = case.test_rig
-    pins = []
-    for hinge in case.pylon_hinges:
-        pin = next((pin for pin in pins if _same_point(pin[0], hinge.position)), None)
-        if pin is None:
-            pins.append((hinge.position, [hinge.name]))
-        else:
-            pin[1].append(hinge.name)
     transducers = {}
-    for position, carried in pins:
+    for position, carried in case.pylon_pins():
         name = TRANSDUCER_PREFIX + " + ".join(carried)
         node = mbs.AddNode(eii.NodePoint(name=exudyn_name("rig", name), referenceCoordinates=list(position),
                                          visualization=eii.VNodePoint(show=False)))

@@ -53,7 +53,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from workbook.errors import CaseError, FourPoleError
-from workbook.model.case import DIRECTIONS, ENGINE, POINT_TOLERANCE, Case, HarmonicForce
+from workbook.model.case import DIRECTIONS, ENGINE, Case, HarmonicForce
 
 __all__ = ["FourPole", "PylonResponse", "four_pole", "frequency_grid", "QUANTITIES"]
 
@@ -344,18 +344,6 @@ class FourPole:
         return fig
 
 
-def _pins(case: Case) -> list[tuple[np.ndarray, list[str]]]:
-    """Pylon-side hinges grouped by pin (position within the point tolerance)."""
-    pins: list[tuple[np.ndarray, list[str]]] = []
-    for hinge in case.pylon_hinges:
-        pin = next((pin for pin in pins if np.linalg.norm(pin[0] - hinge.position) <= POINT_TOLERANCE), None)
-        if pin is None:
-            pins.append((np.asarray(hinge.position, dtype=float), [hinge.name]))
-        else:
-            pin[1].append(hinge.name)
-    return pins
-
-
 def _mount_case(case: Case) -> Case:
     """The case whose scene the four-pole set is formed from: the pylon pins on
     rigid ground (no test-rig transducers: the rig is the pylon's side).
@@ -429,7 +417,7 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     e = slice(0, ENGINE_COORDINATES)
     i = slice(ENGINE_COORDINATES, mass.shape[0])
 
-    pins = _pins(mount)
+    pins = [(np.asarray(position, dtype=float), carried) for position, carried in mount.pylon_pins()]
     channel = {name: n for n, name in enumerate(model.hinge_names)}
     hinges = {h.name: h for h in mount.hinges}
     rows_k, rows_d, direct_k, direct_d = [], [], [], []
