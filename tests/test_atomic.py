@@ -37,3 +37,36 @@ def test_a_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
             raise RuntimeError("disk full")
     assert path.read_text() == "old"
     assert list(tmp_path.iterdir()) == [path]
+
+
+def test_a_figure_that_fails_to_render_leaves_the_old_picture(tmp_path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workbook.answers.saving import save_figure
+
+    path = tmp_path / "mount-layout.png"
+    good = plt.figure()
+    save_figure(good, path)
+    before = path.read_bytes()
+    assert before.startswith(b"\x89PNG")
+    broken = plt.figure()
+    broken.text(0.5, 0.5, r"$\frac{1}$")  # mathtext that cannot be laid out
+    with pytest.raises(ValueError):
+        save_figure(broken, path)
+    plt.close("all")
+    assert path.read_bytes() == before
+    assert list(tmp_path.iterdir()) == [path]
+
+
+def test_a_saved_table_reads_back_whole(tmp_path):
+    import pandas as pd
+
+    from workbook.answers.saving import save_csv, save_text
+
+    frame = pd.DataFrame({"T": [0.0363, 0.0019]}, index=["x", "y"])
+    path = save_csv(frame, tmp_path / "table.csv")
+    pd.testing.assert_frame_equal(pd.read_csv(path, index_col=0), frame)
+    assert save_text("é\n", tmp_path / "note.md").read_text(encoding="utf-8") == "é\n"

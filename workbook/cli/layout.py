@@ -19,9 +19,10 @@ def layout(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
+    from workbook.answers.saving import save_figure
     from workbook.model.drawing import plot_layout
 
     figure = plot_layout(load_case(args.case))
-    figure.savefig(args.output, dpi=130)
+    save_figure(figure, args.output, dpi=130)
     print(args.output)
     return 0

@@ -19,6 +19,7 @@ import dataclasses
 from typing import Callable
 
 from workbook.answers.results import ExcitationResult
+from workbook.answers.saving import save_csv
 from workbook.cli.loading import load_case
 from workbook.errors import UsageError
 from workbook.model.case import AnalysisSettings, Case
@@ -105,7 +106,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         table = comparison_frame(measurement, simulate_run(case, record.run))
         print(table.to_string(float_format=lambda v: f"{v:10.5g}"))
         if args.csv:
-            table.to_csv(args.csv)
+            save_csv(table, args.csv)
             print(args.csv)
         return 0
 

@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from workbook.answers.isolation import pylon_sum
+from workbook.answers.saving import save_text
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS
 
@@ -254,5 +255,4 @@ def write_record(path: str | Path, record: RigRecord, *, digits: int = 4) -> Pat
     table = np.column_stack([record.time, *channels.values()])
     row_format = ",".join(["{:.9f}"] + [f"{{:.{digits}f}}"] * (table.shape[1] - 1))
     lines += [row_format.format(*row) for row in table]
-    path.write_text("\n".join(lines) + "\n")
-    return path
+    return save_text("\n".join(lines) + "\n", path)

@@ -36,7 +36,9 @@ from typing import Callable
 
 import numpy as np
 
+from flexbodies.atomic import replacing
 from flexbodies.selection import MODE_MARGIN
+from workbook.answers.saving import save_figure, save_text
 from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
 from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
@@ -330,13 +332,12 @@ class AccuracyStudy:
             number += 1
             name = f"{stem}-{number}"
         paths = [folder / f"{name}{suffix}" for suffix in (".md", ".png", ".xlsx")]
-        with open(paths[0], "x", encoding="utf-8") as handle:
-            handle.write(self.to_markdown())
+        save_text(self.to_markdown(), paths[0])
         figure = self.plot()
-        figure.savefig(paths[1], dpi=130)
+        save_figure(figure, paths[1], dpi=130)
         plt.close(figure)
-        with open(paths[2], "xb") as handle:
-            self.frame().to_excel(handle, sheet_name="accuracy study", engine="openpyxl")
+        with replacing(paths[2], suffix=".xlsx.tmp") as temporary:
+            self.frame().to_excel(temporary, sheet_name="accuracy study", engine="openpyxl")
         return paths
 
 

@@ -17,6 +17,7 @@ import math
 from pathlib import Path
 
 from flexbodies.atomic import replacing
+from workbook.answers.saving import save_csv, save_figure
 from workbook.errors import UsageError
 from workbook.model.case import DIRECTIONS
 from workbook.studies.parallel import RowOutcome
@@ -110,11 +111,11 @@ def table_path(folder: str | Path, table_format: str = "csv") -> Path:
 
 def _write_table(frame, path: Path) -> None:
     """Write *frame* to *path* (format by its ending) all at once."""
-    with replacing(path, suffix=f".{path.suffix[1:]}.tmp") as temporary:
-        if path.suffix == ".csv":
-            frame.to_csv(temporary, index=False)
-        else:
-            frame.to_parquet(temporary, index=False)
+    if path.suffix == ".csv":
+        save_csv(frame, path, index=False)
+        return
+    with replacing(path, suffix=".parquet.tmp") as temporary:
+        frame.to_parquet(temporary, index=False)
 
 
 class StudyTable:
@@ -228,8 +229,7 @@ def write_study(frame, parameters: list[str], folder: str | Path, table_format: 
         frame.to_excel(temporary, sheet_name="Parameter study", index=False, engine="openpyxl")
     plot = table.with_suffix(".png")
     figure = plot_sensitivity(frame, parameters)
-    with replacing(plot, suffix=".png.tmp") as temporary:
-        figure.savefig(temporary, dpi=120, format="png")
+    save_figure(figure, plot, dpi=120)
     import matplotlib.pyplot as plt
 
     plt.close(figure)
