@@ -159,6 +159,20 @@ def test_bad_transducers_name_the_field():
         dataclasses.replace(sdof_case(()), test_rig=(1e8, 1e8, 1e8))
 
 
+def test_an_item_named_like_a_transducer_is_refused_only_when_the_rig_is_built():
+    case = reference_case()
+    pin = case.pylon_pins()[0][1]
+    clash = f"transducer {' + '.join(pin)}"
+    link = case.links[0]
+    renamed = tuple(dataclasses.replace(h, body_a=clash) if h.body_a == link.name else
+                    dataclasses.replace(h, body_b=clash) if h.body_b == link.name else h for h in case.hinges)
+    on_bench = dataclasses.replace(case, links=(dataclasses.replace(link, name=clash),) + case.links[1:],
+                                   hinges=renamed)  # without the rig, the name is free
+    with pytest.raises(CaseError, match=rf"link '{clash}', field 'name'.*not the test-rig transducer under the "
+                                        rf"pylon pin of {pin[0]}"):
+        dataclasses.replace(on_bench, test_rig=ForceTransducers((1e8,) * 3))
+
+
 def test_transducers_survive_json_and_pickle():
     case = dataclasses.replace(rig_case("frequency"), test_rig=ForceTransducers((1e8, 2e8, 3e8), 0.5, (1.0, 2.0, 3.0)))
     assert from_json(to_json(case)) == case

@@ -30,7 +30,8 @@ from workbook.errors import CaseError
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
-    "SingleFrequencyExcitation", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request"]
+    "SingleFrequencyExcitation", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request",
+    "TRANSDUCER_PREFIX", "transducer_name"]
 
 PYLON = "pylon"
 ENGINE = "engine"
@@ -413,6 +414,15 @@ class ForceTransducers:
         _set(self, "stiffness", stiffness)
         _set(self, "damping", damping)
         _set(self, "mass", _number(self.mass, item, "mass", minimum=0.0, strictly=True))
+
+
+#: A test-rig transducer is named by this prefix and the pylon-side hinges it carries.
+TRANSDUCER_PREFIX = "transducer "
+
+
+def transducer_name(carried) -> str:
+    """Name of the test-rig transducer under the pylon pin of the hinges *carried* (their names)."""
+    return TRANSDUCER_PREFIX + " + ".join(carried)
 
 
 def _frequency(item: str, frequency_hz: Any, rpm: Any) -> float:
@@ -863,7 +873,7 @@ class Case:
                 if not isinstance(item, kinds):
                     raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
             _set(self, name, items)
-        self._check_names(groups)
+        owners = self._check_names(groups)
         links = self.link_map
         for hinge in self.hinges:
             for name in ("body_a", "body_b"):
@@ -877,11 +887,23 @@ class Case:
                     raise CaseError(f"hinge {hinge.name!r}", "position", hinge.position,
                                     f"an eye centre of link {body!r}: {links[body].end_a} or "
                                     f"{links[body].end_b}")
+        if self.test_rig is not None:
+            for _, carried in self.pylon_pins():
+                name = transducer_name(carried)
+                if name in owners:
+                    raise CaseError(f"{owners[name]}", "name", name, "a name that is not the test-rig transducer "
+                                    f"under the pylon pin of {' + '.join(carried)} (rename the item)")
 
-    def _check_names(self, groups) -> None:
+    def _check_names(self, groups) -> dict[str, str]:
         """Every item's name unique across all kinds of items (links, hinges,
         static loads, excitations and the points of each sweep, rotors), and
-        none of them ``"pylon"`` or ``"engine"``."""
+        none of them ``"pylon"`` or ``"engine"``.
+
+        Returns
+        -------
+        dict of str to str
+            What each name names (e.g. ``"hinge 'front-up-left'"``).
+        """
         owners = {reserved: f"the scene's own {reserved}" for reserved in _RESERVED}
         for group, _ in groups:
             kind = group[:-1].replace("_", " ")
@@ -892,6 +914,7 @@ class Case:
                         raise CaseError(f"{kind} {item.name!r}", "name", name,
                                         f"a name not used before (it already names {owners[name]})")
                     owners[name] = f"{kind} {item.name!r}"
+        return owners
 
     @property
     def link_map(self) -> dict[str, Link]:

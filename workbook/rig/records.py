@@ -31,7 +31,7 @@ import numpy as np
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.saving import save_text
 from workbook.errors import RecordError
-from workbook.model.case import DIRECTIONS
+from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 
 __all__ = ["RigRecord", "read_record", "write_record", "EXCITATION_CHANNEL",
            "SAMPLE_RATE_TOLERANCE"]
@@ -159,11 +159,11 @@ def _read_header(path, lines: list[str]) -> tuple[dict, dict, int]:
         if match is None:
             continue
         key, value = match["key"], match["value"]
-        if key.startswith("transducer "):
+        if key.startswith(TRANSDUCER_PREFIX):
             names = tuple(n.strip() for n in value.split("+") if n.strip())
             if not names:
                 raise RecordError(path, "a transducer line must name its hinges ('a + b')", line=number)
-            hinges[key[len("transducer "):].strip()] = names
+            hinges[key[len(TRANSDUCER_PREFIX):].strip()] = names
         else:
             header[key] = (value, number)
     if table_start is None:

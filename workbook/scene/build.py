@@ -39,14 +39,25 @@ from typing import Any, Callable
 
 import numpy as np
 
-from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, SingleFrequencyExcitation
+from workbook.model.case import (
+    ENGINE,
+    POINT_TOLERANCE,
+    PYLON,
+    Case,
+    Gravity,
+    Hinge,
+    PointForce,
+    PointMoment,
+    SingleFrequencyExcitation,
+    transducer_name,
+)
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
            "exudyn_name", "ignored_contact_stiffness", "marker_bodies", "net_angular_momentum",
-           "scene_warnings", "TRANSDUCER_PREFIX", "CANCELLED_MOMENTUM"]
+           "scene_warnings", "CANCELLED_MOMENTUM"]
 
 log = logging.getLogger(__name__)
 
@@ -98,10 +109,6 @@ class HingeItems:
     on_pylon: bool
     clearance: bool
     law: Any = field(default=None, repr=False)
-
-
-#: Transducer names: this prefix and the pylon-side hinges carried, joined by " + ".
-TRANSDUCER_PREFIX = "transducer "
 
 
 @dataclass(frozen=True)
@@ -522,7 +529,7 @@ def _add_transducers(mbs, case: Case, ground: int) -> dict[str, TransducerItems]
     rig = case.test_rig
     transducers = {}
     for position, carried in case.pylon_pins():
-        name = TRANSDUCER_PREFIX + " + ".join(carried)
+        name = transducer_name(carried)
         node = mbs.AddNode(eii.NodePoint(name=exudyn_name("rig", name), referenceCoordinates=list(position),
                                          visualization=eii.VNodePoint(show=False)))
         body = mbs.AddObject(eii.ObjectMassPoint(name=exudyn_name("rig", f"{name} mass"), mass=rig.mass, nodeNumber=node,
