@@ -191,6 +191,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         _spin_restraints(scene),
         _gyroscopics(scene),
         _rig_sensors(scene),
+        _imbalance_planes(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
     frequency_detail = "harmonic solution of the scene linearised about the preload"
@@ -237,6 +238,20 @@ def _gyroscopics(scene) -> EffectEntry:
     listing = ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in rotors)
     return EffectEntry(name, True, f"{listing}: moment -Ip Omega (omega x a) on the engine (symbolic "
                                    f"ObjectGenericODE2); their mass and transverse inertia lumped in the engine")
+
+
+def _imbalance_planes(scene) -> EffectEntry:
+    """The excitation's imbalance planes: one force per plane, or a single force."""
+    from workbook.model.case import Imbalance
+
+    excitation = scene.excitation.excitation if scene.excitation is not None else None
+    if not isinstance(excitation, Imbalance):
+        return EffectEntry("imbalance planes", False, "the excitation is one force at one point")
+    planes = "; ".join(f"{f.force_amplitude:.4g} N at x = {f.point[0]:g} m, phase {f.phase_deg:g} deg"
+                       for f in excitation.plane_forces())
+    return EffectEntry("imbalance planes", True, f"{len(excitation.planes)} planes of {excitation.name!r} at "
+                       f"{excitation.frequency:g} Hz, each its own rotating force U w^2 (or given force): {planes}; "
+                       f"T refers to their summed amplitude {excitation.force_amplitude:.4g} N")
 
 
 def _rig_sensors(scene) -> EffectEntry:

@@ -30,7 +30,8 @@ from workbook.errors import CaseError
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
-    "SingleFrequencyExcitation", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request"]
+    "SingleFrequencyExcitation", "ImbalancePlane", "Imbalance", "RunUp", "SPEED_UNITS",
+    "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request"]
 
 PYLON = "pylon"
 ENGINE = "engine"
@@ -511,6 +512,10 @@ class RotatingForce(_OneFrequency):
         sin_part = amplitude * (v * math.cos(phase) - u * math.sin(phase))
         return cos_part, sin_part
 
+    def point_forces(self) -> tuple[tuple[Vector3, np.ndarray, np.ndarray], ...]:
+        """The forces at their points: ``((point, C, S),)`` (see :meth:`force_coefficients`)."""
+        return ((self.point, *self.force_coefficients()),)
+
 
 @dataclass(frozen=True)
 class HarmonicForce(_OneFrequency):
@@ -560,8 +565,103 @@ class HarmonicForce(_OneFrequency):
         phase = math.radians(self.phase_deg)
         return self.amplitude * math.cos(phase) * d, -self.amplitude * math.sin(phase) * d
 
+    def point_forces(self) -> tuple[tuple[Vector3, np.ndarray, np.ndarray], ...]:
+        """The forces at their points: ``((point, C, S),)`` (see :meth:`force_coefficients`)."""
+        return ((self.point, *self.force_coefficients()),)
 
-SingleFrequencyExcitation = RotatingForce | HarmonicForce
+
+@dataclass(frozen=True)
+class ImbalancePlane:
+    """One imbalance plane of a rotor: an eccentric mass at a point on the spin axis.
+
+    Parameters
+    ----------
+    point : 3 floats
+        The plane's centre on the spin axis, m.
+    unbalance, amplitude : float
+        The unbalance m e in kg m (the force is then U w^2, growing with
+        the speed) or the force amplitude in N; give exactly one (> 0).
+    phase_deg : float
+        Angular position of the eccentric mass at t = 0, degrees.
+    """
+
+    point: Vector3
+    unbalance: float | None = None
+    amplitude: float | None = None
+    phase_deg: float = 0.0
+
+    def check(self, item: str) -> "ImbalancePlane":
+        """The plane with validated fields; *item* names it in a CaseError."""
+        if (self.amplitude is None) == (self.unbalance is None):
+            raise CaseError(item, "unbalance", self.unbalance, "either unbalance or amplitude, not both")
+        given = {name: _number(getattr(self, name), item, name, minimum=0.0, strictly=True)
+                 for name in ("unbalance", "amplitude") if getattr(self, name) is not None}
+        return ImbalancePlane(_vector3(self.point, item, "point"), phase_deg=_number(self.phase_deg, item,
+                                                                                    "phase_deg"), **given)
+
+
+@dataclass(frozen=True)
+class Imbalance(_OneFrequency):
+    """Several imbalance planes of one rotor at one speed, as a rig's rotary
+    exciter applies them (eccentric masses at the front support, the centre of
+    gravity and the rear support, say).
+
+    Plane k exerts the rotating force of a :class:`RotatingForce` at its
+    point, with its own unbalance (or amplitude) and phase; all turn at the
+    same speed about the same axis. The transmissibility refers to the sum
+    of the plane force amplitudes (:attr:`force_amplitude`): the force of
+    planes in phase, and never zero, also when the planes form a couple.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    planes : tuple of ImbalancePlane
+        At least one plane.
+    frequency_hz, rpm : float
+        Rotor speed; give exactly one.
+    axis : 3 floats
+        Spin axis.
+    """
+
+    name: str
+    planes: tuple[ImbalancePlane, ...]
+    frequency_hz: float | None = None
+    rpm: float | None = None
+    axis: Vector3 = (1.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        _frequency(item, self.frequency_hz, self.rpm)
+        _set(self, "axis", _direction(self.axis, item, "axis"))
+        try:
+            planes = tuple(self.planes)
+        except TypeError:
+            raise CaseError(item, "planes", self.planes, "a list of imbalance planes") from None
+        if not planes or not all(isinstance(p, ImbalancePlane) for p in planes):
+            raise CaseError(item, "planes", self.planes, "one or more ImbalancePlane")
+        _set(self, "planes", tuple(p.check(f"{item} plane {k}") for k, p in enumerate(planes, start=1)))
+
+    def plane_forces(self) -> tuple[RotatingForce, ...]:
+        """Each plane as the rotating force it exerts, named ``"<name> plane <k>"``."""
+        return tuple(RotatingForce(f"{self.name} plane {k}", plane.point, frequency_hz=self.frequency,
+                                   amplitude=plane.amplitude, unbalance=plane.unbalance, axis=self.axis,
+                                   phase_deg=plane.phase_deg)
+                     for k, plane in enumerate(self.planes, start=1))
+
+    @property
+    def force_amplitude(self) -> float:
+        """Sum of the plane force amplitudes, N (the reference of the transmissibility)."""
+        return sum(force.force_amplitude for force in self.plane_forces())
+
+    def point_forces(self) -> tuple[tuple[Vector3, np.ndarray, np.ndarray], ...]:
+        """The plane forces at their points: ``(point, C, S)`` per plane."""
+        return tuple(part for force in self.plane_forces() for part in force.point_forces())
+
+
+SingleFrequencyExcitation = RotatingForce | HarmonicForce | Imbalance
+SINGLE_FREQUENCY_KINDS = (RotatingForce, HarmonicForce, Imbalance)
 
 
 @dataclass(frozen=True)
@@ -618,7 +718,7 @@ class Sweep:
     ----------
     name : str
         Unique name.
-    template : RotatingForce or HarmonicForce
+    template : RotatingForce, HarmonicForce or Imbalance
         The excitation; its own frequency is replaced by each sweep frequency
         (an unbalance given as m*e gives a force growing with frequency^2).
     frequencies_hz : floats
@@ -632,8 +732,8 @@ class Sweep:
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         _name(self.name, "excitation")
-        if not isinstance(self.template, (RotatingForce, HarmonicForce)):
-            raise CaseError(item, "template", self.template, "a RotatingForce or HarmonicForce")
+        if not isinstance(self.template, SINGLE_FREQUENCY_KINDS):
+            raise CaseError(item, "template", self.template, "a RotatingForce, HarmonicForce or Imbalance")
         try:
             frequencies = tuple(_number(f, item, "frequencies_hz", minimum=0.0, strictly=True)
                                 for f in self.frequencies_hz)
@@ -664,7 +764,67 @@ class Sweep:
                      for f in self.frequencies_hz)
 
 
-Excitation = RotatingForce | HarmonicForce | Sweep
+#: Speed units of a run-up and their factor to Hz.
+SPEED_UNITS = {"rpm": 1.0 / 60.0, "Hz": 1.0}
+
+
+@dataclass(frozen=True)
+class RunUp(Sweep):
+    """A run-up: a rotor imbalance at evenly spaced speeds, its force growing as U w^2.
+
+    A :class:`Sweep` whose template is an unbalance (a :class:`RotatingForce`
+    given by ``unbalance``, or an :class:`Imbalance` whose planes all are),
+    so that the force amplitude grows with the square of the speed, and
+    whose speeds are kept in the unit they were given in.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    template : RotatingForce or Imbalance
+        The imbalance; its own speed is replaced by each run-up speed.
+    frequencies_hz : floats
+        The speeds, Hz, ascending.
+    speed_unit : {"rpm", "Hz"}
+        The unit the speeds are tabulated and plotted in.
+    """
+
+    speed_unit: str = "rpm"
+
+    def __post_init__(self):
+        super().__post_init__()
+        item = f"excitation {self.name!r}"
+        if self.speed_unit not in SPEED_UNITS:
+            raise CaseError(item, "speed_unit", self.speed_unit, " or ".join(repr(u) for u in SPEED_UNITS))
+        planes = (self.template.planes if isinstance(self.template, Imbalance)
+                  else (self.template,) if isinstance(self.template, RotatingForce) else ())
+        if not planes or any(plane.unbalance is None for plane in planes):
+            raise CaseError(item, "unbalance", None, "an unbalance on every imbalance plane (a run-up's force "
+                            "grows as U w^2; a rotating force or imbalance given by its unbalance)")
+
+    @classmethod
+    def speeds(cls, name: str, template: SingleFrequencyExcitation, start: float, stop: float, points: int,
+               unit: str = "rpm") -> "RunUp":
+        """A run-up over *points* evenly spaced speeds from *start* to *stop*, in *unit* (rpm or Hz)."""
+        item = f"excitation {name!r}"
+        if unit not in SPEED_UNITS:
+            raise CaseError(item, "speed_unit", unit, " or ".join(repr(u) for u in SPEED_UNITS))
+        start = _number(start, item, "start", minimum=0.0, strictly=True)
+        stop = _number(stop, item, "stop", minimum=0.0, strictly=True)
+        if stop <= start:
+            raise CaseError(item, "stop", stop, f"a speed above the start ({start:g} {unit})")
+        if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
+            raise CaseError(item, "points", points, "a whole number >= 2")
+        factor = SPEED_UNITS[unit]
+        return cls(name, template, tuple(float(s) * factor for s in np.linspace(start, stop, int(points))), unit)
+
+    @property
+    def speed_values(self) -> np.ndarray:
+        """The speeds in :attr:`speed_unit`."""
+        return np.asarray(self.frequencies_hz) / SPEED_UNITS[self.speed_unit]
+
+
+Excitation = RotatingForce | HarmonicForce | Imbalance | Sweep
 
 
 @dataclass(frozen=True)
@@ -818,7 +978,7 @@ class Case:
         The ball hinges; a hinge may join any two bodies.
     static_loads : tuple of PointForce, PointMoment, Gravity
         Constant loads solved for first (the preload).
-    excitations : tuple of RotatingForce, HarmonicForce, Sweep
+    excitations : tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp
         Each excitation (each sweep frequency) is one run.
     analysis : AnalysisSettings
         Time step, settle and steady-state settings.
@@ -856,7 +1016,7 @@ class Case:
             raise CaseError("case", "test_rig", self.test_rig, "a ForceTransducers or None")
         groups = (("links", (Link,)), ("hinges", (Hinge,)),
                   ("static_loads", (PointForce, PointMoment, Gravity)),
-                  ("excitations", (RotatingForce, HarmonicForce, Sweep)), ("rotors", (Rotor,)))
+                  ("excitations", (*SINGLE_FREQUENCY_KINDS, Sweep)), ("rotors", (Rotor,)))
         for name, kinds in groups:
             items = tuple(getattr(self, name))
             for item in items:

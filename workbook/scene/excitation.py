@@ -12,7 +12,11 @@ ratio of 25 between excitation and natural frequency needed about 2 decay
 time constants after a 10-period ramp, against more than 4 without).
 
 The same law is evaluated by Exudyn as a symbolic user function (C++ speed)
-and by numpy for plots and checks.
+and by numpy for plots and checks. An excitation of several points (the
+planes of an :class:`~workbook.model.case.Imbalance`) is one such law per
+point (:meth:`ExcitationSignal.at_points`), all with the same start; its
+resultant (:meth:`ExcitationSignal.of`) is their sum, the force the
+excitation history shows.
 """
 from __future__ import annotations
 
@@ -51,11 +55,26 @@ class ExcitationSignal:
 
     @classmethod
     def of(cls, excitation: SingleFrequencyExcitation, ramp_periods: float) -> "ExcitationSignal":
-        """The signal of a case excitation, starting over *ramp_periods* periods."""
-        cos_part, sin_part = excitation.force_coefficients()
+        """The resultant signal of a case excitation (the sum over its points),
+        starting over *ramp_periods* periods; its amplitude is the excitation's
+        ``force_amplitude``."""
+        parts = excitation.point_forces()
+        cos_part = np.sum([c for _, c, _ in parts], axis=0)
+        sin_part = np.sum([s for _, _, s in parts], axis=0)
         frequency = excitation.frequency
         return cls(frequency, tuple(cos_part), tuple(sin_part), excitation.force_amplitude,
                    ramp_periods / frequency)
+
+    @classmethod
+    def at_points(cls, excitation: SingleFrequencyExcitation, ramp_periods: float
+                  ) -> tuple[tuple[tuple, "ExcitationSignal"], ...]:
+        """``(point, signal)`` of each point force of a case excitation, all
+        starting over *ramp_periods* periods; each signal's amplitude is the
+        largest magnitude its force reaches."""
+        frequency = excitation.frequency
+        return tuple((point, cls(frequency, tuple(c), tuple(s), float(np.linalg.norm(np.column_stack([c, s]), 2)),
+                                 ramp_periods / frequency))
+                     for point, c, s in excitation.point_forces())
 
     @property
     def omega(self) -> float:

@@ -1,0 +1,140 @@
+"""Imbalance planes: several eccentric masses of one rotor at one speed.
+
+The scene is the single-DOF mount of test_sdof (a rigid mass on four equal
+spring-dampers at (+-a, +-b, 0) about its centre of gravity, diagonal
+inertia). Two planes of equal force on the spin axis x at +-L about the
+centre of gravity with opposite phases have no resultant force: they form a
+rotating couple of magnitude 2 L F about y and z. On this mount pitch and
+yaw are single-DOF oscillators of their own,
+
+    theta_y = M / (k_ty - I_yy w^2 + i w c_ty),   k_ty = 4 k a^2,
+    theta_z = M / (k_tz - I_zz w^2 + i w c_tz),   k_tz = 4 k (a^2 + b^2),
+
+(c likewise with the hinge damping d), and each hinge carries
+|k + i w d| a |theta_y| vertically and |k + i w d| a |theta_z| laterally.
+"""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from test_sdof import DAMPING, STIFFNESS, sdof_case
+
+from workbook.errors import CaseError
+from workbook.model.case import Imbalance, ImbalancePlane, RotatingForce, RunUp
+from workbook.solve.pipeline import prepare, run_case
+
+HALF_SPAN = 0.4        # a: hinge offset along x, m (test_sdof)
+HALF_WIDTH = 0.3       # b: hinge offset along y, m
+FREQUENCY = 14.0       # Hz
+FORCE = 800.0          # N per plane
+ARM = 0.6              # L: plane offset from the centre of gravity, m
+
+
+def _case(excitation, method="frequency"):
+    case = sdof_case(())
+    return dataclasses.replace(case, excitations=(excitation,),
+                               analysis=dataclasses.replace(case.analysis, method=method))
+
+
+def _couple(arm=ARM, force=FORCE, centre_offset=0.0):
+    cg = np.array(sdof_case(()).engine.center_of_mass)
+    planes = (ImbalancePlane(tuple(cg + (centre_offset + arm, 0, 0)), amplitude=force, phase_deg=0.0),
+              ImbalancePlane(tuple(cg + (centre_offset - arm, 0, 0)), amplitude=force, phase_deg=180.0))
+    return Imbalance("couple", planes, frequency_hz=FREQUENCY)
+
+
+def _closed_form_hinge_amplitudes():
+    """Hinge force amplitudes (x, y, z) of the rotating couple 2 L F, N."""
+    omega = 2 * math.pi * FREQUENCY
+    moment = 2 * ARM * FORCE
+    inertia = np.diag(sdof_case(()).engine.inertia_matrix)
+    spring = abs(STIFFNESS + 1j * omega * DAMPING)
+    arms = {"y": HALF_SPAN ** 2, "z": HALF_SPAN ** 2 + HALF_WIDTH ** 2}
+    theta = {axis: moment / abs(4 * r2 * STIFFNESS - inertia[i] * omega ** 2 + 1j * omega * 4 * r2 * DAMPING)
+             for axis, r2, i in (("y", arms["y"], 1), ("z", arms["z"], 2))}
+    return np.array([spring * HALF_WIDTH * theta["z"], spring * HALF_SPAN * theta["z"], spring * HALF_SPAN * theta["y"]])
+
+
+@pytest.fixture(scope="module")
+def couple_answers():
+    return {method: run_case(_case(_couple(), method)) for method in ("frequency", "time")}
+
+
+@pytest.mark.parametrize("method", ["frequency", "time"])
+def test_opposite_planes_give_the_closed_form_couple(couple_answers, method):
+    run = couple_answers[method].runs[0]
+    expected = _closed_form_hinge_amplitudes()
+    tolerance = 1e-6 if method == "frequency" else 5e-3
+    for name, amplitude in run.hinge_amplitudes.items():
+        np.testing.assert_allclose(amplitude, expected, rtol=tolerance, err_msg=name)
+    # no resultant force: the pylon sum cancels to round-off
+    assert run.pylon_amplitude.max() < 1e-6 * expected.max() * (1 if method == "frequency" else 1e3)
+    assert run.excitation_amplitude == pytest.approx(2 * FORCE)
+
+
+@pytest.mark.parametrize("method", ["frequency", "time"])
+def test_model_card_lists_the_planes_only_when_given(couple_answers, method):
+    card = next(iter(couple_answers[method].model_cards.values()))
+    entry = next(e for e in card.effects if e.name == "imbalance planes")
+    assert entry.on and "2 planes" in entry.detail and "1600 N" in entry.detail
+    single = run_case(_case(RotatingForce("one", (0.2, -0.1, 0.3), frequency_hz=FREQUENCY, amplitude=FORCE)))
+    entry = next(e for e in next(iter(single.model_cards.values())).effects if e.name == "imbalance planes")
+    assert not entry.on
+
+
+def test_any_equal_couple_gives_the_same_answer():
+    """A rigid engine feels the resultant and the moment only: a couple of the
+    same moment from planes elsewhere on the axis, with another arm and force."""
+    moved = run_case(_case(_couple(arm=1.5 * ARM, force=FORCE / 1.5, centre_offset=-0.9))).runs[0]
+    np.testing.assert_allclose(moved.hinge_amplitudes["hinge 0"], _closed_form_hinge_amplitudes(), rtol=1e-6)
+
+
+def test_planes_superpose_and_unbalance_grows_with_the_speed_squared():
+    """Two planes in one solve equal the sum of two single rotating forces
+    (phasors), and an unbalance U gives the force U w^2."""
+    cg = np.array(sdof_case(()).engine.center_of_mass)
+    unbalance, rpm = 2.5e-3, 840.0
+    planes = (ImbalancePlane(tuple(cg + (0.3, 0, 0)), unbalance=unbalance, phase_deg=30.0),
+              ImbalancePlane(tuple(cg - (0.5, 0, 0)), amplitude=300.0, phase_deg=-75.0))
+    both = Imbalance("two planes", planes, rpm=rpm)
+    omega = 2 * math.pi * rpm / 60
+    assert both.plane_forces()[0].force_amplitude == pytest.approx(unbalance * omega ** 2, rel=1e-12)
+    assert both.force_amplitude == pytest.approx(unbalance * omega ** 2 + 300.0, rel=1e-12)
+    case = _case(both)
+    prepared = prepare(case, both)
+    with prepared.scene:
+        model = prepared.model
+        together = model.respond_generalised(both.frequency, model.excitation_input(both))
+        single = [RotatingForce("one", planes[0].point, rpm=rpm, amplitude=unbalance * omega ** 2, phase_deg=30.0),
+                  RotatingForce("two", planes[1].point, rpm=rpm, amplitude=300.0, phase_deg=-75.0)]
+        parts = [model.respond(f.frequency, np.asarray(f.force_coefficients()[0]) - 1j * f.force_coefficients()[1],
+                               f.point) for f in single]
+    for name in together.hinge_forces:
+        np.testing.assert_allclose(together.hinge_forces[name], parts[0].hinge_forces[name] + parts[1].hinge_forces[name],
+                                   rtol=1e-10, atol=1e-9 * FORCE)
+
+
+@pytest.mark.parametrize("planes, field", [
+    ((ImbalancePlane((0, 0, 0), unbalance=-1e-3),), "unbalance"),
+    ((ImbalancePlane((0, 0, 0), amplitude=10.0, phase_deg="north"),), "phase_deg"),
+    ((ImbalancePlane((0, 0, 0)),), "unbalance"),
+    ((), "planes"),
+])
+def test_bad_planes_are_named(planes, field):
+    with pytest.raises(CaseError, match=f"field '{field}'"):
+        Imbalance("bad", planes, frequency_hz=10.0)
+
+
+def test_run_up_needs_an_unbalance_and_a_rising_speed():
+    force = RotatingForce("r", (0, 0, 0), rpm=1000.0, amplitude=10.0)
+    with pytest.raises(CaseError, match="field 'unbalance'"):
+        RunUp.speeds("up", force, 1000.0, 2000.0, 5)
+    rotor = dataclasses.replace(force, amplitude=None, unbalance=1e-3)
+    with pytest.raises(CaseError, match="field 'stop'"):
+        RunUp.speeds("up", rotor, 2000.0, 1000.0, 5)
+    with pytest.raises(CaseError, match="field 'speed_unit'"):
+        RunUp.speeds("up", rotor, 1000.0, 2000.0, 5, unit="rad/s")
+    up = RunUp.speeds("up", rotor, 1200.0, 3000.0, 4)
+    np.testing.assert_allclose(up.frequencies_hz, [20.0, 30.0, 40.0, 50.0])
+    np.testing.assert_allclose(up.speed_values, [1200.0, 1800.0, 2400.0, 3000.0])
