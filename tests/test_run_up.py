@@ -68,3 +68,47 @@ def test_run_up_gives_the_single_runs_at_the_rotor_speeds(coarse_reference):
         expected = result.run(name).transmissibility
         got = frame[["T x", "T y", "T z"]].to_numpy()[row]
         np.testing.assert_allclose(got, expected, rtol=2e-3, atol=1e-4 * expected.max(), err_msg=name)
+
+
+def _sdof_json(tmp_path, *excitations):
+    from workbook.model.codec import to_json
+
+    case = dataclasses.replace(sdof_case(()), excitations=excitations)
+    path = tmp_path / "sdof.json"
+    path.write_text(to_json(case), encoding="utf-8")
+    return case, path
+
+
+def test_command_line_runs_an_imbalance_up_and_writes_table_and_plot(tmp_path, capsys):
+    import pandas as pd
+
+    from workbook.cli.main import main
+
+    case, path = _sdof_json(tmp_path, RotatingForce("rotor", (0.2, -0.1, 0.3), rpm=600.0, amplitude=50.0))
+    csv, png = tmp_path / "run-up.csv", tmp_path / "run-up.png"
+    code = main(["run-up", str(path), "--excitation", "rotor", "--unbalance", str(UNBALANCE), "--from", "5",
+                 "--to", "25", "--points", "5", "--unit", "Hz", "--csv", str(csv), "--plot", str(png)])
+    assert code == 0
+    table = pd.read_csv(csv, index_col=0)
+    omega = 2 * math.pi * table.index.to_numpy()
+    expected = UNBALANCE * omega ** 2 * np.array([closed_form(f / NATURAL_HZ) for f in table.index])
+    np.testing.assert_allclose(table["F z N"], expected, rtol=1e-6)
+    assert png.stat().st_size > 10_000
+    assert "run-up rotor run-up" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--from", "25", "--to", "5"], ["field 'stop'", "a speed above the start"]),
+    (["--from", "5", "--to", "25"], ["field 'unbalance'"]),
+    ([], ["the case has no run-up"]),
+])
+def test_command_line_bad_run_up_exits_2_and_writes_nothing(tmp_path, capsys, extra, words):
+    from workbook.cli.main import main
+
+    _, path = _sdof_json(tmp_path, RotatingForce("rotor", (0.2, -0.1, 0.3), rpm=600.0, amplitude=50.0))
+    csv = tmp_path / "run-up.csv"
+    args = ["run-up", str(path), "--csv", str(csv)] + (["--excitation", "rotor"] if extra else []) + extra
+    assert main(args) == 2
+    message = capsys.readouterr().err
+    assert all(word in message for word in words), message
+    assert not csv.exists()
