@@ -138,3 +138,95 @@ def test_run_up_needs_an_unbalance_and_a_rising_speed():
     up = RunUp.speeds("up", rotor, 1200.0, 3000.0, 4)
     np.testing.assert_allclose(up.frequencies_hz, [20.0, 30.0, 40.0, 50.0])
     np.testing.assert_allclose(up.speed_values, [1200.0, 1800.0, 2400.0, 3000.0])
+
+
+# -- the Excitations sheet ----------------------------------------------------------------------------------
+
+
+def _rig_case():
+    """The reference mount excited as the rig does: three planes (front support,
+    centre of gravity, rear support), and a run-up of the same planes."""
+    from workbook.model.reference import reference_case
+
+    case = reference_case()
+    planes = (ImbalancePlane((0.35, 0.0, 0.0), unbalance=2.0e-3, phase_deg=0.0),
+              ImbalancePlane(case.engine.center_of_mass, unbalance=1.5e-3, phase_deg=120.0),
+              ImbalancePlane((-0.7, 0.0, 0.0), amplitude=900.0, phase_deg=240.0))
+    rig = Imbalance("rig exciter", planes, frequency_hz=100.0)
+    unbalanced = dataclasses.replace(rig, name="rig run-up", planes=planes[:2])
+    run_up = RunUp.speeds("rig run-up", unbalanced, 1000.0, 20000.0, 20, unit="rpm")
+    return dataclasses.replace(case, excitations=(rig, run_up))
+
+
+@pytest.fixture
+def rig_book(tmp_path):
+    from workbook.excel.runs import RunSpec
+    from workbook.excel.template import case_workbook, write_workbook
+
+    runs = (RunSpec("rig exciter", "rig exciter"), RunSpec("rig run-up", "rig run-up"))
+    path, _ = write_workbook(case_workbook(_rig_case(), runs), tmp_path / "rig.xlsx")
+    return path
+
+
+def _plane_rows(path):
+    from openpyxl import load_workbook
+
+    ws = load_workbook(path)["Excitations"]
+    return [r for r in range(3, ws.max_row + 1) if ws.cell(r, 2).value == "imbalance plane"]
+
+
+def _same_excitations(read, expected):
+    assert read[0] == expected[0]
+    assert read[1].template.planes == expected[1].template.planes and read[1].speed_unit == expected[1].speed_unit
+    np.testing.assert_allclose(read[1].frequencies_hz, expected[1].frequencies_hz, rtol=1e-12)
+
+
+def test_planes_and_run_up_round_trip_through_a_workbook(rig_book):
+    from workbook.excel.reader import read_workbook
+
+    _same_excitations(read_workbook(rig_book).case.excitations, _rig_case().excitations)
+    assert len(_plane_rows(rig_book)) == 5        # three planes, and two of the run-up
+
+
+def test_unbalance_in_g_mm_reads_as_kg_m(rig_book):
+    from excel_helpers import set_cells
+
+    from workbook.excel.reader import read_workbook
+
+    first = _plane_rows(rig_book)[0]
+    set_cells(rig_book, {("Excitations", "unbalance", 2): "g*mm", **{("Excitations", "unbalance", r): None
+                                                                    for r in _plane_rows(rig_book)}})
+    set_cells(rig_book, {("Excitations", "unbalance", first): 2000.0, ("Excitations", "unbalance", first + 1): 1500.0,
+                         ("Excitations", "unbalance", first + 3): 2000.0,
+                         ("Excitations", "unbalance", first + 4): 1500.0})
+    case = read_workbook(rig_book).case
+    _same_excitations(case.excitations, _rig_case().excitations)
+    rig = case.excitations[0]
+    assert rig.plane_forces()[0].force_amplitude == pytest.approx(2.0e-3 * (2 * math.pi * 100.0) ** 2, rel=1e-12)
+
+
+@pytest.mark.parametrize("column, row, value, words", [
+    ("phase", 1, "north", ["'north'", "a number"]),
+    ("unbalance", 0, -2.0e-3, ["unbalance", "-0.002", "> 0"]),
+    ("unbalance", "unit", "g*mmm", ["'g*mmm'", "a known unit"]),
+    ("sweep to", 3, 5.0, ["sweep to", "a speed above the start"]),
+    ("run-up", 3, "rad/s", ["run-up", "'rad/s'"]),
+    ("frequency", 4, 50.0, ["frequency", "an empty cell", "first plane"]),
+])
+def test_bad_excitation_cells_are_named_and_exit_2(rig_book, capsys, column, row, value, words):
+    from excel_helpers import column_of, set_cells, sha256
+    from openpyxl import load_workbook
+    from openpyxl.utils import get_column_letter
+
+    from workbook.cli.main import main
+
+    rows = _plane_rows(rig_book)
+    sheet_row = 2 if row == "unit" else rows[row]
+    set_cells(rig_book, {("Excitations", column, sheet_row): value})
+    letter = get_column_letter(column_of(load_workbook(rig_book)["Excitations"], column))
+    before = sha256(rig_book)
+    assert main(["check", str(rig_book)]) == 2
+    message = capsys.readouterr().err
+    for text in ["sheet 'Excitations'", f"cell {letter}{sheet_row}", *words]:
+        assert text in message, f"{text!r} not in\n{message}"
+    assert sha256(rig_book) == before
