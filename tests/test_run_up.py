@@ -112,3 +112,26 @@ def test_command_line_bad_run_up_exits_2_and_writes_nothing(tmp_path, capsys, ex
     message = capsys.readouterr().err
     assert all(word in message for word in words), message
     assert not csv.exists()
+
+
+@pytest.mark.slow
+def test_a_workbook_run_up_row_runs_from_the_command_line(coarse_reference, tmp_path, capsys):
+    """An Excitations row with a run-up speed unit, run by ``mountwb run-up``,
+    gives the run-up of the same case built in Python."""
+    import pandas as pd
+
+    from workbook.cli.main import main
+    from workbook.excel.runs import RunSpec
+    from workbook.excel.template import case_workbook, write_workbook
+    case = coarse_reference.with_rigid_links()
+    rotor = dataclasses.replace(LP_ROTOR, amplitude=None, unbalance=3e-3)
+    item = RunUp.speeds("LP run-up", rotor, 600.0, 6000.0, 4, unit="rpm")
+    case = dataclasses.replace(case, excitations=(item,))
+    path, _ = write_workbook(case_workbook(case, (RunSpec("LP run-up", "LP run-up"),)), tmp_path / "case.xlsx")
+    csv = tmp_path / "run-up.csv"
+    assert main(["run-up", str(path), "--csv", str(csv)]) == 0
+    table = pd.read_csv(csv, index_col=0)
+    expected = run_up(case, item).frame()
+    np.testing.assert_allclose(table.index, [600.0, 2400.0, 4200.0, 6000.0])
+    np.testing.assert_allclose(table.to_numpy(), expected.to_numpy(), rtol=1e-9)
+    assert "LP run-up" in capsys.readouterr().out
