@@ -230,3 +230,72 @@ def test_bad_excitation_cells_are_named_and_exit_2(rig_book, capsys, column, row
     for text in ["sheet 'Excitations'", f"cell {letter}{sheet_row}", *words]:
         assert text in message, f"{text!r} not in\n{message}"
     assert sha256(rig_book) == before
+
+
+# -- two rotors at once ------------------------------------------------------------------------------------
+
+
+def _together_answers(case, item):
+    return {method: run_case(dataclasses.replace(case, excitations=(item,), analysis=dataclasses.replace(
+        case.analysis, method=method))) for method in ("frequency", "time")}
+
+
+def test_two_rotors_in_one_run_match_superposition_and_the_closed_forms():
+    """Two unequal planes at 14 Hz and a rotating force at the centre of gravity
+    at 23 Hz in one time run: the amplitude at each frequency equals the
+    frequency domain's part by part, and the closed form at 23 Hz (test_sdof's T)."""
+    from test_sdof import NATURAL_HZ, closed_form
+
+    from workbook.model.case import Simultaneous
+
+    cg = sdof_case(()).engine.center_of_mass
+    slow = dataclasses.replace(_couple(), name="slow", planes=(
+        _couple().planes[0], dataclasses.replace(_couple().planes[1], amplitude=0.6 * FORCE)))
+    item = Simultaneous("both", (slow, RotatingForce("fast", cg, frequency_hz=23.0, amplitude=FORCE)))
+    answers = _together_answers(sdof_case(()), item)
+    frequency, time = (answers[m] for m in ("frequency", "time"))
+    assert [r.name for r in time.runs] == ["both / slow", "both / fast"] == [r.name for r in frequency.runs]
+    np.testing.assert_allclose(time.runs[1].transmissibility[1:], closed_form(23.0 / NATURAL_HZ), rtol=5e-3)
+    for run, reference in zip(time.runs, frequency.runs):
+        assert run.steady and run.frequency_hz == reference.frequency_hz
+        for name, amplitude in reference.hinge_amplitudes.items():
+            np.testing.assert_allclose(run.hinge_amplitudes[name], amplitude, rtol=5e-3, atol=5e-3 * amplitude.max())
+    card = time.model_cards["both / fast"]
+    entries = {e.name: e for e in card.effects}
+    assert entries["simultaneous excitations"].on and entries["imbalance planes"].on
+    assert "superposition" in frequency.model_cards["both / fast"].method_reason
+
+
+@pytest.mark.slow
+def test_lp_and_hp_together_in_one_time_run_match_the_superposed_frequency_domain(coarse_reference):
+    from workbook.model.case import Simultaneous
+    from workbook.model.reference import HP_ROTOR, LP_ROTOR
+
+    item = Simultaneous("LP and HP", (LP_ROTOR, HP_ROTOR))
+    answers = _together_answers(coarse_reference, item)
+    for run, reference in zip(answers["time"].runs, answers["frequency"].runs):
+        assert run.steady, run.name
+        # the nearly cancelled lateral pylon force compares against the largest direction
+        np.testing.assert_allclose(run.transmissibility, reference.transmissibility, rtol=0.01,
+                                   atol=0.01 * reference.transmissibility.max(), err_msg=run.name)
+
+
+def test_least_squares_separates_two_frequencies_over_any_window():
+    from workbook.answers.amplitude import harmonic_amplitudes
+
+    time = np.arange(0.0, 0.137, 1e-4) + 1.234          # not whole periods of either frequency
+    signal = 5.0 + 2.0 * np.cos(2 * np.pi * 59.0 * time + 0.3) + 0.5 * np.sin(2 * np.pi * 248.5 * time - 1.0)
+    amplitudes = harmonic_amplitudes(time, signal, [59.0, 248.5])
+    np.testing.assert_allclose(amplitudes, [2.0 * np.exp(0.3j), 0.5 * np.exp(1j * (-1.0 - np.pi / 2))], rtol=1e-9)
+
+
+def test_simultaneous_parts_need_their_own_frequencies():
+    from workbook.model.case import Simultaneous
+
+    one = RotatingForce("one", (0, 0, 0), frequency_hz=10.0, amplitude=1.0)
+    with pytest.raises(CaseError, match="field 'parts'"):
+        Simultaneous("both", (one, dataclasses.replace(one, name="two")))
+    with pytest.raises(CaseError, match="field 'parts'"):
+        Simultaneous("both", (one,))
+    both = Simultaneous("both", (one, dataclasses.replace(one, name="two", frequency_hz=30.0)))
+    assert both.frequency == 30.0 and [e.name for e in both.expand()] == ["both / one", "both / two"]

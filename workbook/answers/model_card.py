@@ -191,7 +191,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         _spin_restraints(scene),
         _gyroscopics(scene),
         _rig_sensors(scene),
-        _imbalance_planes(scene),
+        *_imbalance_planes(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
     frequency_detail = "harmonic solution of the scene linearised about the preload"
@@ -240,18 +240,27 @@ def _gyroscopics(scene) -> EffectEntry:
                                    f"ObjectGenericODE2); their mass and transverse inertia lumped in the engine")
 
 
-def _imbalance_planes(scene) -> EffectEntry:
-    """The excitation's imbalance planes: one force per plane, or a single force."""
-    from workbook.model.case import Imbalance
+def _imbalance_planes(scene) -> list[EffectEntry]:
+    """The excitation's imbalance planes (one force per plane) and its
+    simultaneous parts (several frequencies in one run)."""
+    from workbook.model.case import Imbalance, Simultaneous
 
     excitation = scene.excitation.excitation if scene.excitation is not None else None
-    if not isinstance(excitation, Imbalance):
-        return EffectEntry("imbalance planes", False, "the excitation is one force at one point")
-    planes = "; ".join(f"{f.force_amplitude:.4g} N at x = {f.point[0]:g} m, phase {f.phase_deg:g} deg"
-                       for f in excitation.plane_forces())
-    return EffectEntry("imbalance planes", True, f"{len(excitation.planes)} planes of {excitation.name!r} at "
-                       f"{excitation.frequency:g} Hz, each its own rotating force U w^2 (or given force): {planes}; "
-                       f"T refers to their summed amplitude {excitation.force_amplitude:.4g} N")
+    parts = excitation.parts if isinstance(excitation, Simultaneous) else (excitation,)
+    details = []
+    for part in (p for p in parts if isinstance(p, Imbalance)):
+        planes = "; ".join(f"{f.force_amplitude:.4g} N at x = {f.point[0]:g} m, phase {f.phase_deg:g} deg"
+                           for f in part.plane_forces())
+        details.append(f"{len(part.planes)} planes of {part.name!r} at {part.frequency:g} Hz, each its own rotating "
+                       f"force U w^2 (or given force): {planes}; T refers to their summed amplitude "
+                       f"{part.force_amplitude:.4g} N")
+    planes = EffectEntry("imbalance planes", bool(details), "; ".join(details) or "the excitation is one force at "
+                         "one point")
+    together = EffectEntry("simultaneous excitations", isinstance(excitation, Simultaneous),
+                           f"{', '.join(f'{p.name} at {p.frequency:g} Hz' for p in parts)} in one run; the amplitude "
+                           f"at each frequency by least squares over the measured window, T per part against its "
+                           f"own force" if isinstance(excitation, Simultaneous) else "one frequency per run")
+    return [planes, together]
 
 
 def _rig_sensors(scene) -> EffectEntry:

@@ -112,6 +112,9 @@ def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
     """The Excitations rows of one excitation: one row, or one per imbalance plane
     (the first with the speed, the axis and any sweep or run-up)."""
     row = {"name": excitation.name}
+    if isinstance(excitation, cm.Simultaneous):
+        raise ValueError(f"excitation {excitation.name!r}: simultaneous excitations have no Excitations row; "
+                         f"run them from Python or a JSON case")
     if isinstance(excitation, cm.RunUp):
         f = excitation.frequencies_hz
         row.update(sweep_from=f[0], sweep_to=f[-1], sweep_points=len(f), run_up=excitation.speed_unit)

@@ -31,7 +31,7 @@ __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
     "SingleFrequencyExcitation", "ImbalancePlane", "Imbalance", "RunUp", "SPEED_UNITS",
-    "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request"]
+    "Simultaneous", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request"]
 
 PYLON = "pylon"
 ENGINE = "engine"
@@ -824,7 +824,62 @@ class RunUp(Sweep):
         return np.asarray(self.frequencies_hz) / SPEED_UNITS[self.speed_unit]
 
 
-Excitation = RotatingForce | HarmonicForce | Imbalance | Sweep
+@dataclass(frozen=True)
+class Simultaneous:
+    """Several single-frequency excitations acting at once, each at its own
+    frequency: both rotors of a two-spool engine (LP and HP) together.
+
+    The scene is linear about the preload (or is treated so in the
+    frequency domain), so the frequency domain answers each part on its own
+    at its frequency and the response is their sum (superposition). The
+    time domain runs all parts in one run and extracts the amplitude at each
+    frequency from the same histories. Either way the answers are one
+    result per part, named ``"<name> / <part name>"``, whose T refers to that
+    part's force.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    parts : tuple of RotatingForce, HarmonicForce or Imbalance
+        At least two, at different frequencies, with different names.
+    """
+
+    name: str
+    parts: tuple[SingleFrequencyExcitation, ...]
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        try:
+            parts = tuple(self.parts)
+        except TypeError:
+            raise CaseError(item, "parts", self.parts, "a list of excitations") from None
+        if len(parts) < 2 or not all(isinstance(p, SINGLE_FREQUENCY_KINDS) for p in parts):
+            raise CaseError(item, "parts", self.parts, "two or more RotatingForce, HarmonicForce or Imbalance")
+        frequencies = [p.frequency for p in parts]
+        if len(set(frequencies)) < len(frequencies) or len({p.name for p in parts}) < len(parts):
+            raise CaseError(item, "parts", ", ".join(f"{p.name} at {p.frequency:g} Hz" for p in parts),
+                            "parts of different names at different frequencies (parts at one speed are the "
+                            "planes of one Imbalance)")
+        _set(self, "parts", parts)
+
+    @property
+    def frequency(self) -> float:
+        """Highest frequency of the parts, Hz."""
+        return max(p.frequency for p in self.parts)
+
+    @property
+    def force_amplitude(self) -> float:
+        """Sum of the parts' force amplitudes, N (the load scale of the run)."""
+        return sum(p.force_amplitude for p in self.parts)
+
+    def expand(self) -> tuple[SingleFrequencyExcitation, ...]:
+        """The parts as single-frequency excitations, named ``"<name> / <part name>"``."""
+        return tuple(dataclasses.replace(p, name=f"{self.name} / {p.name}") for p in self.parts)
+
+
+Excitation = RotatingForce | HarmonicForce | Imbalance | Sweep | Simultaneous
 
 
 @dataclass(frozen=True)
@@ -978,8 +1033,9 @@ class Case:
         The ball hinges; a hinge may join any two bodies.
     static_loads : tuple of PointForce, PointMoment, Gravity
         Constant loads solved for first (the preload).
-    excitations : tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp
-        Each excitation (each sweep frequency) is one run.
+    excitations : tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp, Simultaneous
+        Each excitation (each sweep frequency) is one run; a Simultaneous
+        excitation is one run with a result per part.
     analysis : AnalysisSettings
         Time step, settle and steady-state settings.
     effects : Effects
@@ -1016,7 +1072,7 @@ class Case:
             raise CaseError("case", "test_rig", self.test_rig, "a ForceTransducers or None")
         groups = (("links", (Link,)), ("hinges", (Hinge,)),
                   ("static_loads", (PointForce, PointMoment, Gravity)),
-                  ("excitations", (*SINGLE_FREQUENCY_KINDS, Sweep)), ("rotors", (Rotor,)))
+                  ("excitations", (*SINGLE_FREQUENCY_KINDS, Sweep, Simultaneous)), ("rotors", (Rotor,)))
         for name, kinds in groups:
             items = tuple(getattr(self, name))
             for item in items:
@@ -1046,7 +1102,8 @@ class Case:
         for group, _ in groups:
             kind = group[:-1].replace("_", " ")
             for item in getattr(self, group):
-                names = [item.name] + ([point.name for point in item.expand()] if isinstance(item, Sweep) else [])
+                names = [item.name] + ([point.name for point in item.expand()]
+                                       if isinstance(item, (Sweep, Simultaneous)) else [])
                 for name in names:
                     if name in owners:
                         raise CaseError(f"{kind} {item.name!r}", "name", name,
@@ -1095,10 +1152,11 @@ class Case:
         return pins
 
     def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
-        """Every run of the case: single excitations and expanded sweeps."""
+        """Every run of the case: single excitations, expanded sweeps and the
+        parts of simultaneous excitations."""
         runs = []
         for excitation in self.excitations:
-            runs.extend(excitation.expand() if isinstance(excitation, Sweep) else (excitation,))
+            runs.extend(excitation.expand() if isinstance(excitation, (Sweep, Simultaneous)) else (excitation,))
         return tuple(runs)
 
     def without_link(self, name: str) -> "Case":

@@ -39,7 +39,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, SingleFrequencyExcitation
+from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, Simultaneous, SingleFrequencyExcitation
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 
@@ -149,9 +149,10 @@ class ExcitationItems:
         (one, or one per imbalance plane).
     loads : tuple of int
         ``LoadForceVector`` at each marker, with a symbolic load user function.
-    signal : ExcitationSignal
+    signal : ExcitationSignal or None
         The resultant force law (the sum over the points), also evaluable
-        with numpy.
+        with numpy; None for a :class:`~workbook.model.case.Simultaneous`
+        excitation (several frequencies).
     functions : tuple of exudyn.symbolic.UserFunction
         The recorded symbolic load functions (kept alive here).
     excitation : RotatingForce, HarmonicForce or Imbalance
@@ -161,7 +162,7 @@ class ExcitationItems:
     name: str
     markers: tuple
     loads: tuple
-    signal: ExcitationSignal
+    signal: ExcitationSignal | None
     functions: tuple = field(repr=False)
     excitation: Any = None
 
@@ -506,8 +507,9 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
             functions.append(CreateSymbolicUserFunction(mbs, part.exudyn_user_function(), "loadVectorUserFunction",
                                                         loads[-1]))
             mbs.SetLoadParameter(loads[-1], "loadVectorUserFunction", functions[-1])
-        excitation_items = ExcitationItems(excitation.name, tuple(markers), tuple(loads),
-                                           ExcitationSignal.of(excitation, case.analysis.ramp_periods),
+        resultant = None if isinstance(excitation, Simultaneous) else ExcitationSignal.of(excitation,
+                                                                                         case.analysis.ramp_periods)
+        excitation_items = ExcitationItems(excitation.name, tuple(markers), tuple(loads), resultant,
                                            tuple(functions), excitation)
 
     mbs.Assemble()

@@ -16,7 +16,9 @@ and by numpy for plots and checks. An excitation of several points (the
 planes of an :class:`~workbook.model.case.Imbalance`) is one such law per
 point (:meth:`ExcitationSignal.at_points`), all with the same start; its
 resultant (:meth:`ExcitationSignal.of`) is their sum, the force the
-excitation history shows.
+excitation history shows. The parts of a
+:class:`~workbook.model.case.Simultaneous` excitation each keep their own
+frequency and share the start of the lowest.
 """
 from __future__ import annotations
 
@@ -25,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workbook.model.case import SingleFrequencyExcitation
+from workbook.model.case import Simultaneous, SingleFrequencyExcitation
 
 __all__ = ["ExcitationSignal"]
 
@@ -66,15 +68,18 @@ class ExcitationSignal:
                    ramp_periods / frequency)
 
     @classmethod
-    def at_points(cls, excitation: SingleFrequencyExcitation, ramp_periods: float
+    def at_points(cls, excitation: SingleFrequencyExcitation | Simultaneous, ramp_periods: float
                   ) -> tuple[tuple[tuple, "ExcitationSignal"], ...]:
         """``(point, signal)`` of each point force of a case excitation, all
-        starting over *ramp_periods* periods; each signal's amplitude is the
-        largest magnitude its force reaches."""
-        frequency = excitation.frequency
-        return tuple((point, cls(frequency, tuple(c), tuple(s), float(np.linalg.norm(np.column_stack([c, s]), 2)),
-                                 ramp_periods / frequency))
-                     for point, c, s in excitation.point_forces())
+        starting together over *ramp_periods* periods of the lowest
+        frequency (the parts of a :class:`Simultaneous` each at its own
+        frequency); each signal's amplitude is the largest magnitude its
+        force reaches."""
+        parts = excitation.parts if isinstance(excitation, Simultaneous) else (excitation,)
+        ramp_time = ramp_periods / min(part.frequency for part in parts)
+        return tuple((point, cls(part.frequency, tuple(c), tuple(s), float(np.linalg.norm(np.column_stack([c, s]), 2)),
+                                 ramp_time))
+                     for part in parts for point, c, s in part.point_forces())
 
     @property
     def omega(self) -> float:
