@@ -299,3 +299,14 @@ def test_simultaneous_parts_need_their_own_frequencies():
         Simultaneous("both", (one,))
     both = Simultaneous("both", (one, dataclasses.replace(one, name="two", frequency_hz=30.0)))
     assert both.frequency == 30.0 and [e.name for e in both.expand()] == ["both / one", "both / two"]
+
+
+def test_a_run_cannot_override_the_force_of_an_imbalance(rig_book, capsys):
+    from excel_helpers import set_cells
+
+    from workbook.cli.main import main
+
+    set_cells(rig_book, {("Runs", "amplitude", 3): 1000.0})
+    assert main(["check", str(rig_book)]) == 2
+    message = capsys.readouterr().err
+    assert "sheet 'Runs'" in message and "is an imbalance" in message, message

@@ -435,6 +435,12 @@ class _CaseReader(SheetReader):
                 self.record_problem(record, ("frequency",), record.typed(("frequency",), None),
                                     f"an empty cell ('{excitation.name}' is a sweep)")
                 continue
+            template = excitation.template if isinstance(excitation, cm.Sweep) else excitation
+            if isinstance(template, cm.Imbalance) and record.get("amplitude") is not None:
+                self.record_problem(record, ("amplitude",), record.typed(("amplitude",), None),
+                                    f"an empty cell ('{excitation.name}' is an imbalance: its planes carry their "
+                                    f"own unbalance or force)")
+                continue
             run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
             if self.build(record, lambda: case_for_run(case, run)) is not None:
                 runs.append((record, run))

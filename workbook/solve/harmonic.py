@@ -47,9 +47,9 @@ VELOCITY_STEP = 1e-3
 
 
 def excitation_phasor(excitation: SingleFrequencyExcitation) -> np.ndarray:
-    """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)."""
-    cos_part, sin_part = excitation.force_coefficients()
-    return np.asarray(cos_part, dtype=complex) - 1j * np.asarray(sin_part, dtype=float)
+    """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)
+    (of an imbalance of several planes: their resultant)."""
+    return sum(np.asarray(c, dtype=complex) - 1j * np.asarray(s, dtype=float) for _, c, s in excitation.point_forces())
 
 
 @dataclass(frozen=True)
