@@ -16,7 +16,8 @@ from workbook.solve.preload import solve_preload
 
 #: Every effect the model card accounts for (docs/physics.md, section 4).
 EFFECTS = {"link flexibility", "static preload", "hinge damping", "link damping", "hinge clearance",
-           "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance", "time domain", "frequency domain"}
+           "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance", "time domain", "frequency domain",
+           "imbalance planes", "simultaneous excitations"}
 
 
 @pytest.fixture(scope="module")

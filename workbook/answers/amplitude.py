@@ -5,7 +5,10 @@ nothing about Exudyn: a history is a time vector and one or more signal
 columns. The amplitude at frequency f is the single-bin DFT of the
 mean-removed signal over a window of an integer number of periods,
 ``A = 2/N |sum (x_k - mean) exp(-i 2 pi f t_k)|``, which is exact for a
-uniformly sampled sinusoid plus a constant.
+uniformly sampled sinusoid plus a constant. A signal holding several known
+frequencies at once (two rotors together) is fitted by least squares
+(:func:`harmonic_amplitudes`), exact for a sum of those sinusoids plus a
+constant over any window.
 """
 from __future__ import annotations
 
@@ -13,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["period_window", "harmonic_amplitude", "steady_amplitude", "SteadyAmplitude",
+__all__ = ["period_window", "harmonic_amplitude", "harmonic_amplitudes", "steady_amplitude", "SteadyAmplitude",
            "amplitude_spectrum"]
 
 
@@ -86,6 +89,38 @@ def harmonic_amplitude(time: np.ndarray, signals: np.ndarray, frequency_hz: floa
     centred = values - values.mean(axis=0)
     phasor = np.exp(-2j * np.pi * frequency_hz * time)
     return 2.0 / len(time) * np.tensordot(phasor, centred, axes=(0, 0))
+
+
+def harmonic_amplitudes(time: np.ndarray, signals: np.ndarray, frequencies_hz) -> np.ndarray:
+    """Complex amplitude of each signal column at each of several frequencies, by least squares.
+
+    Fits ``x(t) = c + sum_j Re(X_j exp(i 2 pi f_j t))`` to each column; exact
+    for such a signal over any window (of at least one period of the
+    closest-spaced frequencies, for a well-conditioned fit).
+
+    Parameters
+    ----------
+    time : ndarray, shape (n,)
+        Times of the window, s.
+    signals : ndarray, shape (n,) or (n, k)
+    frequencies_hz : sequence of float
+        Distinct frequencies, Hz.
+
+    Returns
+    -------
+    ndarray, complex, shape (m,) or (m, k)
+        ``X_j`` per frequency (rows) and signal column.
+    """
+    time = np.asarray(time, dtype=float)
+    values = np.asarray(signals, dtype=float)
+    phase = 2 * np.pi * np.outer(time - time[0], np.asarray(frequencies_hz, dtype=float))
+    design = np.column_stack([np.ones_like(time), np.cos(phase), np.sin(phase)])
+    coefficients, *_ = np.linalg.lstsq(design, values, rcond=None)
+    count = phase.shape[1]
+    cos_part, sin_part = coefficients[1:1 + count], coefficients[1 + count:]
+    shift = np.exp(-2j * np.pi * np.asarray(frequencies_hz, dtype=float) * time[0])
+    shift = shift.reshape((-1,) + (1,) * (values.ndim - 1))
+    return (cos_part - 1j * sin_part) * shift
 
 
 @dataclass(frozen=True)

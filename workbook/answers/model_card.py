@@ -191,6 +191,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         _spin_restraints(scene),
         _gyroscopics(scene),
         _rig_sensors(scene),
+        *_imbalance_planes(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
     frequency_detail = "harmonic solution of the scene linearised about the preload"
@@ -237,6 +238,29 @@ def _gyroscopics(scene) -> EffectEntry:
     listing = ", ".join(f"{r.name} Ip = {r.polar_inertia:g} kg m^2 at {r.frequency:g} Hz" for r in rotors)
     return EffectEntry(name, True, f"{listing}: moment -Ip Omega (omega x a) on the engine (symbolic "
                                    f"ObjectGenericODE2); their mass and transverse inertia lumped in the engine")
+
+
+def _imbalance_planes(scene) -> list[EffectEntry]:
+    """The excitation's imbalance planes (one force per plane) and its
+    simultaneous parts (several frequencies in one run)."""
+    from workbook.model.case import Imbalance, Simultaneous
+
+    excitation = scene.excitation.excitation if scene.excitation is not None else None
+    parts = excitation.parts if isinstance(excitation, Simultaneous) else (excitation,)
+    details = []
+    for part in (p for p in parts if isinstance(p, Imbalance)):
+        planes = "; ".join(f"{f.force_amplitude:.4g} N at x = {f.point[0]:g} m, phase {f.phase_deg:g} deg"
+                           for f in part.plane_forces())
+        details.append(f"{len(part.planes)} planes of {part.name!r} at {part.frequency:g} Hz, each its own rotating "
+                       f"force U w^2 (or given force): {planes}; T refers to their summed amplitude "
+                       f"{part.force_amplitude:.4g} N")
+    planes = EffectEntry("imbalance planes", bool(details), "; ".join(details) or "the excitation is one force at "
+                         "one point")
+    together = EffectEntry("simultaneous excitations", isinstance(excitation, Simultaneous),
+                           f"{', '.join(f'{p.name} at {p.frequency:g} Hz' for p in parts)} in one run; the amplitude "
+                           f"at each frequency by least squares over the measured window, T per part against its "
+                           f"own force" if isinstance(excitation, Simultaneous) else "one frequency per run")
+    return [planes, together]
 
 
 def _rig_sensors(scene) -> EffectEntry:

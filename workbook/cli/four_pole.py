@@ -51,7 +51,9 @@ def run(args) -> int:
     case = load_case(args.case, rigid=args.rigid)
     pole = four_pole(case, frequencies)
     table = pole.table()
-    rigid = {x.name: pole.transmissibility(excitation_phasor(x), x.point) for x in case.single_frequency_excitations()}
+    # the force shape of each excitation at one point (imbalances of several planes have none)
+    rigid = {x.name: pole.transmissibility(excitation_phasor(x), x.point_forces()[0][0])
+             for x in case.single_frequency_excitations() if len(x.point_forces()) == 1}
     loss = None if pylon is None else pole.insertion_loss(pylon)
     figure = pole.plot() if args.plot else None
     print(f"{case.name}: four-pole parameters of the mount, engine (centre of gravity) to {len(pole.pins)} pylon "

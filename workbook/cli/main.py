@@ -16,7 +16,7 @@ import sys
 
 from threadpoolctl import threadpool_limits
 
-from workbook.cli import cache, four_pole, layout, links, rig, run, study, workbooks
+from workbook.cli import cache, four_pole, layout, links, rig, run, run_up, study, workbooks
 from workbook.errors import SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
@@ -35,6 +35,8 @@ COMMANDS = {
               study.arguments),
     "rig": ("measured rig records: measured T and eta, the validation table against simulation, "
             "synthetic records", rig.arguments),
+    "run-up": ("a rotor imbalance over a speed range (force U w^2): pylon force and T per direction against speed, "
+               "the mounted modes marked", run_up.arguments),
     "four-pole": ("the mount's four-pole parameters (dynamic stiffness) against frequency", four_pole.arguments),
     "cache": ("the store of reduced links: info, verify (keys and checksums), clear", cache.arguments),
 }

@@ -253,8 +253,9 @@ STATIC_LOADS = Table("Static loads", help="constant loads solved first (the prel
 EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a sweep runs one at many frequencies",
                     columns=(
     Column("name", "name", "text", required=True, help="unique excitation name"),
-    Column("type", "type", "choice", required=True, choices=("rotating", "harmonic"),
-           help="rotating imbalance force or fixed-direction harmonic force"),
+    Column("type", "type", "choice", required=True, choices=("rotating", "harmonic", "imbalance plane"),
+           help="rotating imbalance force, fixed-direction harmonic force, or one plane of a several-plane "
+                "imbalance (rows of the same name are the planes of one rotor: speed and axis on the first)"),
     *_xyz("point", "point", "m", required=True, help="point of application on the engine"),
     _num("frequency", "frequency", "Hz", help="frequency (rpm accepted); empty for a sweep"),
     _num("amplitude", "amplitude", "N", help="force amplitude"),
@@ -266,6 +267,9 @@ EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a
     _num("sweep_to", "sweep to", "Hz", help="sweep: last frequency"),
     Column("sweep_points", "sweep points", "integer", DIMENSIONLESS, help="sweep: number of frequencies"),
     Column("sweep_spacing", "sweep spacing", "choice", choices=("log", "linear"), help="sweep: spacing"),
+    Column("run_up", "run-up", "choice", choices=("rpm", "Hz"),
+           help="run-up: the sweep's speeds evenly spaced, tabulated in this unit; the force grows as U w^2 "
+                "(give the unbalance)"),
 ))
 
 ROTORS = Table("Rotors", optional=True,

@@ -65,7 +65,9 @@ _FIELD_COLUMNS = {
     "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
                "inertia": ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")},
     "Excitations": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "phase_deg": ("phase",),
-                    "frequencies_hz": ("sweep_from", "sweep_to"), "spacing": ("sweep_spacing",)},
+                    "frequencies_hz": ("sweep_from", "sweep_to"), "spacing": ("sweep_spacing",),
+                    "start": ("sweep_from",), "stop": ("sweep_to",), "points": ("sweep_points",),
+                    "speed_unit": ("run_up",)},
     "Runs": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "radial_clearance": ("gap",),
              "stiffness": ("hinge_stiffness",), "damping": ("hinge_damping",), "modes": ("fidelity",)},
 }
@@ -225,9 +227,61 @@ class _CaseReader(SheetReader):
                 "gravity": lambda: cm.Gravity(name, vector("acceleration"))}[kind]
         return self.build(record, make)
 
+    def excitations(self, records: list[Record]) -> list:
+        """``(record, excitation)`` per excitation: one per row, or one per group
+        of ``imbalance plane`` rows of the same name (at its first row)."""
+        groups: dict[str, list[Record]] = {}
+        for record in records:
+            if record.ok and record.get("type") == "imbalance plane":
+                groups.setdefault(record.get("name"), []).append(record)
+        pairs = []
+        for record in records:
+            if not record.ok:
+                pairs.append((record, None))
+            elif record.get("type") != "imbalance plane":
+                pairs.append((record, self.excitation(record)))
+            elif groups[record.get("name")][0] is record:
+                pairs.append((record, self.imbalance(groups[record.get("name")])))
+        return pairs
+
+    def imbalance(self, records: list[Record]):
+        """One :class:`~workbook.model.case.Imbalance` from its plane rows: each
+        row a plane; speed, axis and any sweep or run-up on the first row."""
+        first = records[0]
+        for record in records[1:]:
+            for key in ("frequency", "axis_x", "axis_y", "axis_z", "sweep_from", "sweep_to", "sweep_points",
+                        "sweep_spacing", "run_up"):
+                if record.get(key) is not None and record.get(key) != first.get(key):
+                    self.record_problem(record, (key,), record.typed((key,), None),
+                                        f"an empty cell (the planes of '{first.get('name')}' take it from the "
+                                        f"first plane, row {first.row})")
+        item = f"excitation {first.get('name')!r}"
+        planes = [self.build(record, lambda r=record, k=k: cm.ImbalancePlane(
+            r.vector("point"), unbalance=r.get("unbalance"), amplitude=r.get("amplitude"),
+            phase_deg=r.get("phase", 0.0)).check(f"{item} plane {k}")) for k, record in enumerate(records, start=1)]
+        if None in planes:
+            return None
+        return self.swept(first, lambda frequency: cm.Imbalance(
+            first.get("name"), tuple(planes), frequency_hz=frequency, axis=first.vector("axis", (1.0, 0.0, 0.0))))
+
     def excitation(self, record: Record):
         get, vector = record.get, record.vector
+        if get("type") == "rotating":
+            return self.swept(record, lambda frequency: cm.RotatingForce(
+                get("name"), vector("point"), frequency_hz=frequency, amplitude=get("amplitude"),
+                unbalance=get("unbalance"), axis=vector("axis", (1.0, 0.0, 0.0)), phase_deg=get("phase", 0.0)))
+        return self.swept(record, lambda frequency: cm.HarmonicForce(
+            get("name"), vector("point"), vector("direction"), get("amplitude"), frequency_hz=frequency,
+            phase_deg=get("phase", 0.0)))
+
+    def swept(self, record: Record, make: Callable):
+        """The excitation ``make(frequency)`` of *record*, or its sweep or run-up."""
+        get = record.get
         sweep = get("sweep_from") is not None or get("sweep_to") is not None
+        if get("run_up") is not None and not sweep:
+            self.record_problem(record, ("sweep_from",), None, "a first speed (a run-up runs from 'sweep from' "
+                                "to 'sweep to')")
+            return None
         if sweep and not self.require(record, ("sweep_from", "sweep_to", "sweep_points"), "a sweep"):
             return None
         if sweep and get("frequency") is not None:
@@ -235,16 +289,15 @@ class _CaseReader(SheetReader):
                                 "an empty cell (a sweep takes its frequencies from 'sweep from' and 'sweep to')")
             return None
         frequency = get("sweep_from") if sweep else get("frequency")
-        if get("type") == "rotating":
-            template = self.build(record, lambda: cm.RotatingForce(
-                get("name"), vector("point"), frequency_hz=frequency, amplitude=get("amplitude"),
-                unbalance=get("unbalance"), axis=vector("axis", (1.0, 0.0, 0.0)), phase_deg=get("phase", 0.0)))
-        else:
-            template = self.build(record, lambda: cm.HarmonicForce(
-                get("name"), vector("point"), vector("direction"), get("amplitude"), frequency_hz=frequency,
-                phase_deg=get("phase", 0.0)))
+        template = self.build(record, lambda: make(frequency))
         if template is None or not sweep:
             return template
+        unit = get("run_up")
+        if unit is not None:
+            factor = cm.SPEED_UNITS[unit]
+            return self.build(record, lambda: cm.RunUp.speeds(get("name"), template, get("sweep_from") / factor,
+                                                              get("sweep_to") / factor, get("sweep_points"), unit),
+                              ("sweep_from", "sweep_to", "sweep_points"))
         return self.build(record, lambda: cm.Sweep.band(get("name"), template, get("sweep_from"), get("sweep_to"),
                                                         get("sweep_points"), get("sweep_spacing", "log")),
                           ("sweep_from", "sweep_to", "sweep_points"))
@@ -273,14 +326,21 @@ class _CaseReader(SheetReader):
     # -- the case ----------------------------------------------------------------------------------------
 
     def case(self, tables: dict) -> cm.Case | None:
-        for key in ("Links", "Hinges", "Static loads", "Excitations", "Rotors"):
+        for key in ("Links", "Hinges", "Static loads", "Rotors"):
             self.unique(tables[key])
+        planes: dict = {}
+        for record in tables["Excitations"]:
+            if record.get("type") == "imbalance plane":
+                planes.setdefault(record.get("name"), record)
+        # the plane rows of one imbalance share its name; its first row stands for it
+        self.unique([r for r in tables["Excitations"] if r.get("type") != "imbalance plane" or planes[r.get("name")] is r])
         engine = [self.engine(r) for r in tables["Engine"] if r.ok]
         settings = [self.settings(r) for r in tables["Case"] if r.ok]
         test_rig = [self.test_rig(r) for r in tables["Test rig"] if r.ok]
         items = {key: [(r, make(r) if r.ok else None) for r in tables[key]] for key, make in
                  (("Links", self.link), ("Hinges", self.hinge), ("Static loads", self.static_load),
-                  ("Excitations", self.excitation), ("Rotors", self.rotor))}
+                  ("Rotors", self.rotor))}
+        items["Excitations"] = self.excitations(tables["Excitations"])
         first_links = {}
         for record, link in items["Links"]:
             first_links.setdefault(record.get("name"), link)
@@ -374,6 +434,12 @@ class _CaseReader(SheetReader):
             if isinstance(excitation, cm.Sweep) and record.get("frequency") is not None:
                 self.record_problem(record, ("frequency",), record.typed(("frequency",), None),
                                     f"an empty cell ('{excitation.name}' is a sweep)")
+                continue
+            template = excitation.template if isinstance(excitation, cm.Sweep) else excitation
+            if isinstance(template, cm.Imbalance) and record.get("amplitude") is not None:
+                self.record_problem(record, ("amplitude",), record.typed(("amplitude",), None),
+                                    f"an empty cell ('{excitation.name}' is an imbalance: its planes carry their "
+                                    f"own unbalance or force)")
                 continue
             run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
             if self.build(record, lambda: case_for_run(case, run)) is not None:

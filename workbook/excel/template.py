@@ -108,9 +108,18 @@ def _vector(key: str, values) -> dict:
     return {f"{key}_{axis}": value for axis, value in zip("xyz", values)}
 
 
-def _row_for_excitation(excitation: cm.Excitation) -> dict:
-    row = {}
-    if isinstance(excitation, cm.Sweep):
+def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
+    """The Excitations rows of one excitation: one row, or one per imbalance plane
+    (the first with the speed, the axis and any sweep or run-up)."""
+    row = {"name": excitation.name}
+    if isinstance(excitation, cm.Simultaneous):
+        raise ValueError(f"excitation {excitation.name!r}: simultaneous excitations have no Excitations row; "
+                         f"run them from Python or a JSON case")
+    if isinstance(excitation, cm.RunUp):
+        f = excitation.frequencies_hz
+        row.update(sweep_from=f[0], sweep_to=f[-1], sweep_points=len(f), run_up=excitation.speed_unit)
+        template = excitation.template
+    elif isinstance(excitation, cm.Sweep):
         f = excitation.frequencies_hz
         spacing = next((name for name, space in (("log", np.geomspace), ("linear", np.linspace))
                         if np.allclose(space(f[0], f[-1], len(f)), f, rtol=1e-12)), None)
@@ -121,14 +130,18 @@ def _row_for_excitation(excitation: cm.Excitation) -> dict:
     else:
         template = excitation
         row["frequency"] = excitation.frequency
-    row.update(name=excitation.name, **_vector("point", template.point), phase=template.phase_deg or None)
+    if isinstance(template, (cm.RotatingForce, cm.Imbalance)) and template.axis != (1.0, 0.0, 0.0):
+        row.update(_vector("axis", template.axis))
+    if isinstance(template, cm.Imbalance):
+        return [{**(row if k == 0 else {"name": excitation.name}), "type": "imbalance plane",
+                 **_vector("point", plane.point), "amplitude": plane.amplitude, "unbalance": plane.unbalance,
+                 "phase": plane.phase_deg or None} for k, plane in enumerate(template.planes)]
+    row.update(**_vector("point", template.point), phase=template.phase_deg or None)
     if isinstance(template, cm.RotatingForce):
         row.update(type="rotating", amplitude=template.amplitude, unbalance=template.unbalance)
-        if template.axis != (1.0, 0.0, 0.0):
-            row.update(_vector("axis", template.axis))
     else:
         row.update(type="harmonic", amplitude=template.amplitude, **_vector("direction", template.direction))
-    return row
+    return [row]
 
 
 def _row_for_load(load: cm.StaticLoad) -> dict:
@@ -169,7 +182,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.LINKS.sheet: [_row_for_link(link) for link in case.links],
         L.HINGES.sheet: hinges,
         L.STATIC_LOADS.sheet: [_row_for_load(load) for load in case.static_loads],
-        L.EXCITATIONS.sheet: [_row_for_excitation(e) for e in case.excitations],
+        L.EXCITATIONS.sheet: [row for e in case.excitations for row in _rows_for_excitation(e)],
         L.ROTORS.sheet: [_row_for_rotor(rotor) for rotor in case.rotors],
         L.TEST_RIG.sheet: _rows_for_test_rig(case.test_rig),
         L.RUNS.sheet: [dataclasses.asdict(run) for run in runs],

@@ -30,7 +30,8 @@ from workbook.errors import CaseError
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
-    "SingleFrequencyExcitation", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request",
+    "SingleFrequencyExcitation", "ImbalancePlane", "Imbalance", "RunUp", "SPEED_UNITS",
+    "Simultaneous", "ForceTransducers", "Rotor", "ModeCutoff", "ModeRequest", "mode_request",
     "TRANSDUCER_PREFIX", "transducer_name"]
 
 PYLON = "pylon"
@@ -521,6 +522,10 @@ class RotatingForce(_OneFrequency):
         sin_part = amplitude * (v * math.cos(phase) - u * math.sin(phase))
         return cos_part, sin_part
 
+    def point_forces(self) -> tuple[tuple[Vector3, np.ndarray, np.ndarray], ...]:
+        """The forces at their points: ``((point, C, S),)`` (see :meth:`force_coefficients`)."""
+        return ((self.point, *self.force_coefficients()),)
+
 
 @dataclass(frozen=True)
 class HarmonicForce(_OneFrequency):
@@ -570,8 +575,103 @@ class HarmonicForce(_OneFrequency):
         phase = math.radians(self.phase_deg)
         return self.amplitude * math.cos(phase) * d, -self.amplitude * math.sin(phase) * d
 
+    def point_forces(self) -> tuple[tuple[Vector3, np.ndarray, np.ndarray], ...]:
+        """The forces at their points: ``((point, C, S),)`` (see :meth:`force_coefficients`)."""
+        return ((self.point, *self.force_coefficients()),)
 
-SingleFrequencyExcitation = RotatingForce | HarmonicForce
+
+@dataclass(frozen=True)
+class ImbalancePlane:
+    """One imbalance plane of a rotor: an eccentric mass at a point on the spin axis.
+
+    Parameters
+    ----------
+    point : 3 floats
+        The plane's centre on the spin axis, m.
+    unbalance, amplitude : float
+        The unbalance m e in kg m (the force is then U w^2, growing with
+        the speed) or the force amplitude in N; give exactly one (> 0).
+    phase_deg : float
+        Angular position of the eccentric mass at t = 0, degrees.
+    """
+
+    point: Vector3
+    unbalance: float | None = None
+    amplitude: float | None = None
+    phase_deg: float = 0.0
+
+    def check(self, item: str) -> "ImbalancePlane":
+        """The plane with validated fields; *item* names it in a CaseError."""
+        if (self.amplitude is None) == (self.unbalance is None):
+            raise CaseError(item, "unbalance", self.unbalance, "either unbalance or amplitude, not both")
+        given = {name: _number(getattr(self, name), item, name, minimum=0.0, strictly=True)
+                 for name in ("unbalance", "amplitude") if getattr(self, name) is not None}
+        return ImbalancePlane(_vector3(self.point, item, "point"), phase_deg=_number(self.phase_deg, item,
+                                                                                    "phase_deg"), **given)
+
+
+@dataclass(frozen=True)
+class Imbalance(_OneFrequency):
+    """Several imbalance planes of one rotor at one speed, as a rig's rotary
+    exciter applies them (eccentric masses at the front support, the centre of
+    gravity and the rear support, say).
+
+    Plane k exerts the rotating force of a :class:`RotatingForce` at its
+    point, with its own unbalance (or amplitude) and phase; all turn at the
+    same speed about the same axis. The transmissibility refers to the sum
+    of the plane force amplitudes (:attr:`force_amplitude`): the force of
+    planes in phase, and never zero, also when the planes form a couple.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    planes : tuple of ImbalancePlane
+        At least one plane.
+    frequency_hz, rpm : float
+        Rotor speed; give exactly one.
+    axis : 3 floats
+        Spin axis.
+    """
+
+    name: str
+    planes: tuple[ImbalancePlane, ...]
+    frequency_hz: float | None = None
+    rpm: float | None = None
+    axis: Vector3 = (1.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        _frequency(item, self.frequency_hz, self.rpm)
+        _set(self, "axis", _direction(self.axis, item, "axis"))
+        try:
+            planes = tuple(self.planes)
+        except TypeError:
+            raise CaseError(item, "planes", self.planes, "a list of imbalance planes") from None
+        if not planes or not all(isinstance(p, ImbalancePlane) for p in planes):
+            raise CaseError(item, "planes", self.planes, "one or more ImbalancePlane")
+        _set(self, "planes", tuple(p.check(f"{item} plane {k}") for k, p in enumerate(planes, start=1)))
+
+    def plane_forces(self) -> tuple[RotatingForce, ...]:
+        """Each plane as the rotating force it exerts, named ``"<name> plane <k>"``."""
+        return tuple(RotatingForce(f"{self.name} plane {k}", plane.point, frequency_hz=self.frequency,
+                                   amplitude=plane.amplitude, unbalance=plane.unbalance, axis=self.axis,
+                                   phase_deg=plane.phase_deg)
+                     for k, plane in enumerate(self.planes, start=1))
+
+    @property
+    def force_amplitude(self) -> float:
+        """Sum of the plane force amplitudes, N (the reference of the transmissibility)."""
+        return sum(force.force_amplitude for force in self.plane_forces())
+
+    def point_forces(self) -> tuple[tuple[Vector3, np.ndarray, np.ndarray], ...]:
+        """The plane forces at their points: ``(point, C, S)`` per plane."""
+        return tuple(part for force in self.plane_forces() for part in force.point_forces())
+
+
+SingleFrequencyExcitation = RotatingForce | HarmonicForce | Imbalance
+SINGLE_FREQUENCY_KINDS = (RotatingForce, HarmonicForce, Imbalance)
 
 
 @dataclass(frozen=True)
@@ -628,7 +728,7 @@ class Sweep:
     ----------
     name : str
         Unique name.
-    template : RotatingForce or HarmonicForce
+    template : RotatingForce, HarmonicForce or Imbalance
         The excitation; its own frequency is replaced by each sweep frequency
         (an unbalance given as m*e gives a force growing with frequency^2).
     frequencies_hz : floats
@@ -642,8 +742,8 @@ class Sweep:
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         _name(self.name, "excitation")
-        if not isinstance(self.template, (RotatingForce, HarmonicForce)):
-            raise CaseError(item, "template", self.template, "a RotatingForce or HarmonicForce")
+        if not isinstance(self.template, SINGLE_FREQUENCY_KINDS):
+            raise CaseError(item, "template", self.template, "a RotatingForce, HarmonicForce or Imbalance")
         try:
             frequencies = tuple(_number(f, item, "frequencies_hz", minimum=0.0, strictly=True)
                                 for f in self.frequencies_hz)
@@ -674,7 +774,122 @@ class Sweep:
                      for f in self.frequencies_hz)
 
 
-Excitation = RotatingForce | HarmonicForce | Sweep
+#: Speed units of a run-up and their factor to Hz.
+SPEED_UNITS = {"rpm": 1.0 / 60.0, "Hz": 1.0}
+
+
+@dataclass(frozen=True)
+class RunUp(Sweep):
+    """A run-up: a rotor imbalance at evenly spaced speeds, its force growing as U w^2.
+
+    A :class:`Sweep` whose template is an unbalance (a :class:`RotatingForce`
+    given by ``unbalance``, or an :class:`Imbalance` whose planes all are),
+    so that the force amplitude grows with the square of the speed, and
+    whose speeds are kept in the unit they were given in.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    template : RotatingForce or Imbalance
+        The imbalance; its own speed is replaced by each run-up speed.
+    frequencies_hz : floats
+        The speeds, Hz, ascending.
+    speed_unit : {"rpm", "Hz"}
+        The unit the speeds are tabulated and plotted in.
+    """
+
+    speed_unit: str = "rpm"
+
+    def __post_init__(self):
+        super().__post_init__()
+        item = f"excitation {self.name!r}"
+        if self.speed_unit not in SPEED_UNITS:
+            raise CaseError(item, "speed_unit", self.speed_unit, " or ".join(repr(u) for u in SPEED_UNITS))
+        planes = (self.template.planes if isinstance(self.template, Imbalance)
+                  else (self.template,) if isinstance(self.template, RotatingForce) else ())
+        if not planes or any(plane.unbalance is None for plane in planes):
+            raise CaseError(item, "unbalance", None, "an unbalance on every imbalance plane (a run-up's force "
+                            "grows as U w^2; a rotating force or imbalance given by its unbalance)")
+
+    @classmethod
+    def speeds(cls, name: str, template: SingleFrequencyExcitation, start: float, stop: float, points: int,
+               unit: str = "rpm") -> "RunUp":
+        """A run-up over *points* evenly spaced speeds from *start* to *stop*, in *unit* (rpm or Hz)."""
+        item = f"excitation {name!r}"
+        if unit not in SPEED_UNITS:
+            raise CaseError(item, "speed_unit", unit, " or ".join(repr(u) for u in SPEED_UNITS))
+        start = _number(start, item, "start", minimum=0.0, strictly=True)
+        stop = _number(stop, item, "stop", minimum=0.0, strictly=True)
+        if stop <= start:
+            raise CaseError(item, "stop", stop, f"a speed above the start ({start:g} {unit})")
+        if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
+            raise CaseError(item, "points", points, "a whole number >= 2")
+        factor = SPEED_UNITS[unit]
+        return cls(name, template, tuple(float(s) * factor for s in np.linspace(start, stop, int(points))), unit)
+
+    @property
+    def speed_values(self) -> np.ndarray:
+        """The speeds in :attr:`speed_unit`."""
+        return np.asarray(self.frequencies_hz) / SPEED_UNITS[self.speed_unit]
+
+
+@dataclass(frozen=True)
+class Simultaneous:
+    """Several single-frequency excitations acting at once, each at its own
+    frequency: both rotors of a two-spool engine (LP and HP) together.
+
+    The scene is linear about the preload (or is treated so in the
+    frequency domain), so the frequency domain answers each part on its own
+    at its frequency and the response is their sum (superposition). The
+    time domain runs all parts in one run and extracts the amplitude at each
+    frequency from the same histories. Either way the answers are one
+    result per part, named ``"<name> / <part name>"``, whose T refers to that
+    part's force.
+
+    Parameters
+    ----------
+    name : str
+        Unique name.
+    parts : tuple of RotatingForce, HarmonicForce or Imbalance
+        At least two, at different frequencies, with different names.
+    """
+
+    name: str
+    parts: tuple[SingleFrequencyExcitation, ...]
+
+    def __post_init__(self):
+        item = f"excitation {self.name!r}"
+        _name(self.name, "excitation")
+        try:
+            parts = tuple(self.parts)
+        except TypeError:
+            raise CaseError(item, "parts", self.parts, "a list of excitations") from None
+        if len(parts) < 2 or not all(isinstance(p, SINGLE_FREQUENCY_KINDS) for p in parts):
+            raise CaseError(item, "parts", self.parts, "two or more RotatingForce, HarmonicForce or Imbalance")
+        frequencies = [p.frequency for p in parts]
+        if len(set(frequencies)) < len(frequencies) or len({p.name for p in parts}) < len(parts):
+            raise CaseError(item, "parts", ", ".join(f"{p.name} at {p.frequency:g} Hz" for p in parts),
+                            "parts of different names at different frequencies (parts at one speed are the "
+                            "planes of one Imbalance)")
+        _set(self, "parts", parts)
+
+    @property
+    def frequency(self) -> float:
+        """Highest frequency of the parts, Hz."""
+        return max(p.frequency for p in self.parts)
+
+    @property
+    def force_amplitude(self) -> float:
+        """Sum of the parts' force amplitudes, N (the load scale of the run)."""
+        return sum(p.force_amplitude for p in self.parts)
+
+    def expand(self) -> tuple[SingleFrequencyExcitation, ...]:
+        """The parts as single-frequency excitations, named ``"<name> / <part name>"``."""
+        return tuple(dataclasses.replace(p, name=f"{self.name} / {p.name}") for p in self.parts)
+
+
+Excitation = RotatingForce | HarmonicForce | Imbalance | Sweep | Simultaneous
 
 
 @dataclass(frozen=True)
@@ -828,8 +1043,9 @@ class Case:
         The ball hinges; a hinge may join any two bodies.
     static_loads : tuple of PointForce, PointMoment, Gravity
         Constant loads solved for first (the preload).
-    excitations : tuple of RotatingForce, HarmonicForce, Sweep
-        Each excitation (each sweep frequency) is one run.
+    excitations : tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp, Simultaneous
+        Each excitation (each sweep frequency) is one run; a Simultaneous
+        excitation is one run with a result per part.
     analysis : AnalysisSettings
         Time step, settle and steady-state settings.
     effects : Effects
@@ -866,7 +1082,7 @@ class Case:
             raise CaseError("case", "test_rig", self.test_rig, "a ForceTransducers or None")
         groups = (("links", (Link,)), ("hinges", (Hinge,)),
                   ("static_loads", (PointForce, PointMoment, Gravity)),
-                  ("excitations", (RotatingForce, HarmonicForce, Sweep)), ("rotors", (Rotor,)))
+                  ("excitations", (*SINGLE_FREQUENCY_KINDS, Sweep, Simultaneous)), ("rotors", (Rotor,)))
         for name, kinds in groups:
             items = tuple(getattr(self, name))
             for item in items:
@@ -908,7 +1124,8 @@ class Case:
         for group, _ in groups:
             kind = group[:-1].replace("_", " ")
             for item in getattr(self, group):
-                names = [item.name] + ([point.name for point in item.expand()] if isinstance(item, Sweep) else [])
+                names = [item.name] + ([point.name for point in item.expand()]
+                                       if isinstance(item, (Sweep, Simultaneous)) else [])
                 for name in names:
                     if name in owners:
                         raise CaseError(f"{kind} {item.name!r}", "name", name,
@@ -958,10 +1175,11 @@ class Case:
         return pins
 
     def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
-        """Every run of the case: single excitations and expanded sweeps."""
+        """Every run of the case: single excitations, expanded sweeps and the
+        parts of simultaneous excitations."""
         runs = []
         for excitation in self.excitations:
-            runs.extend(excitation.expand() if isinstance(excitation, Sweep) else (excitation,))
+            runs.extend(excitation.expand() if isinstance(excitation, (Sweep, Simultaneous)) else (excitation,))
         return tuple(runs)
 
     def without_link(self, name: str) -> "Case":

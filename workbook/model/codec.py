@@ -24,6 +24,7 @@ def _registry() -> dict[str, type]:
 
     classes = [_case.Case, _case.Engine, _case.Link, _case.Hinge, _case.PointForce,
                _case.PointMoment, _case.Gravity, _case.RotatingForce, _case.HarmonicForce,
+               _case.ImbalancePlane, _case.Imbalance, _case.RunUp, _case.Simultaneous,
                _case.Sweep, _case.Rotor, _case.ForceTransducers, _case.AnalysisSettings, _case.Effects,
                flexbodies.LinkModel,
                flexbodies.LinkGeometry, flexbodies.Material, flexbodies.MeshSource, BoreSpec]

@@ -48,6 +48,7 @@ from workbook.model.case import (
     Hinge,
     PointForce,
     PointMoment,
+    Simultaneous,
     SingleFrequencyExcitation,
     transducer_name,
 )
@@ -151,21 +152,27 @@ class ExcitationItems:
     Attributes
     ----------
     name : str
-    marker : int
-        ``MarkerBodyPosition`` on the engine at the excitation point.
-    load : int
-        ``LoadForceVector`` with a symbolic load user function.
-    signal : ExcitationSignal
-        The force law, also evaluable with numpy.
-    function : exudyn.symbolic.UserFunction
-        The recorded symbolic load function (kept alive here).
+    markers : tuple of int
+        ``MarkerBodyPosition`` on the engine at each point of the excitation
+        (one, or one per imbalance plane).
+    loads : tuple of int
+        ``LoadForceVector`` at each marker, with a symbolic load user function.
+    signal : ExcitationSignal or None
+        The resultant force law (the sum over the points), also evaluable
+        with numpy; None for a :class:`~workbook.model.case.Simultaneous`
+        excitation (several frequencies).
+    functions : tuple of exudyn.symbolic.UserFunction
+        The recorded symbolic load functions (kept alive here).
+    excitation : RotatingForce, HarmonicForce or Imbalance
+        The case's excitation.
     """
 
     name: str
-    marker: int
-    load: int
-    signal: ExcitationSignal
-    function: Any = field(repr=False)
+    markers: tuple
+    loads: tuple
+    signal: ExcitationSignal | None
+    functions: tuple = field(repr=False)
+    excitation: Any = None
 
 
 @dataclass(frozen=True)
@@ -284,12 +291,13 @@ class Scene:
         if self.excitation is None:
             yield
             return
-        load, function = self.excitation.load, self.excitation.function
-        self.mbs.SetLoadParameter(load, "loadVectorUserFunction", 0)
+        for load in self.excitation.loads:
+            self.mbs.SetLoadParameter(load, "loadVectorUserFunction", 0)
         try:
             yield
         finally:
-            self.mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
+            for load, function in zip(self.excitation.loads, self.excitation.functions):
+                self.mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
 
     @contextmanager
     def gaps_closed(self):
@@ -496,13 +504,21 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
 
     excitation_items = None
     if excitation is not None:
-        signal = ExcitationSignal.of(excitation, case.analysis.ramp_periods)
-        point = mbs.AddMarker(eii.MarkerBodyPosition(
-            bodyNumber=engine.body, localPosition=list(np.subtract(excitation.point, case.engine.center_of_mass))))
-        load = mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", excitation.name), markerNumber=point, loadVector=[0.0] * 3))
-        function = CreateSymbolicUserFunction(mbs, signal.exudyn_user_function(), "loadVectorUserFunction", load)
-        mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
-        excitation_items = ExcitationItems(excitation.name, point, load, signal, function)
+        markers, loads, functions = [], [], []
+        parts = ExcitationSignal.at_points(excitation, case.analysis.ramp_periods)
+        for k, (position, part) in enumerate(parts, start=1):
+            markers.append(mbs.AddMarker(eii.MarkerBodyPosition(
+                bodyNumber=engine.body, localPosition=list(np.subtract(position, case.engine.center_of_mass)))))
+            label = excitation.name if len(parts) == 1 else f"{excitation.name} {k}"
+            loads.append(mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", label),
+                                                         markerNumber=markers[-1], loadVector=[0.0] * 3)))
+            functions.append(CreateSymbolicUserFunction(mbs, part.exudyn_user_function(), "loadVectorUserFunction",
+                                                        loads[-1]))
+            mbs.SetLoadParameter(loads[-1], "loadVectorUserFunction", functions[-1])
+        resultant = None if isinstance(excitation, Simultaneous) else ExcitationSignal.of(excitation,
+                                                                                         case.analysis.ramp_periods)
+        excitation_items = ExcitationItems(excitation.name, tuple(markers), tuple(loads), resultant,
+                                           tuple(functions), excitation)
 
     mbs.Assemble()
     link_mass = sum(link.mass for link in links.values())

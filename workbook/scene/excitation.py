@@ -12,7 +12,13 @@ ratio of 25 between excitation and natural frequency needed about 2 decay
 time constants after a 10-period ramp, against more than 4 without).
 
 The same law is evaluated by Exudyn as a symbolic user function (C++ speed)
-and by numpy for plots and checks.
+and by numpy for plots and checks. An excitation of several points (the
+planes of an :class:`~workbook.model.case.Imbalance`) is one such law per
+point (:meth:`ExcitationSignal.at_points`), all with the same start; its
+resultant (:meth:`ExcitationSignal.of`) is their sum, the force the
+excitation history shows. The parts of a
+:class:`~workbook.model.case.Simultaneous` excitation each keep their own
+frequency and share the start of the lowest.
 """
 from __future__ import annotations
 
@@ -21,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workbook.model.case import SingleFrequencyExcitation
+from workbook.model.case import Simultaneous, SingleFrequencyExcitation
 
 __all__ = ["ExcitationSignal"]
 
@@ -51,11 +57,29 @@ class ExcitationSignal:
 
     @classmethod
     def of(cls, excitation: SingleFrequencyExcitation, ramp_periods: float) -> "ExcitationSignal":
-        """The signal of a case excitation, starting over *ramp_periods* periods."""
-        cos_part, sin_part = excitation.force_coefficients()
+        """The resultant signal of a case excitation (the sum over its points),
+        starting over *ramp_periods* periods; its amplitude is the excitation's
+        ``force_amplitude``."""
+        parts = excitation.point_forces()
+        cos_part = np.sum([c for _, c, _ in parts], axis=0)
+        sin_part = np.sum([s for _, _, s in parts], axis=0)
         frequency = excitation.frequency
         return cls(frequency, tuple(cos_part), tuple(sin_part), excitation.force_amplitude,
                    ramp_periods / frequency)
+
+    @classmethod
+    def at_points(cls, excitation: SingleFrequencyExcitation | Simultaneous, ramp_periods: float
+                  ) -> tuple[tuple[tuple, "ExcitationSignal"], ...]:
+        """``(point, signal)`` of each point force of a case excitation, all
+        starting together over *ramp_periods* periods of the lowest
+        frequency (the parts of a :class:`Simultaneous` each at its own
+        frequency); each signal's amplitude is the largest magnitude its
+        force reaches."""
+        parts = excitation.parts if isinstance(excitation, Simultaneous) else (excitation,)
+        ramp_time = ramp_periods / min(part.frequency for part in parts)
+        return tuple((point, cls(part.frequency, tuple(c), tuple(s), float(np.linalg.norm(np.column_stack([c, s]), 2)),
+                                 ramp_time))
+                     for part in parts for point, c, s in part.point_forces())
 
     @property
     def omega(self) -> float:

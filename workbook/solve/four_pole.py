@@ -451,7 +451,7 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     jacobian = lambda point: (model.engine_point_jacobian(np.asarray(point, dtype=float)) @ turn)[:, e]  # noqa: E731
     kinematics = np.vstack([jacobian(position) for position, _ in pins])
     wanted = [center, *(np.asarray(p, dtype=float) for p in points),
-              *(np.asarray(x.point, dtype=float) for x in case.single_frequency_excitations())]
+              *(np.asarray(p, dtype=float) for x in case.single_frequency_excitations() for p, _, _ in x.point_forces())]
     inputs = {}
     for point in wanted:
         key = tuple(np.round(point, 12))

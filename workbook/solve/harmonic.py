@@ -47,9 +47,9 @@ VELOCITY_STEP = 1e-3
 
 
 def excitation_phasor(excitation: SingleFrequencyExcitation) -> np.ndarray:
-    """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)."""
-    cos_part, sin_part = excitation.force_coefficients()
-    return np.asarray(cos_part, dtype=complex) - 1j * np.asarray(sin_part, dtype=float)
+    """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)
+    (of an imbalance of several planes: their resultant)."""
+    return sum(np.asarray(c, dtype=complex) - 1j * np.asarray(s, dtype=float) for _, c, s in excitation.point_forces())
 
 
 @dataclass(frozen=True)
@@ -114,11 +114,20 @@ class HarmonicModel:
 
     def respond(self, frequency_hz: float, force: np.ndarray, point) -> FrequencyResponse:
         """Steady-state hinge forces for the force phasor *force* (N) at *point* (m) at *frequency_hz*."""
+        return self.respond_generalised(frequency_hz, self.input_matrix(point) @ np.asarray(force, dtype=complex))
+
+    def excitation_input(self, excitation: SingleFrequencyExcitation) -> np.ndarray:
+        """Generalised force phasor of *excitation*: the sum over its point
+        forces (one, or one per imbalance plane), shape (n,)."""
+        return sum(self.input_matrix(point) @ (np.asarray(c, dtype=complex) - 1j * np.asarray(s, dtype=float))
+                   for point, c, s in excitation.point_forces())
+
+    def respond_generalised(self, frequency_hz: float, load: np.ndarray) -> FrequencyResponse:
+        """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*."""
         lin = self.linearization
         omega = 2 * np.pi * frequency_hz
         dynamic = lin.stiffness - omega ** 2 * lin.mass + 1j * omega * lin.damping
-        motion = sla.solve(dynamic, self.input_matrix(point) @ np.asarray(force, dtype=complex),
-                           check_finite=False)
+        motion = sla.solve(dynamic, load, check_finite=False)
         forces = ((self.stiffness_output + 1j * omega * self.damping_output) @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces))
         pylon = pylon_sum(hinges, self.pylon_hinges)
@@ -126,7 +135,7 @@ class HarmonicModel:
 
     def result(self, excitation: SingleFrequencyExcitation, steady_tolerance: float) -> ExcitationResult:
         """The answers of *excitation* as an :class:`ExcitationResult` (no time histories)."""
-        response = self.respond(excitation.frequency, excitation_phasor(excitation), excitation.point)
+        response = self.respond_generalised(excitation.frequency, self.excitation_input(excitation))
         empty = np.zeros((0, 3))
         return ExcitationResult(
             name=excitation.name, frequency_hz=excitation.frequency,

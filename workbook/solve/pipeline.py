@@ -25,7 +25,7 @@ import time
 
 from workbook.answers.model_card import ModelCard, model_card
 from workbook.answers.results import ExcitationResult, MountResult
-from workbook.model.case import Case, SingleFrequencyExcitation, Sweep
+from workbook.model.case import Case, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
@@ -33,10 +33,12 @@ from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicMode
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
 from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
 from workbook.solve.preload import Preload, solve_preload
+from workbook.solve.simultaneous import extract_simultaneous, plan_simultaneous
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
 from workbook.solve.time_domain import extract, integrate, plan_run
 
-__all__ = ["PreparedScene", "prepare", "run_excitation", "solve_frequencies", "run_case", "RESONANCE_BAND"]
+__all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
+           "RESONANCE_BAND"]
 
 log = logging.getLogger(__name__)
 
@@ -161,13 +163,25 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         an undamped mode, a failed or diverging integration, or an exhausted
         time budget; the message says when and why.
     """
+    results, card, preload = run_in_time(case, excitation, reduce_for=reduce_for, progress=progress, method=method)
+    return results[0], card, preload
+
+
+def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous, *,
+                reduce_for: SingleFrequencyExcitation | None = None, progress: ProgressFactory | None = None,
+                method: MethodChoice | None = None) -> tuple[list[ExcitationResult], ModelCard, Preload]:
+    """One time-domain run of *excitation*: one result, or one per part of a
+    :class:`~workbook.model.case.Simultaneous` excitation (all parts in the
+    same run, see :mod:`workbook.solve.simultaneous`); see :func:`run_excitation`."""
     method = method or MethodChoice(TIME, "asked for directly (run_excitation)")
     prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
+    together = isinstance(excitation, Simultaneous)
     with scene:
-        plan = plan_run(case.analysis, scene.excitation.signal, prepared.modes,
-                        where=run_label(case.name, excitation.name))
+        where = run_label(case.name, excitation.name)
+        plan = (plan_simultaneous(case.analysis, excitation, prepared.modes, where) if together
+                else plan_run(case.analysis, scene.excitation.signal, prepared.modes, where=where))
         log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
         with timed(timings, "time integration"):
             if progress is None:
@@ -179,11 +193,13 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                 finally:
                     close()
         with timed(timings, "amplitude extraction"):
-            result = extract(scene, plan, histories)
-        result.warnings.extend(link_warnings(case, scene.reduced))
+            results = (extract_simultaneous(scene, plan, histories, excitation) if together
+                       else [extract(scene, plan, histories)])
+        for result in results:
+            result.warnings.extend(link_warnings(case, scene.reduced))
         card = model_card(scene, prepared.preload, mounted, plan, timings, method)
     card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
-    return result, card, prepared.preload
+    return results, card, prepared.preload
 
 
 def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
@@ -266,13 +282,21 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     """
     runs, cards, preloads = [], {}, {}
     for item in case.excitations:
-        points = item.expand() if isinstance(item, Sweep) else (item,)
+        points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
+        highest = max(points, key=lambda point: point.frequency)
         chosen = method or choose_method(case, sweep=isinstance(item, Sweep))
         if chosen.method == FREQUENCY:
-            prepared = prepare(case, points[0], reduce_for=points[-1], progress=progress)
+            if isinstance(item, Simultaneous):
+                chosen = dataclasses.replace(chosen, reason=f"{chosen.reason}; {item.name!r} by superposition: "
+                                             "each part solved at its own frequency, the response is their sum")
+            prepared = prepare(case, points[0], reduce_for=highest, progress=progress)
             with prepared.scene:
                 item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
                                                                          progress=progress)
+        elif isinstance(item, Simultaneous):
+            item_runs, card, preload = run_in_time(case, item, reduce_for=highest, progress=progress, method=chosen)
+            item_cards = {result.name: card for result in item_runs}
+            item_preloads = {result.name: preload for result in item_runs}
         else:
             item_runs, item_cards, item_preloads = [], {}, {}
             for excitation in points:

@@ -55,7 +55,7 @@ from workbook.solve.guards import MAX_STEPS, UNDAMPED_RATIO, check_undamped_reso
 from workbook.solve.modes import Mode, mounted_modes
 from workbook.solve.step_accuracy import ACCURACY_LIMIT, ACCURACY_TARGET, amplitude_error, steps_for_accuracy
 
-__all__ = ["TimePlan", "plan_run", "integrate", "extract", "TimeHistories", "TRANSIENT_SEGMENTS"]
+__all__ = ["TimePlan", "plan_run", "integrate", "extract", "run_warnings", "TimeHistories", "TRANSIENT_SEGMENTS"]
 
 log = logging.getLogger(__name__)
 
@@ -353,11 +353,24 @@ def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> Excitatio
     window = steady.window
     hinge_amplitudes = {name: np.abs(harmonic_amplitude(time[window], forces[window], plan.frequency_hz))
                         for name, forces in histories.hinge_forces.items()}
+    warnings = run_warnings(scene, plan, steady.relative_change)
+    return ExcitationResult(
+        name=scene.excitation.name, frequency_hz=plan.frequency_hz, excitation_amplitude=signal.amplitude,
+        pylon_amplitude=steady.amplitude, hinge_amplitudes=hinge_amplitudes, pylon_hinges=list(scene.pylon_channels),
+        steady_change=steady.relative_change, steady_tolerance=analysis.steady_tolerance, warnings=warnings,
+        time=time, hinge_histories=histories.hinge_forces, pylon_history=pylon,
+        excitation_history=signal.force(time), window=window)
+
+
+def run_warnings(scene: Scene, plan: TimePlan, relative_change: float) -> list[str]:
+    """The warnings of a time run: not steady (the pylon amplitudes of the two
+    windows differ by *relative_change*), a coarse step, undamped modes."""
+    analysis = scene.case.analysis
     warnings = []
-    if not steady.steady:
+    if relative_change > analysis.steady_tolerance:
         warnings.append(
             f"not steady: the pylon-force amplitudes of the last two {plan.measured_periods}-period windows "
-            f"differ by {100 * steady.relative_change:.2f} % (> {100 * analysis.steady_tolerance:.2g} %); "
+            f"differ by {100 * relative_change:.2f} % (> {100 * analysis.steady_tolerance:.2g} %); "
             f"lengthen the settle time or check the damping")
         log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     if plan.amplitude_error > ACCURACY_LIMIT:
@@ -373,9 +386,4 @@ def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> Excitatio
             f"started by the ramp never decays and is part of the measured forces; the frequency domain gives "
             f"the steady answer")
         log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
-    return ExcitationResult(
-        name=scene.excitation.name, frequency_hz=plan.frequency_hz, excitation_amplitude=signal.amplitude,
-        pylon_amplitude=steady.amplitude, hinge_amplitudes=hinge_amplitudes, pylon_hinges=list(scene.pylon_channels),
-        steady_change=steady.relative_change, steady_tolerance=analysis.steady_tolerance, warnings=warnings,
-        time=time, hinge_histories=histories.hinge_forces, pylon_history=pylon,
-        excitation_history=signal.force(time), window=window)
+    return warnings

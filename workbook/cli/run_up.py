@@ -1,0 +1,96 @@
+"""``mountwb run-up [CASE] [--excitation NAME --from S --to S --points N --unit rpm|Hz] [--csv OUT] [--plot OUT.png]``.
+
+A rotor imbalance over a speed range, its force growing as U w^2
+(:mod:`workbook.solve.run_up`): per speed the excitation force, the
+pylon-force amplitude and T per direction, the mounted modes, and one plot.
+Without ``--from``/``--to`` the case's own run-ups run (an Excitations row
+with a run-up speed unit, or a :class:`~workbook.model.case.RunUp` in a JSON
+case); with them, the imbalance ``--excitation`` (a rotating force or an
+imbalance given by its unbalance, or made one with ``--unbalance``) is run
+up over that range. Everything is computed before a file is written.
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+from typing import Callable
+
+from workbook.cli.loading import load_case
+from workbook.errors import UsageError
+from workbook.model.case import SPEED_UNITS, Case, RotatingForce, RunUp
+
+__all__ = ["arguments"]
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    parser.add_argument("--excitation", metavar="NAME",
+                        help="the run-up to run, or with --from/--to the imbalance to run up (default: every "
+                             "run-up of the case)")
+    parser.add_argument("--from", dest="start", type=float, metavar="SPEED", help="first speed (in --unit)")
+    parser.add_argument("--to", dest="stop", type=float, metavar="SPEED", help="last speed (in --unit)")
+    parser.add_argument("--points", type=int, default=41, help="speeds, evenly spaced (default 41)")
+    parser.add_argument("--unit", choices=tuple(SPEED_UNITS), default="rpm", help="speed unit (default rpm)")
+    parser.add_argument("--unbalance", type=float, metavar="KG_M",
+                        help="unbalance of a rotating force given by its amplitude, kg m (replaces the amplitude)")
+    parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+    parser.add_argument("--csv", metavar="OUT", help="write the table as CSV (one run-up)")
+    parser.add_argument("--plot", metavar="OUT.png", help="write the plot as PNG (one run-up)")
+    return run
+
+
+def _run_ups(case: Case, args) -> list[RunUp]:
+    """The run-ups the arguments ask for."""
+    excitations = {e.name: e for e in case.excitations}
+    if args.start is None and args.stop is None:
+        if args.unbalance is not None:
+            raise UsageError("--unbalance makes a run-up of --excitation over --from to --to; give those too")
+        chosen = [e for e in case.excitations if isinstance(e, RunUp)
+                  and (args.excitation is None or e.name == args.excitation)]
+        if not chosen:
+            have = ", ".join(e.name for e in case.excitations if isinstance(e, RunUp)) or "none"
+            raise UsageError(f"--excitation {args.excitation!r}: expected a run-up of the case (run-ups: {have}); or "
+                             f"give --from and --to to run up an imbalance" if args.excitation else
+                             "the case has no run-up: name an imbalance with --excitation and give --from and --to")
+        return chosen
+    if args.start is None or args.stop is None or args.excitation is None:
+        raise UsageError("a run-up of an imbalance needs --excitation NAME, --from and --to")
+    template = excitations.get(args.excitation)
+    if template is None or isinstance(template, RunUp) or not hasattr(template, "point_forces"):
+        raise UsageError(f"--excitation {args.excitation!r}: expected a rotating force or an imbalance of the case "
+                         f"({', '.join(excitations) or 'none'})")
+    if args.unbalance is not None:
+        if not isinstance(template, RotatingForce):
+            raise UsageError(f"--unbalance: {args.excitation!r} is not a rotating force; give its planes' unbalance "
+                             f"in the case")
+        template = dataclasses.replace(template, amplitude=None, unbalance=args.unbalance)
+    return [RunUp.speeds(f"{args.excitation} run-up", template, args.start, args.stop, args.points, args.unit)]
+
+
+def run(args) -> int:
+    from workbook.solve.run_up import run_up
+
+    case = load_case(args.case, rigid=args.rigid)
+    items = _run_ups(case, args)
+    if (args.csv or args.plot) and len(items) > 1:
+        raise UsageError(f"--csv/--plot write one run-up; the case has {len(items)}: choose one with --excitation")
+    answers = [run_up(case, item) for item in items]
+    figure = answers[0].plot() if args.plot else None
+    for answer in answers:
+        print(f"{case.name}: run-up {answer.sweep.name}, force U w^2 per plane; pylon force amplitude and "
+              f"T = |F_pylon| / |F| per direction\n")
+        print(answer.frame().to_string(float_format=lambda v: f"{v:10.4g}"))
+        print("\nmodes (marked on the plot at the speed equal to their frequency):")
+        print(answer.modes_frame().to_string(float_format=lambda v: f"{v:8.2f}"))
+        warnings: dict[str, list[str]] = {}
+        for run_result in answer.result.runs:
+            for warning in run_result.warnings:
+                warnings.setdefault(warning, []).append(run_result.name)
+        for warning, names in warnings.items():
+            where = names[0] if len(names) == 1 else f"{len(names)} speeds from {names[0]} to {names[-1]}"
+            print(f"\nWARNING {where}: {warning}")
+    if args.csv:
+        answers[0].frame().to_csv(args.csv)
+    if figure is not None:
+        figure.savefig(args.plot, dpi=120)
+    return 0
