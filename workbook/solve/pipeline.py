@@ -4,7 +4,9 @@ Every excitation goes through the same stages, each timed:
 
 1. reduce links (for the excitation's frequency, or a sweep's highest);
 2. build the scene;
-3. static preload;
+3. static preload, then stress stiffening of the flexible links by their
+   axial preload (:mod:`~workbook.solve.stress_stiffening`: the scene is
+   rebuilt and preloaded again when a link is stiffened);
 4. linearisation and mounted modes (the harmonic model in the frequency
    domain);
 5. solve: time integration and amplitude extraction (time domain) or one
@@ -34,6 +36,7 @@ from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
 from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
 from workbook.solve.preload import Preload, solve_preload
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
+from workbook.solve.stress_stiffening import stiffen_links
 from workbook.solve.time_domain import extract, integrate, plan_run
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "solve_frequencies", "run_case", "RESONANCE_BAND"]
@@ -116,6 +119,8 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
     try:
         with timed(timings, "static preload"):
             preload = solve_preload(scene)
+        with timed(timings, "stress stiffening"):
+            scene, preload = stiffen_links(case, excitation, scene, preload)
         model = None
         if harmonic:
             with timed(timings, "linearisation"):

@@ -77,6 +77,8 @@ class Preload:
         ``|pylon_force - applied_force| / |applied_force|``.
     solved : bool
         False when the case has no preload (nothing was solved).
+    stiffening : workbook.solve.stress_stiffening.StressStiffening or None
+        What the stress-stiffening stage did (None before it ran).
     """
 
     hinge_forces: dict
@@ -84,6 +86,7 @@ class Preload:
     applied_force: np.ndarray
     relative_mismatch: float
     solved: bool
+    stiffening: object = None
 
 
 def applied_static_force(scene: Scene) -> np.ndarray:
