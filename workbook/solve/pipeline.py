@@ -195,7 +195,9 @@ def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
     return {
         "analysis": "frequency domain: (K - w^2 M + i w D) z = B f per frequency (dense complex solve), "
                     "F_hinge = (C_k + i w C_d) z",
-        "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness included); "
+        "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness of the preload for "
+                         "the rigid-body motion of the engine and the links; the links' elastic modes stiffened by "
+                         "their axial preload only where the stress-stiffening effect is on); "
                          "Euler-parameter constraints projected out (null space by SVD)",
         "independent coordinates": model.dof,
         "input and outputs": f"central differences of Exudyn's engine-point position and the hinge (and "
