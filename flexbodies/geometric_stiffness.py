@@ -47,7 +47,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import skfem
 
-from .assembly import assemble
+from .assembly import _node_major_permutation, assemble
 from .atomic import replacing
 from .cache import default_cache_dir
 from .frequencies import mounted_constraint_basis
@@ -141,18 +141,6 @@ class LinkStiffening:
         return float(loaded / unloaded - 1.0)
 
 
-def _node_major(basis: skfem.CellBasis, mesh) -> np.ndarray:
-    """``p`` with ``p[3*i + c]`` = scikit-fem DOF of component c at finite element node i."""
-    perm = np.empty(basis.N, dtype=np.int64)
-    for kind in ("nodal_dofs", "edge_dofs", "facet_dofs", "interior_dofs"):
-        nodes = getattr(mesh.dofs, kind)
-        if nodes.shape[0]:
-            components = getattr(basis.dofs, kind)
-            for c in range(3):
-                perm[3 * nodes[0] + c] = components[c]
-    return perm
-
-
 def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Material) -> np.ndarray:
     """Cauchy stress of a small displacement field at the initial-stress form's integration points.
 
@@ -170,8 +158,11 @@ def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Materi
     """
     mesh = link_mesh.mesh
     basis = skfem.Basis(mesh, skfem.ElementVector(mesh.elem()), intorder=_INTORDER[type(mesh)])
-    values = np.empty(basis.N)
-    values[_node_major(basis, mesh)] = displacement
+    perm = _node_major_permutation(basis, mesh)
+    values = np.asarray(displacement, dtype=float)
+    if perm is not None:
+        values = np.empty(basis.N)
+        values[perm] = displacement
     grad = basis.interpolate(values).grad
     strain = 0.5 * (grad + np.swapaxes(grad, 0, 1))
     trace = strain[0, 0] + strain[1, 1] + strain[2, 2]
