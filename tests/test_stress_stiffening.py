@@ -7,7 +7,8 @@ import pytest
 import skfem
 from excel_helpers import copy_reference, set_cells
 
-from flexbodies.geometric_stiffness import mesh_stiffening
+from flexbodies import LinkGeometry, LinkModel, reduce_link
+from flexbodies.geometric_stiffness import link_stiffening, mesh_stiffening, stiffened
 from flexbodies.materials import STEEL
 from flexbodies.meshing import Bore, LinkMesh
 from workbook.errors import EXIT_TROUBLE, BucklingError, CaseError, WorkbookError, exit_code
@@ -175,3 +176,23 @@ def test_a_workbook_switches_it(tmp_path):
     set_cells(path, {("Case", "stress stiffening", 3): "sometimes"})
     with pytest.raises(WorkbookError, match="stress stiffening"):
         read_workbook(path)
+
+
+@pytest.mark.slow
+def test_the_geometric_stiffness_is_cached_and_a_damaged_entry_recomputed(tmp_path):
+    model = LinkModel(geometry=LinkGeometry(length=0.20, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020,
+                                            shank_width=0.030, shank_thickness=0.020), element_size=0.012)
+    link = reduce_link(model, 4, cache_dir=tmp_path)
+    first = link_stiffening(model, cache_dir=tmp_path)
+    (entry,) = tmp_path.glob("stiffening-*.npz")
+    assert link_stiffening(model, cache_dir=tmp_path).buckling_load == first.buckling_load
+    entry.write_bytes(b"not an archive")
+    again = link_stiffening(model, cache_dir=tmp_path)
+    assert again.buckling_load == pytest.approx(first.buckling_load, rel=1e-9)
+    # the stiffened body: K_r + P K_G,r, linear in P and symmetric
+    base = np.asarray(link.ffrf["stiffnessMatrixReduced"])
+    pulled = stiffened(link, again, 1e4).ffrf["stiffnessMatrixReduced"]
+    pushed = stiffened(link, again, -1e4).ffrf["stiffnessMatrixReduced"]
+    np.testing.assert_allclose(pulled + pushed, 2 * base, rtol=1e-12, atol=1e-9 * np.abs(base).max())
+    np.testing.assert_allclose(pulled, pulled.T, rtol=0, atol=1e-12 * np.abs(base).max())
+    assert np.abs(pulled - base).max() > 1e-6 * np.abs(base).max()
