@@ -11,9 +11,11 @@ from flexbodies import LinkGeometry, LinkModel, reduce_link
 from flexbodies.geometric_stiffness import link_stiffening, mesh_stiffening, stiffened
 from flexbodies.materials import STEEL
 from flexbodies.meshing import Bore, LinkMesh
+from workbook.cli.main import main
 from workbook.errors import EXIT_TROUBLE, BucklingError, CaseError, WorkbookError, exit_code
 from workbook.excel.reader import read_workbook
 from workbook.model.case import Effects
+from workbook.model.codec import to_json
 from workbook.model.reference import LP_ROTOR
 from workbook.solve.pipeline import prepare, run_case
 from workbook.solve.stress_stiffening import AUTO_SHIFT, TENSION_TOLERANCE
@@ -196,3 +198,12 @@ def test_the_geometric_stiffness_is_cached_and_a_damaged_entry_recomputed(tmp_pa
     np.testing.assert_allclose(pulled + pushed, 2 * base, rtol=1e-12, atol=1e-9 * np.abs(base).max())
     np.testing.assert_allclose(pulled, pulled.T, rtol=0, atol=1e-12 * np.abs(base).max())
     assert np.abs(pulled - base).max() > 1e-6 * np.abs(base).max()
+
+
+@pytest.mark.slow
+def test_the_command_line_exits_1_with_the_buckling_in_words(coarse_reference, tmp_path, capsys):
+    path = tmp_path / "slender.json"
+    path.write_text(to_json(dataclasses.replace(_slender_and_pushed(coarse_reference), excitations=(LP_ROTOR,))))
+    assert main(["run", str(path), "--json", "--no-progress"]) == 1
+    out, err = capsys.readouterr()
+    assert out == "" and "buckles" in err and "times its buckling load" in err and "Traceback" not in err
