@@ -16,8 +16,8 @@ from workbook.solve.preload import solve_preload
 
 #: Every effect the model card accounts for (docs/physics.md, section 4).
 EFFECTS = {"link flexibility", "static preload", "hinge damping", "link damping", "hinge clearance",
-           "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance", "time domain", "frequency domain",
-           "imbalance planes", "simultaneous excitations"}
+           "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance", "link stress stiffening",
+           "time domain", "frequency domain", "imbalance planes", "simultaneous excitations"}
 
 
 @pytest.fixture(scope="module")
@@ -115,4 +115,5 @@ def test_the_model_card_lists_every_effect_with_its_reason(rigid):
     assert entries["hinge clearance"].on and "hinge damping" in entries and not entries["hinge damping"].on
     assert entries["hinge damping"].detail == "switched off"
     assert not entries["link flexibility"].on and "rigid" in entries["link flexibility"].detail
+    assert not entries["link stress stiffening"].on and entries["link stress stiffening"].detail == "no flexible link"
     assert all(e.detail for e in card.effects)

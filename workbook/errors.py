@@ -22,7 +22,8 @@ from typing import Any
 
 __all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
-           "MechanismError", "EquilibriumError", "FourPoleError", "UnstablePreloadError", "UsageError", "BAD_INPUT",
+           "MechanismError", "EquilibriumError", "FourPoleError", "UnstablePreloadError", "BucklingError", "UsageError",
+           "BAD_INPUT",
            "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
            "EXIT_INTERRUPTED", "EXIT_TERMINATED", "EXIT_FAILED_ROWS", "Terminated", "interruption", "exit_code"]
 
@@ -236,6 +237,31 @@ class UnstablePreloadError(SimulationError):
     def __init__(self, message: str, omega_squared: list[float]):
         self.omega_squared = list(omega_squared)
         super().__init__(message)
+
+
+class BucklingError(SimulationError):
+    """A flexible link carries more compression at the preload than its
+    buckling load (the compression at which its first pinned-pinned bending
+    mode vanishes).
+
+    Attributes
+    ----------
+    link : str
+    compression : float
+        Axial compression at the preload, N.
+    buckling_load : float
+        N.
+    """
+
+    def __init__(self, case_name: str, link: str, compression: float, buckling_load: float, unloaded_hz: float):
+        self.link, self.compression, self.buckling_load = link, compression, buckling_load
+        super().__init__(
+            f"case {case_name!r}: link {link!r} buckles: the preload pushes it with {compression / 1e3:.4g} kN of "
+            f"compression, {compression / buckling_load:.3g} times its buckling load of {buckling_load / 1e3:.4g} kN "
+            f"(the compression at which its first bending mode between the two pinned eyes, {unloaded_hz:.4g} Hz "
+            f"unloaded, falls to zero). No equilibrium exists with the link straight. Reduce or redirect the "
+            f"static loads, or make the link stiffer in bending (a larger shank section, a stiffer material or a "
+            f"shorter link).")
 
 
 class UsageError(ValueError):

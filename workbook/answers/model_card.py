@@ -191,6 +191,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         _spin_restraints(scene),
         _gyroscopics(scene),
         _rig_sensors(scene),
+        _stress_stiffening(preload),
         *_imbalance_planes(scene),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
@@ -274,6 +275,14 @@ def _rig_sensors(scene) -> EffectEntry:
     damping = "" if not any(rig.damping) else f", d = ({', '.join(f'{d:.3g}' for d in rig.damping)}) N s/m"
     return EffectEntry(name, True, f"{len(scene.transducers)} transducers, k = ({stiffness}) N/m in x, y, z"
                        f"{damping}, m = {rig.mass:g} kg on pins {pins}; their forces make the pylon force")
+
+
+def _stress_stiffening(preload) -> EffectEntry:
+    """The links' stress stiffening by their axial preload: where, why, per-link shift."""
+    record = preload.stiffening
+    if record is None:
+        return EffectEntry("link stress stiffening", False, "not assessed (the preload was solved alone)")
+    return EffectEntry("link stress stiffening", record.applied, record.describe())
 
 
 def _solver(scene, plan) -> dict[str, Any]:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS
+from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -188,6 +188,9 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
            help="no: the rotors' gyroscopic moments are not built (their inertia stays lumped in the engine)"),
     Column("rig_sensors", "rig sensors", "yesno",
            help="no: the pylon pins sit on rigid ground even when the Test rig sheet gives transducers"),
+    Column("stress_stiffening", "stress stiffening", "choice", choices=STRESS_STIFFENING,
+           help="the flexible links' geometric stiffness of their axial preload, with a buckling check: on; off; "
+                "auto: on for a link whose preload moves its first pinned-pinned mode by more than 0.5 %"),
 ))
 
 ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(

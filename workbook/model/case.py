@@ -39,6 +39,8 @@ ENGINE = "engine"
 DIRECTIONS = ("x", "y", "z")
 #: Analysis methods a case may ask for (AnalysisSettings.method).
 ANALYSIS_METHODS = ("time", "frequency", "auto")
+#: Settings of ``Effects.stress_stiffening``.
+STRESS_STIFFENING = ("auto", "on", "off")
 _RESERVED = (PYLON, ENGINE)
 # Two points closer than this (m) are the same point (a hinge on a link eye).
 POINT_TOLERANCE = 1e-6
@@ -1011,6 +1013,13 @@ class Effects:
         Build the rotors' gyroscopic moments when the case gives rotors
         (``Case.rotors``); False leaves the rotors as inertia lumped in the
         engine.
+    stress_stiffening : {"auto", "on", "off"}
+        The geometric stiffness of each flexible link's axial preload
+        (:mod:`workbook.solve.stress_stiffening`): "on" for every flexible
+        link, "auto" for the links whose preload moves their first
+        pinned-pinned mode by more than
+        :data:`~workbook.solve.stress_stiffening.AUTO_SHIFT`, "off" for none
+        (and no buckling check of the links).
     """
 
     flexible_links: bool = True
@@ -1020,10 +1029,15 @@ class Effects:
     clearance: bool = True
     rig_sensors: bool = True
     gyroscopics: bool = True
+    stress_stiffening: str = "auto"
 
     def __post_init__(self):
         for item in dataclasses.fields(self):
-            if not isinstance(getattr(self, item.name), bool):
+            if item.name == "stress_stiffening":
+                if self.stress_stiffening not in STRESS_STIFFENING:
+                    raise CaseError("effects", item.name, self.stress_stiffening,
+                                    " or ".join(repr(s) for s in STRESS_STIFFENING))
+            elif not isinstance(getattr(self, item.name), bool):
                 raise CaseError("effects", item.name, getattr(self, item.name), "True or False")
 
 

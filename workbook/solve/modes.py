@@ -1,7 +1,11 @@
 """Linearised modes of a scene: free motions (mechanisms) and mounted modes.
 
 Exudyn linearises the system at its initial state (``ComputeLinearizedSystem``:
-M, K, D, geometric stiffness included). Euler-parameter nodes of the links add
+M, K, D). K holds the geometric stiffness of the preload for the bodies'
+rigid-body motion (the hinge forces turning with a link or the engine); a
+flexible link's modal coordinates have the stiffness of its reduced body,
+which holds its own stress stiffening only when that effect built it in
+(:mod:`workbook.solve.stress_stiffening`). Euler-parameter nodes of the links add
 one algebraic constraint each; the matrices are projected onto the null
 space of the constraint Jacobian. Then
 

@@ -4,7 +4,9 @@ Every excitation goes through the same stages, each timed:
 
 1. reduce links (for the excitation's frequency, or a sweep's highest);
 2. build the scene;
-3. static preload;
+3. static preload, then stress stiffening of the flexible links by their
+   axial preload (:mod:`~workbook.solve.stress_stiffening`: the scene is
+   rebuilt and preloaded again when a link is stiffened);
 4. linearisation and mounted modes (the harmonic model in the frequency
    domain);
 5. solve: time integration and amplitude extraction (time domain) or one
@@ -35,6 +37,7 @@ from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
 from workbook.solve.preload import Preload, solve_preload
 from workbook.solve.simultaneous import extract_simultaneous, plan_simultaneous
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
+from workbook.solve.stress_stiffening import stiffen_links
 from workbook.solve.time_domain import extract, integrate, plan_run
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
@@ -118,6 +121,8 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
     try:
         with timed(timings, "static preload"):
             preload = solve_preload(scene)
+        with timed(timings, "stress stiffening"):
+            scene, preload = stiffen_links(case, excitation, scene, preload)
         model = None
         if harmonic:
             with timed(timings, "linearisation"):
@@ -206,7 +211,9 @@ def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
     return {
         "analysis": "frequency domain: (K - w^2 M + i w D) z = B f per frequency (dense complex solve), "
                     "F_hinge = (C_k + i w C_d) z",
-        "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness included); "
+        "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness of the preload for "
+                         "the rigid-body motion of the engine and the links; the links' elastic modes stiffened by "
+                         "their axial preload only where the stress-stiffening effect is on); "
                          "Euler-parameter constraints projected out (null space by SVD)",
         "independent coordinates": model.dof,
         "input and outputs": f"central differences of Exudyn's engine-point position and the hinge (and "

@@ -14,8 +14,11 @@
    was not (a stiffness beyond double precision), with Exudyn's own output
    as its ``detail``.
 3. The scene is linearised again about the preloaded equilibrium, where the
-   loads add geometric stiffness (a compressed link pushes sideways as it
-   turns). A negative stiffness there stops the run with
+   loads add geometric stiffness to the rigid-body motion of the engine and
+   the links (a compressed link pushes sideways as it turns); the bending of
+   a compressed flexible link is checked against its buckling load by the
+   stress-stiffening stage that follows
+   (:mod:`workbook.solve.stress_stiffening`). A negative stiffness there stops the run with
    :class:`UnstablePreloadError` (the preload buckles a link or tips the
    mount) naming the motion, the loads and the compressed links; a free
    motion there is a :class:`MechanismError` as in 1.
@@ -77,6 +80,8 @@ class Preload:
         ``|pylon_force - applied_force| / |applied_force|``.
     solved : bool
         False when the case has no preload (nothing was solved).
+    stiffening : workbook.solve.stress_stiffening.StressStiffening or None
+        What the stress-stiffening stage did (None before it ran).
     """
 
     hinge_forces: dict
@@ -84,6 +89,7 @@ class Preload:
     applied_force: np.ndarray
     relative_mismatch: float
     solved: bool
+    stiffening: object = None
 
 
 def applied_static_force(scene: Scene) -> np.ndarray:
@@ -209,7 +215,9 @@ def _load_listing(scene: Scene) -> str:
 
 def check_preloaded_stability(scene: Scene, forces: dict) -> list[Mode]:
     """Linearise the scene about its preloaded state (geometric stiffness of
-    the loads included) and stop if it is unstable or free there.
+    the loads for the bodies' rigid-body motion included; not that of a
+    flexible link's own bending, see :mod:`workbook.solve.stress_stiffening`)
+    and stop if it is unstable or free there.
 
     Parameters
     ----------

@@ -1,0 +1,340 @@
+"""Geometric (initial-stress) stiffness of a link under an axial load.
+
+A link that carries an axial force ``P`` between its eyes is stiffer in
+bending when pulled and softer when pushed. The linear FE model and its
+Craig-Bampton reduction do not know that: their stiffness is that of the
+unloaded link. This module adds it.
+
+1. The static stress field of a unit tension: eye A's master node held
+   (six DOF), a force of 1 N on eye B's master node along the line from
+   eye A to eye B. The Craig-Bampton statics are exact, so the condensed
+   boundary stiffness and the static modes of the link's interior
+   factorisation give the full displacement field; the stress at each
+   integration point is ``sigma = lambda tr(eps) I + 2 mu eps``.
+2. The initial-stress bilinear form ``int sigma_ij dN_a/dx_i dN_b/dx_j dV``
+   assembled with scikit-fem on the scalar element; it acts alike on each
+   displacement component, so the FE geometric stiffness is
+   ``K_G = G (x) I3`` (node-major), the same in every rotated frame.
+3. Projected on a link's elastic mode basis it gives the reduced geometric
+   stiffness per newton of tension, ``K_G,r``; the stiffened modal
+   stiffness under a tension ``P`` (N, negative in compression) is
+   ``K_r + P K_G,r`` (the stress is linear in ``P``).
+4. The same projection on a pinned-pinned Craig-Bampton model (both masters
+   pinned, the spin about the link axis held, static modes plus the lowest
+   fixed-interface modes) gives the link's first mounted frequency under
+   ``P`` and its buckling load, the compression at which that frequency
+   reaches zero.
+
+The floating frame of the multibody body already carries the stiffness of
+the loads turning with the rigid link; ``K_G,r`` adds the part of the
+elastic coordinates, which the linear modal stiffness lacks.
+
+The FE part (``G``, the pinned-pinned model and its buckling load) is kept
+on disk next to the reduced links, keyed by the link model's hash
+(:meth:`flexbodies.link.LinkModel.key`); projecting ``G`` on a reduced
+link's modes costs a few sparse products.
+"""
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import skfem
+
+from .assembly import _node_major_permutation, assemble
+from .atomic import replacing
+from .cache import default_cache_dir
+from .frequencies import mounted_constraint_basis
+from .interior import InteriorSolver
+from .materials import Material
+from .meshing import LinkMesh, load_mesh, mesh_link
+from .reduced import ReducedLink
+from .reduction import couple
+
+__all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement",
+           "mesh_stiffening", "link_stiffening", "stiffened", "PINNED_FIXED_MODES"]
+
+#: Fixed-interface modes in the pinned-pinned model that gives the first
+#: mounted frequency and the buckling load (the link's own reduction may keep
+#: fewer): enough for the first two bending modes in both planes.
+PINNED_FIXED_MODES = 12
+
+#: Integration order of the initial-stress form per mesh type: exact for
+#: straight-sided elements (stress of degree p - 1 times two shape-function
+#: gradients of degree p - 1).
+_INTORDER = {skfem.MeshTet2: 3, skfem.MeshTet1: 1, skfem.MeshHex2: 4, skfem.MeshHex1: 2}
+
+_FORMAT = "mountwb-link-stiffening-1"
+
+
+@dataclass(frozen=True)
+class LinkStiffening:
+    """A link's geometric stiffness per newton of axial tension.
+
+    Attributes
+    ----------
+    scalar : scipy.sparse.csr_matrix, shape (n, n)
+        ``G`` of the unit tension's stress field on the scalar element (FE
+        nodes); the FE geometric stiffness is ``G (x) I3`` node-major,
+        (N/m) per N of tension.
+    pinned_stiffness, pinned_mass, pinned_geometric : ndarray, shape (k, k)
+        The pinned-pinned Craig-Bampton model (both masters pinned, spin
+        held): stiffness (N/m), mass (kg) and geometric stiffness per N of
+        tension.
+    buckling_load : float
+        Compression at which the first pinned-pinned mode reaches zero, N
+        (``inf`` when no compression buckles the model).
+    """
+
+    scalar: sp.csr_matrix
+    pinned_stiffness: np.ndarray
+    pinned_mass: np.ndarray
+    pinned_geometric: np.ndarray
+    buckling_load: float
+
+    def project(self, basis: np.ndarray) -> np.ndarray:
+        """``V^T (G (x) I3) V`` of node-major displacement vectors (rows beyond the FE nodes ignored).
+
+        Parameters
+        ----------
+        basis : ndarray, shape (>= 3 n, k)
+            E.g. a reduced link's ``mode_basis`` (FE nodes first, any rotation).
+
+        Returns
+        -------
+        ndarray, shape (k, k)
+            (N/m) per N of tension.
+        """
+        n = self.scalar.shape[0]
+        nodal = np.asarray(basis)[: 3 * n].reshape(n, 3, -1)
+        product = np.einsum("ick,icl->kl", nodal, (self.scalar @ nodal.reshape(n, -1)).reshape(n, 3, -1))
+        return 0.5 * (product + product.T)
+
+    def pinned_hz(self, tension: float, count: int = 2) -> np.ndarray:
+        """Lowest pinned-pinned frequencies under an axial tension, Hz.
+
+        Parameters
+        ----------
+        tension : float
+            Axial force, N (negative: compression).
+        count : int
+
+        Returns
+        -------
+        ndarray, shape (count,)
+            Frequencies, Hz; a mode past its buckling load has a negative
+            squared frequency, returned as a negative number.
+        """
+        lam = sla.eigh(self.pinned_stiffness + tension * self.pinned_geometric, self.pinned_mass,
+                       eigvals_only=True, subset_by_index=[0, count - 1])
+        return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+
+    def first_mode_shift(self, tension: float) -> float:
+        """Relative change of the first pinned-pinned frequency under *tension* (N); -1 at buckling."""
+        loaded, unloaded = self.pinned_hz(tension, 1)[0], self.pinned_hz(0.0, 1)[0]
+        return float(loaded / unloaded - 1.0)
+
+
+def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Material) -> np.ndarray:
+    """Cauchy stress of a small displacement field at the initial-stress form's integration points.
+
+    Parameters
+    ----------
+    link_mesh : LinkMesh
+    displacement : ndarray, shape (3 n,)
+        Node-major nodal displacements, m.
+    material : Material
+
+    Returns
+    -------
+    ndarray, shape (3, 3, n_elements, n_points)
+        Stress, Pa.
+    """
+    mesh = link_mesh.mesh
+    basis = skfem.Basis(mesh, skfem.ElementVector(mesh.elem()), intorder=_INTORDER[type(mesh)])
+    perm = _node_major_permutation(basis, mesh)
+    values = np.asarray(displacement, dtype=float)
+    if perm is not None:
+        values = np.empty(basis.N)
+        values[perm] = displacement
+    grad = basis.interpolate(values).grad
+    strain = 0.5 * (grad + np.swapaxes(grad, 0, 1))
+    trace = strain[0, 0] + strain[1, 1] + strain[2, 2]
+    return 2 * material.shear_modulus * strain + material.lame_lambda * trace * np.eye(3)[:, :, None, None]
+
+
+@skfem.BilinearForm
+def _initial_stress(u, v, w):
+    return np.einsum("ij...,i...,j...->...", w["sigma"], u.grad, v.grad)
+
+
+def geometric_stiffness(link_mesh: LinkMesh, stress: np.ndarray) -> sp.csr_matrix:
+    """Initial-stress form of a stress field on the scalar element, ``int sigma_ij dN_a/dx_i dN_b/dx_j dV``.
+
+    The FE geometric stiffness is this matrix ``G`` times the 3 x 3 identity
+    (node-major ``G (x) I3``), the same in every rotated frame.
+
+    Parameters
+    ----------
+    link_mesh : LinkMesh
+    stress : ndarray, shape (3, 3, n_elements, n_points)
+        From :func:`stress_field`, Pa.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n, n)
+        N/m, symmetric; rows follow the finite element nodes.
+    """
+    mesh = link_mesh.mesh
+    scalar = skfem.Basis(mesh, mesh.elem(), intorder=_INTORDER[type(mesh)])
+    matrix = skfem.asm(_initial_stress, scalar, sigma=stress)
+    return sp.csr_matrix(0.5 * (matrix + matrix.T))
+
+
+def unit_tension_displacement(solver: InteriorSolver) -> np.ndarray:
+    """Coupled-coordinate displacement of a unit tension: eye A held, 1 N on eye B away from A.
+
+    Parameters
+    ----------
+    solver : InteriorSolver
+        The link's interior factorisation (two interfaces, A first).
+
+    Returns
+    -------
+    ndarray, shape (n_q,)
+        m per N.
+    """
+    coupling = solver.coupling
+    axis = coupling.centres[1] - coupling.centres[0]
+    force = np.zeros(6)
+    force[:3] = axis / np.linalg.norm(axis)
+    loaded = solver.condensed[6:12, 6:12]
+    master_b = np.linalg.solve(loaded, force)
+    return solver.static_modes()[:, 6:12] @ master_b
+
+
+def _buckling_load(stiffness: np.ndarray, geometric: np.ndarray) -> float:
+    """Smallest compression ``P`` with ``(K - P G) x = 0``, N (inf when none)."""
+    # G x = kappa K x: the largest positive kappa is 1 / P_cr
+    kappa = sla.eigh(geometric, stiffness, eigvals_only=True)
+    return float(1.0 / kappa.max()) if kappa.max() > 0 else float("inf")
+
+
+def mesh_stiffening(link_mesh: LinkMesh, material: Material, interface: str = "RBE2",
+                    fixed_modes: int = PINNED_FIXED_MODES) -> LinkStiffening:
+    """The geometric stiffness of a meshed link per newton of tension.
+
+    Parameters
+    ----------
+    link_mesh : LinkMesh
+        Two bores, A first.
+    material : Material
+    interface : {"RBE2", "RBE3"}
+    fixed_modes : int
+        Fixed-interface modes of the pinned-pinned model.
+
+    Returns
+    -------
+    LinkStiffening
+    """
+    coupled = couple(assemble(link_mesh, material), interface)
+    solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+    transform = coupled.coupling.transform
+    displacement = transform @ unit_tension_displacement(solver)
+    scalar = geometric_stiffness(link_mesh, stress_field(link_mesh, displacement, material))
+    _, fixed = solver.fixed_interface_modes(fixed_modes)
+    basis = np.hstack([solver.static_modes() @ mounted_constraint_basis(coupled.coupling), fixed])
+
+    def project(matrix):
+        product = basis.T @ (matrix @ basis)
+        return 0.5 * (product + product.T)
+
+    stiffening = LinkStiffening(scalar, project(coupled.stiffness), project(coupled.mass), np.zeros(0), 0.0)
+    g_pinned = stiffening.project((transform @ basis))
+    return dataclasses.replace(stiffening, pinned_geometric=g_pinned,
+                               buckling_load=_buckling_load(stiffening.pinned_stiffness, g_pinned))
+
+
+def _path(model, cache_dir) -> Path:
+    key = hashlib.sha256(json.dumps([_FORMAT, model.key(), PINNED_FIXED_MODES]).encode()).hexdigest()[:24]
+    return Path(cache_dir if cache_dir is not None else default_cache_dir()) / f"stiffening-{key}.npz"
+
+
+def _load(path: Path) -> LinkStiffening | None:
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            scalar = sp.csr_matrix((data["data"], data["indices"], data["indptr"]), shape=tuple(data["shape"]))
+            return LinkStiffening(scalar, data["pinned_stiffness"], data["pinned_mass"],
+                                  data["pinned_geometric"], float(data["buckling_load"]))
+    except (OSError, ValueError, KeyError, EOFError):
+        return None
+
+
+def link_stiffening(model, *, cache_dir=None, use_cache: bool = True) -> LinkStiffening:
+    """The geometric stiffness of a link model per newton of tension, cached on disk.
+
+    Parameters
+    ----------
+    model : flexbodies.LinkModel
+        Meshed and assembled as for its reduction (same mesh, same node
+        order), so :meth:`LinkStiffening.project` applies to its reduced
+        links' mode bases.
+    cache_dir : str or Path, optional
+        Default :func:`flexbodies.cache.default_cache_dir`.
+    use_cache : bool
+        False recomputes and does not write.
+
+    Returns
+    -------
+    LinkStiffening
+    """
+    path = _path(model, cache_dir)
+    if use_cache:
+        stored = _load(path)
+        if stored is not None:
+            return stored
+    if model.geometry is not None:
+        link_mesh = mesh_link(model.geometry, model.element_size)
+    else:
+        link_mesh = load_mesh(model.mesh.path, model.mesh.bores, scale=model.mesh.scale)
+    stiffening = mesh_stiffening(link_mesh, model.material, model.interface)
+    if use_cache:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        scalar = stiffening.scalar
+        with replacing(path) as temporary, open(temporary, "wb") as handle:
+            np.savez(handle, data=scalar.data, indices=scalar.indices, indptr=scalar.indptr,
+                     shape=np.array(scalar.shape), pinned_stiffness=stiffening.pinned_stiffness,
+                     pinned_mass=stiffening.pinned_mass, pinned_geometric=stiffening.pinned_geometric,
+                     buckling_load=np.float64(stiffening.buckling_load))
+    return stiffening
+
+
+def stiffened(link: ReducedLink, stiffening: LinkStiffening, tension: float) -> ReducedLink:
+    """The reduced link with its modal stiffness under an axial tension: ``K_r + P K_G,r``.
+
+    Parameters
+    ----------
+    link : ReducedLink
+    stiffening : LinkStiffening
+        Of the link's model (:func:`link_stiffening`).
+    tension : float
+        Axial force, N (negative: compression).
+
+    Returns
+    -------
+    ReducedLink
+        A copy; ``info["axial_tension_N"]`` records the tension.
+    """
+    if int(link.master_nodes[0]) != stiffening.scalar.shape[0]:
+        raise ValueError(f"the link's reduction has {int(link.master_nodes[0])} FE nodes but its geometric "
+                         f"stiffness {stiffening.scalar.shape[0]}: they were meshed differently")
+    ffrf = dict(link.ffrf)
+    ffrf["stiffnessMatrixReduced"] = (np.asarray(link.ffrf["stiffnessMatrixReduced"])
+                                      + tension * stiffening.project(link.mode_basis))
+    return dataclasses.replace(link, ffrf=ffrf, info={**link.info, "axial_tension_N": float(tension)})
