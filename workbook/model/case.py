@@ -203,6 +203,9 @@ class Link:
         Rayleigh stiffness-proportional damping of the link, s.
     mass_damping : float
         Rayleigh mass-proportional damping of the link, 1/s.
+    loss_factor : float
+        Material loss factor eta of the link (complex modulus: the link's
+        elastic stiffness acts as K (1 + i eta)), dimensionless, >= 0.
     spin_frequency_hz : float or None
         Frequency of the torsional restraint of the free spin about the link
         axis (None: the flexbodies default).
@@ -220,6 +223,7 @@ class Link:
     mass_damping: float = 0.0
     spin_frequency_hz: float | None = None
     bore_axis: Vector3 | None = None
+    loss_factor: float = 0.0
 
     def __post_init__(self):
         item = f"link {self.name!r}"
@@ -241,6 +245,7 @@ class Link:
         _set(self, "stiffness_damping",
              _number(self.stiffness_damping, item, "stiffness_damping", minimum=0.0))
         _set(self, "mass_damping", _number(self.mass_damping, item, "mass_damping", minimum=0.0))
+        _set(self, "loss_factor", _number(self.loss_factor, item, "loss_factor", minimum=0.0))
         if self.spin_frequency_hz is not None:
             _set(self, "spin_frequency_hz", _number(self.spin_frequency_hz, item,
                                                     "spin_frequency_hz", minimum=0.0, strictly=True))
@@ -275,11 +280,16 @@ class Hinge:
     stiffness : float
         Translational stiffness in every direction, N/m.
     damping : float
-        Translational damping in every direction, N s/m.
+        Translational (viscous) damping in every direction, N s/m.
     radial_clearance : float
         Gap of the spherical bearing, m (0: no clearance law is built).
     contact_stiffness : float or None
         Stiffness once the gap is closed, N/m (None: *stiffness*).
+    loss_factor : float
+        Structural (hysteretic) loss factor eta, dimensionless, >= 0: the
+        hinge's stiffness acts as k (1 + i eta), a damping force in phase
+        with the velocity whose size does not grow with the frequency
+        (docs/physics.md, hinge damping).
     """
 
     name: str
@@ -290,6 +300,7 @@ class Hinge:
     damping: float = 0.0
     radial_clearance: float = 0.0
     contact_stiffness: float | None = None
+    loss_factor: float = 0.0
 
     def __post_init__(self):
         item = f"hinge {self.name!r}"
@@ -307,6 +318,7 @@ class Hinge:
         if self.contact_stiffness is not None:
             _set(self, "contact_stiffness", _number(self.contact_stiffness, item,
                                                     "contact_stiffness", minimum=0.0, strictly=True))
+        _set(self, "loss_factor", _number(self.loss_factor, item, "loss_factor", minimum=0.0))
 
     @property
     def bodies(self) -> tuple[str, str]:

@@ -42,10 +42,11 @@ import numpy as np
 from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, SingleFrequencyExcitation
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
+from workbook.scene.structural_damping import equivalent_viscous_damping
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "exudyn_name", "ignored_contact_stiffness", "marker_bodies", "net_angular_momentum",
+           "exudyn_name", "ignored_contact_stiffness", "loss_factors", "marker_bodies", "net_angular_momentum",
            "scene_warnings", "TRANSDUCER_PREFIX", "CANCELLED_MOMENTUM"]
 
 log = logging.getLogger(__name__)
@@ -212,6 +213,11 @@ class Scene:
     gyroscopics : GyroscopicItems or None
         The rotors' gyroscopic moment (None: not built, see
         :func:`gyroscopics_built`).
+    loss_factor_hz : float or None
+        The frequency at which the loss factors of the hinges and links were
+        built as their equivalent viscous damping (the time domain), Hz;
+        None when they were not (no loss factor, no excitation, or the
+        frequency domain adds them exactly, see :func:`loss_factors`).
     """
 
     case: Case
@@ -227,6 +233,7 @@ class Scene:
     load_scale: float
     transducers: dict = field(default_factory=dict)
     gyroscopics: GyroscopicItems | None = None
+    loss_factor_hz: float | None = None
 
     def close(self) -> None:
         """Free Exudyn's system: reset the system container, whose memory
@@ -348,6 +355,17 @@ def scene_warnings(case: Case) -> list[str]:
     return warnings
 
 
+def loss_factors(case: Case) -> tuple[dict[str, float], dict[str, float]]:
+    """The loss factors the scene of *case* carries: those of the hinges
+    (with hinge damping switched on) and of the flexible links (with link
+    damping switched on), each by name, only where > 0."""
+    effects = case.effects
+    hinges = {h.name: h.loss_factor for h in case.hinges if effects.hinge_damping and h.loss_factor > 0}
+    links = {link.name: link.loss_factor for link in case.links
+             if effects.link_damping and case.link_is_flexible(link.name) and link.loss_factor > 0}
+    return hinges, links
+
+
 def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | None) -> float:
     """Highest excitation frequency a reduction must serve, Hz."""
     if excitation is not None:
@@ -405,7 +423,7 @@ def _load_scale(case: Case, excitation: SingleFrequencyExcitation | None, link_m
 
 
 def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None, *,
-                reduced: dict | None = None) -> Scene:
+                reduced: dict | None = None, exact_loss_factors: bool = False) -> Scene:
     """Build the Exudyn system of *case*.
 
     Parameters
@@ -416,6 +434,12 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         the static scene only.
     reduced : dict of str to flexbodies.ReducedLink, optional
         Reduced links from :func:`reduce_links` (computed when omitted).
+    exact_loss_factors : bool
+        False (for a time integration): the loss factors of hinges and links
+        become their equivalent viscous damping at the excitation's
+        frequency (:mod:`workbook.scene.structural_damping`; nothing without
+        an excitation). True: they are left out of the scene, for the
+        frequency domain to add them exactly as complex stiffness.
 
     Returns
     -------
@@ -436,6 +460,13 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
 
     ground = mbs.AddObject(eii.ObjectGround(visualization=eii.VObjectGround(show=False)))
     engine = _add_engine(mbs, case)
+    hinge_loss, link_loss = loss_factors(case)
+    loss_hz = None if exact_loss_factors or excitation is None or not (hinge_loss or link_loss) \
+        else excitation.frequency
+
+    def viscous(loss_factor: float, stiffness: float) -> float:
+        """The equivalent viscous damping built for a loss factor (0 when none is built)."""
+        return 0.0 if loss_hz is None else equivalent_viscous_damping(loss_factor, stiffness, loss_hz)
 
     links = {}
     for link in case.links:
@@ -444,7 +475,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         links[link.name] = add_link_to_exudyn(
             mbs, reduced[link.name], link.end_a, link.end_b,
             flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
-            stiffness_damping=link.stiffness_damping if damping else 0.0,
+            stiffness_damping=(link.stiffness_damping if damping else 0.0) + viscous(link_loss.get(link.name, 0.0), 1.0),
             mass_damping=link.mass_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
 
     transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
@@ -466,9 +497,10 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     for hinge in case.hinges:
         first, second = marker_bodies(hinge)
         markers = (marker(first, hinge.position), marker(second, hinge.position))
-        damping = hinge.damping if case.effects.hinge_damping else 0.0
         clearance = case.effects.clearance and hinge.radial_clearance > 0
         stiffness = hinge.gap_contact_stiffness if clearance else hinge.stiffness
+        damping = (hinge.damping if case.effects.hinge_damping else 0.0) \
+            + viscous(hinge_loss.get(hinge.name, 0.0), stiffness)
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
             name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
             visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
@@ -501,7 +533,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     link_mass = sum(link.mass for link in links.values())
     scene = Scene(case, system, mbs, ground, engine, links, reduced, hinges, static_loads, excitation_items,
                   _load_scale(case, excitation, link_mass), transducers=transducers,
-                  gyroscopics=gyroscopics)
+                  gyroscopics=gyroscopics, loss_factor_hz=loss_hz)
     log.info("scene of %r: %d bodies, %d hinges, %d transducers, %d ODE2 coordinates", case.name,
              1 + len(links), len(hinges), len(transducers), mbs.systemData.ODE2Size())
     return scene
