@@ -168,7 +168,8 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
     damped_links = [link.name for link in case.links
                     if link.name in flexible and (link.stiffness_damping > 0 or link.mass_damping > 0)]
     gaps = [h for h in case.hinges if h.radial_clearance > 0]
-    hinge_damping = [h for h in case.hinges if h.damping > 0]
+    hinge_damping = [h for h in case.hinges if h.values("damping").max() > 0]
+    anisotropic = [h.name for h in case.hinges if not h.isotropic]
     hinge_loss, link_loss = loss_factors(case)
     loads = ", ".join(load.name for load in case.static_loads)
     entries = [
@@ -182,6 +183,10 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                     f"{len(hinge_damping)} hinges with viscous damping" if effects.hinge_damping and hinge_damping
                     else ("switched off" if not effects.hinge_damping else "no hinge has viscous damping")),
         _loss_factor_entry(scene, "hinge loss factor", hinge_loss, effects.hinge_damping, "hinge", "k"),
+        EffectEntry("hinge properties per direction", bool(anisotropic),
+                    f"stiffness, damping or loss factor per direction of the hinge frame (radial 1, radial 2, "
+                    f"axial) on {', '.join(anisotropic)}: R^T diag(k) R in global axes (symbolic spring law)"
+                    if anisotropic else "every hinge isotropic (one value in every direction)"),
         EffectEntry("link damping", effects.link_damping and bool(damped_links),
                     f"Rayleigh damping on {', '.join(damped_links)}" if effects.link_damping and damped_links else
                     ("switched off" if not effects.link_damping else "no flexible link has Rayleigh damping")),
@@ -210,7 +215,11 @@ def _loss_factor_entry(scene, name: str, lossy: dict, switched_on: bool, kind: s
     stiffness, or its viscous equivalent at one frequency), or why not."""
     if not lossy:
         return EffectEntry(name, False, f"no {kind} has a loss factor" if switched_on else "switched off")
-    listing = ", ".join(f"{item} eta = {eta:g}" for item, eta in lossy.items())
+    groups: dict[str, list[str]] = {}
+    for item, eta in lossy.items():
+        value = f"{eta:g}" if isinstance(eta, float) else f"({', '.join(f'{e:g}' for e in eta)}) per direction"
+        groups.setdefault(value, []).append(item)
+    listing = "; ".join(f"eta = {value} on {', '.join(items)}" for value, items in groups.items())
     if scene.loss_factor_hz is None:
         how = f"complex stiffness {stiffness} (1 + i eta), exact at every frequency"
     else:

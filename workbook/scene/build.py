@@ -40,6 +40,7 @@ from typing import Any, Callable
 import numpy as np
 
 from workbook.model.case import ENGINE, POINT_TOLERANCE, PYLON, Case, Gravity, Hinge, PointForce, PointMoment, SingleFrequencyExcitation
+from workbook.scene.bearing import exudyn_bearing_function, hinge_matrix
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 from workbook.scene.structural_damping import equivalent_viscous_damping
@@ -90,7 +91,9 @@ class HingeItems:
     clearance : bool
         The clearance law is built (gap > 0 and clearance switched on).
     law : exudyn.symbolic.UserFunction or None
-        The recorded clearance law (``springForceUserFunction``), if built.
+        The recorded ``springForceUserFunction``, if built: the clearance
+        law, or the per-direction law of an anisotropic hinge
+        (:mod:`workbook.scene.bearing`).
     """
 
     connector: int
@@ -297,7 +300,7 @@ class Scene:
         stiffness, as if each gap were closed (for the mechanism check: the
         gaps of an unloaded mount are open, and inside them only the small
         residual stiffness of :mod:`workbook.scene.hinge_law` acts)."""
-        laws = {items.connector: items.law for items in self.hinges.values() if items.law is not None}
+        laws = {items.connector: items.law for items in self.hinges.values() if items.clearance}
         for connector in laws:
             self.mbs.SetObjectParameter(connector, "springForceUserFunction", 0)
         try:
@@ -338,7 +341,7 @@ def ignored_contact_stiffness(case: Case) -> list[Hinge]:
     """Hinges that give a contact stiffness (other than their stiffness) but
     no gap: no clearance law is built, so the contact stiffness never acts."""
     return [h for h in case.hinges if h.contact_stiffness is not None and h.radial_clearance == 0
-            and h.contact_stiffness != h.stiffness]
+            and np.any(h.values("stiffness") != h.contact_stiffness)]
 
 
 def scene_warnings(case: Case) -> list[str]:
@@ -346,7 +349,8 @@ def scene_warnings(case: Case) -> list[str]:
     contact stiffness on a hinge without a gap, and rotors whose spin
     angular momenta cancel (no gyroscopic moment)."""
     warnings = [f"hinge {h.name!r}: contact_stiffness {h.contact_stiffness:g} N/m is ignored: the hinge has no gap "
-                f"(radial_clearance 0), so its stiffness {h.stiffness:g} N/m acts"
+                f"(radial_clearance 0), so its stiffness "
+                f"{' / '.join(f'{k:g}' for k in h.values('stiffness'))} N/m acts"
                 for h in ignored_contact_stiffness(case)]
     if case.rotors and case.effects.gyroscopics and not gyroscopics_built(case):
         warnings.append(f"rotors {', '.join(repr(r.name) for r in case.rotors)}: their spin angular momenta cancel "
@@ -355,12 +359,13 @@ def scene_warnings(case: Case) -> list[str]:
     return warnings
 
 
-def loss_factors(case: Case) -> tuple[dict[str, float], dict[str, float]]:
+def loss_factors(case: Case) -> tuple[dict[str, Any], dict[str, float]]:
     """The loss factors the scene of *case* carries: those of the hinges
-    (with hinge damping switched on) and of the flexible links (with link
-    damping switched on), each by name, only where > 0."""
+    (with hinge damping switched on; one value or three, per direction) and
+    of the flexible links (with link damping switched on), each by name,
+    only where > 0."""
     effects = case.effects
-    hinges = {h.name: h.loss_factor for h in case.hinges if effects.hinge_damping and h.loss_factor > 0}
+    hinges = {h.name: h.loss_factor for h in case.hinges if effects.hinge_damping and h.values("loss_factor").max() > 0}
     links = {link.name: link.loss_factor for link in case.links
              if effects.link_damping and case.link_is_flexible(link.name) and link.loss_factor > 0}
     return hinges, links
@@ -498,18 +503,26 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         first, second = marker_bodies(hinge)
         markers = (marker(first, hinge.position), marker(second, hinge.position))
         clearance = case.effects.clearance and hinge.radial_clearance > 0
-        stiffness = hinge.gap_contact_stiffness if clearance else hinge.stiffness
-        damping = (hinge.damping if case.effects.hinge_damping else 0.0) \
-            + viscous(hinge_loss.get(hinge.name, 0.0), stiffness)
+        stiffness = hinge.values("stiffness")
+        if clearance:
+            stiffness[:] = hinge.gap_contact_stiffness
+        damping = (hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)) \
+            + [viscous(eta, k) for eta, k in zip(hinge.values("loss_factor") if hinge.name in hinge_loss
+                                                 else np.zeros(3), stiffness)]
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
-            visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
+            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
+            damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         law = None
         if clearance:
             gap = hinge.radial_clearance
             if gap not in clearance_functions:
                 clearance_functions[gap] = exudyn_clearance_function(gap)
             law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
+            mbs.SetObjectParameter(connector, "springForceUserFunction", law)
+        elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
+            bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),
+                                              hinge_matrix(case, hinge, "damping", damping))
+            law = CreateSymbolicUserFunction(mbs, bearing, "springForceUserFunction", connector)
             mbs.SetObjectParameter(connector, "springForceUserFunction", law)
         sensor = mbs.AddSensor(eii.SensorObject(
             name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,

@@ -44,6 +44,7 @@ import scipy.linalg as sla
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.model.case import ENGINE, SingleFrequencyExcitation
+from workbook.scene.bearing import hinge_matrix
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.modes import Linearization, linearize
 
@@ -245,6 +246,7 @@ def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.n
     mbs = scene.mbs
     if hinge_loss:
         lossy = list(hinge_loss)
+        by_name = {hinge.name: hinge for hinge in scene.case.hinges}
         connectors = [scene.hinges[name].connector for name in lossy]
 
         def displacements() -> np.ndarray:
@@ -253,7 +255,7 @@ def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.n
         jacobian = _central_difference(displacements, set_q, q0, range(len(q0)), COORDINATE_STEP) @ lin.basis
         for k, name in enumerate(lossy):
             rows = slice(3 * names.index(name), 3 * names.index(name) + 3)
-            output[rows] = hinge_loss[name] * stiffness_output[rows]
+            output[rows] = hinge_matrix(scene.case, by_name[name], "loss_factor") @ stiffness_output[rows]
             structural += jacobian[3 * k:3 * k + 3].T @ output[rows]
     for name, eta in link_loss.items():
         modal_node = scene.links[name].nodes[1]
