@@ -270,14 +270,18 @@ HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
 
 
 def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | Vector3:
-    """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*)."""
+    """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
+
+    A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
+    """
     if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
         return _number(value, item, name, minimum=0.0, strictly=strictly)
     values = tuple(value)
     if len(values) != 3:
         raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
                                            f"{len(values)} given")
-    return tuple(_number(v, item, name, minimum=0.0, strictly=strictly) for v in values)
+    return tuple(_number(v, item, f"{name}[{direction}]", minimum=0.0, strictly=strictly)
+                 for v, direction in zip(values, HINGE_DIRECTIONS))
 
 
 def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
