@@ -182,7 +182,8 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         EffectEntry("hinge damping", effects.hinge_damping and bool(hinge_damping),
                     f"{len(hinge_damping)} hinges with viscous damping" if effects.hinge_damping and hinge_damping
                     else ("switched off" if not effects.hinge_damping else "no hinge has viscous damping")),
-        _loss_factor_entry(scene, "hinge loss factor", hinge_loss, effects.hinge_damping, "hinge", "k"),
+        _loss_factor_entry(scene, "hinge loss factor", hinge_loss, effects.hinge_damping, "hinge", "k",
+                           len(case.hinges)),
         EffectEntry("hinge properties per direction", bool(anisotropic),
                     f"stiffness, damping or loss factor per direction of the hinge frame (radial 1, radial 2, "
                     f"axial) on {', '.join(anisotropic)}: R^T diag(k) R in global axes (symbolic spring law)"
@@ -191,7 +192,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                     f"Rayleigh damping on {', '.join(damped_links)}" if effects.link_damping and damped_links else
                     ("switched off" if not effects.link_damping else "no flexible link has Rayleigh damping")),
         _loss_factor_entry(scene, "link material loss factor", link_loss, effects.link_damping, "flexible link",
-                           "K_red"),
+                           "K_red", len(flexible)),
         EffectEntry("hinge clearance", effects.clearance and bool(gaps),
                     f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
                     if effects.clearance and gaps else
@@ -210,7 +211,8 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
     return entries
 
 
-def _loss_factor_entry(scene, name: str, lossy: dict, switched_on: bool, kind: str, stiffness: str) -> EffectEntry:
+def _loss_factor_entry(scene, name: str, lossy: dict, switched_on: bool, kind: str, stiffness: str,
+                       total: int) -> EffectEntry:
     """Loss factors of hinges or links: how they were built (exact complex
     stiffness, or its viscous equivalent at one frequency), or why not."""
     if not lossy:
@@ -219,7 +221,8 @@ def _loss_factor_entry(scene, name: str, lossy: dict, switched_on: bool, kind: s
     for item, eta in lossy.items():
         value = f"{eta:g}" if isinstance(eta, float) else f"({', '.join(f'{e:g}' for e in eta)}) per direction"
         groups.setdefault(value, []).append(item)
-    listing = "; ".join(f"eta = {value} on {', '.join(items)}" for value, items in groups.items())
+    listing = "; ".join(f"eta = {value} on " + (f"every {kind} ({total})" if len(items) == total else ', '.join(items))
+                        for value, items in groups.items())
     if scene.loss_factor_hz is None:
         how = f"complex stiffness {stiffness} (1 + i eta), exact at every frequency"
     else:
