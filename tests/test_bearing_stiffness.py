@@ -148,3 +148,12 @@ def test_four_pole_set_of_anisotropic_lossy_hinges_gives_the_rig_run():
         response = pole.respond(excitation_phasor(excitation), excitation.point, pylon)[j]
         measured = np.abs((transducer[j] * response.pin_motions).sum(axis=0)) / excitation.force_amplitude
         np.testing.assert_allclose(measured, result.run(excitation.name).transmissibility, rtol=1e-6, atol=1e-12)
+
+
+def test_per_direction_hinges_and_loss_factors_round_trip_through_json():
+    from workbook.model.codec import from_json, to_json
+
+    case = mount(STIFFNESS, (50.0, 80.0, 20.0), (0.02, 0.05, 0.1), FRAME)
+    again = from_json(to_json(case))
+    assert again == case
+    assert again.hinges[0].frame == case.hinges[0].frame and not again.hinges[0].isotropic
