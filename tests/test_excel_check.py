@@ -13,7 +13,7 @@ from openpyxl import load_workbook
 from workbook.cli.main import main
 from workbook.errors import UnitProblem, WorkbookError
 from workbook.excel.reader import read_workbook
-from workbook.excel.template import reference_workbook, template_workbook, write_workbook
+from workbook.excel.template import case_workbook, reference_workbook, template_workbook, write_workbook
 from workbook.model.case import ForceTransducers
 from workbook.model.codec import to_dict
 from workbook.model.reference import HP_SPOOL, LP_SPOOL, reference_case
@@ -114,6 +114,27 @@ def test_units_are_converted_on_reading(tmp_path):
     assert case.rotors[0].polar_inertia == pytest.approx(100.0, rel=1e-12)
     assert case.test_rig.stiffness == pytest.approx((1e8, 1e8, 3e8), rel=1e-12)
     assert case.test_rig.mass == pytest.approx(0.8, rel=1e-12)
+
+
+def test_hinge_values_per_direction_and_loss_factors_are_read_and_written_back(tmp_path):
+    """Radial 2 / axial columns make three values (an empty one: as the first column); the
+    frame comes from its radial 1 and axial directions; the case writes back to the same cells."""
+    path = copy_reference(tmp_path)
+    axial = (0.0, 0.6, 0.8)
+    set_cells(path, {("Hinges", "stiffness axial", 3): 5e6, ("Hinges", "loss factor", 3): 0.05,
+                     ("Hinges", "loss factor axial", 3): 0.1, ("Links", "loss factor", 3): 0.002,
+                     **{("Hinges", f"frame radial 1 {a}", 3): v for a, v in zip("xyz", (1.0, 0.0, 0.0))},
+                     **{("Hinges", f"frame axial {a}", 3): v for a, v in zip("xyz", axial)}})
+    case = read_workbook(path).case
+    hinge, plain = case.hinges[0], case.hinges[1]
+    assert hinge.stiffness == (plain.stiffness, plain.stiffness, 5e6)
+    assert hinge.loss_factor == (0.05, 0.05, 0.1)
+    assert not hinge.isotropic and plain.isotropic
+    assert hinge.frame == ((1.0, 0.0, 0.0), (0.0, 0.8, -0.6), axial)
+    assert case.links[0].loss_factor == 0.002
+    again = tmp_path / "again.xlsx"
+    write_workbook(case_workbook(case, read_workbook(path).runs), again)
+    assert _numbers(read_workbook(again).case) == _numbers(case)
 
 
 def test_rotors_and_test_rig_are_read(tmp_path):
@@ -340,6 +361,21 @@ BAD_INPUTS = {
                               ["sheet 'Hinges'", "at least one hinge to the pylon"]),
     "bad rig sensors switch": (_edit({("Case", "rig sensors", 3): "sometimes"}),
                                ["sheet 'Case'", "cell V3", "yes or no"]),
+    "negative loss factor": (_edit({("Hinges", "loss factor", 4): -0.1}),
+                             ["sheet 'Hinges'", "cell K4", "column 'loss factor'", "found -0.1", ">= 0"]),
+    "negative axial loss factor": (_edit({("Hinges", "loss factor axial", 5): -0.05}),
+                                   ["sheet 'Hinges'", "cell Q5", "column 'loss factor axial'", "found -0.05", ">= 0"]),
+    "zero axial stiffness": (_edit({("Hinges", "stiffness axial", 6): 0}),
+                             ["sheet 'Hinges'", "cell M6", "column 'stiffness axial'", "> 0"]),
+    "hinge frame not orthonormal": (_edit({("Hinges", "frame radial 1 x", 4): 1, ("Hinges", "frame radial 1 y", 4): 0,
+                                           ("Hinges", "frame radial 1 z", 4): 0, ("Hinges", "frame axial x", 4): 0.5,
+                                           ("Hinges", "frame axial y", 4): 0, ("Hinges", "frame axial z", 4): 1}),
+                                    ["sheet 'Hinges'", "cell R4:W4", "orthonormal"]),
+    "hinge frame with one direction": (_edit({("Hinges", "frame axial x", 4): 0, ("Hinges", "frame axial y", 4): 0,
+                                              ("Hinges", "frame axial z", 4): 1}),
+                                       ["sheet 'Hinges'", "cell R4:W4", "three"]),
+    "negative link loss factor": (_edit({("Links", "loss factor", 3): -0.01}),
+                                  ["sheet 'Links'", "cell AO3", "found -0.01", ">= 0"]),
 }
 
 

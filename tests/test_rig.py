@@ -24,7 +24,10 @@ SHORT = AnalysisSettings(settle_time=0.2, measured_periods=10)
 
 @pytest.fixture(scope="module")
 def lp_run(cache_dir):
-    case = reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE).with_rigid_links()
+    # the former viscous hinge damping: a short, cheap time run whose lateral pylon force
+    # (T_y 0.0012) is not the deeper cancellation of the loss-factor mount (0.0004)
+    case = reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE,
+                          hinge_damping="viscous").with_rigid_links()
     return run_excitation(case, LP_ROTOR)[0]
 
 

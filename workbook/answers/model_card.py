@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from workbook.scene.build import Scene
+from workbook.scene.build import Scene, loss_factors
 
 __all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
 
@@ -168,7 +168,9 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
     damped_links = [link.name for link in case.links
                     if link.name in flexible and (link.stiffness_damping > 0 or link.mass_damping > 0)]
     gaps = [h for h in case.hinges if h.radial_clearance > 0]
-    hinge_damping = [h for h in case.hinges if h.damping > 0]
+    hinge_damping = [h for h in case.hinges if h.values("damping").max() > 0]
+    anisotropic = [h.name for h in case.hinges if not h.isotropic]
+    hinge_loss, link_loss = loss_factors(case)
     loads = ", ".join(load.name for load in case.static_loads)
     entries = [
         EffectEntry("link flexibility", bool(flexible),
@@ -178,11 +180,19 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                     f"{loads} solved first; dynamics start from that equilibrium" if preload.solved else
                     ("switched off" if not effects.preload else "no static loads given")),
         EffectEntry("hinge damping", effects.hinge_damping and bool(hinge_damping),
-                    f"{len(hinge_damping)} hinges with damping" if effects.hinge_damping and hinge_damping else
-                    ("switched off" if not effects.hinge_damping else "no hinge has damping")),
+                    f"{len(hinge_damping)} hinges with viscous damping" if effects.hinge_damping and hinge_damping
+                    else ("switched off" if not effects.hinge_damping else "no hinge has viscous damping")),
+        _loss_factor_entry(scene, "hinge loss factor", hinge_loss, effects.hinge_damping, "hinge", "k",
+                           len(case.hinges)),
+        EffectEntry("hinge properties per direction", bool(anisotropic),
+                    f"stiffness, damping or loss factor per direction of the hinge frame (radial 1, radial 2, "
+                    f"axial) on {', '.join(anisotropic)}: R^T diag(k) R in global axes (symbolic spring law)"
+                    if anisotropic else "every hinge isotropic (one value in every direction)"),
         EffectEntry("link damping", effects.link_damping and bool(damped_links),
                     f"Rayleigh damping on {', '.join(damped_links)}" if effects.link_damping and damped_links else
                     ("switched off" if not effects.link_damping else "no flexible link has Rayleigh damping")),
+        _loss_factor_entry(scene, "link material loss factor", link_loss, effects.link_damping, "flexible link",
+                           "K_red", len(flexible)),
         EffectEntry("hinge clearance", effects.clearance and bool(gaps),
                     f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
                     if effects.clearance and gaps else
@@ -201,6 +211,26 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                 EffectEntry("frequency domain", method.method == "frequency",
                             f"{frequency_detail}: {method.reason}" if method.method == "frequency" else "not used")]
     return entries
+
+
+def _loss_factor_entry(scene, name: str, lossy: dict, switched_on: bool, kind: str, stiffness: str,
+                       total: int) -> EffectEntry:
+    """Loss factors of hinges or links: how they were built (exact complex
+    stiffness, or its viscous equivalent at one frequency), or why not."""
+    if not lossy:
+        return EffectEntry(name, False, f"no {kind} has a loss factor" if switched_on else "switched off")
+    groups: dict[str, list[str]] = {}
+    for item, eta in lossy.items():
+        value = f"{eta:g}" if isinstance(eta, float) else f"({', '.join(f'{e:g}' for e in eta)}) per direction"
+        groups.setdefault(value, []).append(item)
+    listing = "; ".join(f"eta = {value} on " + (f"every {kind} ({total})" if len(items) == total else ', '.join(items))
+                        for value, items in groups.items())
+    if scene.loss_factor_hz is None:
+        how = f"complex stiffness {stiffness} (1 + i eta), exact at every frequency"
+    else:
+        how = (f"as the equivalent viscous damping eta {stiffness} / w at {scene.loss_factor_hz:g} Hz (the "
+               f"excitation frequency of this run): exact in the steady state at {scene.loss_factor_hz:g} Hz only")
+    return EffectEntry(name, True, f"{listing}: {how}")
 
 
 def _ignored_contact(case) -> str:

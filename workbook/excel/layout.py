@@ -230,6 +230,7 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     *_xyz("mesh_bore_a", "mesh bore A", "m", unit="mm", help="mesh: a point on bore A's axis, mesh frame"),
     *_xyz("mesh_bore_b", "mesh bore B", "m", unit="mm", help="mesh: a point on bore B's axis, mesh frame"),
     *_xyz("mesh_bore_axis", "mesh bore axis", DIMENSIONLESS, help="mesh: bore axis direction, mesh frame"),
+    _num("loss_factor", "loss factor", help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"),
 ))
 
 HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", columns=(
@@ -237,10 +238,21 @@ HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", 
     Column("body_a", "body A", "text", required=True, help="pylon, engine or a link name"),
     Column("body_b", "body B", "text", required=True, help="pylon, engine or a link name"),
     *_xyz("position", "position", "m", required=True, help="hinge centre: an eye centre of its links"),
-    _num("stiffness", "stiffness", "N/m", required=True, help="translational stiffness"),
+    _num("stiffness", "stiffness", "N/m", required=True,
+         help="translational stiffness (with the radial 2 or axial columns: radial 1)"),
     _num("damping", "damping", "N*s/m", help="translational damping (empty: 0)"),
     _num("radial_clearance", "radial clearance", "m", unit="mm", help="bearing gap (empty: 0)"),
     _num("contact_stiffness", "contact stiffness", "N/m", help="stiffness once the gap closes"),
+    _num("loss_factor", "loss factor", help="structural loss factor eta, k (1 + i eta) (empty: 0)"),
+    *(_num(f"{key}_{suffix}", f"{header} {direction}", unit, help=f"{header} along the hinge frame's {direction} "
+           f"direction (empty: as '{header}')")
+      for key, header, unit in (("stiffness", "stiffness", "N/m"), ("damping", "damping", "N*s/m"),
+                                ("loss_factor", "loss factor", DIMENSIONLESS))
+      for suffix, direction in (("radial_2", "radial 2"), ("axial", "axial"))),
+    *_xyz("frame_radial_1", "frame radial 1", DIMENSIONLESS,
+          help="hinge frame: radial 1 direction, unit length (empty: the link's frame)"),
+    *_xyz("frame_axial", "frame axial", DIMENSIONLESS,
+          help="hinge frame: axial (pin) direction, at right angles to radial 1 (empty: the link's frame)"),
 ))
 
 STATIC_LOADS = Table("Static loads", help="constant loads solved first (the preload)", columns=(

@@ -15,6 +15,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
+
 import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import WorkbookError
@@ -68,6 +70,10 @@ _FIELD_COLUMNS = {
                     "frequencies_hz": ("sweep_from", "sweep_to"), "spacing": ("sweep_spacing",),
                     "start": ("sweep_from",), "stop": ("sweep_to",), "points": ("sweep_points",),
                     "speed_unit": ("run_up",)},
+    "Hinges": {**{f"{key}[{direction}]": (key if direction == cm.HINGE_DIRECTIONS[0] else
+                                          f"{key}_{direction.replace(' ', '_')}",)
+                  for key in ("stiffness", "damping", "loss_factor") for direction in cm.HINGE_DIRECTIONS},
+               "frame": (*L.HINGES.vector_keys("frame_radial_1"), *L.HINGES.vector_keys("frame_axial"))},
     "Runs": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "radial_clearance": ("gap",),
              "stiffness": ("hinge_stiffness",), "damping": ("hinge_damping",), "modes": ("fidelity",)},
 }
@@ -87,6 +93,20 @@ def _field_keys(table: L.Table, field: str) -> tuple:
         return (field,)
     vector = table.vector_keys(field)
     return vector if vector[0] in keys else ()
+
+
+def _hinge_frame(record: Record) -> tuple | None:
+    """A hinge's frame from its radial 1 and axial direction columns (radial 2 = axial x radial 1),
+    None when both are empty; what cannot be a direction is passed on for the case to name."""
+    radial, axial = record.vector("frame_radial_1"), record.vector("frame_axial")
+    if radial is None and axial is None:
+        return None
+    empty = (None, None, None)
+    try:
+        middle = tuple(np.cross(np.asarray(axial, dtype=float), np.asarray(radial, dtype=float)))
+    except (TypeError, ValueError):
+        middle = empty
+    return radial or empty, middle, axial or empty
 
 
 class _CaseReader(SheetReader):
@@ -203,7 +223,7 @@ class _CaseReader(SheetReader):
             get("name"), record.vector("end_a"), record.vector("end_b"), model, modes=get("modes", "auto"),
             flexible=get("flexible", True), stiffness_damping=get("stiffness_damping", 0.0),
             mass_damping=get("mass_damping", 0.0), spin_frequency_hz=get("spin_frequency_hz"),
-            bore_axis=record.vector("bore_axis")))
+            bore_axis=record.vector("bore_axis"), loss_factor=get("loss_factor", 0.0)))
 
     def hinge(self, record: Record) -> cm.Hinge | None:
         get = record.get
@@ -212,9 +232,18 @@ class _CaseReader(SheetReader):
             name = get(key)
             return name.lower() if name.lower() in (cm.PYLON, cm.ENGINE) else name
 
+        def per_direction(key: str, default: Any) -> Any:
+            """One value, or three when a radial 2 or axial column is given (empty ones: as *key*)."""
+            first = get(key, default)
+            others = [get(f"{key}_radial_2"), get(f"{key}_axial")]
+            if all(value is None for value in others):
+                return first
+            return (first, *(first if value is None else value for value in others))
+
         return self.build(record, lambda: cm.Hinge(
-            get("name"), body("body_a"), body("body_b"), record.vector("position"), get("stiffness"),
-            get("damping", 0.0), get("radial_clearance", 0.0), get("contact_stiffness")))
+            get("name"), body("body_a"), body("body_b"), record.vector("position"), per_direction("stiffness", None),
+            per_direction("damping", 0.0), get("radial_clearance", 0.0), get("contact_stiffness"),
+            per_direction("loss_factor", 0.0), _hinge_frame(record)))
 
     def static_load(self, record: Record):
         kind, name, vector = record.get("type"), record.get("name"), record.vector

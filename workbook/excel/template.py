@@ -92,7 +92,8 @@ def _row_for_link(link: cm.Link) -> dict:
     row = {"name": link.name, **_vector("end_a", link.end_a), **_vector("end_b", link.end_b),
            "element_size": model.element_size, "interface": model.interface, "modes": link.modes,
            "flexible": link.flexible, "stiffness_damping": link.stiffness_damping,
-           "mass_damping": link.mass_damping, "spin_frequency_hz": link.spin_frequency_hz}
+           "mass_damping": link.mass_damping, "spin_frequency_hz": link.spin_frequency_hz,
+           "loss_factor": link.loss_factor or None}
     row.update({key: getattr(model.geometry, key) for key in
                 ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")})
     base = flexbodies.material(model.material.name.split(" ")[0])
@@ -165,6 +166,22 @@ def _rows_for_test_rig(rig: cm.ForceTransducers | None) -> list[dict]:
     return [{**_vector("stiffness", rig.stiffness), "mass": rig.mass, **_vector("damping", rig.damping)}]
 
 
+def _per_direction(hinge: cm.Hinge, key: str) -> dict:
+    """A hinge's *key* as one cell, or three (radial 1 in *key*, then radial 2 and axial)."""
+    values = hinge.values(key)
+    row = {key: float(values[0])}
+    if np.ptp(values) > 0:
+        row.update({f"{key}_radial_2": float(values[1]), f"{key}_axial": float(values[2])})
+    return row
+
+
+def _frame(hinge: cm.Hinge) -> dict:
+    """A hinge's own frame as its radial 1 and axial directions (none: empty)."""
+    if hinge.frame is None:
+        return {}
+    return {**_vector("frame_radial_1", hinge.frame[0]), **_vector("frame_axial", hinge.frame[2])}
+
+
 def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> dict[str, list[dict]]:
     """The rows of every input sheet (values in SI, by column key) for *case*."""
     inertia = case.engine.inertia
@@ -175,8 +192,9 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
                  ((("x", 0), ("x", 0)), (("y", 1), ("y", 1)), (("z", 2), ("z", 2)),
                   (("x", 0), ("y", 1)), (("x", 0), ("z", 2)), (("y", 1), ("z", 2)))}}
     hinges = [{"name": h.name, "body_a": h.body_a, "body_b": h.body_b, **_vector("position", h.position),
-               "stiffness": h.stiffness, "damping": h.damping, "radial_clearance": h.radial_clearance or None,
-               "contact_stiffness": h.contact_stiffness} for h in case.hinges]
+               **_per_direction(h, "stiffness"), **_per_direction(h, "damping"),
+               "radial_clearance": h.radial_clearance or None, "contact_stiffness": h.contact_stiffness,
+               **_per_direction(h, "loss_factor"), **_frame(h)} for h in case.hinges]
     return {
         L.CASE.sheet: [settings], L.ENGINE.sheet: [engine],
         L.LINKS.sheet: [_row_for_link(link) for link in case.links],

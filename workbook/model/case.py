@@ -27,7 +27,7 @@ import numpy as np
 
 from workbook.errors import CaseError
 
-__all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
+__all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
     "Sweep", "AnalysisSettings", "Effects", "Case", "StaticLoad", "Excitation",
     "SingleFrequencyExcitation", "ImbalancePlane", "Imbalance", "RunUp", "SPEED_UNITS",
@@ -207,6 +207,9 @@ class Link:
         Rayleigh stiffness-proportional damping of the link, s.
     mass_damping : float
         Rayleigh mass-proportional damping of the link, 1/s.
+    loss_factor : float
+        Material loss factor eta of the link (complex modulus: the link's
+        elastic stiffness acts as K (1 + i eta)), dimensionless, >= 0.
     spin_frequency_hz : float or None
         Frequency of the torsional restraint of the free spin about the link
         axis (None: the flexbodies default).
@@ -224,6 +227,7 @@ class Link:
     mass_damping: float = 0.0
     spin_frequency_hz: float | None = None
     bore_axis: Vector3 | None = None
+    loss_factor: float = 0.0
 
     def __post_init__(self):
         item = f"link {self.name!r}"
@@ -245,6 +249,7 @@ class Link:
         _set(self, "stiffness_damping",
              _number(self.stiffness_damping, item, "stiffness_damping", minimum=0.0))
         _set(self, "mass_damping", _number(self.mass_damping, item, "mass_damping", minimum=0.0))
+        _set(self, "loss_factor", _number(self.loss_factor, item, "loss_factor", minimum=0.0))
         if self.spin_frequency_hz is not None:
             _set(self, "spin_frequency_hz", _number(self.spin_frequency_hz, item,
                                                     "spin_frequency_hz", minimum=0.0, strictly=True))
@@ -264,9 +269,50 @@ class Link:
         return None
 
 
+#: Names of a hinge's three directions (:attr:`Hinge.frame`).
+HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
+
+
+def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | Vector3:
+    """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
+
+    A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
+    """
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        return _number(value, item, name, minimum=0.0, strictly=strictly)
+    values = tuple(value)
+    if len(values) != 3:
+        raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
+                                           f"{len(values)} given")
+    return tuple(_number(v, item, f"{name}[{direction}]", minimum=0.0, strictly=strictly)
+                 for v, direction in zip(values, HINGE_DIRECTIONS))
+
+
+def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
+    """*value* as three orthonormal rows (a hinge frame) or raise CaseError."""
+    try:
+        rows = tuple(_vector3(row, item, "frame") for row in value)
+    except TypeError:
+        raise CaseError(item, "frame", value, "three directions of three numbers each") from None
+    if len(rows) != 3:
+        raise CaseError(item, "frame", value, f"three directions ({', '.join(HINGE_DIRECTIONS)}); "
+                                              f"{len(rows)} given")
+    matrix = np.array(rows)
+    if not np.allclose(matrix @ matrix.T, np.eye(3), rtol=0.0, atol=1e-6):
+        raise CaseError(item, "frame", value, "three orthonormal directions (unit length, at right angles "
+                                              "to each other, within 1e-6)")
+    return rows
+
+
 @dataclass(frozen=True)
 class Hinge:
-    """A ball hinge: an isotropic translational spring-damper between two bodies.
+    """A ball hinge: a translational spring-damper between two bodies.
+
+    Stiffness, damping and loss factor are either one value (the same in
+    every direction: isotropic, the default) or three, one per direction of
+    the hinge's frame (:data:`HINGE_DIRECTIONS`): two radial and one along
+    the bore (pin) axis, as a spherical bearing in a link eye is stiffer
+    radially than along its pin.
 
     Parameters
     ----------
@@ -276,24 +322,38 @@ class Hinge:
         The two bodies joined: ``"pylon"``, ``"engine"`` or a link name.
     position : 3 floats
         Hinge centre, m; on a link it must be one of the link's eye centres.
-    stiffness : float
-        Translational stiffness in every direction, N/m.
-    damping : float
-        Translational damping in every direction, N s/m.
+    stiffness : float or 3 floats
+        Translational stiffness, N/m: in every direction, or per direction
+        of the frame.
+    damping : float or 3 floats
+        Translational (viscous) damping, N s/m, likewise.
     radial_clearance : float
         Gap of the spherical bearing, m (0: no clearance law is built).
     contact_stiffness : float or None
         Stiffness once the gap is closed, N/m (None: *stiffness*).
+    loss_factor : float or 3 floats
+        Structural (hysteretic) loss factor eta, dimensionless, >= 0: the
+        hinge's stiffness acts as k (1 + i eta), a damping force in phase
+        with the velocity whose size does not grow with the frequency
+        (docs/physics.md, hinge damping); likewise one or three values.
+    frame : 3x3 floats or None
+        The hinge's directions radial 1, radial 2, axial as rows, in global
+        coordinates (orthonormal). None: the frame of the link the hinge
+        sits on (radial 1 along the link towards eye B, axial along its
+        bore axis), or the global axes x, y, z for a hinge between the
+        pylon and the engine. Only per-direction values use it.
     """
 
     name: str
     body_a: str
     body_b: str
     position: Vector3
-    stiffness: float
-    damping: float = 0.0
+    stiffness: float | Vector3
+    damping: float | Vector3 = 0.0
     radial_clearance: float = 0.0
     contact_stiffness: float | None = None
+    loss_factor: float | Vector3 = 0.0
+    frame: tuple[Vector3, Vector3, Vector3] | None = None
 
     def __post_init__(self):
         item = f"hinge {self.name!r}"
@@ -304,13 +364,33 @@ class Hinge:
         if self.body_a == self.body_b:
             raise CaseError(item, "body_b", self.body_b, "a body other than body_a")
         _set(self, "position", _vector3(self.position, item, "position"))
-        _set(self, "stiffness", _number(self.stiffness, item, "stiffness", minimum=0.0, strictly=True))
-        _set(self, "damping", _number(self.damping, item, "damping", minimum=0.0))
+        _set(self, "stiffness", _per_direction(self.stiffness, item, "stiffness", strictly=True))
+        _set(self, "damping", _per_direction(self.damping, item, "damping", strictly=False))
         _set(self, "radial_clearance",
              _number(self.radial_clearance, item, "radial_clearance", minimum=0.0))
         if self.contact_stiffness is not None:
             _set(self, "contact_stiffness", _number(self.contact_stiffness, item,
                                                     "contact_stiffness", minimum=0.0, strictly=True))
+        _set(self, "loss_factor", _per_direction(self.loss_factor, item, "loss_factor", strictly=False))
+        if self.frame is not None:
+            _set(self, "frame", _frame(self.frame, item))
+        if self.radial_clearance > 0 and not self.isotropic:
+            raise CaseError(item, "stiffness", self.stiffness, "one value (the same in every direction) for a "
+                            "hinge with a radial clearance: the clearance law is isotropic")
+
+    @property
+    def isotropic(self) -> bool:
+        """True if stiffness, damping and loss factor are each the same in every direction."""
+        return all(np.ptp(self.values(name)) == 0 for name in ("stiffness", "damping", "loss_factor"))
+
+    def values(self, name: str) -> np.ndarray:
+        """*name* (``"stiffness"``, ``"damping"`` or ``"loss_factor"``) per hinge direction, shape (3,)."""
+        return np.broadcast_to(np.asarray(getattr(self, name), dtype=float), (3,)).copy()
+
+    @property
+    def largest_stiffness(self) -> float:
+        """The largest of the stiffness and contact stiffness, N/m (for scaling)."""
+        return float(max(self.values("stiffness").max(), self.gap_contact_stiffness))
 
     @property
     def bodies(self) -> tuple[str, str]:
@@ -323,8 +403,10 @@ class Hinge:
 
     @property
     def gap_contact_stiffness(self) -> float:
-        """Stiffness beyond the gap, N/m."""
-        return self.stiffness if self.contact_stiffness is None else self.contact_stiffness
+        """Stiffness beyond the gap, N/m (the largest stiffness for a hinge with three)."""
+        if self.contact_stiffness is not None:
+            return self.contact_stiffness
+        return float(self.values("stiffness").max())
 
 
 @dataclass(frozen=True)

@@ -110,6 +110,11 @@ def link_table(case: Case, reduced: dict | None = None):
     return pd.DataFrame(rows)
 
 
+def _per_direction(value) -> str:
+    """One value, or three (a hinge's directions) separated by slashes."""
+    return f"{value:.3g}" if isinstance(value, float) else " / ".join(f"{v:.3g}" for v in value)
+
+
 def hinge_table(case: Case):
     """One row per hinge: bodies, position (mm), stiffness, damping, clearance.
 
@@ -121,7 +126,7 @@ def hinge_table(case: Case):
 
     rows = [{"hinge": h.name, "body A": h.body_a, "body B": h.body_b, "position (mm)": _mm(h.position),
              "pylon side": "yes" if PYLON in h.bodies else "",
-             "stiffness (N/m)": f"{h.stiffness:.3g}", "damping (N s/m)": f"{h.damping:.3g}",
+             "stiffness (N/m)": _per_direction(h.stiffness), "damping (N s/m)": _per_direction(h.damping),
              "radial clearance (mm)": f"{1e3 * h.radial_clearance:g}"} for h in case.hinges]
     return pd.DataFrame(rows)
 

@@ -52,12 +52,14 @@ from workbook.model.case import (
     SingleFrequencyExcitation,
     transducer_name,
 )
+from workbook.scene.bearing import exudyn_bearing_function, hinge_matrix
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
+from workbook.scene.structural_damping import equivalent_viscous_damping
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
-           "exudyn_name", "ignored_contact_stiffness", "marker_bodies", "net_angular_momentum",
+           "exudyn_name", "ignored_contact_stiffness", "loss_factors", "marker_bodies", "net_angular_momentum",
            "scene_warnings", "CANCELLED_MOMENTUM"]
 
 log = logging.getLogger(__name__)
@@ -101,7 +103,9 @@ class HingeItems:
     clearance : bool
         The clearance law is built (gap > 0 and clearance switched on).
     law : exudyn.symbolic.UserFunction or None
-        The recorded clearance law (``springForceUserFunction``), if built.
+        The recorded ``springForceUserFunction``, if built: the clearance
+        law, or the per-direction law of an anisotropic hinge
+        (:mod:`workbook.scene.bearing`).
     """
 
     connector: int
@@ -226,6 +230,11 @@ class Scene:
     gyroscopics : GyroscopicItems or None
         The rotors' gyroscopic moment (None: not built, see
         :func:`gyroscopics_built`).
+    loss_factor_hz : float or None
+        The frequency at which the loss factors of the hinges and links were
+        built as their equivalent viscous damping (the time domain), Hz;
+        None when they were not (no loss factor, no excitation, or the
+        frequency domain adds them exactly, see :func:`loss_factors`).
     """
 
     case: Case
@@ -241,6 +250,7 @@ class Scene:
     load_scale: float
     transducers: dict = field(default_factory=dict)
     gyroscopics: GyroscopicItems | None = None
+    loss_factor_hz: float | None = None
 
     def close(self) -> None:
         """Free Exudyn's system: reset the system container, whose memory
@@ -305,7 +315,7 @@ class Scene:
         stiffness, as if each gap were closed (for the mechanism check: the
         gaps of an unloaded mount are open, and inside them only the small
         residual stiffness of :mod:`workbook.scene.hinge_law` acts)."""
-        laws = {items.connector: items.law for items in self.hinges.values() if items.law is not None}
+        laws = {items.connector: items.law for items in self.hinges.values() if items.clearance}
         for connector in laws:
             self.mbs.SetObjectParameter(connector, "springForceUserFunction", 0)
         try:
@@ -346,7 +356,7 @@ def ignored_contact_stiffness(case: Case) -> list[Hinge]:
     """Hinges that give a contact stiffness (other than their stiffness) but
     no gap: no clearance law is built, so the contact stiffness never acts."""
     return [h for h in case.hinges if h.contact_stiffness is not None and h.radial_clearance == 0
-            and h.contact_stiffness != h.stiffness]
+            and np.any(h.values("stiffness") != h.contact_stiffness)]
 
 
 def scene_warnings(case: Case) -> list[str]:
@@ -354,13 +364,26 @@ def scene_warnings(case: Case) -> list[str]:
     contact stiffness on a hinge without a gap, and rotors whose spin
     angular momenta cancel (no gyroscopic moment)."""
     warnings = [f"hinge {h.name!r}: contact_stiffness {h.contact_stiffness:g} N/m is ignored: the hinge has no gap "
-                f"(radial_clearance 0), so its stiffness {h.stiffness:g} N/m acts"
+                f"(radial_clearance 0), so its stiffness "
+                f"{' / '.join(f'{k:g}' for k in h.values('stiffness'))} N/m acts"
                 for h in ignored_contact_stiffness(case)]
     if case.rotors and case.effects.gyroscopics and not gyroscopics_built(case):
         warnings.append(f"rotors {', '.join(repr(r.name) for r in case.rotors)}: their spin angular momenta cancel "
                         f"(net {np.linalg.norm(net_angular_momentum(case)):.3g} kg m^2/s), so they exert no "
                         f"gyroscopic moment and none is built")
     return warnings
+
+
+def loss_factors(case: Case) -> tuple[dict[str, Any], dict[str, float]]:
+    """The loss factors the scene of *case* carries: those of the hinges
+    (with hinge damping switched on; one value or three, per direction) and
+    of the flexible links (with link damping switched on), each by name,
+    only where > 0."""
+    effects = case.effects
+    hinges = {h.name: h.loss_factor for h in case.hinges if effects.hinge_damping and h.values("loss_factor").max() > 0}
+    links = {link.name: link.loss_factor for link in case.links
+             if effects.link_damping and case.link_is_flexible(link.name) and link.loss_factor > 0}
+    return hinges, links
 
 
 def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | None) -> float:
@@ -420,7 +443,7 @@ def _load_scale(case: Case, excitation: SingleFrequencyExcitation | None, link_m
 
 
 def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None, *,
-                reduced: dict | None = None) -> Scene:
+                reduced: dict | None = None, exact_loss_factors: bool = False) -> Scene:
     """Build the Exudyn system of *case*.
 
     Parameters
@@ -431,6 +454,12 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         the static scene only.
     reduced : dict of str to flexbodies.ReducedLink, optional
         Reduced links from :func:`reduce_links` (computed when omitted).
+    exact_loss_factors : bool
+        False (for a time integration): the loss factors of hinges and links
+        become their equivalent viscous damping at the excitation's
+        frequency (:mod:`workbook.scene.structural_damping`; nothing without
+        an excitation). True: they are left out of the scene, for the
+        frequency domain to add them exactly as complex stiffness.
 
     Returns
     -------
@@ -451,6 +480,13 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
 
     ground = mbs.AddObject(eii.ObjectGround(visualization=eii.VObjectGround(show=False)))
     engine = _add_engine(mbs, case)
+    hinge_loss, link_loss = loss_factors(case)
+    loss_hz = None if exact_loss_factors or excitation is None or not (hinge_loss or link_loss) \
+        else excitation.frequency
+
+    def viscous(loss_factor: float, stiffness: float) -> float:
+        """The equivalent viscous damping built for a loss factor (0 when none is built)."""
+        return 0.0 if loss_hz is None else equivalent_viscous_damping(loss_factor, stiffness, loss_hz)
 
     links = {}
     for link in case.links:
@@ -459,7 +495,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         links[link.name] = add_link_to_exudyn(
             mbs, reduced[link.name], link.end_a, link.end_b,
             flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
-            stiffness_damping=link.stiffness_damping if damping else 0.0,
+            stiffness_damping=(link.stiffness_damping if damping else 0.0) + viscous(link_loss.get(link.name, 0.0), 1.0),
             mass_damping=link.mass_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
 
     transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
@@ -481,18 +517,27 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     for hinge in case.hinges:
         first, second = marker_bodies(hinge)
         markers = (marker(first, hinge.position), marker(second, hinge.position))
-        damping = hinge.damping if case.effects.hinge_damping else 0.0
         clearance = case.effects.clearance and hinge.radial_clearance > 0
-        stiffness = hinge.gap_contact_stiffness if clearance else hinge.stiffness
+        stiffness = hinge.values("stiffness")
+        if clearance:
+            stiffness[:] = hinge.gap_contact_stiffness
+        damping = (hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)) \
+            + [viscous(eta, k) for eta, k in zip(hinge.values("loss_factor") if hinge.name in hinge_loss
+                                                 else np.zeros(3), stiffness)]
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=[stiffness] * 3, damping=[damping] * 3,
-            visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
+            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
+            damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         law = None
         if clearance:
             gap = hinge.radial_clearance
             if gap not in clearance_functions:
                 clearance_functions[gap] = exudyn_clearance_function(gap)
             law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
+            mbs.SetObjectParameter(connector, "springForceUserFunction", law)
+        elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
+            bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),
+                                              hinge_matrix(case, hinge, "damping", damping))
+            law = CreateSymbolicUserFunction(mbs, bearing, "springForceUserFunction", connector)
             mbs.SetObjectParameter(connector, "springForceUserFunction", law)
         sensor = mbs.AddSensor(eii.SensorObject(
             name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,
@@ -524,7 +569,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     link_mass = sum(link.mass for link in links.values())
     scene = Scene(case, system, mbs, ground, engine, links, reduced, hinges, static_loads, excitation_items,
                   _load_scale(case, excitation, link_mass), transducers=transducers,
-                  gyroscopics=gyroscopics)
+                  gyroscopics=gyroscopics, loss_factor_hz=loss_hz)
     log.info("scene of %r: %d bodies, %d hinges, %d transducers, %d ODE2 coordinates", case.name,
              1 + len(links), len(hinges), len(transducers), mbs.systemData.ODE2Size())
     return scene

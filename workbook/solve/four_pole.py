@@ -54,6 +54,7 @@ import scipy.linalg as sla
 
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case, HarmonicForce
+from workbook.scene.bearing import hinge_matrix
 
 __all__ = ["FourPole", "PylonResponse", "four_pole", "frequency_grid", "QUANTITIES"]
 
@@ -413,6 +414,7 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     turn = _engine_first(lin.basis, lin.body_coordinates[ENGINE])
     project = lambda matrix: turn.T @ matrix @ turn  # noqa: E731
     mass, stiffness, damping = project(lin.mass), project(lin.stiffness), project(lin.damping)
+    structural = np.zeros_like(mass) if lin.structural is None else project(lin.structural)
     gyroscopic = np.zeros_like(mass) if lin.gyroscopic is None else project(lin.gyroscopic)
     e = slice(0, ENGINE_COORDINATES)
     i = slice(ENGINE_COORDINATES, mass.shape[0])
@@ -420,14 +422,19 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     pins = [(np.asarray(position, dtype=float), carried) for position, carried in mount.pylon_pins()]
     channel = {name: n for n, name in enumerate(model.hinge_names)}
     hinges = {h.name: h for h in mount.hinges}
-    rows_k, rows_d, direct_k, direct_d = [], [], [], []
+    rows_k, rows_h, rows_d, direct_k, direct_d = [], [], [], [], []
+    damped = mount.effects.hinge_damping
     for _, carried in pins:
         rows_k.append(sum(model.stiffness_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
+        rows_h.append(sum(model.structural_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
         rows_d.append(sum(model.damping_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
-        direct_k.append(sum(hinges[h].stiffness for h in carried))
-        direct_d.append(sum(hinges[h].damping for h in carried) if mount.effects.hinge_damping else 0.0)
-    output_k, output_d = np.vstack(rows_k), np.vstack(rows_d)
-    direct_k, direct_d = np.repeat(direct_k, 3), np.repeat(direct_d, 3)
+        own_k = [hinge_matrix(mount, hinges[h], "stiffness") for h in carried]
+        direct_k.append(sum(k + (1j * hinge_matrix(mount, hinges[h], "loss_factor") @ k if damped else 0.0)
+                            for h, k in zip(carried, own_k)))
+        direct_d.append(sum(hinge_matrix(mount, hinges[h], "damping") for h in carried) if damped
+                        else np.zeros((3, 3)))
+    output_k, output_h, output_d = np.vstack(rows_k), np.vstack(rows_h), np.vstack(rows_d)
+    direct_k, direct_d = sla.block_diag(*direct_k), sla.block_diag(*direct_d)
 
     count, size = len(frequencies), 3 * len(pins)
     k11 = np.empty((count, ENGINE_COORDINATES, ENGINE_COORDINATES), dtype=complex)
@@ -437,16 +444,16 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     own = np.empty_like(k11)
     for j, frequency in enumerate(frequencies):
         omega = 2 * np.pi * frequency
-        dynamic = stiffness - omega ** 2 * mass + 1j * omega * damping
+        dynamic = stiffness - omega ** 2 * mass + 1j * (omega * damping + structural)
         own[j] = (-omega ** 2 * mass + 1j * omega * gyroscopic)[e, e]
-        outputs = output_k + 1j * omega * output_d
+        outputs = output_k + 1j * (output_h + omega * output_d)
         condensed = _solve(dynamic[i, i], np.hstack([dynamic[i, e], outputs[:, i].T]),
                            "the mount with both terminals blocked", frequency)
         by_engine, by_pins = condensed[:, :ENGINE_COORDINATES], condensed[:, ENGINE_COORDINATES:]
         k11[j] = dynamic[e, e] - own[j] - dynamic[e, i] @ by_engine
         k12[j] = dynamic[e, i] @ by_pins - outputs[:, e].T
         k21[j] = outputs[:, i] @ by_engine - outputs[:, e]
-        k22[j] = np.diag(direct_k + 1j * omega * direct_d) - outputs[:, i] @ by_pins
+        k22[j] = direct_k + 1j * omega * direct_d - outputs[:, i] @ by_pins
 
     jacobian = lambda point: (model.engine_point_jacobian(np.asarray(point, dtype=float)) @ turn)[:, e]  # noqa: E731
     kinematics = np.vstack([jacobian(position) for position, _ in pins])

@@ -8,10 +8,20 @@ constraints projected out),
 
 with f the excitation force (3 components, N) at a point of the engine.
 For ``f(t) = Re(f_hat exp(i w t))`` the steady state is
-``z_hat = (K - w^2 M + i w D)^-1 B f_hat`` and
-``F_hat = (C_k + i w C_d) z_hat``: exact for a linear scene (no clearance),
-at any frequency, with no transient to wait for. The hinge damping is the
-case's viscous damping, exactly as in the time domain.
+``z_hat = (K - w^2 M + i w D + i H)^-1 B f_hat`` and
+``F_hat = (C_k + i C_h + i w C_d) z_hat``: exact for a linear scene (no
+clearance), at any frequency, with no transient to wait for. The viscous
+damping D is the case's, exactly as in the time domain.
+
+H is the structural (hysteretic) damping of the loss factors, exact at every
+frequency (:mod:`workbook.scene.structural_damping`). A hinge j with loss
+factor eta_j acts with ``(1 + i eta_j)`` times its tangent stiffness: with
+``J_j = d(p1 - p0)/dz`` (Exudyn's ``Displacement`` output of the connector,
+by central differences) and ``C_k,j = K_j J_j`` its force rows, its
+hysteretic force is ``i eta_j C_k,j z`` (the rows of C_h) and its
+generalised force adds ``J_j^T eta_j C_k,j`` to H. A flexible link with loss
+factor eta adds ``eta K_red`` on its modal coordinates (complex modulus of
+its elastic stiffness).
 
 B and C_k, C_d come from Exudyn itself: central differences of the
 engine's point position (``GetObjectOutputBody``) and of the ``Force``
@@ -23,6 +33,7 @@ parts 90 degrees apart are superposed in one complex solve.
 """
 from __future__ import annotations
 
+import dataclasses
 import logging
 from dataclasses import dataclass, field
 from typing import Callable
@@ -33,7 +44,8 @@ import scipy.linalg as sla
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.model.case import ENGINE, SingleFrequencyExcitation
-from workbook.scene.build import Scene
+from workbook.scene.bearing import hinge_matrix
+from workbook.scene.build import Scene, loss_factors
 from workbook.solve.modes import Linearization, linearize
 
 __all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "FrequencyResponse"]
@@ -90,6 +102,10 @@ class HarmonicModel:
     engine_point_jacobian : callable
         ``jacobian(point)``: d(position of a point of the engine)/dz,
         shape (3, n); *point* in global coordinates of the reference state, m.
+    structural_output : ndarray, shape (3 h, n)
+        C_h, the hysteretic channel force per coordinate, N/m ... (zero
+        without loss factors or when the scene holds their viscous
+        equivalent instead); H is ``linearization.structural``.
     """
 
     linearization: Linearization
@@ -98,7 +114,12 @@ class HarmonicModel:
     stiffness_output: np.ndarray
     damping_output: np.ndarray
     engine_point_jacobian: Callable[[np.ndarray], np.ndarray] = field(repr=False)
+    structural_output: np.ndarray = field(default=None, repr=False)
     _inputs: dict = field(default_factory=dict, repr=False)
+
+    def __post_init__(self):
+        if self.structural_output is None:
+            self.structural_output = np.zeros_like(self.stiffness_output)
 
     @property
     def dof(self) -> int:
@@ -127,8 +148,11 @@ class HarmonicModel:
         lin = self.linearization
         omega = 2 * np.pi * frequency_hz
         dynamic = lin.stiffness - omega ** 2 * lin.mass + 1j * omega * lin.damping
+        if lin.structural is not None:
+            dynamic = dynamic + 1j * lin.structural
         motion = sla.solve(dynamic, load, check_finite=False)
-        forces = ((self.stiffness_output + 1j * omega * self.damping_output) @ motion).reshape(-1, 3)
+        outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
+        forces = (outputs @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces))
         pylon = pylon_sum(hinges, self.pylon_hinges)
         return FrequencyResponse(frequency_hz, hinges, pylon)
@@ -193,6 +217,9 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
     everything = range(len(q0))
     stiffness = _central_difference(forces, set_q, q0, everything, COORDINATE_STEP) @ lin.basis
     damping = _central_difference(forces, set_v, v0, everything, VELOCITY_STEP) @ lin.basis
+    structural, structural_output = _structural_damping(scene, lin, stiffness, names, set_q, q0)
+    if structural is not None:
+        lin = dataclasses.replace(lin, structural=structural)
 
     engine_coordinates = lin.body_coordinates[ENGINE]
     engine_body = scene.engine.body
@@ -210,4 +237,39 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
 
     log.info("harmonic model of %r: %d independent coordinates, %d force channels", scene.case.name,
              lin.mass.shape[0], len(names))
-    return HarmonicModel(lin, names, list(scene.pylon_channels), stiffness, damping, point_jacobian)
+    return HarmonicModel(lin, names, list(scene.pylon_channels), stiffness, damping, point_jacobian,
+                         structural_output)
+
+
+def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.ndarray, names: list,
+                        set_q, q0: np.ndarray) -> tuple[np.ndarray | None, np.ndarray]:
+    """H and C_h of the loss factors the scene does not hold as viscous
+    damping (module docstring); H is None when there are none."""
+    import exudyn as exu
+
+    output = np.zeros_like(stiffness_output)
+    hinge_loss, link_loss = loss_factors(scene.case)
+    if scene.loss_factor_hz is not None or not (hinge_loss or link_loss):
+        return None, output
+    structural = np.zeros_like(lin.stiffness)
+    mbs = scene.mbs
+    if hinge_loss:
+        lossy = list(hinge_loss)
+        by_name = {hinge.name: hinge for hinge in scene.case.hinges}
+        connectors = [scene.hinges[name].connector for name in lossy]
+
+        def displacements() -> np.ndarray:
+            return np.concatenate([mbs.GetObjectOutput(c, exu.OutputVariableType.Displacement) for c in connectors])
+
+        jacobian = _central_difference(displacements, set_q, q0, range(len(q0)), COORDINATE_STEP) @ lin.basis
+        for k, name in enumerate(lossy):
+            rows = slice(3 * names.index(name), 3 * names.index(name) + 3)
+            output[rows] = hinge_matrix(scene.case, by_name[name], "loss_factor") @ stiffness_output[rows]
+            structural += jacobian[3 * k:3 * k + 3].T @ output[rows]
+    for name, eta in link_loss.items():
+        modal_node = scene.links[name].nodes[1]
+        start = mbs.GetNodeODE2Index(modal_node)
+        reduced_stiffness = np.asarray(scene.reduced[name].ffrf["stiffnessMatrixReduced"], dtype=float)
+        projection = lin.basis[start:start + reduced_stiffness.shape[0]]
+        structural += eta * projection.T @ reduced_stiffness @ projection
+    return structural, output

@@ -69,6 +69,11 @@ class Linearization:
     gyroscopic : ndarray, shape (n, n), or None
         The rotors' gyroscopic matrix G (skew-symmetric, N m s), projected;
         *damping* already contains it. None when no rotor is built.
+    structural : ndarray, shape (n, n), or None
+        Structural damping H of loss factors (complex stiffness K + i H,
+        N/m ...; :mod:`workbook.solve.harmonic`), when the frequency domain
+        adds it; a mode of circular frequency w counts it as the viscous
+        damping H / w.
     """
 
     mass: np.ndarray
@@ -78,6 +83,7 @@ class Linearization:
     full_mass: np.ndarray
     body_coordinates: dict
     gyroscopic: np.ndarray | None = None
+    structural: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -236,6 +242,8 @@ def modes_of(linearization: Linearization, *, gyroscopic: bool = True) -> list[M
                                  / kinetic)
         engine = _real_shape(full[lin.body_coordinates[ENGINE]])
         decay = float(np.real(np.conj(vector) @ lin.damping @ vector)) / (2 * kinetic)
+        if lin.structural is not None and omega_squared > 0:
+            decay += float(np.real(np.conj(vector) @ lin.structural @ vector)) / (2 * kinetic * np.sqrt(omega_squared))
         modes.append(Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), decay, shares[ENGINE],
                           engine, {b: s for b, s in shares.items() if b != ENGINE}, float(omega_squared)))
     return modes

@@ -117,7 +117,7 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
         if reduced is None:
             reduced = _reduce(case, excitation, reduce_for or excitation, progress)
     with timed(timings, "build scene"):
-        scene = build_scene(case, excitation, reduced=reduced)
+        scene = build_scene(case, excitation, reduced=reduced, exact_loss_factors=harmonic)
     try:
         with timed(timings, "static preload"):
             preload = solve_preload(scene)
@@ -209,8 +209,8 @@ def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
 
 def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
     return {
-        "analysis": "frequency domain: (K - w^2 M + i w D) z = B f per frequency (dense complex solve), "
-                    "F_hinge = (C_k + i w C_d) z",
+        "analysis": "frequency domain: (K - w^2 M + i w D + i H) z = B f per frequency (dense complex solve), "
+                    "F_hinge = (C_k + i C_h + i w C_d) z",
         "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness of the preload for "
                          "the rigid-body motion of the engine and the links; the links' elastic modes stiffened by "
                          "their axial preload only where the stress-stiffening effect is on); "
@@ -220,7 +220,8 @@ def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
                              f"transducer) Force outputs (coordinate step {COORDINATE_STEP:g}, velocity step "
                              f"{VELOCITY_STEP:g})",
         "damping": "viscous: hinge damping and Rayleigh link damping exactly as in the time domain, plus the "
-                   "rotors' gyroscopic coupling when built",
+                   "rotors' gyroscopic coupling when built; structural: the loss factors as complex stiffness "
+                   "k (1 + i eta), exact at every frequency",
         "static equilibrium check": f"relative {case.analysis.equilibrium_tolerance:g}",
     }
 

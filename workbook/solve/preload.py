@@ -136,7 +136,7 @@ def spring_roundoff_force(scene: Scene) -> float:
     :data:`ROUNDOFF_MARGIN`.
     """
     case = scene.case
-    stiffness = [max(h.stiffness, h.gap_contact_stiffness) for h in case.hinges]
+    stiffness = [h.largest_stiffness for h in case.hinges]
     if scene.transducers:
         stiffness += list(case.test_rig.stiffness)
     reach = max((float(np.abs(h.position).max()) for h in case.hinges), default=0.0)
@@ -353,7 +353,7 @@ def static_failure_message(scene: Scene, reached: float, tolerance: float) -> st
         Newton's absolute tolerance, N.
     """
     case = scene.case
-    stiffest = max(max(h.stiffness, h.gap_contact_stiffness) for h in case.hinges)
+    stiffest = max(h.largest_stiffness for h in case.hinges)
     where = f"case {case.name!r}: the static solve failed"
     if reached >= LIMIT_LOAD_SHARE:
         return (f"{where}: applied in steps, the static loads ({_load_listing(scene)}) could be carried up to "

@@ -1,0 +1,80 @@
+"""A hinge's stiffness, damping and loss factor per direction of its frame.
+
+A spherical bearing in a link eye is stiffer radially than along its pin.
+A hinge may give three values in its frame (rows ``n_1, n_2, n_3``: radial
+1, radial 2, axial; :attr:`workbook.model.case.Hinge.frame`), which act in
+global coordinates as the matrix
+
+    S = R^T diag(s_1, s_2, s_3) R,        R = [n_1; n_2; n_3],
+
+so a displacement along ``n_i`` meets ``s_i`` alone. Exudyn's Cartesian
+spring-damper takes one diagonal in global axes; an anisotropic hinge gets
+a symbolic ``springForceUserFunction`` ``F = S_k u + S_d v`` (recorded, it
+runs at C++ speed), an isotropic hinge stays the plain spring-damper.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from workbook.model.case import ENGINE, PYLON, Case, Hinge
+
+__all__ = ["hinge_frame", "hinge_matrix", "exudyn_bearing_function"]
+
+
+def hinge_frame(case: Case, hinge: Hinge) -> np.ndarray:
+    """The hinge's directions radial 1, radial 2, axial as rows, global coordinates.
+
+    The hinge's own ``frame`` when given; else the frame of the link it sits
+    on (radial 1 along the link towards eye B, axial along the link's bore
+    axis, see :func:`flexbodies.exudyn_body.link_rotation`); else (a hinge
+    between the pylon and the engine) the global axes.
+    """
+    from flexbodies.exudyn_body import link_rotation
+
+    if hinge.frame is not None:
+        return np.array(hinge.frame, dtype=float)
+    links = [body for body in hinge.bodies if body not in (PYLON, ENGINE)]
+    if not links:
+        return np.eye(3)
+    link = case.link_map[links[0]]
+    return link_rotation(link.end_a, link.end_b, link.bore_axis).T
+
+
+def hinge_matrix(case: Case, hinge: Hinge, name: str, values=None) -> np.ndarray:
+    """``R^T diag(values) R``: a per-direction quantity of *hinge* in global coordinates, shape (3, 3).
+
+    Parameters
+    ----------
+    case : Case
+    hinge : Hinge
+    name : {"stiffness", "damping", "loss_factor"}
+        The quantity (N/m, N s/m or dimensionless).
+    values : array_like, shape (3,), optional
+        Values to use instead of the hinge's own *name*.
+    """
+    values = hinge.values(name) if values is None else np.broadcast_to(np.asarray(values, dtype=float), (3,))
+    if np.ptp(values) == 0:
+        return values[0] * np.eye(3)
+    frame = hinge_frame(case, hinge)
+    return frame.T @ np.diag(values) @ frame
+
+
+def exudyn_bearing_function(stiffness: np.ndarray, damping: np.ndarray):
+    """A ``springForceUserFunction`` for ``ObjectConnectorCartesianSpringDamper``:
+    ``F = S_k u + S_d v`` with constant 3x3 matrices (global coordinates).
+
+    Parameters
+    ----------
+    stiffness : ndarray, shape (3, 3)
+        N/m.
+    damping : ndarray, shape (3, 3)
+        N s/m.
+    """
+    k = [[float(v) for v in row] for row in np.asarray(stiffness)]
+    d = [[float(v) for v in row] for row in np.asarray(damping)]
+
+    def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
+        return [k[i][0] * displacement[0] + k[i][1] * displacement[1] + k[i][2] * displacement[2]
+                + d[i][0] * velocity[0] + d[i][1] * velocity[1] + d[i][2] * velocity[2] for i in range(3)]
+
+    return spring_force
