@@ -41,7 +41,8 @@ def run(args) -> int:
     import numpy as np
 
     from workbook.model.case import DIRECTIONS
-    from workbook.solve.four_pole import QUANTITIES, four_pole, frequency_grid
+    from workbook.solve.four_pole import QUANTITIES, frequency_grid
+    from workbook.solve.four_pole_set import four_pole
     from workbook.solve.harmonic import excitation_phasor
 
     frequencies = frequency_grid(args.start, args.stop, args.points)

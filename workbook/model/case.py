@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from workbook.errors import CaseError
+from workbook.model.pylon_impedance import PylonImpedance
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
@@ -832,6 +833,9 @@ class Case:
     rotors : tuple of Rotor
         Spinning rotors whose gyroscopic moments act on the engine (their
         mass and inertia are part of ``engine``).
+    pylon_impedance : PylonImpedance or None
+        The pylon's point dynamic stiffness at its pins against frequency
+        (None: a rigid pylon); frequency domain only.
     """
 
     name: str
@@ -845,6 +849,7 @@ class Case:
     description: str = ""
     test_rig: ForceTransducers | None = None
     rotors: tuple[Rotor, ...] = ()
+    pylon_impedance: PylonImpedance | None = None
 
     def __post_init__(self):
         _name(self.name, "case")
@@ -864,6 +869,10 @@ class Case:
                     raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
             _set(self, name, items)
         self._check_names(groups)
+        if self.pylon_impedance is not None:
+            if not isinstance(self.pylon_impedance, PylonImpedance):
+                raise CaseError("case", "pylon_impedance", self.pylon_impedance, "a PylonImpedance or None")
+            self.pylon_impedance.pin_order(self.pylon_pins())
         links = self.link_map
         for hinge in self.hinges:
             for name in ("body_a", "body_b"):

@@ -53,9 +53,9 @@ import numpy as np
 import scipy.linalg as sla
 
 from workbook.errors import CaseError, FourPoleError
-from workbook.model.case import DIRECTIONS, ENGINE, Case, HarmonicForce
+from workbook.model.case import DIRECTIONS, ENGINE, Case
 
-__all__ = ["FourPole", "PylonResponse", "four_pole", "frequency_grid", "QUANTITIES"]
+__all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES"]
 
 #: The per-direction quantities of :meth:`FourPole.direction_values` with their meaning.
 QUANTITIES = {
@@ -84,6 +84,20 @@ def frequency_grid(start_hz: float, stop_hz: float, points: int) -> np.ndarray:
     if int(points) != points or points < 1:
         raise CaseError("four-pole frequencies", "points", points, "a whole number >= 1")
     return np.geomspace(start_hz, stop_hz, int(points)) if points > 1 else np.array([float(start_hz)])
+
+
+def checked_frequencies(frequencies_hz) -> np.ndarray:
+    """*frequencies_hz* as a flat array, Hz.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        No frequency, or one not > 0.
+    """
+    frequencies = np.asarray(frequencies_hz, dtype=float).reshape(-1)
+    if frequencies.size == 0 or not np.all(np.isfinite(frequencies)) or frequencies.min() <= 0:
+        raise CaseError("four-pole frequencies", "frequencies", list(frequencies), "one or more frequencies > 0 Hz")
+    return frequencies
 
 
 def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) -> np.ndarray:
@@ -344,7 +358,7 @@ class FourPole:
         return fig
 
 
-def _mount_case(case: Case) -> Case:
+def mount_case(case: Case) -> Case:
     """The case whose scene the four-pole set is formed from: the pylon pins on
     rigid ground (no test-rig transducers: the rig is the pylon's side).
 
@@ -373,16 +387,16 @@ def _engine_first(basis: np.ndarray, engine: np.ndarray) -> np.ndarray:
     return np.hstack([rows.T, sla.null_space(rows)])
 
 
-def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
-    """The four-pole set of the mount of *case* at *frequencies_hz*, about
-    its preloaded equilibrium.
+def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
+    """The four-pole set of the mount of *case* at *frequencies_hz* from the
+    harmonic model of its preloaded scene.
 
     Parameters
     ----------
+    model : HarmonicModel
+        Of the scene of ``mount_case(case)`` (:func:`mount_case`), prepared
+        with its preload.
     case : Case
-        Its links are reduced for the highest frequency. Test-rig
-        transducers are not part of the mount (give them as a pylon
-        impedance).
     frequencies_hz : sequence of float
         Hz, > 0.
     points : sequence of 3 floats
@@ -393,22 +407,13 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     Raises
     ------
     workbook.errors.CaseError
-        A hinge with a clearance law, no pylon-side hinge, or no frequency.
-    workbook.errors.SimulationError
-        A mechanism or a failed equilibrium (preload); a singular set
-        (:class:`~workbook.errors.FourPoleError`).
+        No frequency.
+    workbook.errors.FourPoleError
+        A singular set.
     """
-    from workbook.solve.pipeline import prepare
-
-    frequencies = np.asarray(frequencies_hz, dtype=float).reshape(-1)
-    if frequencies.size == 0 or not np.all(np.isfinite(frequencies)) or frequencies.min() <= 0:
-        raise CaseError("four-pole frequencies", "frequencies", list(frequencies), "one or more frequencies > 0 Hz")
-    mount = _mount_case(case)
+    frequencies = checked_frequencies(frequencies_hz)
+    mount = mount_case(case)
     center = np.asarray(case.engine.center_of_mass, dtype=float)
-    probe = HarmonicForce("four-pole probe", point=tuple(center), direction=(1.0, 0.0, 0.0), amplitude=1.0,
-                          frequency_hz=float(frequencies.max()))
-    prepared = prepare(mount, probe)
-    model = prepared.model
     lin = model.linearization
     turn = _engine_first(lin.basis, lin.body_coordinates[ENGINE])
     project = lambda matrix: turn.T @ matrix @ turn  # noqa: E731

@@ -28,6 +28,8 @@ from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
+from workbook.solve.flexible_pylon import refuse_time_domain, solve_on_pylon
+from workbook.solve.four_pole import mount_case
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
@@ -162,6 +164,7 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         time budget; the message says when and why.
     """
     method = method or MethodChoice(TIME, "asked for directly (run_excitation)")
+    refuse_time_domain(case, method.reason)
     prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
@@ -268,7 +271,11 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     for item in case.excitations:
         points = item.expand() if isinstance(item, Sweep) else (item,)
         chosen = method or choose_method(case, sweep=isinstance(item, Sweep))
-        if chosen.method == FREQUENCY:
+        if chosen.method == FREQUENCY and case.pylon_impedance is not None:
+            prepared = prepare(mount_case(case), points[0], reduce_for=points[-1], progress=progress)
+            with prepared.scene:
+                item_runs, item_cards, item_preloads = solve_on_pylon(case, prepared, points, chosen)
+        elif chosen.method == FREQUENCY:
             prepared = prepare(case, points[0], reduce_for=points[-1], progress=progress)
             with prepared.scene:
                 item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
