@@ -42,6 +42,9 @@ def run(args) -> int:
         if args.pylon_impedance:
             raise UsageError("--pylon-impedance: a case workbook takes the table as its 'Pylon impedance' sheet")
         return workbooks.run_workbook(args)
+    if args.four_pole:
+        raise UsageError("--four-pole adds a sheet to a case workbook's --report; for a JSON case or the reference "
+                         "mount use mountwb four-pole")
     case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget, method=args.method,
                      pylon_impedance=args.pylon_impedance)
     result = run_case(case, progress=None if args.no_progress else progress_factory())

@@ -55,7 +55,8 @@ import scipy.linalg as sla
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
 
-__all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES"]
+__all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
+           "REPORT_GRID"]
 
 #: The per-direction quantities of :meth:`FourPole.direction_values` with their meaning.
 QUANTITIES = {
@@ -65,6 +66,8 @@ QUANTITIES = {
 }
 #: Engine coordinates of the four-pole set: centre-of-gravity translations, then rotations.
 ENGINE_COORDINATES = 6
+#: The default frequencies of a four-pole table: from (Hz), to (Hz), log-spaced points.
+REPORT_GRID = (10.0, 500.0, 41)
 #: Smallest reciprocal condition number of a matrix the four-pole set inverts.
 SINGULAR_RCOND = 1e-13
 

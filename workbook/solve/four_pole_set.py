@@ -4,10 +4,10 @@ engine and the pylon pins (:func:`workbook.solve.four_pole.condense`)."""
 from __future__ import annotations
 
 from workbook.model.case import Case, HarmonicForce
-from workbook.solve.four_pole import FourPole, checked_frequencies, condense, mount_case
+from workbook.solve.four_pole import REPORT_GRID, FourPole, checked_frequencies, condense, frequency_grid, mount_case
 from workbook.solve.pipeline import prepare
 
-__all__ = ["four_pole"]
+__all__ = ["four_pole", "report_four_pole"]
 
 
 def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
@@ -41,3 +41,9 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     prepared = prepare(mount_case(case), probe)
     with prepared.scene:
         return condense(prepared.model, case, frequencies, points=points)
+
+
+def report_four_pole(case: Case) -> FourPole:
+    """The four-pole set of *case* on the default grid (:data:`~workbook.solve.four_pole.REPORT_GRID`),
+    for the report workbook's Four-pole sheet."""
+    return four_pole(case, frequency_grid(*REPORT_GRID))
