@@ -31,7 +31,7 @@ from workbook.solve.method import MethodChoice
 from workbook.solve.modes import mounted_modes
 from workbook.solve.stages import link_warnings
 
-__all__ = ["refuse_time_domain", "solve_on_pylon", "pylon_effect"]
+__all__ = ["refuse_time_domain", "pylon_stiffness", "solve_on_pylon", "pylon_effect"]
 
 
 def refuse_time_domain(case: Case, reason: str) -> None:
@@ -74,8 +74,21 @@ def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.nd
         pylon_history=empty, excitation_history=empty, window=slice(0, 0))
 
 
-def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], method: MethodChoice
-                   ) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict]:
+def pylon_stiffness(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> np.ndarray:
+    """``Z_p`` of the pylon impedance of *case* at the frequencies of *points*, in the order of
+    ``case.pylon_pins()``, complex, shape (len(points), pins, 3, 3), N/m.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        An excitation frequency outside the impedance table.
+    """
+    impedance = case.pylon_impedance
+    return impedance.at([x.frequency for x in points], impedance.pin_order(case.pylon_pins()))
+
+
+def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], stiffness: np.ndarray,
+                   method: MethodChoice) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict]:
     """Frequency-domain answers of *points* on the pylon impedance of *case*.
 
     Parameters
@@ -85,6 +98,8 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
     prepared : PreparedScene
         The scene of ``mount_case(case)`` prepared with its harmonic model.
     points : tuple of RotatingForce or HarmonicForce
+    stiffness : ndarray, complex, shape (len(points), pins, 3, 3)
+        The pylon's point dynamic stiffness at each excitation (:func:`pylon_stiffness`), N/m.
     method : MethodChoice
 
     Returns
@@ -97,14 +112,9 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
 
     Raises
     ------
-    workbook.errors.CaseError
-        An excitation frequency outside the impedance table.
     workbook.errors.FourPoleError
         A singular set (an undamped resonance at an excitation frequency).
     """
-    impedance = case.pylon_impedance
-    order = impedance.pin_order(case.pylon_pins())
-    stiffness = impedance.at([x.frequency for x in points], order)
     mounted = mounted_modes(prepared.modes)
     runs, cards, preloads = [], {}, {}
     for excitation, pylon in zip(points, stiffness):

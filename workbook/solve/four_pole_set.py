@@ -20,12 +20,8 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
         Its links are reduced for the highest frequency. Test-rig
         transducers are not part of the mount (give them as a pylon
         impedance).
-    frequencies_hz : sequence of float
-        Hz, > 0.
-    points : sequence of 3 floats
-        Excitation points of the engine (m) whose force inputs the set
-        keeps for :meth:`FourPole.respond`; the case's excitation points and
-        the centre of gravity are always kept.
+    frequencies_hz, points
+        As :func:`~workbook.solve.four_pole.condense` takes them.
 
     Raises
     ------
