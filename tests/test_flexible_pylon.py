@@ -79,6 +79,7 @@ def test_soft_pylon_is_two_springs_in_series(tmp_path):
         assert run.transmissibility[0] < 1e-9
         card = result.model_cards[run.name]
         assert any(e.name.startswith("flexible pylon") and "pylon.csv" in e.detail for e in card.effects)
+        assert not any("rigid" in e.detail for e in card.effects if e.name.startswith("test-rig"))
 
 
 def test_between_table_frequencies_real_and_imaginary_parts_are_linear(tmp_path):
