@@ -243,8 +243,8 @@ def _rig_sensors(scene) -> EffectEntry:
     """The test-rig force transducers: built or not, and why."""
     name, rig = "test-rig force-sensor compliance", scene.case.test_rig
     if not scene.transducers:
-        fittings = ("the pylon is the case's point dynamic stiffness instead (flexible pylon)"
-                    if scene.case.pylon_impedance is not None else "the pylon fittings are rigid")
+        fittings = ("the case's flexible pylon is at the pins instead"
+                    if scene.case.flexible_pylon else "the pylon fittings are rigid")
         return EffectEntry(name, False, f"switched off: {fittings}" if rig is not None
                            else f"no transducers given: {fittings}")
     pins = "; ".join(" + ".join(items.hinges) for items in scene.transducers.values())

@@ -1,23 +1,31 @@
-"""Runs on a flexible pylon given as a point dynamic stiffness at its pins.
+"""Runs on a flexible pylon: a point dynamic stiffness table or a box beam at the pins.
 
-The case's :class:`~workbook.model.pylon_impedance.PylonImpedance` ``Z_p(f)``
-enters exactly in the frequency domain: the mount's four-pole set at the
-excitation's frequency (:func:`workbook.solve.four_pole.condense`, formed
-from the harmonic model of the preloaded scene with the pins on rigid
-ground) is closed by the pylon,
+The mount's four-pole set at the excitation's frequency
+(:func:`workbook.solve.four_pole.condense`, formed from the harmonic model
+of the preloaded scene with the pins on rigid ground) is closed by the
+pylon, exactly in the frequency domain:
 
-    (Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f,    x2 = -(K22 + Z_p)^-1 K21 x1,
+- a :class:`~workbook.model.pylon_impedance.PylonImpedance` ``Z_p(f)`` per
+  pin: ``(Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f``,
+  ``x2 = -(K22 + Z_p)^-1 K21 x1``, the pylon loaded with ``Z_p x2``;
+- a :class:`~workbook.model.pylon_beam.BoxBeamPylon`: its compliance ``G``
+  at the pins, coupled through the beam (:mod:`workbook.solve.pylon_beam`):
+  ``(Z_e + K11 - K12 G (I + K22 G)^-1 K21) x1 = B f``, the pylon loaded with
+  ``-(I + K22 G)^-1 K21 x1``.
 
-and the pylon is loaded with ``Z_p x2`` at each pin. The pylon force is the
-sum of the pin forces, whose amplitudes give T and eta as on a rigid pylon.
+The pylon force is the sum of the pin forces, whose amplitudes give T and
+eta as on a rigid pylon.
 
-The time domain cannot take a dynamic stiffness that is only known at
-frequencies (a convolution kernel would need its causal, stable fit over all
-frequencies, which a table over a band does not give): it refuses the case.
+The time domain refuses both: a dynamic stiffness known only at table
+frequencies has no time-domain model here (a convolution kernel would need
+its causal, stable fit over all frequencies, which a table over a band does
+not give), and the box beam is built as a frequency-domain compliance, not
+as a body of the time-domain scene.
 """
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -29,37 +37,86 @@ from workbook.solve.four_pole import condense
 from workbook.solve.harmonic import excitation_phasor
 from workbook.solve.method import MethodChoice
 from workbook.solve.modes import mounted_modes
+from workbook.solve.pylon_beam import beam_model
 from workbook.solve.stages import link_warnings
 
-__all__ = ["refuse_time_domain", "pylon_stiffness", "solve_on_pylon", "pylon_effect"]
+__all__ = ["PylonAt", "refuse_time_domain", "pylon_at", "solve_on_pylon"]
+
+
+@dataclass(frozen=True)
+class PylonAt:
+    """The case's flexible pylon at the frequencies of its excitations.
+
+    Attributes
+    ----------
+    stiffness : ndarray or None, complex, shape (n, p, 3, 3)
+        Point dynamic stiffness per pin (an impedance table), N/m.
+    compliance : ndarray or None, complex, shape (n, 3 p, 3 p)
+        Compliance at the pins, coupled between them (a box beam), m/N.
+    effect : EffectEntry
+        The model-card entry.
+    seconds : float
+        Wall time of forming it, s.
+    """
+
+    stiffness: np.ndarray | None
+    compliance: np.ndarray | None
+    effect: EffectEntry
+    seconds: float
+
+    def closure(self, j: int) -> dict:
+        """The keyword arguments of :meth:`~workbook.solve.four_pole.FourPole.respond` at excitation *j*."""
+        if self.stiffness is not None:
+            return {"pylon": self.stiffness[j][None]}
+        return {"compliance": self.compliance[j][None]}
 
 
 def refuse_time_domain(case: Case, reason: str) -> None:
-    """Refuse a time-domain run of *case* when it has a pylon impedance.
+    """Refuse a time-domain run of *case* when it has a flexible pylon.
 
     Raises
     ------
     workbook.errors.CaseError
-        The case gives a pylon impedance: a table against frequency has no
-        time-domain counterpart.
+        The case gives a pylon impedance or a pylon beam.
     """
-    impedance = case.pylon_impedance
-    if impedance is not None:
-        raise CaseError(f"case {case.name!r}", "pylon_impedance", impedance.source,
+    if case.pylon_impedance is not None:
+        raise CaseError(f"case {case.name!r}", "pylon_impedance", case.pylon_impedance.source,
                         f"no frequency-dependent pylon impedance in the time domain ({reason}): a dynamic "
                         f"stiffness tabulated against frequency has no time-domain model here; run the "
                         f"frequency domain (method 'auto' or 'frequency', no hinge clearance) or remove the "
                         f"pylon impedance")
+    if case.pylon_beam is not None:
+        raise CaseError(f"case {case.name!r}", "pylon_beam", case.pylon_beam.name,
+                        f"no pylon beam in the time domain ({reason}): the box beam is built as the pylon's "
+                        f"compliance in the frequency domain; run the frequency domain (method 'auto' or "
+                        f"'frequency', no hinge clearance) or remove the pylon beam")
 
 
-def pylon_effect(case: Case, seconds: float) -> EffectEntry:
-    """The model-card entry of the pylon impedance of *case* (which must have one)."""
-    return EffectEntry(
-        "flexible pylon (point dynamic stiffness)", True,
-        f"{case.pylon_impedance.describe()}; real and imaginary parts interpolated linearly in frequency; "
-        f"enters exactly through the mount's four-pole set closed by the pylon (6 engine + "
-        f"{3 * len(case.pylon_pins())} pin coordinates, {seconds:.3g} s); the mounted modes listed are "
-        f"those on a rigid pylon")
+def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> PylonAt:
+    """The flexible pylon of *case* at the frequencies of *points*, in the order of ``case.pylon_pins()``.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        An excitation frequency outside the impedance table; a pin beyond
+        the beam's ends.
+    """
+    start = time.perf_counter()
+    frequencies = [x.frequency for x in points]
+    pins = case.pylon_pins()
+    if case.pylon_impedance is not None:
+        impedance = case.pylon_impedance
+        stiffness = impedance.at(frequencies, impedance.pin_order(pins))
+        effect = EffectEntry("flexible pylon (point dynamic stiffness)", True,
+                             f"{impedance.describe()}; real and imaginary parts interpolated linearly in frequency")
+        return PylonAt(stiffness, None, effect, time.perf_counter() - start)
+    beam = case.pylon_beam
+    model = beam_model(beam, [position for position, _ in pins])
+    compliance = model.compliance(frequencies)
+    effect = EffectEntry("flexible pylon (box beam)", True,
+                         f"{beam.describe()}; {len(model.stations) - 1} Euler-Bernoulli elements, "
+                         f"{model.stiffness.shape[0]} DOF, pins on rigid offsets, compliance at the pins")
+    return PylonAt(None, compliance, effect, time.perf_counter() - start)
 
 
 def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.ndarray,
@@ -74,32 +131,19 @@ def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.nd
         pylon_history=empty, excitation_history=empty, window=slice(0, 0))
 
 
-def pylon_stiffness(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> np.ndarray:
-    """``Z_p`` of the pylon impedance of *case* at the frequencies of *points*, in the order of
-    ``case.pylon_pins()``, complex, shape (len(points), pins, 3, 3), N/m.
-
-    Raises
-    ------
-    workbook.errors.CaseError
-        An excitation frequency outside the impedance table.
-    """
-    impedance = case.pylon_impedance
-    return impedance.at([x.frequency for x in points], impedance.pin_order(case.pylon_pins()))
-
-
-def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], stiffness: np.ndarray,
+def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], pylon: PylonAt,
                    method: MethodChoice) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict]:
-    """Frequency-domain answers of *points* on the pylon impedance of *case*.
+    """Frequency-domain answers of *points* on the flexible pylon of *case*.
 
     Parameters
     ----------
     case : Case
-        With a pylon impedance.
+        With a pylon impedance or a pylon beam.
     prepared : PreparedScene
         The scene of ``mount_case(case)`` prepared with its harmonic model.
     points : tuple of RotatingForce or HarmonicForce
-    stiffness : ndarray, complex, shape (len(points), pins, 3, 3)
-        The pylon's point dynamic stiffness at each excitation (:func:`pylon_stiffness`), N/m.
+    pylon : PylonAt
+        The pylon at the frequencies of *points* (:func:`pylon_at`).
     method : MethodChoice
 
     Returns
@@ -117,20 +161,22 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
     """
     mounted = mounted_modes(prepared.modes)
     runs, cards, preloads = [], {}, {}
-    for excitation, pylon in zip(points, stiffness):
+    for j, excitation in enumerate(points):
         start = time.perf_counter()
         pole = condense(prepared.model, case, [excitation.frequency], points=[excitation.point])
-        response = pole.respond(excitation_phasor(excitation), excitation.point, pylon[None])[0]
+        response = pole.respond(excitation_phasor(excitation), excitation.point, **pylon.closure(j))[0]
         seconds = time.perf_counter() - start
         result = _result(excitation, pole.pins, response.pin_forces, case.analysis.steady_tolerance)
         result.warnings.extend(link_warnings(case, prepared.scene.reduced))
-        timings = dict(prepared.timings, **{"harmonic solve on the pylon": seconds})
-        solver = {"analysis": "frequency domain on a flexible pylon: (Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f, "
-                              "pin forces Z_p x2, x2 = -(K22 + Z_p)^-1 K21 x1",
+        timings = dict(prepared.timings, **{"pylon": pylon.seconds, "harmonic solve on the pylon": seconds})
+        solver = {"analysis": "frequency domain on a flexible pylon: the mount's four-pole set (6 engine + "
+                              f"{3 * len(pole.pins)} pin coordinates) closed by the pylon",
                   "independent coordinates": prepared.model.dof,
                   "static equilibrium check": f"relative {case.analysis.equilibrium_tolerance:g}"}
         card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method, solver)
-        card.effects.append(pylon_effect(case, seconds))
+        card.effects.append(EffectEntry(pylon.effect.name, True, f"{pylon.effect.detail}; exact through the "
+                                        f"mount's four-pole set; the mounted modes listed are those on a rigid "
+                                        f"pylon"))
         card.run_name = excitation.name
         runs.append(result)
         cards[result.name] = card

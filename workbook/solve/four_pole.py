@@ -235,7 +235,7 @@ class FourPole:
             blocks[:, 3 * p:3 * p + 3, 3 * p:3 * p + 3] = value[:, p]
         return blocks
 
-    def respond(self, force, point, pylon=None) -> list[PylonResponse]:
+    def respond(self, force, point, pylon=None, *, compliance=None) -> list[PylonResponse]:
         """Response to the force phasor *force* (N, shape (3,)) at *point* of
         the engine (m), at every frequency of the set.
 
@@ -248,14 +248,26 @@ class FourPole:
             Point dynamic stiffness of the pylon at each pin (force on the
             pylon per pin motion), N/m: a scalar, a scalar per frequency, a
             3x3, a 3x3 per frequency, or a 3x3 per frequency and pin. None:
-            a rigid pylon.
+            a rigid pylon (unless *compliance* is given).
+        compliance : array-like, complex, shape (f, 3 p, 3 p), optional
+            The pylon given instead by its compliance at the pins, coupled
+            between them (pin motion per force on the pylon, m/N; it need
+            not be invertible: pins joined rigidly by the pylon): then
+            ``(Z_e + K11 - K12 G (I + K22 G)^-1 K21) x1 = B f``, the force
+            on the pylon ``-(I + K22 G)^-1 K21 x1`` and ``x2 = G F``.
 
         Raises
         ------
+        workbook.errors.CaseError
+            Both *pylon* and *compliance*, or a compliance of the wrong shape.
         workbook.errors.FourPoleError
             A singular matrix at a frequency.
         """
         source = self._input(point) @ np.asarray(force, dtype=complex)
+        if compliance is not None:
+            if pylon is not None:
+                raise CaseError("pylon", "compliance", "a stiffness and a compliance", "one of them")
+            return self._respond_compliant(source, self._compliance_matrix(compliance))
         pylon_matrix = None if pylon is None else self._pylon_matrix(pylon)
         responses = []
         for j, frequency in enumerate(self.frequencies_hz):
@@ -272,6 +284,30 @@ class FourPole:
                 pins = -coupled @ engine
                 loads = pylon_matrix[j] @ pins
             responses.append(PylonResponse(float(frequency), engine, pins.reshape(-1, 3), loads.reshape(-1, 3)))
+        return responses
+
+    def _compliance_matrix(self, compliance) -> np.ndarray:
+        """*compliance* checked: finite, complex, shape (f, 3 p, 3 p)."""
+        value = np.asarray(compliance, dtype=complex)
+        shape = (len(self.frequencies_hz), 3 * len(self.pins), 3 * len(self.pins))
+        if value.shape != shape or not np.all(np.isfinite(value)):
+            raise CaseError("pylon compliance", "shape", value.shape,
+                            f"finite compliances (m/N) of shape {shape} (frequencies, 3 x pins, 3 x pins)")
+        return value
+
+    def _respond_compliant(self, source: np.ndarray, compliance: np.ndarray) -> list[PylonResponse]:
+        """:meth:`respond` on a pylon of compliance *compliance* (checked)."""
+        responses = []
+        identity = np.eye(compliance.shape[1])
+        for j, frequency in enumerate(self.frequencies_hz):
+            g = compliance[j]
+            coupled = _solve(identity + self.k22[j] @ g, self.k21[j], "the mount's pylon side on the pylon",
+                             frequency)
+            engine = _solve(self.engine_stiffness[j] + self.k11[j] - self.k12[j] @ g @ coupled, source[:, None],
+                            "the engine on its mount on the pylon", frequency)[:, 0]
+            loads = -coupled @ engine
+            responses.append(PylonResponse(float(frequency), engine, (g @ loads).reshape(-1, 3),
+                                           loads.reshape(-1, 3)))
         return responses
 
     def transmissibility(self, force, point, pylon=None) -> np.ndarray:

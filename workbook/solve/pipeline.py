@@ -28,7 +28,7 @@ from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
-from workbook.solve.flexible_pylon import pylon_stiffness, refuse_time_domain, solve_on_pylon
+from workbook.solve.flexible_pylon import pylon_at, refuse_time_domain, solve_on_pylon
 from workbook.solve.four_pole import mount_case
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
@@ -267,16 +267,16 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     -------
     MountResult
 
-    A case with a pylon impedance (``Case.pylon_impedance``) is answered on
-    that pylon (:mod:`workbook.solve.flexible_pylon`), in the frequency
-    domain only.
+    A case with a flexible pylon (``Case.pylon_impedance`` or
+    ``Case.pylon_beam``) is answered on that pylon
+    (:mod:`workbook.solve.flexible_pylon`), in the frequency domain only.
     """
     runs, cards, preloads = [], {}, {}
     for item in case.excitations:
         points = item.expand() if isinstance(item, Sweep) else (item,)
         chosen = method or choose_method(case, sweep=isinstance(item, Sweep))
-        if chosen.method == FREQUENCY and case.pylon_impedance is not None:
-            pylon = pylon_stiffness(case, points)       # frequencies outside the table: refused before any work
+        if chosen.method == FREQUENCY and case.flexible_pylon:
+            pylon = pylon_at(case, points)              # bad pylon input refused before any work
             prepared = prepare(mount_case(case), points[0], reduce_for=points[-1], progress=progress)
             with prepared.scene:
                 item_runs, item_cards, item_preloads = solve_on_pylon(case, prepared, points, pylon, chosen)
