@@ -1,11 +1,31 @@
-"""Replace the generated sections of a markdown document.
+"""Read and replace the generated sections of a markdown document.
 
 A generated section sits between ``<!-- generated: NAME -->`` and
-``<!-- end: NAME -->``; the ``make_*_docs.py`` scripts rewrite only those.
+``<!-- end: NAME -->``; the ``make_*_docs.py`` scripts rewrite only those,
+and ``tests/test_docs_current.py`` compares them with what the scripts
+generate now.
 """
 from __future__ import annotations
 
 import re
+
+
+def _pattern(name: str) -> re.Pattern:
+    return re.compile(rf"(<!-- generated: {re.escape(name)} -->\n)(.*?)\n?(<!-- end: {re.escape(name)} -->)", re.S)
+
+
+def section(text: str, name: str, document: str) -> str:
+    """The content of the section *name* of *text*.
+
+    Raises
+    ------
+    ValueError
+        If the section's markers are missing (named with *document*).
+    """
+    match = _pattern(name).search(text)
+    if match is None:
+        raise ValueError(f"marker 'generated: {name}' missing in {document}")
+    return match.group(2)
 
 
 def replace_section(text: str, name: str, content: str, document: str) -> str:
@@ -16,7 +36,5 @@ def replace_section(text: str, name: str, content: str, document: str) -> str:
     ValueError
         If the section's markers are missing (named with *document*).
     """
-    pattern = re.compile(rf"(<!-- generated: {name} -->\n).*?(<!-- end: {name} -->)", re.S)
-    if not pattern.search(text):
-        raise ValueError(f"marker 'generated: {name}' missing in {document}")
-    return pattern.sub(lambda m: m.group(1) + content + "\n" + m.group(2), text)
+    section(text, name, document)
+    return _pattern(name).sub(lambda m: m.group(1) + content + "\n" + m.group(3), text)

@@ -30,6 +30,7 @@ from workbook.solve.modes import mounted_modes  # noqa: E402
 from workbook.solve.pipeline import prepare, run_excitation  # noqa: E402
 
 DOCS = Path(__file__).resolve().parent
+DOCUMENT = "rig-sensors.md"
 #: Stiffnesses of the table, N/m per direction (None: the pylon pins on rigid ground).
 TABLE_STIFFNESS = (None, 1e10, 1e9, 3e8, 1e8, 3e7)
 #: Stiffness checked against the time domain, N/m.
@@ -45,16 +46,23 @@ def _cells(t) -> str:
     return f"{t[0]:.5f} | {t[1]:.6f} | {t[2]:.5f}"
 
 
-def main() -> None:
+def study():
+    """The LP-rotor case and its answer per transducer stiffness: ``answer(k) -> (T, mounted modes)``."""
     case = dataclasses.replace(reference_case(), excitations=(LP_ROTOR,))
     reduced = reduce_links(case, LP_ROTOR)
 
     def answer(stiffness):
         prepared = prepare(_with_rig(case, stiffness), LP_ROTOR, reduced=reduced)
-        mounted = mounted_modes(prepared.modes)
-        return prepared.model.result(LP_ROTOR, case.analysis.steady_tolerance).transmissibility, mounted
+        with prepared.scene:
+            mounted = mounted_modes(prepared.modes)
+            return prepared.model.result(LP_ROTOR, case.analysis.steady_tolerance).transmissibility, mounted
 
-    rigid, rigid_modes = answer(None)
+    return case, answer
+
+
+def sections(case, answer) -> dict[str, str]:
+    """Every generated section of docs/rig-sensors.md, by name."""
+    rigid, _ = answer(None)
     rows = ["| transducer k (N/m) | T x | T y | T z | change x (%) | change y (%) | change z (%) | "
             "mounted modes (Hz) |", "|---|---|---|---|---|---|---|---|"]
     for stiffness in TABLE_STIFFNESS:
@@ -64,6 +72,21 @@ def main() -> None:
         rows.append(f"| {label} | {_cells(t)} | " + " | ".join(f"{c:+.2f}" for c in change)
                     + f" | {mounted[0].frequency_hz:.2f} to {mounted[-1].frequency_hz:.2f} |")
 
+    check = ["| transducers | method | T x | T y | T z |", "|---|---|---|---|---|"]
+    for stiffness in (None, TIME_DOMAIN_STIFFNESS):
+        label = "none (rigid ground)" if stiffness is None else f"k = {stiffness:.0e} N/m"
+        frequency_t, _ = answer(stiffness)
+        time_case = _with_rig(dataclasses.replace(case, analysis=AnalysisSettings(method="time")), stiffness)
+        run, card, _ = run_excitation(time_case, LP_ROTOR)
+        difference = 100 * (run.transmissibility / frequency_t - 1)
+        check += [f"| {label} | frequency domain | {_cells(frequency_t)} |",
+                  f"| {label} | time domain, step {card.solver['time step']} | {_cells(run.transmissibility)} |",
+                  f"| {label} | difference (%) | " + " | ".join(f"{d:+.2f}" for d in difference) + " |"]
+    return {"stiffness table": "\n".join(rows), "time-domain check": "\n".join(check)}
+
+
+def _figure(answer) -> None:
+    rigid, _ = answer(None)
     curve = np.geomspace(1e7, 1e11, 33)
     ratios = np.array([answer(k)[0] / rigid for k in curve])
     figure, axes = plt.subplots(figsize=(7, 4.2))
@@ -79,22 +102,14 @@ def main() -> None:
     figure.tight_layout()
     figure.savefig(DOCS / "rig-sensors.png", dpi=110)
 
-    check = ["| transducers | method | T x | T y | T z |", "|---|---|---|---|---|"]
-    for stiffness in (None, TIME_DOMAIN_STIFFNESS):
-        label = "none (rigid ground)" if stiffness is None else f"k = {stiffness:.0e} N/m"
-        frequency_t, _ = answer(stiffness)
-        time_case = _with_rig(dataclasses.replace(case, analysis=AnalysisSettings(method="time")), stiffness)
-        run, card, _ = run_excitation(time_case, LP_ROTOR)
-        difference = 100 * (run.transmissibility / frequency_t - 1)
-        check += [f"| {label} | frequency domain | {_cells(frequency_t)} |",
-                  f"| {label} | time domain, step {card.solver['time step']} | {_cells(run.transmissibility)} |",
-                  f"| {label} | difference (%) | " + " | ".join(f"{d:+.2f}" for d in difference) + " |"]
-    check = "\n".join(check)
 
-    path = DOCS / "rig-sensors.md"
+def main() -> None:
+    case, answer = study()
+    _figure(answer)
+    path = DOCS / DOCUMENT
     text = path.read_text()
-    for name, content in (("stiffness table", "\n".join(rows)), ("time-domain check", check)):
-        text = replace_section(text, name, content, "rig-sensors.md")
+    for name, content in sections(case, answer).items():
+        text = replace_section(text, name, content, DOCUMENT)
     path.write_text(text)
     print(f"wrote {DOCS / 'rig-sensors.png'} and the tables of {path}")
 

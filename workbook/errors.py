@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "RecordError", "SimulationError",
+__all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "TableError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
            "MechanismError", "EquilibriumError", "FourPoleError", "UnstablePreloadError", "BucklingError", "UsageError",
            "BAD_INPUT",
@@ -113,6 +113,11 @@ class WorkbookError(ValueError):
     def __init__(self, problems: list[Problem]):
         self.problems = list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class TableError(WorkbookError):
+    """A table file (CSV) or table sheet that cannot be used; :attr:`problems`
+    names the file, sheet, row and column of each problem."""
 
 
 class RecordError(ValueError):

@@ -298,8 +298,10 @@ def _rig_sensors(scene) -> EffectEntry:
     """The test-rig force transducers: built or not, and why."""
     name, rig = "test-rig force-sensor compliance", scene.case.test_rig
     if not scene.transducers:
-        return EffectEntry(name, False, "switched off: the pylon fittings are rigid" if rig is not None
-                           else "no transducers given: the pylon fittings are rigid")
+        fittings = ("the case's flexible pylon is at the pins instead"
+                    if scene.case.flexible_pylon else "the pylon fittings are rigid")
+        return EffectEntry(name, False, f"switched off: {fittings}" if rig is not None
+                           else f"no transducers given: {fittings}")
     pins = "; ".join(" + ".join(items.hinges) for items in scene.transducers.values())
     stiffness = ", ".join(f"{k:.3g}" for k in rig.stiffness)
     damping = "" if not any(rig.damping) else f", d = ({', '.join(f'{d:.3g}' for d in rig.damping)}) N s/m"

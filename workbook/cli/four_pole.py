@@ -15,17 +15,19 @@ from typing import Callable
 
 from workbook.cli.loading import load_case
 from workbook.errors import UsageError
+from workbook.solve.four_pole import REPORT_GRID
 
 __all__ = ["arguments"]
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
-    parser.add_argument("--from", dest="start", type=float, default=10.0, metavar="HZ",
-                        help="lowest frequency, Hz (default 10)")
-    parser.add_argument("--to", dest="stop", type=float, default=500.0, metavar="HZ",
-                        help="highest frequency, Hz (default 500)")
-    parser.add_argument("--points", type=int, default=41, help="frequencies, log-spaced (default 41)")
+    parser.add_argument("--from", dest="start", type=float, default=REPORT_GRID[0], metavar="HZ",
+                        help=f"lowest frequency, Hz (default {REPORT_GRID[0]:g})")
+    parser.add_argument("--to", dest="stop", type=float, default=REPORT_GRID[1], metavar="HZ",
+                        help=f"highest frequency, Hz (default {REPORT_GRID[1]:g})")
+    parser.add_argument("--points", type=int, default=REPORT_GRID[2],
+                        help=f"frequencies, log-spaced (default {REPORT_GRID[2]})")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
     parser.add_argument("--csv", metavar="OUT", help="write the table as CSV")
     parser.add_argument("--plot", metavar="OUT.png", help="write the magnitude plot as PNG")
@@ -41,7 +43,8 @@ def run(args) -> int:
     import numpy as np
 
     from workbook.model.case import DIRECTIONS
-    from workbook.solve.four_pole import QUANTITIES, four_pole, frequency_grid
+    from workbook.solve.four_pole import QUANTITIES, frequency_grid
+    from workbook.solve.four_pole_set import four_pole
     from workbook.solve.harmonic import excitation_phasor
 
     frequencies = frequency_grid(args.start, args.stop, args.points)
@@ -81,10 +84,10 @@ def run(args) -> int:
         from openpyxl import Workbook
 
         from workbook.excel.files import save_atomic
-        from workbook.excel.report import four_pole_sheet
+        from workbook.excel.report import FOUR_POLE_SHEET, four_pole_sheet
 
         book = Workbook()
-        book.active.title = "Four-pole"
+        book.active.title = FOUR_POLE_SHEET
         four_pole_sheet(book.active, pole)
         save_atomic(book, args.xlsx)
     return 0

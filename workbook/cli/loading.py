@@ -14,6 +14,7 @@ from pathlib import Path
 from workbook.errors import CaseError, UsageError
 from workbook.model.case import Case
 from workbook.model.codec import from_json
+from workbook.model.pylon_impedance import read_impedance_csv
 from workbook.model.reference import reference_case
 from workbook.solve.stages import ProgressFactory
 
@@ -42,7 +43,8 @@ def _json_case(path: str) -> Case:
 
 
 def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = False,
-              time_budget: float | None = None, method: str | None = None) -> Case:
+              time_budget: float | None = None, method: str | None = None,
+              pylon_impedance: str | None = None) -> Case:
     """The case a command works on.
 
     Parameters
@@ -58,11 +60,14 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         Wall-time budget of one run, s (None: as the case says).
     method : {"auto", "time", "frequency"} or None
         Analysis method (None: as the case says).
+    pylon_impedance : str or None
+        A CSV table of the pylon's point dynamic stiffness per pin
+        (:mod:`workbook.model.pylon_impedance`; None: as the case says).
 
     Raises
     ------
     workbook.errors.WorkbookError, CaseError, UsageError, OSError
-        A bad workbook, case or file, or a run name given for a case that is
+        A bad workbook, case, impedance table or file, or a run name given for a case that is
         not a workbook.
     """
     if is_workbook(path):
@@ -79,6 +84,8 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, time_budget=time_budget))
     if method is not None:
         case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method=method))
+    if pylon_impedance is not None:
+        case = dataclasses.replace(case, pylon_impedance=read_impedance_csv(pylon_impedance))
     return case.with_rigid_links() if rigid else case
 
 

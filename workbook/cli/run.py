@@ -1,4 +1,4 @@
-"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--time-budget S]``: run a case.
+"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--time-budget S] [--pylon-impedance CSV]``: run a case.
 
 Prints the three-way isolation-efficiency table, the dB table and the model
 card of each run, or the answers as JSON. A case workbook runs the rows of
@@ -11,6 +11,7 @@ from typing import Callable
 
 from workbook.cli import workbooks
 from workbook.cli.loading import is_workbook, load_case, progress_factory
+from workbook.errors import UsageError
 from workbook.model.case import ANALYSIS_METHODS
 
 __all__ = ["arguments"]
@@ -27,6 +28,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument("--time-budget", type=float, metavar="SECONDS",
                         help="wall time one run may take before it stops with an estimate of the time it needs")
+    parser.add_argument("--pylon-impedance", metavar="TABLE.csv",
+                        help="the pylon's point dynamic stiffness per pin against frequency (CSV, see "
+                             "docs/four-pole.md): answers on that flexible pylon, frequency domain only")
     workbooks.add_run_arguments(parser)
     return run
 
@@ -35,8 +39,14 @@ def run(args) -> int:
     from workbook.solve.pipeline import run_case
 
     if is_workbook(args.case):
+        if args.pylon_impedance:
+            raise UsageError("--pylon-impedance: a case workbook takes the table as its 'Pylon impedance' sheet")
         return workbooks.run_workbook(args)
-    case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget, method=args.method)
+    if args.four_pole:
+        raise UsageError("--four-pole adds a sheet to a case workbook's --report; for a JSON case or the reference "
+                         "mount use mountwb four-pole")
+    case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget, method=args.method,
+                     pylon_impedance=args.pylon_impedance)
     result = run_case(case, progress=None if args.no_progress else progress_factory())
     if args.json:
         print(result.to_json(indent=2))

@@ -77,6 +77,9 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--run", action="append", dest="runs", metavar="NAME",
                         help="case workbook: run only this row of Runs (repeat for several)")
     parser.add_argument("--report", metavar="OUT.xlsx", help="case workbook: also write a report workbook")
+    parser.add_argument("--four-pole", action="store_true",
+                        help="case workbook: the report gets a Four-pole sheet, the mount's driving-point and "
+                             "transfer dynamic stiffness per direction (as mountwb four-pole with its defaults)")
 
 
 def _print_summary(runs) -> None:
@@ -101,11 +104,15 @@ def run_workbook(args) -> int:
     from workbook.excel.reader import read_workbook
     from workbook.excel.report import write_report
     from workbook.excel.writer import write_results
+    from workbook.solve.four_pole_set import report_four_pole
 
     if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None) \
             or getattr(args, "method", None):
         print("mountwb run: --json, --rigid, --method and --time-budget are for JSON cases; a workbook sets its "
               "runs' fidelity in its Runs sheet and its method and time budget in its Case sheet", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    if args.four_pole and not args.report:
+        print("mountwb run: --four-pole adds a sheet to the report: give --report OUT.xlsx", file=sys.stderr)
         return EXIT_BAD_INPUT
     try:
         book = read_workbook(args.case)
@@ -115,6 +122,7 @@ def run_workbook(args) -> int:
     progress = None if getattr(args, "no_progress", False) else progress_factory()
     try:
         runs = run_book(book, selected, progress=progress)
+        pole = report_four_pole(book.case) if args.four_pole else None
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
@@ -128,7 +136,7 @@ def run_workbook(args) -> int:
     _print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
-            report = write_report(args.report, book, runs, outcome)
+            report = write_report(args.report, book, runs, outcome, four_pole=pole)
         except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE

@@ -21,6 +21,7 @@ import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import WorkbookError
 from workbook.excel.files import bounded_file_problem
+from workbook.excel.impedance_sheet import with_impedance_sheet
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import Record, SheetReader, open_workbook
 from workbook.model import case as cm
@@ -561,6 +562,7 @@ def read_workbook(path: str | Path) -> CaseBook:
     if case is None:
         reader.unique(tables["Runs"])
         raise WorkbookError(reader.problems)
+    case = with_impedance_sheet(case, path, values)
     runs = reader.runs(case, tables["Runs"])
     tests = reader.tests(runs, tables["Test data"], case)
     if reader.problems:

@@ -43,10 +43,12 @@ from workbook.excel.styling import FORMATS, print_setup
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["write_report", "is_report", "four_pole_sheet", "PACKAGES", "REPORT_KEYWORDS"]
+__all__ = ["write_report", "is_report", "four_pole_sheet", "FOUR_POLE_SHEET", "PACKAGES", "REPORT_KEYWORDS"]
 
 #: Document keywords that mark a report workbook (an existing report may be replaced).
 REPORT_KEYWORDS = "mountwb report"
+#: The report's sheet of the mount's four-pole parameters (asked for with ``mountwb run --four-pole``).
+FOUR_POLE_SHEET = "Four-pole"
 
 #: Distributions whose versions the metadata sheet records.
 PACKAGES = ("engine-mount-workbook", "exudyn", "scikit-fem", "numpy", "scipy", "pandas", "openpyxl", "pint",
@@ -353,7 +355,7 @@ def is_report(path: Path) -> bool:
 
 
 def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
-                 written: WriteOutcome | None = None) -> WriteOutcome:
+                 written: WriteOutcome | None = None, *, four_pole=None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
     An existing *path* is replaced only if it is a report this module wrote
@@ -369,6 +371,8 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     written : WriteOutcome, optional
         Where the results were written (:func:`~workbook.excel.writer.write_results`):
         the metadata records that file's SHA-256 as it is now.
+    four_pole : FourPole, optional
+        The mount's four-pole set: a Four-pole sheet (:func:`four_pole_sheet`).
 
     Returns
     -------
@@ -386,5 +390,7 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     _warnings(workbook.create_sheet("Warnings"), runs)
     _plots(workbook.create_sheet("Plots"), runs)
     _model_cards(workbook.create_sheet("Model card"), runs)
+    if four_pole is not None:
+        four_pole_sheet(workbook.create_sheet(FOUR_POLE_SHEET), four_pole)
     _metadata(workbook.create_sheet("Metadata"), book, runs, written)
     return WriteOutcome(save_atomic(workbook, target), reason)

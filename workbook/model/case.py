@@ -26,6 +26,8 @@ from typing import Any
 import numpy as np
 
 from workbook.errors import CaseError
+from workbook.model.pylon_beam import BoxBeamPylon
+from workbook.model.pylon_impedance import PylonImpedance
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
@@ -1154,6 +1156,12 @@ class Case:
     rotors : tuple of Rotor
         Spinning rotors whose gyroscopic moments act on the engine (their
         mass and inertia are part of ``engine``).
+    pylon_impedance : PylonImpedance or None
+        The pylon's point dynamic stiffness at its pins against frequency
+        (None: a rigid pylon); frequency domain only.
+    pylon_beam : BoxBeamPylon or None
+        The pylon as a clamped box beam carrying the pins (None: a rigid
+        pylon); frequency domain only, not with a pylon impedance.
     """
 
     name: str
@@ -1167,6 +1175,8 @@ class Case:
     description: str = ""
     test_rig: ForceTransducers | None = None
     rotors: tuple[Rotor, ...] = ()
+    pylon_impedance: PylonImpedance | None = None
+    pylon_beam: BoxBeamPylon | None = None
 
     def __post_init__(self):
         _name(self.name, "case")
@@ -1186,6 +1196,16 @@ class Case:
                     raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
             _set(self, name, items)
         owners = self._check_names(groups)
+        if self.pylon_impedance is not None:
+            if not isinstance(self.pylon_impedance, PylonImpedance):
+                raise CaseError("case", "pylon_impedance", self.pylon_impedance, "a PylonImpedance or None")
+            self.pylon_impedance.pin_order(self.pylon_pins())
+        if self.pylon_beam is not None:
+            if not isinstance(self.pylon_beam, BoxBeamPylon):
+                raise CaseError("case", "pylon_beam", self.pylon_beam, "a BoxBeamPylon or None")
+            if self.pylon_impedance is not None:
+                raise CaseError("case", "pylon_beam", self.pylon_beam.name,
+                                "no pylon beam when a pylon impedance is given (one pylon model)")
         links = self.link_map
         for hinge in self.hinges:
             for name in ("body_a", "body_b"):
@@ -1251,6 +1271,11 @@ class Case:
     def rig_sensors_built(self) -> bool:
         """True if the case gives test-rig force transducers and asks for them."""
         return self.test_rig is not None and self.effects.rig_sensors
+
+    @property
+    def flexible_pylon(self) -> bool:
+        """True if the case gives a flexible pylon (an impedance table or a box beam)."""
+        return self.pylon_impedance is not None or self.pylon_beam is not None
 
     @property
     def pylon_hinges(self) -> tuple[Hinge, ...]:

@@ -53,10 +53,11 @@ import numpy as np
 import scipy.linalg as sla
 
 from workbook.errors import CaseError, FourPoleError
-from workbook.model.case import DIRECTIONS, ENGINE, Case, HarmonicForce
+from workbook.model.case import DIRECTIONS, ENGINE, Case
 from workbook.scene.bearing import hinge_matrix
 
-__all__ = ["FourPole", "PylonResponse", "four_pole", "frequency_grid", "QUANTITIES"]
+__all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
+           "REPORT_GRID"]
 
 #: The per-direction quantities of :meth:`FourPole.direction_values` with their meaning.
 QUANTITIES = {
@@ -66,6 +67,8 @@ QUANTITIES = {
 }
 #: Engine coordinates of the four-pole set: centre-of-gravity translations, then rotations.
 ENGINE_COORDINATES = 6
+#: The default frequencies of a four-pole table: from (Hz), to (Hz), log-spaced points.
+REPORT_GRID = (10.0, 500.0, 41)
 #: Smallest reciprocal condition number of a matrix the four-pole set inverts.
 SINGULAR_RCOND = 1e-13
 
@@ -85,6 +88,20 @@ def frequency_grid(start_hz: float, stop_hz: float, points: int) -> np.ndarray:
     if int(points) != points or points < 1:
         raise CaseError("four-pole frequencies", "points", points, "a whole number >= 1")
     return np.geomspace(start_hz, stop_hz, int(points)) if points > 1 else np.array([float(start_hz)])
+
+
+def checked_frequencies(frequencies_hz) -> np.ndarray:
+    """*frequencies_hz* as a flat array, Hz.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        No frequency, or one not > 0.
+    """
+    frequencies = np.asarray(frequencies_hz, dtype=float).reshape(-1)
+    if frequencies.size == 0 or not np.all(np.isfinite(frequencies)) or frequencies.min() <= 0:
+        raise CaseError("four-pole frequencies", "frequencies", list(frequencies), "one or more frequencies > 0 Hz")
+    return frequencies
 
 
 def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) -> np.ndarray:
@@ -219,7 +236,7 @@ class FourPole:
             blocks[:, 3 * p:3 * p + 3, 3 * p:3 * p + 3] = value[:, p]
         return blocks
 
-    def respond(self, force, point, pylon=None) -> list[PylonResponse]:
+    def respond(self, force, point, pylon=None, *, compliance=None) -> list[PylonResponse]:
         """Response to the force phasor *force* (N, shape (3,)) at *point* of
         the engine (m), at every frequency of the set.
 
@@ -232,14 +249,26 @@ class FourPole:
             Point dynamic stiffness of the pylon at each pin (force on the
             pylon per pin motion), N/m: a scalar, a scalar per frequency, a
             3x3, a 3x3 per frequency, or a 3x3 per frequency and pin. None:
-            a rigid pylon.
+            a rigid pylon (unless *compliance* is given).
+        compliance : array-like, complex, shape (f, 3 p, 3 p), optional
+            The pylon given instead by its compliance at the pins, coupled
+            between them (pin motion per force on the pylon, m/N; it need
+            not be invertible: pins joined rigidly by the pylon): then
+            ``(Z_e + K11 - K12 G (I + K22 G)^-1 K21) x1 = B f``, the force
+            on the pylon ``-(I + K22 G)^-1 K21 x1`` and ``x2 = G F``.
 
         Raises
         ------
+        workbook.errors.CaseError
+            Both *pylon* and *compliance*, or a compliance of the wrong shape.
         workbook.errors.FourPoleError
             A singular matrix at a frequency.
         """
         source = self._input(point) @ np.asarray(force, dtype=complex)
+        if compliance is not None:
+            if pylon is not None:
+                raise CaseError("pylon", "compliance", "a stiffness and a compliance", "one of them")
+            return self._respond_compliant(source, self._compliance_matrix(compliance))
         pylon_matrix = None if pylon is None else self._pylon_matrix(pylon)
         responses = []
         for j, frequency in enumerate(self.frequencies_hz):
@@ -256,6 +285,30 @@ class FourPole:
                 pins = -coupled @ engine
                 loads = pylon_matrix[j] @ pins
             responses.append(PylonResponse(float(frequency), engine, pins.reshape(-1, 3), loads.reshape(-1, 3)))
+        return responses
+
+    def _compliance_matrix(self, compliance) -> np.ndarray:
+        """*compliance* checked: finite, complex, shape (f, 3 p, 3 p)."""
+        value = np.asarray(compliance, dtype=complex)
+        shape = (len(self.frequencies_hz), 3 * len(self.pins), 3 * len(self.pins))
+        if value.shape != shape or not np.all(np.isfinite(value)):
+            raise CaseError("pylon compliance", "shape", value.shape,
+                            f"finite compliances (m/N) of shape {shape} (frequencies, 3 x pins, 3 x pins)")
+        return value
+
+    def _respond_compliant(self, source: np.ndarray, compliance: np.ndarray) -> list[PylonResponse]:
+        """:meth:`respond` on a pylon of compliance *compliance* (checked)."""
+        responses = []
+        identity = np.eye(compliance.shape[1])
+        for j, frequency in enumerate(self.frequencies_hz):
+            g = compliance[j]
+            coupled = _solve(identity + self.k22[j] @ g, self.k21[j], "the mount's pylon side on the pylon",
+                             frequency)
+            engine = _solve(self.engine_stiffness[j] + self.k11[j] - self.k12[j] @ g @ coupled, source[:, None],
+                            "the engine on its mount on the pylon", frequency)[:, 0]
+            loads = -coupled @ engine
+            responses.append(PylonResponse(float(frequency), engine, (g @ loads).reshape(-1, 3),
+                                           loads.reshape(-1, 3)))
         return responses
 
     def transmissibility(self, force, point, pylon=None) -> np.ndarray:
@@ -345,7 +398,7 @@ class FourPole:
         return fig
 
 
-def _mount_case(case: Case) -> Case:
+def mount_case(case: Case) -> Case:
     """The case whose scene the four-pole set is formed from: the pylon pins on
     rigid ground (no test-rig transducers: the rig is the pylon's side).
 
@@ -374,16 +427,16 @@ def _engine_first(basis: np.ndarray, engine: np.ndarray) -> np.ndarray:
     return np.hstack([rows.T, sla.null_space(rows)])
 
 
-def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
-    """The four-pole set of the mount of *case* at *frequencies_hz*, about
-    its preloaded equilibrium.
+def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
+    """The four-pole set of the mount of *case* at *frequencies_hz* from the
+    harmonic model of its preloaded scene.
 
     Parameters
     ----------
+    model : HarmonicModel
+        Of the scene of ``mount_case(case)`` (:func:`mount_case`), prepared
+        with its preload.
     case : Case
-        Its links are reduced for the highest frequency. Test-rig
-        transducers are not part of the mount (give them as a pylon
-        impedance).
     frequencies_hz : sequence of float
         Hz, > 0.
     points : sequence of 3 floats
@@ -394,22 +447,13 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
     Raises
     ------
     workbook.errors.CaseError
-        A hinge with a clearance law, no pylon-side hinge, or no frequency.
-    workbook.errors.SimulationError
-        A mechanism or a failed equilibrium (preload); a singular set
-        (:class:`~workbook.errors.FourPoleError`).
+        No frequency.
+    workbook.errors.FourPoleError
+        A singular set.
     """
-    from workbook.solve.pipeline import prepare
-
-    frequencies = np.asarray(frequencies_hz, dtype=float).reshape(-1)
-    if frequencies.size == 0 or not np.all(np.isfinite(frequencies)) or frequencies.min() <= 0:
-        raise CaseError("four-pole frequencies", "frequencies", list(frequencies), "one or more frequencies > 0 Hz")
-    mount = _mount_case(case)
+    frequencies = checked_frequencies(frequencies_hz)
+    mount = mount_case(case)
     center = np.asarray(case.engine.center_of_mass, dtype=float)
-    probe = HarmonicForce("four-pole probe", point=tuple(center), direction=(1.0, 0.0, 0.0), amplitude=1.0,
-                          frequency_hz=float(frequencies.max()))
-    prepared = prepare(mount, probe)
-    model = prepared.model
     lin = model.linearization
     turn = _engine_first(lin.basis, lin.body_coordinates[ENGINE])
     project = lambda matrix: turn.T @ matrix @ turn  # noqa: E731

@@ -48,7 +48,7 @@ from workbook.scene.bearing import hinge_matrix
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.modes import Linearization, linearize
 
-__all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "FrequencyResponse"]
+__all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "point_phasors", "FrequencyResponse"]
 
 log = logging.getLogger(__name__)
 
@@ -58,10 +58,18 @@ COORDINATE_STEP = 1e-7
 VELOCITY_STEP = 1e-3
 
 
+def point_phasors(excitation: SingleFrequencyExcitation) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The forces of *excitation* as ``(point, f_hat)`` with ``F(t) = Re(f_hat exp(i w t))``:
+    one, or one per imbalance plane; point in m, ``f_hat`` in N, shape (3,) each.
+    A force ``C cos wt + S sin wt`` is ``f_hat = C - i S``."""
+    return [(np.asarray(point, dtype=float), np.asarray(c, dtype=complex) - 1j * np.asarray(s, dtype=float))
+            for point, c, s in excitation.point_forces()]
+
+
 def excitation_phasor(excitation: SingleFrequencyExcitation) -> np.ndarray:
     """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)
     (of an imbalance of several planes: their resultant)."""
-    return sum(np.asarray(c, dtype=complex) - 1j * np.asarray(s, dtype=float) for _, c, s in excitation.point_forces())
+    return sum(phasor for _, phasor in point_phasors(excitation))
 
 
 @dataclass(frozen=True)
@@ -140,8 +148,7 @@ class HarmonicModel:
     def excitation_input(self, excitation: SingleFrequencyExcitation) -> np.ndarray:
         """Generalised force phasor of *excitation*: the sum over its point
         forces (one, or one per imbalance plane), shape (n,)."""
-        return sum(self.input_matrix(point) @ (np.asarray(c, dtype=complex) - 1j * np.asarray(s, dtype=float))
-                   for point, c, s in excitation.point_forces())
+        return sum(self.input_matrix(point) @ phasor for point, phasor in point_phasors(excitation))
 
     def respond_generalised(self, frequency_hz: float, load: np.ndarray) -> FrequencyResponse:
         """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*."""

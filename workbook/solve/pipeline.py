@@ -30,6 +30,8 @@ from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
+from workbook.solve.flexible_pylon import pylon_at, refuse_time_domain, solve_on_pylon
+from workbook.solve.four_pole import mount_case
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
@@ -179,6 +181,7 @@ def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
     :class:`~workbook.model.case.Simultaneous` excitation (all parts in the
     same run, see :mod:`workbook.solve.simultaneous`); see :func:`run_excitation`."""
     method = method or MethodChoice(TIME, "asked for directly (run_excitation)")
+    refuse_time_domain(case, method.reason)
     prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
@@ -287,13 +290,22 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     Returns
     -------
     MountResult
+
+    A case with a flexible pylon (``Case.pylon_impedance`` or
+    ``Case.pylon_beam``) is answered on that pylon
+    (:mod:`workbook.solve.flexible_pylon`), in the frequency domain only.
     """
     runs, cards, preloads = [], {}, {}
     for item in case.excitations:
         points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
         highest = max(points, key=lambda point: point.frequency)
         chosen = method or choose_method(case, sweep=isinstance(item, Sweep))
-        if chosen.method == FREQUENCY:
+        if chosen.method == FREQUENCY and case.flexible_pylon:
+            pylon = pylon_at(case, points)              # bad pylon input refused before any work
+            prepared = prepare(mount_case(case), points[0], reduce_for=highest, progress=progress)
+            with prepared.scene:
+                item_runs, item_cards, item_preloads = solve_on_pylon(case, prepared, points, pylon, chosen)
+        elif chosen.method == FREQUENCY:
             if isinstance(item, Simultaneous):
                 chosen = dataclasses.replace(chosen, reason=f"{chosen.reason}; {item.name!r} by superposition: "
                                              "each part solved at its own frequency, the response is their sum")

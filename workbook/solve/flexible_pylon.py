@@ -1,0 +1,185 @@
+"""Runs on a flexible pylon: a point dynamic stiffness table or a box beam at the pins.
+
+The mount's four-pole set at the excitation's frequency
+(:func:`workbook.solve.four_pole.condense`, formed from the harmonic model
+of the preloaded scene with the pins on rigid ground) is closed by the
+pylon, exactly in the frequency domain:
+
+- a :class:`~workbook.model.pylon_impedance.PylonImpedance` ``Z_p(f)`` per
+  pin: ``(Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f``,
+  ``x2 = -(K22 + Z_p)^-1 K21 x1``, the pylon loaded with ``Z_p x2``;
+- a :class:`~workbook.model.pylon_beam.BoxBeamPylon`: its compliance ``G``
+  at the pins, coupled through the beam (:mod:`workbook.solve.pylon_beam`):
+  ``(Z_e + K11 - K12 G (I + K22 G)^-1 K21) x1 = B f``, the pylon loaded with
+  ``-(I + K22 G)^-1 K21 x1``.
+
+The pylon force is the sum of the pin forces, whose amplitudes give T and
+eta as on a rigid pylon.
+
+The time domain refuses both: a dynamic stiffness known only at table
+frequencies has no time-domain model here (a convolution kernel would need
+its causal, stable fit over all frequencies, which a table over a band does
+not give), and the box beam is built as a frequency-domain compliance, not
+as a body of the time-domain scene.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from workbook.answers.model_card import EffectEntry, ModelCard, model_card
+from workbook.answers.results import ExcitationResult
+from workbook.errors import CaseError
+from workbook.model.case import Case, SingleFrequencyExcitation
+from workbook.solve.four_pole import condense
+from workbook.solve.harmonic import point_phasors
+from workbook.solve.method import MethodChoice
+from workbook.solve.modes import mounted_modes
+from workbook.solve.pylon_beam import beam_model
+from workbook.solve.stages import link_warnings
+
+__all__ = ["PylonAt", "refuse_time_domain", "pylon_at", "solve_on_pylon"]
+
+
+@dataclass(frozen=True)
+class PylonAt:
+    """The case's flexible pylon at the frequencies of its excitations.
+
+    Attributes
+    ----------
+    stiffness : ndarray or None, complex, shape (n, p, 3, 3)
+        Point dynamic stiffness per pin (an impedance table), N/m.
+    compliance : ndarray or None, complex, shape (n, 3 p, 3 p)
+        Compliance at the pins, coupled between them (a box beam), m/N.
+    effect : EffectEntry
+        The model-card entry.
+    seconds : float
+        Wall time of forming it, s.
+    """
+
+    stiffness: np.ndarray | None
+    compliance: np.ndarray | None
+    effect: EffectEntry
+    seconds: float
+
+    def closure(self, j: int) -> dict:
+        """The keyword arguments of :meth:`~workbook.solve.four_pole.FourPole.respond` at excitation *j*."""
+        if self.stiffness is not None:
+            return {"pylon": self.stiffness[j][None]}
+        return {"compliance": self.compliance[j][None]}
+
+
+def refuse_time_domain(case: Case, reason: str) -> None:
+    """Refuse a time-domain run of *case* when it has a flexible pylon.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        The case gives a pylon impedance or a pylon beam.
+    """
+    if case.pylon_impedance is not None:
+        raise CaseError(f"case {case.name!r}", "pylon_impedance", case.pylon_impedance.source,
+                        f"no frequency-dependent pylon impedance in the time domain ({reason}): a dynamic "
+                        f"stiffness tabulated against frequency has no time-domain model here; run the "
+                        f"frequency domain (method 'auto' or 'frequency', no hinge clearance) or remove the "
+                        f"pylon impedance")
+    if case.pylon_beam is not None:
+        raise CaseError(f"case {case.name!r}", "pylon_beam", case.pylon_beam.name,
+                        f"no pylon beam in the time domain ({reason}): the box beam is built as the pylon's "
+                        f"compliance in the frequency domain; run the frequency domain (method 'auto' or "
+                        f"'frequency', no hinge clearance) or remove the pylon beam")
+
+
+def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> PylonAt:
+    """The flexible pylon of *case* at the frequencies of *points*, in the order of ``case.pylon_pins()``.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        An excitation frequency outside the impedance table; a pin beyond
+        the beam's ends.
+    """
+    start = time.perf_counter()
+    frequencies = [x.frequency for x in points]
+    pins = case.pylon_pins()
+    if case.pylon_impedance is not None:
+        impedance = case.pylon_impedance
+        stiffness = impedance.at(frequencies, impedance.pin_order(pins))
+        effect = EffectEntry("flexible pylon (point dynamic stiffness)", True,
+                             f"{impedance.describe()}; real and imaginary parts interpolated linearly in frequency")
+        return PylonAt(stiffness, None, effect, time.perf_counter() - start)
+    beam = case.pylon_beam
+    model = beam_model(beam, [position for position, _ in pins])
+    compliance = model.compliance(frequencies)
+    effect = EffectEntry("flexible pylon (box beam)", True,
+                         f"{beam.describe()}; {len(model.stations) - 1} Euler-Bernoulli elements, "
+                         f"{model.stiffness.shape[0]} DOF, pins on rigid offsets, compliance at the pins")
+    return PylonAt(None, compliance, effect, time.perf_counter() - start)
+
+
+def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.ndarray,
+            steady_tolerance: float) -> ExcitationResult:
+    empty = np.zeros((0, 3))
+    return ExcitationResult(
+        name=excitation.name, frequency_hz=excitation.frequency,
+        excitation_amplitude=excitation.force_amplitude, pylon_amplitude=np.abs(pin_forces.sum(axis=0)),
+        hinge_amplitudes={pin: np.abs(force) for pin, force in zip(pins, pin_forces)},
+        pylon_hinges=list(pins), steady_change=0.0, steady_tolerance=steady_tolerance,
+        warnings=[], time=np.zeros(0), hinge_histories={pin: empty for pin in pins},
+        pylon_history=empty, excitation_history=empty, window=slice(0, 0))
+
+
+def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], pylon: PylonAt,
+                   method: MethodChoice) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict]:
+    """Frequency-domain answers of *points* on the flexible pylon of *case*.
+
+    Parameters
+    ----------
+    case : Case
+        With a pylon impedance or a pylon beam.
+    prepared : PreparedScene
+        The scene of ``mount_case(case)`` prepared with its harmonic model.
+    points : tuple of RotatingForce, HarmonicForce or Imbalance
+    pylon : PylonAt
+        The pylon at the frequencies of *points* (:func:`pylon_at`).
+    method : MethodChoice
+
+    Returns
+    -------
+    runs : list of ExcitationResult
+        The pylon force is the sum of the pin forces; ``hinge_amplitudes``
+        holds the force on the pylon at each pin (named by its hinges).
+    cards : dict of str to ModelCard
+    preloads : dict of str to Preload
+
+    Raises
+    ------
+    workbook.errors.FourPoleError
+        A singular set (an undamped resonance at an excitation frequency).
+    """
+    mounted = mounted_modes(prepared.modes)
+    runs, cards, preloads = [], {}, {}
+    for j, excitation in enumerate(points):
+        start = time.perf_counter()
+        forces = point_phasors(excitation)  # one force, or one per imbalance plane: their responses add
+        pole = condense(prepared.model, case, [excitation.frequency], points=[point for point, _ in forces])
+        pin_forces = sum(pole.respond(phasor, point, **pylon.closure(j))[0].pin_forces for point, phasor in forces)
+        seconds = time.perf_counter() - start
+        result = _result(excitation, pole.pins, pin_forces, case.analysis.steady_tolerance)
+        result.warnings.extend(link_warnings(case, prepared.scene.reduced))
+        timings = dict(prepared.timings, **{"pylon": pylon.seconds, "harmonic solve on the pylon": seconds})
+        solver = {"analysis": "frequency domain on a flexible pylon: the mount's four-pole set (6 engine + "
+                              f"{3 * len(pole.pins)} pin coordinates) closed by the pylon",
+                  "independent coordinates": prepared.model.dof,
+                  "static equilibrium check": f"relative {case.analysis.equilibrium_tolerance:g}"}
+        card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method, solver)
+        card.effects.append(EffectEntry(pylon.effect.name, True, f"{pylon.effect.detail}; exact through the "
+                                        f"mount's four-pole set; the mounted modes listed are those on a rigid "
+                                        f"pylon"))
+        card.run_name = excitation.name
+        runs.append(result)
+        cards[result.name] = card
+        preloads[result.name] = prepared.preload
+    return runs, cards, preloads
