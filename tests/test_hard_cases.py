@@ -130,10 +130,10 @@ def test_rattling_in_every_hinge_without_preload_is_periodic_and_bounded(rigid):
 # --- 4. a small excitation on the large preload ---------------------------------------------------------
 
 
-def test_one_newton_on_the_58_kN_preload_gives_the_same_transmissibility(cache_dir):
+def test_one_newton_on_the_58_kN_preload_gives_the_same_transmissibility(coarse_reference):
     """The answer of a linear(ised) mount does not depend on the amplitude;
     1 N is 2e-5 of the static loads (flexible links, nonlinear FFRF)."""
-    case = reference_case(element_size=COARSE_ELEMENT_SIZE)
+    case = coarse_reference
     one = _time(case, dataclasses.replace(LP_ROTOR, amplitude=1.0))
     full = _time(case, LP_ROTOR)
     assert one.steady and one.transmissibility == pytest.approx(full.transmissibility, rel=1e-3)
