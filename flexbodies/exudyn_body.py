@@ -29,7 +29,8 @@ import numpy as np
 
 from .reduced import ReducedLink
 
-__all__ = ["ExudynLink", "add_link_to_exudyn", "exudyn_cms_interface", "export_exudyn_file", "link_rotation", "DEFAULT_SPIN_FREQUENCY_HZ"]
+__all__ = ["ExudynLink", "add_link_to_exudyn", "exudyn_cms_interface", "modal_damping_matrix", "export_exudyn_file",
+           "link_rotation", "DEFAULT_SPIN_FREQUENCY_HZ"]
 
 #: Frequency of the spin mode the torsional restraint adds, Hz.
 DEFAULT_SPIN_FREQUENCY_HZ = 2000.0
@@ -151,7 +152,19 @@ def exudyn_cms_interface(link: ReducedLink, node_type: str = "NodeType.RotationE
     return cms
 
 
-def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping, mass_damping, name):
+def modal_damping_matrix(link: ReducedLink, ratio: float) -> np.ndarray:
+    """Damping of the link's modal coordinates that gives each elastic mode the damping ratio *ratio*.
+
+    The body's modal coordinates are mass-normalised modes with a diagonal
+    reduced stiffness, so the matrix is ``diag(2 zeta w_i)``, N s/m per unit
+    modal mass (``w_i`` from the reduced stiffness, rad/s).
+    """
+    stiffness = np.diag(np.asarray(link.ffrf["stiffnessMatrixReduced"], dtype=float))
+    mass = np.diag(np.asarray(link.ffrf["massMatrixReduced"], dtype=float))
+    return np.diag(2.0 * ratio * np.sqrt(np.clip(stiffness, 0.0, None) * mass))
+
+
+def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping, mass_damping, modal_ratio, name):
     import exudyn as exu
 
     cms = exudyn_cms_interface(link)
@@ -161,6 +174,11 @@ def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping,
         name=name,
     )
     body = items["oFFRFreducedOrder"]
+    if modal_ratio > 0:
+        damping = exu.MatrixContainer()
+        damping.SetWithDenseMatrix(np.asarray(cms.dampingMatrixReduced, dtype=float)
+                                   + modal_damping_matrix(link, modal_ratio), useDenseMatrix=False)
+        mbs.SetObjectParameter(body, "dampingMatrixReduced", damping)
     markers = [
         mbs.AddMarker(exu.itemInterface.MarkerSuperElementPosition(
             bodyNumber=body, meshNodeNumbers=[int(i)], weightingFactors=[1.0]))
@@ -200,6 +218,7 @@ def add_link_to_exudyn(
     bore_axis=None,
     stiffness_damping: float = 0.0,
     mass_damping: float = 0.0,
+    modal_damping_ratio: float = 0.0,
     spin_frequency_hz: float = DEFAULT_SPIN_FREQUENCY_HZ,
     name: str = "",
 ) -> ExudynLink:
@@ -220,6 +239,9 @@ def add_link_to_exudyn(
         Rayleigh stiffness-proportional damping of the modal coordinates, s.
     mass_damping : float
         Rayleigh mass-proportional damping of the modal coordinates, 1/s.
+    modal_damping_ratio : float
+        Damping ratio of every elastic mode, added to the Rayleigh damping
+        (:func:`modal_damping_matrix`), dimensionless.
     spin_frequency_hz : float
         Frequency of the spin mode the torsional restraint adds, Hz.
     name : str
@@ -244,7 +266,8 @@ def add_link_to_exudyn(
         raise ValueError(f"link {name!r}: spin_frequency_hz must be > 0, got {spin_frequency_hz}")
     rotation = link_rotation(end_a, end_b, bore_axis)
     if flexible:
-        body, nodes, markers = _add_flexible(mbs, link, end_a, rotation, stiffness_damping, mass_damping, name)
+        body, nodes, markers = _add_flexible(mbs, link, end_a, rotation, stiffness_damping, mass_damping,
+                                             modal_damping_ratio, name)
     else:
         body, nodes, markers = _add_rigid(mbs, link, end_a, rotation, name)
 

@@ -16,7 +16,7 @@ from workbook.solve.preload import solve_preload
 
 #: Every effect the model card accounts for (docs/physics.md, section 4).
 EFFECTS = {"link flexibility", "static preload", "hinge damping", "hinge loss factor",
-           "hinge properties per direction", "link damping", "link material loss factor", "hinge clearance",
+           "hinge properties per direction", "link damping", "link modal damping", "link material loss factor", "hinge clearance",
            "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance", "link stress stiffening",
            "time domain", "frequency domain", "imbalance planes", "simultaneous excitations"}
 

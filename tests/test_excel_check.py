@@ -123,6 +123,7 @@ def test_hinge_values_per_direction_and_loss_factors_are_read_and_written_back(t
     axial = (0.0, 0.6, 0.8)
     set_cells(path, {("Hinges", "stiffness axial", 3): 5e6, ("Hinges", "loss factor", 3): 0.05,
                      ("Hinges", "loss factor axial", 3): 0.1, ("Links", "loss factor", 3): 0.002,
+                     ("Links", "modal damping", 3): 0.02,
                      **{("Hinges", f"frame radial 1 {a}", 3): v for a, v in zip("xyz", (1.0, 0.0, 0.0))},
                      **{("Hinges", f"frame axial {a}", 3): v for a, v in zip("xyz", axial)}})
     case = read_workbook(path).case
@@ -131,7 +132,7 @@ def test_hinge_values_per_direction_and_loss_factors_are_read_and_written_back(t
     assert hinge.loss_factor == (0.05, 0.05, 0.1)
     assert not hinge.isotropic and plain.isotropic
     assert hinge.frame == ((1.0, 0.0, 0.0), (0.0, 0.8, -0.6), axial)
-    assert case.links[0].loss_factor == 0.002
+    assert case.links[0].loss_factor == 0.002 and case.links[0].modal_damping == 0.02
     again = tmp_path / "again.xlsx"
     write_workbook(case_workbook(case, read_workbook(path).runs), again)
     assert _numbers(read_workbook(again).case) == _numbers(case)
@@ -376,6 +377,8 @@ BAD_INPUTS = {
                                        ["sheet 'Hinges'", "cell R4:W4", "three"]),
     "negative link loss factor": (_edit({("Links", "loss factor", 3): -0.01}),
                                   ["sheet 'Links'", "cell AO3", "found -0.01", ">= 0"]),
+    "link modal damping of one": (_edit({("Links", "modal damping", 3): 1.0}),
+                                  ["sheet 'Links'", "cell AP3", "column 'modal damping'", "found 1", "< 1"]),
 }
 
 

@@ -88,6 +88,25 @@ def test_linearised_frequencies_in_exudyn_equal_craig_bampton(link_12_modes):
     assert item.dof == 6 + link.n_modes == 6 + 6 + 12
 
 
+
+@pytest.mark.parametrize("ratio", [0.0, 0.03])
+def test_a_modal_damping_ratio_damps_every_elastic_mode_by_that_ratio(link_12_modes, ratio):
+    """The free link (spin restraint at 1 Hz): every elastic mode of its
+    linearisation has the damping ratio asked for, at its undamped frequency."""
+    link = link_12_modes
+    mbs = exu.SystemContainer().AddSystem()
+    add_link_to_exudyn(mbs, link, END_A, END_A + link.length * DIRECTION, spin_frequency_hz=1.0,
+                       modal_damping_ratio=ratio)
+    mbs.Assemble()
+    M, K, D = mbs.ComputeLinearizedSystem(_static_settings(), projectIntoConstraintNullspace=True)[:3]
+    n = M.shape[0]
+    state = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, D)]])
+    roots = np.linalg.eigvals(state)
+    elastic = roots[(np.abs(roots) > 2 * np.pi * 10.0) & (roots.imag > 0)]
+    elastic = elastic[np.argsort(np.abs(elastic))]
+    assert np.abs(elastic) / (2 * np.pi) == pytest.approx(link.frequencies["reduced_hz"], rel=0.005)
+    np.testing.assert_allclose(-elastic.real / np.abs(elastic), ratio, atol=1e-6)
+
 def _swing_frequencies(link, flexible):
     """Link pinned at eye A, eye B on soft sideways springs: the two swing frequencies, Hz."""
     SC = exu.SystemContainer()

@@ -167,6 +167,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
     flexible = [link.name for link in case.links if case.link_is_flexible(link.name)]
     damped_links = [link.name for link in case.links
                     if link.name in flexible and (link.stiffness_damping > 0 or link.mass_damping > 0)]
+    modal_links = [link.name for link in case.links if link.name in flexible and link.modal_damping > 0]
     gaps = [h for h in case.hinges if h.radial_clearance > 0]
     hinge_damping = [h for h in case.hinges if h.values("damping").max() > 0]
     anisotropic = [h.name for h in case.hinges if not h.isotropic]
@@ -191,6 +192,11 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         EffectEntry("link damping", effects.link_damping and bool(damped_links),
                     f"Rayleigh damping on {', '.join(damped_links)}" if effects.link_damping and damped_links else
                     ("switched off" if not effects.link_damping else "no flexible link has Rayleigh damping")),
+        EffectEntry("link modal damping", effects.link_damping and bool(modal_links),
+                    "damping ratio zeta of every elastic mode (2 zeta w_i per mass-normalised mode) on "
+                    + ", ".join(f"{name} ({case.link_map[name].modal_damping:g})" for name in modal_links)
+                    if effects.link_damping and modal_links else
+                    ("switched off" if not effects.link_damping else "no flexible link has a modal damping ratio")),
         _loss_factor_entry(scene, "link material loss factor", link_loss, effects.link_damping, "flexible link",
                            "K_red", len(flexible)),
         EffectEntry("hinge clearance", effects.clearance and bool(gaps),

@@ -231,6 +231,7 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     *_xyz("mesh_bore_b", "mesh bore B", "m", unit="mm", help="mesh: a point on bore B's axis, mesh frame"),
     *_xyz("mesh_bore_axis", "mesh bore axis", DIMENSIONLESS, help="mesh: bore axis direction, mesh frame"),
     _num("loss_factor", "loss factor", help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"),
+    _num("modal_damping", "modal damping", help="damping ratio zeta of each elastic mode of the link (empty: 0)"),
 ))
 
 HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", columns=(

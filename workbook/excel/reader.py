@@ -224,7 +224,8 @@ class _CaseReader(SheetReader):
             get("name"), record.vector("end_a"), record.vector("end_b"), model, modes=get("modes", "auto"),
             flexible=get("flexible", True), stiffness_damping=get("stiffness_damping", 0.0),
             mass_damping=get("mass_damping", 0.0), spin_frequency_hz=get("spin_frequency_hz"),
-            bore_axis=record.vector("bore_axis"), loss_factor=get("loss_factor", 0.0)))
+            bore_axis=record.vector("bore_axis"), loss_factor=get("loss_factor", 0.0),
+            modal_damping=get("modal_damping", 0.0)))
 
     def hinge(self, record: Record) -> cm.Hinge | None:
         get = record.get

@@ -93,7 +93,7 @@ def _row_for_link(link: cm.Link) -> dict:
            "element_size": model.element_size, "interface": model.interface, "modes": link.modes,
            "flexible": link.flexible, "stiffness_damping": link.stiffness_damping,
            "mass_damping": link.mass_damping, "spin_frequency_hz": link.spin_frequency_hz,
-           "loss_factor": link.loss_factor or None}
+           "loss_factor": link.loss_factor or None, "modal_damping": link.modal_damping or None}
     row.update({key: getattr(model.geometry, key) for key in
                 ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")})
     base = flexbodies.material(model.material.name.split(" ")[0])

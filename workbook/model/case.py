@@ -212,6 +212,11 @@ class Link:
     loss_factor : float
         Material loss factor eta of the link (complex modulus: the link's
         elastic stiffness acts as K (1 + i eta)), dimensionless, >= 0.
+    modal_damping : float
+        Damping ratio zeta of each of the link's elastic modes (the
+        free-free modes of its reduced model, the coordinates of its
+        flexible body): a modal damper ``2 zeta w_i`` per mass-normalised
+        mode, in both domains; dimensionless, 0 <= zeta < 1.
     spin_frequency_hz : float or None
         Frequency of the torsional restraint of the free spin about the link
         axis (None: the flexbodies default).
@@ -230,6 +235,7 @@ class Link:
     spin_frequency_hz: float | None = None
     bore_axis: Vector3 | None = None
     loss_factor: float = 0.0
+    modal_damping: float = 0.0
 
     def __post_init__(self):
         item = f"link {self.name!r}"
@@ -252,6 +258,9 @@ class Link:
              _number(self.stiffness_damping, item, "stiffness_damping", minimum=0.0))
         _set(self, "mass_damping", _number(self.mass_damping, item, "mass_damping", minimum=0.0))
         _set(self, "loss_factor", _number(self.loss_factor, item, "loss_factor", minimum=0.0))
+        _set(self, "modal_damping", _number(self.modal_damping, item, "modal_damping", minimum=0.0))
+        if self.modal_damping >= 1.0:
+            raise CaseError(item, "modal_damping", self.modal_damping, "a damping ratio >= 0 and < 1")
         if self.spin_frequency_hz is not None:
             _set(self, "spin_frequency_hz", _number(self.spin_frequency_hz, item,
                                                     "spin_frequency_hz", minimum=0.0, strictly=True))

@@ -496,7 +496,8 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
             mbs, reduced[link.name], link.end_a, link.end_b,
             flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
             stiffness_damping=(link.stiffness_damping if damping else 0.0) + viscous(link_loss.get(link.name, 0.0), 1.0),
-            mass_damping=link.mass_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
+            mass_damping=link.mass_damping if damping else 0.0,
+            modal_damping_ratio=link.modal_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
 
     transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
 
