@@ -21,9 +21,10 @@ from workbook.cli.main import main
 from workbook.errors import EXIT_BAD_INPUT, CaseError, TableError, WorkbookError
 from workbook.excel.impedance_sheet import SHEET
 from workbook.excel.reader import read_workbook
-from workbook.model.case import AnalysisSettings
+from workbook.model.case import AnalysisSettings, Imbalance, ImbalancePlane
 from workbook.model.codec import from_json, to_json
 from workbook.model.pylon_impedance import FORMAT_HEADER, PylonImpedance, read_impedance_csv
+from workbook.model.reference import LP_ROTOR
 from workbook.solve.pipeline import run_case
 
 PYLON_STIFFNESS = 3.0 * STIFFNESS      # per pin, N/m
@@ -98,8 +99,13 @@ def test_between_table_frequencies_real_and_imaginary_parts_are_linear(tmp_path)
 
 @pytest.mark.slow
 def test_a_rigid_pylon_is_the_limit_of_a_stiff_one(coarse_reference):
-    """The reference mount: as Z_p grows to infinity T tends to the rigid-pylon run's T."""
-    case = coarse_reference
+    """The reference mount: as Z_p grows to infinity T tends to the rigid-pylon run's T (the rotors, and
+    an imbalance of two planes in opposite phase, whose responses add plane by plane)."""
+    front, rear = np.add(LP_ROTOR.point, (0.8, 0.0, 0.0)), np.add(LP_ROTOR.point, (-0.8, 0.0, 0.0))
+    planes = Imbalance("two planes", (ImbalancePlane(tuple(front), unbalance=0.002),
+                                      ImbalancePlane(tuple(rear), unbalance=0.002, phase_deg=180.0)),
+                       frequency_hz=LP_ROTOR.frequency_hz)
+    case = dataclasses.replace(coarse_reference, excitations=coarse_reference.excitations + (planes,))
     rigid = run_case(case)
     frequencies = [x.frequency for x in case.single_frequency_excitations()]
     grid = [min(frequencies) / 2, max(frequencies) * 2]
