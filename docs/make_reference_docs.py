@@ -6,7 +6,8 @@ every generated section of ``docs/reference-mount.md`` (between the
 for ``workbook.model.reference.reference_case()``: the tables, and every
 number of the prose that the code computes (masses, stiffnesses, mode
 frequencies, damping ratios, the preload, the isolation efficiency in the
-time domain, the gyroscopic rotors' effect). ``tests/test_docs_current.py``
+frequency domain, the hinge damping models side by side, the time-domain
+plans, the gyroscopic rotors' effect). ``tests/test_docs_current.py``
 regenerates the sections and fails when the committed page differs. Run
 from anywhere (a few minutes with an empty link cache)::
 
@@ -30,23 +31,64 @@ from flexbodies.selection import LOW_FREQUENCY_RATIO  # noqa: E402
 from workbook.answers.link_stiffness import axial_stiffness  # noqa: E402
 from workbook.model.case import AnalysisSettings, Gravity, PointForce  # noqa: E402
 from workbook.model.drawing import hinge_table, link_table, markdown_table, plot_layout  # noqa: E402
-from workbook.model.reference import HP_ROTOR, LP_ROTOR, reference_case, reference_sweep  # noqa: E402
-from workbook.scene.build import build_scene, reduce_links  # noqa: E402
-from workbook.solve.modes import linearize, modes_of, mounted_modes  # noqa: E402
-from workbook.solve.pipeline import run_case  # noqa: E402
-from workbook.solve.preload import solve_preload  # noqa: E402
+from workbook.model.reference import HINGE_DAMPING_MODELS, HP_ROTOR, LP_ROTOR, reference_case, reference_sweep  # noqa: E402
+from workbook.scene.build import reduce_links  # noqa: E402
+from workbook.scene.structural_damping import equivalent_viscous_damping  # noqa: E402
+from workbook.solve.modes import mounted_modes  # noqa: E402
+from workbook.solve.pipeline import prepare, run_case  # noqa: E402
+from workbook.solve.time_domain import plan_run  # noqa: E402
 
 DOCS = Path(__file__).resolve().parent
 DOCUMENT = "reference-mount.md"
 #: The link removed in the topology argument.
 LATERAL_LINK = "rear-lateral"
+#: Loss factors of bolted and riveted metal joints quoted in the structural-damping
+#: literature (Ungar, structural damping, in Beranek and Ver, *Noise and Vibration
+#: Control Engineering*): the range the reference hinges' loss factor is chosen from.
+JOINT_LOSS_FACTORS = (0.02, 0.1)
+#: Share of a mode's kinetic energy in the thrust rods above which the mode is theirs.
+ROD_SHARE = 0.8
 
 
-def _mounted(case, reduced):
-    """Preload and mounted modes of *case* with the reduced links *reduced*."""
-    with build_scene(case, reduced=reduced) as scene:
-        preload = solve_preload(scene)
-        return preload, mounted_modes(modes_of(linearize(scene)))
+def _mounted(case, reduced, excitation=HP_ROTOR):
+    """Preload and mounted modes of *case* with the reduced links *reduced*, as a run prepares them.
+
+    The one pipeline (stress stiffening included), linearised for the frequency
+    domain: the damping ratios include the hinges' loss factors exactly (H).
+    Returns the preload, the mounted modes and every mode.
+    """
+    prepared = prepare(case, excitation, reduced=reduced)
+    with prepared.scene:
+        return prepared.preload, mounted_modes(prepared.modes), prepared.modes
+
+
+def _time_plan(case, excitation, reduced):
+    """The time-domain plan of one run of *case* (its scene built for the time domain), and its mounted modes."""
+    timed = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method="time"))
+    prepared = prepare(timed, excitation, reduced=reduced, harmonic=False)
+    with prepared.scene:
+        return plan_run(timed.analysis, prepared.scene.excitation.signal, prepared.modes), \
+            mounted_modes(prepared.modes)
+
+
+def _rod_modes(modes):
+    """The thrust rods' own modes in the mount."""
+    return [m for m in modes if m.body_shares.get("thrust-left", 0) + m.body_shares.get("thrust-right", 0) > ROD_SHARE]
+
+
+def _around(modes, frequency_hz: float):
+    """The mode just below and the mode just above *frequency_hz*."""
+    below = max((m for m in modes if m.frequency_hz < frequency_hz), key=lambda m: m.frequency_hz)
+    above = min((m for m in modes if m.frequency_hz > frequency_hz), key=lambda m: m.frequency_hz)
+    return below, above
+
+
+def _one(values, what: str) -> float:
+    """The single value all hinges share (isotropic and equal), else an error naming *what*."""
+    distinct = {tuple(v) for v in values}
+    if len(distinct) != 1 or len(set(next(iter(distinct)))) != 1:
+        raise ValueError(f"the reference hinges no longer share one isotropic {what}: the page's argument needs it")
+    return next(iter(distinct))[0]
 
 
 def _sci(value: float) -> str:
@@ -136,17 +178,13 @@ def _links(case, reduced, per_rotor) -> tuple[str, str]:
     return markdown_table(table), text
 
 
-def _hinges(case, reduced, mounted) -> tuple[str, str]:
-    """The paragraphs on the hinge stiffness and damping."""
-    stiffness = {h.stiffness for h in case.hinges}
-    beta = {h.damping / h.stiffness for h in case.hinges}
-    if len(stiffness) != 1 or len(beta) != 1:
-        raise ValueError("the reference hinges no longer share one stiffness and one damping time")
-    (k,), (beta,) = stiffness, beta
+def _hinges(case, reduced, mounted) -> str:
+    """The paragraph on the hinge stiffness."""
+    k = _one((h.values("stiffness") for h in case.hinges), "stiffness")
     links = {link.name: axial_stiffness(reduced[link.name]) for link in case.links}
     series = {name: 100 * (k / 2) / value for name, value in links.items()}   # link compliance / two hinges'
     first, last = mounted[0], mounted[-1]
-    stiffness_text = (
+    return (
         f"All {len(case.hinges)} hinges have the same spherical-bearing-plus-fitting stiffness, **k = {_sci(k)} N/m** "
         f"in every direction, chosen so that the engine's {len(mounted)} mounted modes lie at "
         f"{first.frequency_hz:.1f}-{last.frequency_hz:.1f} Hz, well below the LP rotor's {LP_ROTOR.frequency_hz:g} Hz "
@@ -155,19 +193,77 @@ def _hinges(case, reduced, mounted) -> tuple[str, str]:
         + ", ".join(f"{links[n] / 1e9:.2f} GN/m {n}" for n in ("front-left", "rear-left", "thrust-left"))
         + f"): in series with a link's two hinges its compliance adds {_range(series.values(), 1)} % "
         f"(the thrust rods the most).")
+
+
+def _hinge_damping(case, viscous_case, mounted, viscous_mounted) -> tuple[str, str]:
+    """The paragraphs on the loss factor (with its reason) and on the former viscous damping."""
+    k = _one((h.values("stiffness") for h in case.hinges), "stiffness")
+    eta = _one((h.values("loss_factor") for h in case.hinges), "loss factor")
+    _one((h.values("damping") for h in case.hinges), "viscous damping")   # none in the reference
+    low, high = JOINT_LOSS_FACTORS
+    if not low <= eta <= high:
+        raise ValueError(f"the reference hinges' loss factor {eta:g} lies outside the quoted range {low:g}-{high:g}")
+    zeta = [100 * m.damping_ratio for m in mounted]
+    loss = (
+        f"Damping is structural: every hinge has the **loss factor eta = {eta:g}** (`HINGE_LOSS_FACTOR`), its "
+        f"stiffness acting as k (1 + i eta), and {'no' if not case.hinges[0].damping else 'a'} viscous damper. A "
+        f"bolted or riveted metal joint dissipates energy by micro-slip and friction at its contact faces; the loss "
+        f"factor of such built-up steel and titanium structures lies at about {low:g}-{high:g} and hardly changes "
+        f"with frequency (the range quoted for bolted and riveted joints in the structural-damping literature, e.g. "
+        f"Ungar's chapter on structural damping in Beranek and Ver, *Noise and Vibration Control Engineering*); "
+        f"{eta:g} is the middle of it, for a spherical bearing clamped in a bolted fitting. Linearised with the "
+        f"structural matrix H (the frequency domain's exact form), it gives the mounted modes zeta = "
+        f"{_range(zeta, 2)} % (eta / 2 = {100 * eta / 2:g} % for a mode whose strain energy is all in the hinges; "
+        f"table below), the same at every frequency.")
+    beta = _one((h.values("damping") / h.values("stiffness") for h in viscous_case.hinges), "damping time")
     omega = {rotor.frequency_hz: 2 * math.pi * rotor.frequency_hz for rotor in (LP_ROTOR, HP_ROTOR)}
-    damping_text = (
-        f"Damping is stiffness-proportional, **d = beta k with beta = {_sci(beta)} s** ({_sci(beta * k)} N s/m per "
-        f"hinge). That gives zeta = beta w / 2 at the mounted modes, from {100 * first.damping_ratio:.1f} % "
-        f"({first.frequency_hz:.1f} Hz) to {100 * last.damping_ratio:.1f} % ({last.frequency_hz:.1f} Hz) - see the "
-        f"table below - in the range of a bolted metal mount. The price of the stiffness-proportional form: the "
-        f"equivalent loss factor beta w grows with frequency, "
-        + " and ".join(f"{beta * w:.2f} at {f:g} Hz" for f, w in omega.items())
-        + f". A metal joint's damping is closer to frequency independent, so at the HP frequency the hinge "
-        f"dampers pass more force than a real mount would (the damper term sqrt(1 + (beta w)^2) is "
+    first, last = viscous_mounted[0], viscous_mounted[-1]
+    viscous = (
+        f"The former model, **d = beta k with beta = {_sci(beta)} s** ({_sci(beta * k)} N s/m per hinge; "
+        f"`reference_case(hinge_damping=\"viscous\")`), gave zeta = beta w / 2 from "
+        f"{100 * first.damping_ratio:.1f} % ({first.frequency_hz:.1f} Hz) to {100 * last.damping_ratio:.1f} % "
+        f"({last.frequency_hz:.1f} Hz) at the mounted modes, but its equivalent loss factor beta w grows with the "
+        f"frequency: " + " and ".join(f"{beta * w:.2f} at {f:g} Hz" for f, w in omega.items())
+        + f", where the dampers passed more force than the springs (the damper term sqrt(1 + (beta w)^2) is "
         f"{math.sqrt(1 + (beta * omega[HP_ROTOR.frequency_hz]) ** 2):.1f} at {HP_ROTOR.frequency_hz:g} Hz) and "
-        f"the HP transmissibility is conservative.")
-    return stiffness_text, damping_text
+        f"the HP transmissibility came out too high. The viscous beta therefore goes: a bolted joint has no "
+        f"velocity-proportional damper, and keeping one would bring the frequency-growing force back. The two "
+        f"models side by side are in \"Damping models\" below.")
+    return loss, viscous
+
+
+def _time_domain_damping(case, plans, viscous_plans) -> str:
+    """The loss factor in the time domain: its viscous equivalent per run and the settle times it implies."""
+    k = _one((h.values("stiffness") for h in case.hinges), "stiffness")
+    eta = _one((h.values("loss_factor") for h in case.hinges), "loss factor")
+    rotors = (LP_ROTOR, HP_ROTOR)
+    least = {rotor: min(plans[rotor][1], key=lambda m: m.decay_rate) for rotor in rotors}
+    settle = {rotor: plans[rotor][0].settle_periods / rotor.frequency_hz for rotor in rotors}
+    former = {rotor: viscous_plans[rotor][0].settle_periods / rotor.frequency_hz for rotor in rotors}
+    steps = {rotor: plans[rotor][0].steps / viscous_plans[rotor][0].steps for rotor in rotors}
+    constants = case.analysis.settle_time_constants
+    return (
+        "In the frequency domain (the default for this linear scene) the loss factor is exact at every frequency. "
+        "The time domain uses its viscous equivalent d = eta k / w at the run's own frequency ("
+        + " and ".join(f"{_sci(equivalent_viscous_damping(eta, k, r.frequency_hz))} N s/m per hinge at "
+                       f"{r.frequency_hz:g} Hz" for r in rotors)
+        + "), exact in the steady state there but far weaker at the mounted modes (the least damped: zeta "
+        + ", ".join(f"{100 * least[r].damping_ratio:.2f} % at {least[r].frequency_hz:.1f} Hz in the {r.name} run"
+                    for r in rotors)
+        + f"), so a time-domain run settles {constants:g} decay time constant(s) of "
+        + " and ".join(f"{settle[r]:.0f} s ({r.name})" for r in rotors)
+        + f" instead of {_range(former.values(), 1)} s with the former viscous damping: "
+        + " and ".join(f"{steps[r]:.0f}" for r in rotors)
+        + " times the steps. The model card of each run says which form was built and at which frequency.")
+
+
+def _hinge_rows(case) -> str:
+    """The hinge table with each hinge's loss factor."""
+    table = hinge_table(case)
+    table.insert(list(table.columns).index("damping (N s/m)") + 1, "loss factor",
+                 [" / ".join(f"{v:g}" for v in h.values("loss_factor")) if not h.isotropic
+                  else f"{h.values('loss_factor')[0]:g}" for h in case.hinges])
+    return markdown_table(table)
 
 
 def _loads(case, reduced) -> str:
@@ -199,7 +295,7 @@ def _lowest(mounted) -> str:
 
 def _without_lateral(case, reduced, first_hz: float) -> str:
     reduced = {name: item for name, item in reduced.items() if name != LATERAL_LINK}
-    _, mounted = _mounted(case.without_link(LATERAL_LINK), reduced)
+    _, mounted, _ = _mounted(case.without_link(LATERAL_LINK), reduced)
     return (f"Without `{LATERAL_LINK}` the first mounted mode ({mounted[0].description}) drops to "
             f"{mounted[0].frequency_hz:.2f} Hz, from {first_hz:.2f} Hz (the same flexible links and preload, "
             f"geometric stiffness included).")
@@ -223,10 +319,8 @@ def _balance(case, preload) -> str:
             f"if it misses by more than {case.analysis.equilibrium_tolerance:g}.")
 
 
-def _efficiency(case, settle_s: float) -> tuple[str, str, str]:
-    """The time-domain efficiency table, the flexible-vs-rigid change of T and the time-domain settings."""
-    timed = dataclasses.replace(case, analysis=AnalysisSettings(method="time"))
-    results = {"flexible (auto modes)": run_case(timed), "rigid (`--rigid`)": run_case(timed.with_rigid_links())}
+def _efficiency(results) -> tuple[str, str]:
+    """The efficiency table (frequency domain) and the flexible-vs-rigid change of T."""
     rows = ["| links | run | f (Hz) | eta x (%) | eta y (%) | eta z (%) |", "|---|---|---|---|---|---|"]
     for label, result in results.items():
         for run in result.runs:
@@ -238,16 +332,60 @@ def _efficiency(case, settle_s: float) -> tuple[str, str, str]:
         t, reference = run.transmissibility, rigid.run(run.name).transmissibility
         change.append(f"| {run.name} | " + ", ".join(f"{v:.4g}" for v in t) + " | "
                       + ", ".join(f"{v:+.1f}" for v in 100 * (t / reference - 1)) + " |")
-    analysis = timed.analysis
-    steady = max(run.steady_change for result in results.values() for run in result.runs)
-    settings = (f"Settings: {analysis.steps_per_period} steps per period (generalized-alpha, spectral radius "
-                f"{analysis.spectral_radius:g}, whose period error makes a mass-dominated T about "
-                f"(2 pi / n)^2 / 6 = {100 * (2 * math.pi / analysis.steps_per_period) ** 2 / 6:.2f} % low), a "
-                f"{analysis.ramp_periods:g}-period smooth start, a settle time of {analysis.settle_time_constants:g} "
-                f"decay time constant(s) 1 / (zeta w) of the least damped mounted mode ({settle_s:.2f} s here), then two "
-                f"windows of {analysis.measured_periods} periods; the run is steady when the two windows agree within "
-                f"{100 * analysis.steady_tolerance:g} % (here within {steady:.0e}).")
-    return "\n".join(rows), "\n".join(change), settings
+    return "\n".join(rows), "\n".join(change)
+
+
+def _damping_models(results) -> str:
+    """T in dB per direction of the LP and HP runs under each hinge damping model (frequency domain)."""
+    rows = ["| hinge damping | run | f (Hz) | T x (dB) | T y (dB) | T z (dB) | mounted-mode zeta (%) |",
+            "|---|---|---|---|---|---|---|"]
+    for model in HINGE_DAMPING_MODELS[::-1]:
+        result = results[model]
+        for run in result.runs:
+            zeta = [100 * z for _, z, _ in result.model_cards[run.name].mounted_modes]
+            db = 20 * np.log10(run.transmissibility)
+            rows.append(f"| {model} | {run.name} | {run.frequency_hz:g} | {db[0]:.2f} | {db[1]:.2f} | {db[2]:.2f} | "
+                        f"{_range(zeta, 2)} |")
+    old, new = results["viscous"], results["loss factor"]
+    for run in new.runs:
+        change = 20 * np.log10(run.transmissibility / old.run(run.name).transmissibility)
+        rows.append(f"| change | {run.name} | {run.frequency_hz:g} | {change[0]:+.2f} | {change[1]:+.2f} | "
+                    f"{change[2]:+.2f} | |")
+    return "\n".join(rows)
+
+
+def _damping_change(results, rod_modes) -> str:
+    """What the change of damping model does at each rotor frequency, and why the heading force at HP moves."""
+    old, new = results["viscous"], results["loss factor"]
+    change = {run.name: 20 * np.log10(run.transmissibility / old.run(run.name).transmissibility) for run in new.runs}
+    hp = HP_ROTOR.name
+    pairs = {model: _around(rod_modes[model], HP_ROTOR.frequency_hz) for model in HINGE_DAMPING_MODELS}
+    frequencies = " and ".join(f"{m.frequency_hz:.0f}" for m in pairs["loss factor"])
+    zeta = {model: _range([100 * m.damping_ratio for m in pair], 1) for model, pair in pairs.items()}
+    words = "rises" if change[hp][0] > 0 else "falls"
+    return (
+        "From the former to the new model T changes by "
+        + "; ".join(f"{', '.join(f'{v:+.1f}' for v in change[run.name])} dB in x, y, z at {run.frequency_hz:g} Hz"
+                    for run in new.runs)
+        + f" (negative: less force reaches the pylon). At {HP_ROTOR.frequency_hz:g} Hz the heading force {words}: "
+        f"the thrust rods' bending modes in the mount on either side of it, at {frequencies} Hz, were damped at "
+        f"{zeta['viscous']} % of critical by the former dampers and are at {zeta['loss factor']} % with the loss "
+        f"factor (T_x {new.run(hp).transmissibility[0]:.2g}).")
+
+
+def _settings(case, plans) -> str:
+    """The time-domain settings and what they plan for the reference's two runs (nothing integrated)."""
+    analysis = case.analysis
+    return (f"Settings: {analysis.steps_per_period} steps per period (generalized-alpha, spectral radius "
+            f"{analysis.spectral_radius:g}, whose period error makes a mass-dominated T about "
+            f"(2 pi / n)^2 / 6 = {100 * (2 * math.pi / analysis.steps_per_period) ** 2 / 6:.2f} % low), a "
+            f"{analysis.ramp_periods:g}-period smooth start, a settle time of {analysis.settle_time_constants:g} "
+            f"decay time constant(s) 1 / (zeta w) of the least damped mounted mode of the time-domain scene, then two "
+            f"windows of {analysis.measured_periods} periods; the run is steady when the two windows agree within "
+            f"{100 * analysis.steady_tolerance:g} %. For the reference (flexible links) that plans "
+            + " and ".join(f"{plan.steps:,} steps ({plan.end_time:.0f} s simulated) for the {rotor.name}".replace(",", " ")
+                           for rotor, (plan, _) in plans.items())
+            + ".")
 
 
 def _rotors(case) -> tuple[str, str]:
@@ -297,13 +435,20 @@ def _rotors(case) -> tuple[str, str]:
 def sections() -> dict[str, str]:
     """Every generated section of docs/reference-mount.md, by name."""
     case = reference_case()
-    per_rotor = {rotor: reduce_links(case, rotor) for rotor in (LP_ROTOR, HP_ROTOR)}
+    viscous_case = reference_case(hinge_damping="viscous")
+    rotors = (LP_ROTOR, HP_ROTOR)
+    per_rotor = {rotor: reduce_links(case, rotor) for rotor in rotors}
     reduced = per_rotor[HP_ROTOR]
-    preload, mounted = _mounted(case, reduced)
+    preload, mounted, modes = _mounted(case, reduced)
+    _, viscous_mounted, viscous_modes = _mounted(viscous_case, reduced)
     links, rule = _links(case, reduced, per_rotor)
-    stiffness, damping = _hinges(case, reduced, mounted)
-    least_damped = min(mounted, key=lambda m: m.decay_rate)
-    efficiency, change, settings = _efficiency(case, 1 / least_damped.decay_rate)
+    loss, viscous = _hinge_damping(case, viscous_case, mounted, viscous_mounted)
+    plans = {rotor: _time_plan(case, rotor, per_rotor[rotor]) for rotor in rotors}
+    viscous_plans = {rotor: _time_plan(viscous_case, rotor, per_rotor[rotor]) for rotor in rotors}
+    flexible = run_case(case)
+    efficiency, change = _efficiency({"flexible (auto modes)": flexible, "rigid (`--rigid`)": run_case(case.with_rigid_links())})
+    by_model = {"loss factor": flexible, "viscous": run_case(viscous_case)}
+    rod_modes = {"loss factor": _rod_modes(modes), "viscous": _rod_modes(viscous_modes)}
     numbers, rotor_table, rotor_check = _rotors(case)
     return {
         "engine": _engine(case),
@@ -312,16 +457,20 @@ def sections() -> dict[str, str]:
         "without rear-lateral": _without_lateral(case, reduced, mounted[0].frequency_hz),
         "link rule": rule,
         "links": links,
-        "hinge stiffness": stiffness,
-        "hinge damping": damping,
-        "hinges": markdown_table(hinge_table(case)),
+        "hinge stiffness": _hinges(case, reduced, mounted),
+        "hinge damping": loss,
+        "former damping": viscous,
+        "time-domain damping": _time_domain_damping(case, plans, viscous_plans),
+        "hinges": _hinge_rows(case),
         "loads": _loads(case, reduced),
         "modes": _modes(mounted),
         "balance": _balance(case, preload),
         "static forces": _forces(preload),
         "efficiency": efficiency,
         "flexibility": change,
-        "time-domain settings": settings,
+        "damping models": _damping_models(by_model),
+        "damping change": _damping_change(by_model, rod_modes),
+        "time-domain settings": _settings(case, plans),
         "rotor numbers": numbers,
         "rotor table": rotor_table,
         "rotor check": rotor_check,

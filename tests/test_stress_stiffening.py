@@ -5,6 +5,7 @@ import dataclasses
 import numpy as np
 import pytest
 import skfem
+from conftest import COARSE_ELEMENT_SIZE
 from excel_helpers import copy_reference, set_cells
 
 from flexbodies import LinkGeometry, LinkModel, reduce_link
@@ -14,9 +15,10 @@ from flexbodies.meshing import Bore, LinkMesh
 from workbook.cli.main import main
 from workbook.errors import EXIT_TROUBLE, BucklingError, CaseError, WorkbookError, exit_code
 from workbook.excel.reader import read_workbook
-from workbook.model.case import Effects
+from workbook.model.case import AnalysisSettings, Effects
 from workbook.model.codec import to_json
 from workbook.model.reference import LP_ROTOR
+from workbook.solve.modes import mounted_modes
 from workbook.solve.pipeline import prepare, run_case
 from workbook.solve.stress_stiffening import AUTO_SHIFT, TENSION_TOLERANCE
 
@@ -207,3 +209,22 @@ def test_the_command_line_exits_1_with_the_buckling_in_words(coarse_reference, t
     assert main(["run", str(path), "--json", "--no-progress"]) == 1
     out, err = capsys.readouterr()
     assert out == "" and "buckles" in err and "times its buckling load" in err and "Traceback" not in err
+
+
+@pytest.mark.slow
+def test_the_rebuilt_scene_keeps_the_loss_factors_exact_in_the_frequency_domain(cache_dir):
+    """The stiffened scene of a frequency-domain run leaves the hinges' loss factor to the
+    structural matrix H: every mounted mode (hinge-dominated) has zeta close to eta / 2, not the
+    viscous equivalent's eta f / (2 f_exc), and the card says the loss factor is exact."""
+    from workbook.model.reference import HINGE_LOSS_FACTOR, reference_case
+
+    case = dataclasses.replace(reference_case(element_size=COARSE_ELEMENT_SIZE), excitations=(LP_ROTOR,))
+    prepared = prepare(case, LP_ROTOR)
+    with prepared.scene:
+        assert any(link.stiffened for link in prepared.preload.stiffening.links)
+        assert prepared.scene.loss_factor_hz is None and prepared.model.linearization.structural is not None
+        zeta = [m.damping_ratio for m in mounted_modes(prepared.modes)]
+    np.testing.assert_allclose(zeta, HINGE_LOSS_FACTOR / 2, rtol=0.05)
+    card = run_case(dataclasses.replace(case, analysis=AnalysisSettings(method="frequency"))).model_cards["LP rotor"]
+    detail = next(e for e in card.effects if e.name == "hinge loss factor")
+    assert "exact at every frequency" in detail.detail

@@ -224,7 +224,9 @@ def stiffen_links(case: Case, excitation: SingleFrequencyExcitation | None, scen
     while chosen and passes < MAX_PASSES:
         reduced = dict(original)
         reduced.update({name: stiffened(original[name], stiffenings[name], tensions[name]) for name in chosen})
-        rebuilt = build_scene(case, excitation, reduced=reduced)
+        # rebuilt as the scene was: loss factors exact (left to the frequency domain) or as
+        # their viscous equivalent at the excitation's frequency (time domain)
+        rebuilt = build_scene(case, excitation, reduced=reduced, exact_loss_factors=scene.loss_factor_hz is None)
         try:
             preload = solve_preload(rebuilt)
         except BaseException:
