@@ -8,6 +8,7 @@ generate now.
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 
 def _pattern(name: str) -> re.Pattern:
@@ -38,3 +39,18 @@ def replace_section(text: str, name: str, content: str, document: str) -> str:
     """
     section(text, name, document)
     return _pattern(name).sub(lambda m: m.group(1) + content + "\n" + m.group(3), text)
+
+
+def rewrite_sections(path: Path, sections: dict[str, str]) -> Path:
+    """Replace each generated section of the document at *path* by its content in *sections* (by name).
+
+    Raises
+    ------
+    ValueError
+        If a section's markers are missing; the document is then left as it was.
+    """
+    text = path.read_text()
+    for name, content in sections.items():
+        text = replace_section(text, name, content, path.name)
+    path.write_text(text)
+    return path

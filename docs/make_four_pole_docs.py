@@ -22,7 +22,7 @@ import scipy.linalg as sla
 
 matplotlib.use("Agg")
 
-from generated_sections import replace_section  # noqa: E402
+from generated_sections import rewrite_sections  # noqa: E402
 
 from flexbodies import TITANIUM  # noqa: E402
 from workbook.model.pylon_beam import BoxBeamPylon  # noqa: E402
@@ -136,11 +136,7 @@ def sections(figure_path: Path | None = None) -> dict[str, str]:
 
 
 def main() -> None:
-    path = DOCS / DOCUMENT
-    text = path.read_text()
-    for name, content in sections(DOCS / "four-pole.png").items():
-        text = replace_section(text, name, content, DOCUMENT)
-    path.write_text(text)
+    path = rewrite_sections(DOCS / DOCUMENT, sections(DOCS / "four-pole.png"))
     print(f"wrote {DOCS / 'four-pole.png'} and the generated sections of {path}")
 
 

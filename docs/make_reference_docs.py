@@ -24,7 +24,7 @@ import numpy as np
 
 matplotlib.use("Agg")
 
-from generated_sections import replace_section  # noqa: E402
+from generated_sections import rewrite_sections  # noqa: E402
 
 from flexbodies.exudyn_body import DEFAULT_SPIN_FREQUENCY_HZ  # noqa: E402
 from flexbodies.selection import LOW_FREQUENCY_RATIO  # noqa: E402
@@ -480,11 +480,7 @@ def sections() -> dict[str, str]:
 def main() -> None:
     figure = plot_layout(reference_case())
     figure.savefig(DOCS / "reference-mount.png", dpi=110)
-    path = DOCS / DOCUMENT
-    text = path.read_text()
-    for name, content in sections().items():
-        text = replace_section(text, name, content, DOCUMENT)
-    path.write_text(text)
+    path = rewrite_sections(DOCS / DOCUMENT, sections())
     print(f"wrote {DOCS / 'reference-mount.png'} and the generated sections of {path}")
 
 

@@ -21,7 +21,7 @@ import numpy as np
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt  # noqa: E402
-from generated_sections import replace_section  # noqa: E402
+from generated_sections import rewrite_sections  # noqa: E402
 
 from workbook.model.case import AnalysisSettings, ForceTransducers  # noqa: E402
 from workbook.model.reference import LP_ROTOR, reference_case  # noqa: E402
@@ -150,11 +150,7 @@ def _figure(answer) -> None:
 def main() -> None:
     case, answer = study()
     _figure(answer)
-    path = DOCS / DOCUMENT
-    text = path.read_text()
-    for name, content in sections(case, answer).items():
-        text = replace_section(text, name, content, DOCUMENT)
-    path.write_text(text)
+    path = rewrite_sections(DOCS / DOCUMENT, sections(case, answer))
     print(f"wrote {DOCS / 'rig-sensors.png'} and the tables of {path}")
 
 

@@ -18,7 +18,7 @@ import dataclasses
 import time
 from pathlib import Path
 
-from generated_sections import replace_section
+from generated_sections import rewrite_sections
 
 from flexbodies.geometric_stiffness import link_stiffening
 from workbook.model.reference import LP_ROTOR, reference_case
@@ -74,11 +74,7 @@ def sections() -> dict[str, str]:
 
 
 def main() -> None:
-    path = DOCS / DOCUMENT
-    text = path.read_text()
-    for name, content in sections().items():
-        text = replace_section(text, name, content, DOCUMENT)
-    path.write_text(text)
+    path = rewrite_sections(DOCS / DOCUMENT, sections())
     print(f"wrote the stress-stiffening tables of {path} (auto threshold {100 * AUTO_SHIFT:g} %)")
 
 
