@@ -85,7 +85,7 @@ def start_vector(n: int) -> np.ndarray:
     return np.random.default_rng(0).standard_normal(n)
 
 
-def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None):
+def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None, *, tol: float = 0.0, ncv: int | None = None):
     """Eigenpairs of ``K x = lambda M x`` nearest to ``sigma``, by shift-invert Lanczos.
 
     Parameters
@@ -97,6 +97,10 @@ def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None):
         Shift, (rad/s)^2.
     factor : optional
         A factorisation of ``K - sigma M`` from :func:`factorize`, to reuse.
+    tol : float
+        Lanczos's relative accuracy of the eigenvalues (0: machine precision).
+    ncv : int, optional
+        Lanczos vectors between restarts (ARPACK's default: ``max(2 count + 1, 20)``).
 
     Returns
     -------
@@ -110,7 +114,8 @@ def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None):
         factor = factorize((stiffness - sigma * mass).tocsc())
     lam, vec = spla.eigsh(
         stiffness, k=min(count, n - 2), M=mass, sigma=sigma, which="LM",
-        OPinv=factor.as_operator(), v0=start_vector(n),
+        OPinv=factor.as_operator(), v0=start_vector(n), tol=tol,
+        ncv=None if ncv is None else min(max(ncv, count + 1), n - 1),
     )
     order = np.argsort(lam)
     return np.sqrt(np.clip(lam[order], 0.0, None)) / (2 * np.pi), vec[:, order]
