@@ -112,16 +112,21 @@ def measure(size_mm: float, repeats: int, with_exudyn: bool) -> dict:
 
 
 def _before(case, frequencies_hz):
-    """The reduction chain as it was: per excitation, per link not yet reduced for that decision."""
+    """The reduction chain as it was: per excitation, per link not yet reduced for that decision.
+
+    As it was also means: a link keyed by its exact length (0.26 and 0.25999999999999995 m were two
+    links) and the floating-frame invariants computed by Exudyn.
+    """
     from flexbodies.craig_bampton import craig_bampton
     from flexbodies.link import build_fe_model
     from flexbodies.reduction import couple, reduce_coupled, reference_frequencies
     from flexbodies.selection import decide_modes
+    from flexbodies.validation import exudyn_invariants
 
     summaries, done, links = {}, set(), {}
     for f in frequencies_hz:
         for link in case.links:
-            key = link.model.key()
+            key = (link.model.key(), link.length)
             decision = decide_modes(link.modes, summaries[key]["mounted_hz"][0], f) if key in summaries else None
             if decision is not None and (key, decision.key) in done:
                 continue  # a cache hit
@@ -134,7 +139,10 @@ def _before(case, frequencies_hz):
                     continue
             cb = craig_bampton(coupled.stiffness, coupled.mass, coupled.coupling.boundary,
                                count=decision.count, cutoff_hz=decision.cutoff_hz)
-            links[(link.name, f)] = reduce_coupled(coupled, cb, decision, summaries[key], {})
+            reduced = reduce_coupled(coupled, cb, decision, summaries[key], {})
+            exudyn_invariants(reduced.nodes[:len(fe.nodes)], fe.mass, fe.stiffness,
+                              reduced.mode_basis[:fe.ndof], fe.surface_triangles)
+            links[(link.name, f)] = reduced
             done.add((key, decision.key))
     return links
 

@@ -1,4 +1,10 @@
-"""How good is a static-modes-only link? Harmonic response against the full FE model.
+"""Checks against independent computations.
+
+:func:`exudyn_invariants` gives the floating-frame invariants as Exudyn's own
+``ObjectFFRFreducedOrderInterface`` computes them, the peer of
+:func:`flexbodies.invariants.ffrf_invariants`.
+
+How good is a static-modes-only link? Harmonic response against the full FE model.
 
 The check the seed study's low-frequency approximation rests on: a link
 clamped at eye A and forced harmonically at eye B's master node. Three
@@ -21,8 +27,9 @@ import scipy.sparse as sp
 
 from .craig_bampton import craig_bampton
 from .eigen import factorize, free_dofs, natural_frequencies
+from .reduced import FFRF_KEYS
 
-__all__ = ["HarmonicCheck", "harmonic_response_check"]
+__all__ = ["HarmonicCheck", "harmonic_response_check", "exudyn_invariants"]
 
 #: Force directions at eye B, in the link frame.
 DIRECTIONS = {"axial": 0, "in-plane": 1, "out-of-plane": 2}
@@ -118,3 +125,35 @@ def harmonic_response_check(coupled, direction: str = "axial", ratios=(0.05, 0.1
         err_static.append(abs(reduced - full) / abs(full))
         err_quasi.append(abs(quasi_static - full) / abs(full))
     return HarmonicCheck(direction, f1, ratios, np.array(err_static), np.array(err_quasi))
+
+
+def exudyn_invariants(nodes, mass, stiffness, mode_basis, triangles) -> dict:
+    """Floating-frame invariants computed by Exudyn's ``ObjectFFRFreducedOrderInterface``.
+
+    Parameters
+    ----------
+    nodes : ndarray, shape (n, 3)
+        Node positions, m.
+    mass, stiffness : scipy.sparse matrix, shape (3n, 3n)
+        Node-major mass (kg) and stiffness (N/m).
+    mode_basis : ndarray, shape (3n, m)
+        Elastic modes.
+    triangles : ndarray of int, shape (k, 3)
+        Surface triangles (Exudyn wants a surface).
+
+    Returns
+    -------
+    dict
+        The arrays of :data:`~flexbodies.reduced.FFRF_KEYS`.
+    """
+    from exudyn.FEM import FEMinterface, ObjectFFRFreducedOrderInterface
+
+    fem = FEMinterface()
+    fem.nodes = {"Position": np.asarray(nodes, dtype=float)}
+    # Exudyn needs scipy's csr_matrix, not csr_array.
+    fem.massMatrix = sp.csr_matrix(mass)
+    fem.stiffnessMatrix = sp.csr_matrix(stiffness)
+    fem.surface = [{"Name": "surface", "Trigs": np.asarray(triangles, dtype=int)}]
+    fem.modeBasis = {"matrix": np.asarray(mode_basis, dtype=float), "type": "HCBmodes"}
+    data = ObjectFFRFreducedOrderInterface(fem).GetDictionary()
+    return {key: np.asarray(data[key], dtype=float) for key in FFRF_KEYS}
