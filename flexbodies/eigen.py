@@ -29,23 +29,24 @@ class _Factor:
             options={"SymmetricMode": True},
         )
 
-    def _refined(self, rhs: np.ndarray) -> np.ndarray:
-        # One step of iterative refinement recovers the digits that the
-        # ill-conditioning of coupled (RBE3) matrices costs; it is skipped
-        # when the residual is already at round-off.
+    def solve(self, rhs: np.ndarray) -> np.ndarray:
+        """Solve for a vector or for each column of a matrix, with one refinement step.
+
+        One step of iterative refinement recovers the digits that the
+        ill-conditioning of coupled (RBE3) matrices costs; it is skipped for
+        the columns whose residual is already at round-off. The columns of a
+        matrix are solved together (SuperLU's block solve costs about a third
+        of a loop over them).
+        """
+        rhs = np.asarray(rhs, dtype=float)
         x = self._lu.solve(rhs)
         residual = rhs - self._matrix @ x
-        if np.linalg.norm(residual) <= _ROUND_OFF * np.linalg.norm(rhs):
-            return x
-        return x + self._lu.solve(residual)
-
-    def solve(self, rhs: np.ndarray) -> np.ndarray:
-        """Solve for a vector or for each column of a matrix, with one refinement step."""
-        rhs = np.asarray(rhs, dtype=float)
         if rhs.ndim == 1:
-            return self._refined(rhs)
-        # SuperLU on a 2-D right-hand side is slower than a loop over columns.
-        return np.column_stack([self._refined(np.ascontiguousarray(c)) for c in rhs.T])
+            return x if np.linalg.norm(residual) <= _ROUND_OFF * np.linalg.norm(rhs) else x + self._lu.solve(residual)
+        refine = np.linalg.norm(residual, axis=0) > _ROUND_OFF * np.linalg.norm(rhs, axis=0)
+        if refine.any():
+            x[:, refine] += self._lu.solve(np.ascontiguousarray(residual[:, refine]))
+        return x
 
     def solve_plain(self, rhs: np.ndarray) -> np.ndarray:
         """Solve for one vector, without refinement (what an eigen-solver's operator needs)."""
