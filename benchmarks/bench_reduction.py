@@ -161,9 +161,30 @@ def _now(case, frequencies_hz):
     return links
 
 
+def largest_difference(case, before: dict, now: dict) -> float:
+    """Largest relative difference of any frequency between the links reduced before and now.
+
+    Both map (link name, excitation Hz) to a reduced link; ``now`` holds the
+    first link of each unique model, which serves every equal one.
+    """
+    import numpy as np
+
+    keys = {link.name: link.model.key() for link in case.links}
+    now_by_key = {(keys[name], f): link for (name, f), link in now.items()}
+    worst = 0.0
+    for (name, f), old in before.items():
+        new = now_by_key[(keys[name], f)]
+        assert old.decision.key == new.decision.key, (name, f)
+        for key in ("free_free_hz", "mounted_hz", "fixed_interface_hz", "reduced_hz"):
+            a, b = np.asarray(old.frequencies[key]), np.asarray(new.frequencies[key])
+            assert a.shape == b.shape, (name, f, key)
+            if a.size:
+                worst = max(worst, float(np.max(np.abs(b / a - 1))))
+    return worst
+
+
 def reference_links(repeats: int) -> None:
     """Cold reduction of the reference mount's links, before and now, with the largest frequency difference."""
-    import numpy as np
 
     from workbook.model.reference import reference_case
 
@@ -171,15 +192,7 @@ def reference_links(repeats: int) -> None:
     frequencies_hz = sorted({e.frequency for e in case.excitations})
     before_s, before = _timed(lambda: _before(case, frequencies_hz), repeats)
     now_s, now = _timed(lambda: _now(case, frequencies_hz), repeats)
-    worst = 0.0
-    for key, old in before.items():
-        new = now[key]
-        assert old.decision.key == new.decision.key, key
-        for name in ("free_free_hz", "mounted_hz", "fixed_interface_hz", "reduced_hz"):
-            a, b = np.asarray(old.frequencies[name]), np.asarray(new.frequencies[name])
-            assert a.shape == b.shape, (key, name)
-            if a.size:
-                worst = max(worst, float(np.max(np.abs(b / a - 1))))
+    worst = largest_difference(case, before, now)
     unique = len({link.model.key() for link in case.links})
     print(f"Cold reduction of the {len(case.links)} reference links ({unique} unique) for "
           f"{', '.join(f'{f:g}' for f in frequencies_hz)} Hz, median of {repeats}, 1 BLAS thread")

@@ -15,13 +15,15 @@ as :meth:`HarmonicModel.respond` does.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.linalg as sla
 
 from workbook.answers.isolation import pylon_sum
 from workbook.solve.harmonic import FrequencyResponse, HarmonicModel
 
-__all__ = ["respond_many", "modal_motions", "ROUND_OFF"]
+__all__ = ["respond_many", "modal_motions", "SweepResponse", "ROUND_OFF"]
 
 #: Backward error accepted as exact: residual of ``(K - w^2 M + i w D) z = b`` over
 #: ``|K - w^2 M + i w D| |z| + |b|`` (a direct solve reaches about 1e-16).
@@ -51,7 +53,9 @@ class _Modal:
 
 def _times(matrix: np.ndarray, values: np.ndarray) -> np.ndarray:
     """``matrix @ values`` for a real matrix and complex values, in real arithmetic (half the work)."""
-    return matrix @ values.real + 1j * (matrix @ values.imag)
+    columns = values.shape[1]
+    both = matrix @ np.hstack([values.real, values.imag])
+    return both[:, :columns] + 1j * both[:, columns:]
 
 
 def _residual(model: HarmonicModel, omegas, motion, loads):
@@ -63,10 +67,10 @@ def _residual(model: HarmonicModel, omegas, motion, loads):
 
 
 def _backward_errors(model: HarmonicModel, omegas, motion, loads) -> np.ndarray:
-    """Normwise backward error of each frequency's solution (2-norms)."""
+    """Normwise backward error of each frequency's solution (Frobenius norms of the matrices)."""
     lin = model.linearization
-    size = (np.linalg.norm(lin.stiffness, 2) + omegas ** 2 * np.linalg.norm(lin.mass, 2)
-            + omegas * np.linalg.norm(lin.damping, 2))
+    size = (np.linalg.norm(lin.stiffness) + omegas ** 2 * np.linalg.norm(lin.mass)
+            + omegas * np.linalg.norm(lin.damping))
     residual = np.linalg.norm(_residual(model, omegas, motion, loads), axis=0)
     return residual / (size * np.linalg.norm(motion, axis=0) + np.linalg.norm(loads, axis=0))
 
@@ -94,8 +98,34 @@ def modal_motions(model: HarmonicModel, omegas: np.ndarray, load: np.ndarray) ->
     return motion, _backward_errors(model, omegas, motion, loads)
 
 
-def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> list[FrequencyResponse]:
-    """Steady-state hinge forces at every frequency of a sweep, as :meth:`HarmonicModel.respond` gives them.
+@dataclass(frozen=True)
+class SweepResponse:
+    """Complex force amplitudes of one harmonic excitation at many frequencies.
+
+    Attributes
+    ----------
+    frequencies_hz : ndarray, shape (f,)
+    hinge_names : list of str
+        The force channels, in the order of ``hinge_forces``' second axis.
+    hinge_forces : ndarray, complex, shape (f, h, 3)
+        ``F_hat`` of each channel (force on its marker-0 body), N.
+    pylon_force : ndarray, complex, shape (f, 3)
+        Sum over the pylon channels, N.
+    """
+
+    frequencies_hz: np.ndarray
+    hinge_names: list
+    hinge_forces: np.ndarray
+    pylon_force: np.ndarray
+
+    def response(self, index: int) -> FrequencyResponse:
+        """The answer at one frequency, as :meth:`HarmonicModel.respond` gives it."""
+        return FrequencyResponse(float(self.frequencies_hz[index]), dict(zip(self.hinge_names, self.hinge_forces[index])),
+                                 self.pylon_force[index])
+
+
+def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> SweepResponse:
+    """Steady-state hinge forces at every frequency of a sweep, equal to :meth:`HarmonicModel.respond`'s.
 
     Parameters
     ----------
@@ -109,8 +139,7 @@ def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> list[Fre
 
     Returns
     -------
-    list of FrequencyResponse
-        One per frequency, in order.
+    SweepResponse
     """
     frequencies_hz = np.asarray(frequencies_hz, dtype=float)
     omegas = 2 * np.pi * frequencies_hz
@@ -121,9 +150,7 @@ def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> list[Fre
         dynamic = lin.stiffness - omegas[j] ** 2 * lin.mass + 1j * omegas[j] * lin.damping
         motion[:, j] = sla.solve(dynamic, load, check_finite=False)
     outputs = _times(np.vstack([model.stiffness_output, model.damping_output]), motion)
-    forces = outputs[:len(outputs) // 2] + 1j * omegas * outputs[len(outputs) // 2:]  # (3 h, f)
-    responses = []
-    for j, frequency in enumerate(frequencies_hz):
-        hinges = dict(zip(model.hinge_names, forces[:, j].reshape(-1, 3)))
-        responses.append(FrequencyResponse(float(frequency), hinges, pylon_sum(hinges, model.pylon_hinges)))
-    return responses
+    half = len(outputs) // 2
+    forces = (outputs[:half] + 1j * omegas * outputs[half:]).T.reshape(len(omegas), -1, 3)  # (f, h, 3)
+    hinges = dict(zip(model.hinge_names, np.moveaxis(forces, 1, 0)))
+    return SweepResponse(frequencies_hz, list(model.hinge_names), forces, pylon_sum(hinges, model.pylon_hinges))
