@@ -22,9 +22,9 @@ class _Factor:
 
     def __init__(self, matrix: sp.spmatrix):
         self.shape = matrix.shape
-        self._matrix = sp.csr_matrix(matrix)
+        self._matrix = sp.csc_matrix(matrix)
         self._lu = spla.splu(
-            sp.csc_matrix(matrix),
+            self._matrix,
             permc_spec="MMD_AT_PLUS_A",
             options={"SymmetricMode": True},
         )

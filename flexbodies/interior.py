@@ -60,14 +60,14 @@ class InteriorSolver:
         self.interior = np.setdiff1d(np.arange(K.shape[0]), self.masters)
         if not np.array_equal(self.masters, np.arange(len(self.interior), K.shape[0])):
             raise ValueError("the master DOF must be the last coordinates of the coupled model")
-        K_i = K[self.interior]
-        self.K_ii = K_i[:, self.interior].tocsc()
-        self.K_ib = K_i[:, self.masters].toarray()
-        self.M_ii = self.mass[self.interior][:, self.interior].tocsc()
+        n_i = len(self.interior)  # the interior coordinates come first: slices, not index arrays
+        self.K_ii = K[:n_i, :n_i].tocsc()
+        self.K_ib = K[:n_i, n_i:].toarray()
+        self.M_ii = self.mass[:n_i, :n_i].tocsc()
         self.factor = factorize(self.K_ii)
         #: Interior part of the static modes, one column per master DOF.
         self.psi = -self.factor.solve(self.K_ib)
-        K_bb = K[self.masters][:, self.masters].toarray()
+        K_bb = K[n_i:, n_i:].toarray()
         condensed = K_bb + self.K_ib.T @ self.psi
         #: Condensed (Guyan) boundary stiffness, symmetrised.
         self.condensed = 0.5 * (condensed + condensed.T)
