@@ -9,9 +9,9 @@ Measured, each the median of its repeats:
   (both rotors and the Sweep row, written back into a fresh copy, plus the
   report);
 - cold reduction of the reference mount's links for both rotors, as before
-  (``bench_reduction.py``'s before path: a factorisation per eigenproblem, a
-  new FE model per excitation, Exudyn's invariants, a link keyed by its exact
-  length) and as now (one factorisation per unique link), with the largest
+  (``bench_reduction.py``'s before path: K and M by scikit-fem's weak forms,
+  a factorisation per eigenproblem, a new FE model per excitation, Exudyn's
+  invariants, a link keyed by its exact length) and as now (one factorisation per unique link), with the largest
   relative difference of every frequency;
 - both rotors in the frequency domain (the case's own links) against the
   seed study's complete-MNF model (every link with 20 fixed-interface

@@ -115,13 +115,23 @@ def _before(case, frequencies_hz):
     """The reduction chain as it was: per excitation, per link not yet reduced for that decision.
 
     As it was also means: a link keyed by its exact length (0.26 and 0.25999999999999995 m were two
-    links) and the floating-frame invariants computed by Exudyn.
+    links), K and M by scikit-fem's assembly of the weak forms and the floating-frame invariants
+    computed by Exudyn.
     """
+    from flexbodies.assembly import FEModel
     from flexbodies.craig_bampton import craig_bampton
-    from flexbodies.link import build_fe_model
+    from flexbodies.meshing import mesh_link
     from flexbodies.reduction import couple, reduce_coupled, reference_frequencies
     from flexbodies.selection import decide_modes
-    from flexbodies.validation import exudyn_invariants
+    from flexbodies.validation import exudyn_invariants, scikit_fem_matrices
+
+    def build_fe_model(model):
+        # a parametric link is meshed in its link frame already
+        link_mesh = mesh_link(model.geometry, model.element_size)
+        stiffness, mass = scikit_fem_matrices(link_mesh.mesh, model.material)
+        fe = FEModel(nodes=link_mesh.nodes, stiffness=stiffness, mass=mass, bores=tuple(link_mesh.bores),
+                     surface_triangles=link_mesh.surface_triangles(), material=model.material, description="")
+        return fe, {}
 
     summaries, done, links = {}, set(), {}
     for f in frequencies_hz:

@@ -17,14 +17,14 @@ import skfem
 from .materials import Material
 from .meshing import Bore, LinkMesh
 
-__all__ = ["FEModel", "Bore", "assemble"]
+__all__ = ["FEModel", "Bore", "assemble", "INTEGRATION_ORDERS"]
 
 logger = logging.getLogger(__name__)
 
 #: Default integration orders (stiffness, mass) per mesh type: exact for
 #: straight-sided elements, and few points for hexahedra (scikit-fem's
 #: default of twice the element degree means 64 points for a quadratic hex).
-_DEFAULT_INTORDER = {
+INTEGRATION_ORDERS = {
     skfem.MeshTet2: (2, 4),
     skfem.MeshTet1: (1, 2),
     skfem.MeshHex2: (4, 4),
@@ -111,7 +111,7 @@ def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = Non
         valid and accepted.
     """
     mesh = link_mesh.mesh
-    k_order, m_order = _DEFAULT_INTORDER[type(mesh)] if intorder is None else (intorder, intorder)
+    k_order, m_order = INTEGRATION_ORDERS[type(mesh)] if intorder is None else (intorder, intorder)
     k_basis = skfem.Basis(mesh, mesh.elem(), intorder=k_order)
     _check_orientation(k_basis, link_mesh.source)
     m_basis = k_basis if m_order == k_order else skfem.Basis(mesh, mesh.elem(), intorder=m_order)

@@ -215,25 +215,12 @@ def test_reference_link_mesh_convergence(reference_link):
 
 
 @pytest.mark.parametrize("mesh_cls", [skfem.MeshTet2, skfem.MeshHex2, skfem.MeshTet1])
-def test_assembly_equals_scikit_fems_vector_forms(mesh_cls):
+def test_assembly_equals_scikit_fems_forms(mesh_cls):
     """The batched element matrices equal scikit-fem's own assembly of the elasticity and mass forms."""
+    from flexbodies.validation import scikit_fem_matrices
+
     mesh = _bar_mesh(mesh_cls, 4, 2)
     model = assemble(LinkMesh(mesh), TITANIUM)
-    lam, mu, rho = TITANIUM.lame_lambda, TITANIUM.shear_modulus, TITANIUM.density
-
-    @skfem.BilinearForm
-    def elasticity(u, v, _):
-        gu, gv = u.grad, v.grad
-        eps_u, eps_v = 0.5 * (gu + np.swapaxes(gu, 0, 1)), 0.5 * (gv + np.swapaxes(gv, 0, 1))
-        return 2 * mu * np.einsum("ij...,ij...->...", eps_u, eps_v) + lam * np.trace(gu) * np.trace(gv)
-
-    @skfem.BilinearForm
-    def inertia(u, v, _):
-        return rho * np.einsum("i...,i...->...", u, v)
-
-    k_order, m_order = {skfem.MeshTet2: (2, 4), skfem.MeshHex2: (4, 4), skfem.MeshTet1: (1, 2)}[mesh_cls]
-    element = skfem.ElementVector(mesh.elem())  # scikit-fem numbers its DOF node-major, as the model does
-    stiffness = skfem.asm(elasticity, skfem.Basis(mesh, element, intorder=k_order))
-    mass = skfem.asm(inertia, skfem.Basis(mesh, element, intorder=m_order))
+    stiffness, mass = scikit_fem_matrices(mesh, TITANIUM)
     for ours, theirs in ((model.stiffness, stiffness), (model.mass, mass)):
         assert abs(ours - theirs).max() <= 1e-12 * abs(theirs).max()
