@@ -11,8 +11,9 @@ Measured, each the median of its repeats:
 - cold reduction of the reference mount's links for both rotors, as before
   (``bench_reduction.py``'s before path: K and M by scikit-fem's weak forms,
   a factorisation per eigenproblem, a new FE model per excitation, Exudyn's
-  invariants, a link keyed by its exact length) and as now (one factorisation per unique link), with the largest
-  relative difference of every frequency;
+  invariants, a link keyed by its exact length) and as now (one factorisation
+  per unique link), the two interleaved, with the largest relative difference
+  of every frequency;
 - both rotors in the frequency domain (the case's own links) against the
   seed study's complete-MNF model (every link with 20 fixed-interface
   modes, time domain + DFT), as the accuracy study times its rungs (links
