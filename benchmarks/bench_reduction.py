@@ -9,7 +9,7 @@ factorisation of the interior stiffness (fill-reducing ordering, and
 scipy's default ordering for comparison), the fixed-interface eigen-solve
 (12 modes, reusing that factorisation) and the whole Craig-Bampton
 reduction with 12 modes (static modes, eigen-solve, orthonormalisation,
-Exudyn's floating-frame invariants). ``--exudyn`` adds Exudyn's own
+the floating-frame invariants). ``--exudyn`` adds Exudyn's own
 ``ComputeHurtyCraigBamptonModes`` (RBE2, 12 modes) on the same matrices.
 
 ``--reference`` instead reduces the links of the reference mount cold (no
@@ -68,7 +68,8 @@ def measure(size_mm: float, repeats: int, with_exudyn: bool) -> dict:
     from flexbodies import STEEL, LinkGeometry, assemble, mesh_link
     from flexbodies.craig_bampton import craig_bampton, elastic_modes
     from flexbodies.eigen import factorize, lowest_modes
-    from flexbodies.reduction import couple, ffrf_invariants
+    from flexbodies.invariants import ffrf_invariants
+    from flexbodies.reduction import couple
 
     geometry = LinkGeometry(**TEST_LINK)
     row = {"size [mm]": size_mm}
@@ -103,7 +104,7 @@ def measure(size_mm: float, repeats: int, with_exudyn: bool) -> dict:
         )
     modes = reduce_12()
     row["invariants [s]"], _ = _timed(
-        lambda: ffrf_invariants(fe.nodes, fe.mass, fe.stiffness, coupled.coupling.transform @ modes, fe.surface_triangles),
+        lambda: ffrf_invariants(fe.nodes, fe.mass, fe.stiffness, coupled.coupling.transform @ modes),
         repeats,
     )
     row["peak memory [MB]"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
@@ -111,16 +112,31 @@ def measure(size_mm: float, repeats: int, with_exudyn: bool) -> dict:
 
 
 def _before(case, frequencies_hz):
-    """The reduction chain as it was: per excitation, per link not yet reduced for that decision."""
+    """The reduction chain as it was: per excitation, per link not yet reduced for that decision.
+
+    As it was also means: a link keyed by its exact length (0.26 and 0.25999999999999995 m were two
+    links), K and M by scikit-fem's assembly of the weak forms and the floating-frame invariants
+    computed by Exudyn.
+    """
+    from flexbodies.assembly import FEModel
     from flexbodies.craig_bampton import craig_bampton
-    from flexbodies.link import build_fe_model
+    from flexbodies.meshing import mesh_link
     from flexbodies.reduction import couple, reduce_coupled, reference_frequencies
     from flexbodies.selection import decide_modes
+    from flexbodies.validation import exudyn_invariants, scikit_fem_matrices
+
+    def build_fe_model(model):
+        # a parametric link is meshed in its link frame already
+        link_mesh = mesh_link(model.geometry, model.element_size)
+        stiffness, mass = scikit_fem_matrices(link_mesh.mesh, model.material)
+        fe = FEModel(nodes=link_mesh.nodes, stiffness=stiffness, mass=mass, bores=tuple(link_mesh.bores),
+                     surface_triangles=link_mesh.surface_triangles(), material=model.material, description="")
+        return fe, {}
 
     summaries, done, links = {}, set(), {}
     for f in frequencies_hz:
         for link in case.links:
-            key = link.model.key()
+            key = (link.model.key(), link.length)
             decision = decide_modes(link.modes, summaries[key]["mounted_hz"][0], f) if key in summaries else None
             if decision is not None and (key, decision.key) in done:
                 continue  # a cache hit
@@ -133,7 +149,10 @@ def _before(case, frequencies_hz):
                     continue
             cb = craig_bampton(coupled.stiffness, coupled.mass, coupled.coupling.boundary,
                                count=decision.count, cutoff_hz=decision.cutoff_hz)
-            links[(link.name, f)] = reduce_coupled(coupled, cb, decision, summaries[key], {})
+            reduced = reduce_coupled(coupled, cb, decision, summaries[key], {})
+            exudyn_invariants(reduced.nodes[:len(fe.nodes)], fe.mass, fe.stiffness,
+                              reduced.mode_basis[:fe.ndof], fe.surface_triangles)
+            links[(link.name, f)] = reduced
             done.add((key, decision.key))
     return links
 
@@ -152,9 +171,30 @@ def _now(case, frequencies_hz):
     return links
 
 
+def largest_difference(case, before: dict, now: dict) -> float:
+    """Largest relative difference of any frequency between the links reduced before and now.
+
+    Both map (link name, excitation Hz) to a reduced link; ``now`` holds the
+    first link of each unique model, which serves every equal one.
+    """
+    import numpy as np
+
+    keys = {link.name: link.model.key() for link in case.links}
+    now_by_key = {(keys[name], f): link for (name, f), link in now.items()}
+    worst = 0.0
+    for (name, f), old in before.items():
+        new = now_by_key[(keys[name], f)]
+        assert old.decision.key == new.decision.key, (name, f)
+        for key in ("free_free_hz", "mounted_hz", "fixed_interface_hz", "reduced_hz"):
+            a, b = np.asarray(old.frequencies[key]), np.asarray(new.frequencies[key])
+            assert a.shape == b.shape, (name, f, key)
+            if a.size:
+                worst = max(worst, float(np.max(np.abs(b / a - 1))))
+    return worst
+
+
 def reference_links(repeats: int) -> None:
     """Cold reduction of the reference mount's links, before and now, with the largest frequency difference."""
-    import numpy as np
 
     from workbook.model.reference import reference_case
 
@@ -162,15 +202,7 @@ def reference_links(repeats: int) -> None:
     frequencies_hz = sorted({e.frequency for e in case.excitations})
     before_s, before = _timed(lambda: _before(case, frequencies_hz), repeats)
     now_s, now = _timed(lambda: _now(case, frequencies_hz), repeats)
-    worst = 0.0
-    for key, old in before.items():
-        new = now[key]
-        assert old.decision.key == new.decision.key, key
-        for name in ("free_free_hz", "mounted_hz", "fixed_interface_hz", "reduced_hz"):
-            a, b = np.asarray(old.frequencies[name]), np.asarray(new.frequencies[name])
-            assert a.shape == b.shape, (key, name)
-            if a.size:
-                worst = max(worst, float(np.max(np.abs(b / a - 1))))
+    worst = largest_difference(case, before, now)
     unique = len({link.model.key() for link in case.links})
     print(f"Cold reduction of the {len(case.links)} reference links ({unique} unique) for "
           f"{', '.join(f'{f:g}' for f in frequencies_hz)} Hz, median of {repeats}, 1 BLAS thread")

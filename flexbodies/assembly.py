@@ -17,14 +17,14 @@ import skfem
 from .materials import Material
 from .meshing import Bore, LinkMesh
 
-__all__ = ["FEModel", "Bore", "assemble"]
+__all__ = ["FEModel", "Bore", "assemble", "INTEGRATION_ORDERS"]
 
 logger = logging.getLogger(__name__)
 
 #: Default integration orders (stiffness, mass) per mesh type: exact for
 #: straight-sided elements, and few points for hexahedra (scikit-fem's
 #: default of twice the element degree means 64 points for a quadratic hex).
-_DEFAULT_INTORDER = {
+INTEGRATION_ORDERS = {
     skfem.MeshTet2: (2, 4),
     skfem.MeshTet1: (1, 2),
     skfem.MeshHex2: (4, 4),
@@ -79,6 +79,12 @@ class FEModel:
 def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = None) -> FEModel:
     """Assemble linear elastic stiffness and consistent mass of a link.
 
+    scikit-fem gives the shape functions, their gradients and the
+    integration weights of every element; the element matrices of all
+    elements are then formed at once (batched products) and summed into
+    node blocks over one sorted pattern, which the stiffness (3x3 blocks)
+    and the mass (one scalar per block, ``M = M_scalar (x) I3``) share.
+
     Parameters
     ----------
     link_mesh : LinkMesh
@@ -105,24 +111,20 @@ def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = Non
         valid and accepted.
     """
     mesh = link_mesh.mesh
-    k_order, m_order = _DEFAULT_INTORDER[type(mesh)] if intorder is None else (intorder, intorder)
-    k_basis = skfem.Basis(mesh, skfem.ElementVector(mesh.elem()), intorder=k_order)
+    k_order, m_order = INTEGRATION_ORDERS[type(mesh)] if intorder is None else (intorder, intorder)
+    k_basis = skfem.Basis(mesh, mesh.elem(), intorder=k_order)
     _check_orientation(k_basis, link_mesh.source)
-    stiffness = _symmetric(skfem.asm(_stiffness_form(material), k_basis))
-    perm = _node_major_permutation(k_basis, mesh)
-    if perm is not None:
-        stiffness = stiffness[perm][:, perm]
-    # The mass couples equal components only: M = M_scalar (x) I3, node-major,
-    # nine times fewer form evaluations than with the vector element.
-    scalar_mass = skfem.asm(_mass_form(material.density), skfem.Basis(mesh, mesh.elem(), intorder=m_order))
-    mass = sp.kron(_symmetric(scalar_mass), sp.identity(3), format="csr")
+    m_basis = k_basis if m_order == k_order else skfem.Basis(mesh, mesh.elem(), intorder=m_order)
+    pattern = _BlockPattern(k_basis.element_dofs, k_basis.N)
+    stiffness = pattern.blocks(_element_stiffness(k_basis, material))
+    mass = sp.kron(pattern.scalars(_element_mass(m_basis, material.density)), sp.identity(3), format="csr")
     nodes = np.ascontiguousarray(link_mesh.nodes)
     description = f"{link_mesh.element_name}, {nodes.shape[0]} nodes, {3 * nodes.shape[0]} DOF"
     logger.info("assembled %s, material %s", description, material.name)
     return FEModel(
         nodes=nodes,
-        stiffness=sp.csr_matrix(stiffness),
-        mass=sp.csr_matrix(mass),
+        stiffness=stiffness,
+        mass=mass,
         bores=tuple(link_mesh.bores),
         surface_triangles=link_mesh.surface_triangles(),
         material=material,
@@ -130,35 +132,76 @@ def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = Non
     )
 
 
-def _stiffness_form(material: Material) -> skfem.BilinearForm:
-    """Isotropic elasticity: 2 mu eps(u):eps(v) + lambda div(u) div(v)."""
+def _gradients(basis: skfem.CellBasis) -> np.ndarray:
+    """Shape-function gradients at the integration points, shape (elements, points, functions, 3), 1/m."""
+    return np.stack([np.moveaxis(field[0].grad, 0, -1) for field in basis.basis], axis=2)
+
+
+def _element_stiffness(basis: skfem.CellBasis, material: Material) -> np.ndarray:
+    """Element stiffness of isotropic elasticity, shape (elements, functions, 3, functions, 3), N/m.
+
+    For shape functions a, b and components i, j:
+    ``K[a,i,b,j] = int mu (delta_ij grad a . grad b + d_j a d_i b) + lambda d_i a d_j b``,
+    the form ``2 mu eps(u):eps(v) + lambda div u div v``.
+    """
+    grad = _gradients(basis)
+    n_e, n_p, n_f, _ = grad.shape
+    flat = grad.reshape(n_e, n_p, 3 * n_f)
+    # T[e, (a,i), (b,j)] = int d_i a d_j b
+    products = np.matmul(np.swapaxes(flat * basis.dx[:, :, None], 1, 2), flat).reshape(n_e, n_f, 3, n_f, 3)
+    laplace = np.einsum("eaibi->eab", products)
     lam, mu = material.lame_lambda, material.shear_modulus
-
-    @skfem.BilinearForm
-    def stiffness(u, v, _):
-        gu, gv = u.grad, v.grad
-        shear = np.einsum("ij...,ij...->...", gu, gv) + np.einsum("ij...,ji...->...", gu, gv)
-        trace_u = gu[0, 0] + gu[1, 1] + gu[2, 2]
-        trace_v = gv[0, 0] + gv[1, 1] + gv[2, 2]
-        return mu * shear + lam * trace_u * trace_v
-
-    return stiffness
+    element = lam * products + mu * np.swapaxes(products, 2, 4)
+    element += mu * laplace[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
+    return 0.5 * (element + element.transpose(0, 3, 4, 1, 2))
 
 
-def _mass_form(density: float) -> skfem.BilinearForm:
-    """Consistent mass of one displacement component: rho u v (scalar element)."""
-
-    @skfem.BilinearForm
-    def mass(u, v, _):
-        return density * u * v
-
-    return mass
+def _element_mass(basis: skfem.CellBasis, density: float) -> np.ndarray:
+    """Element mass of one displacement component, ``int rho a b``, shape (elements, functions, functions), kg."""
+    values = np.stack([field[0].value for field in basis.basis], axis=2)  # (elements, points, functions)
+    element = density * np.matmul(np.swapaxes(values * basis.dx[:, :, None], 1, 2), values)
+    return 0.5 * (element + np.swapaxes(element, 1, 2))
 
 
-def _symmetric(matrix) -> sp.csr_matrix:
-    """Remove round-off asymmetry of an assembled symmetric form."""
-    matrix = sp.csr_matrix(matrix)
-    return sp.csr_matrix((matrix + matrix.T) * 0.5)
+class _BlockPattern:
+    """Node-pair pattern of a mesh: where each element's (a, b) pair sums into the global matrix.
+
+    Parameters
+    ----------
+    element_nodes : ndarray of int, shape (functions, elements)
+        Global node of each element's shape function (scikit-fem's ``element_dofs``).
+    n_nodes : int
+    """
+
+    def __init__(self, element_nodes: np.ndarray, n_nodes: int):
+        rows = np.broadcast_to(element_nodes[:, None, :], (element_nodes.shape[0],) * 2 + element_nodes.shape[1:])
+        cols = np.swapaxes(rows, 0, 1)
+        # entry order of the element arrays: (element, a, b)
+        keys = (rows.astype(np.int64) * n_nodes + cols).transpose(2, 0, 1).ravel()
+        self._order = np.argsort(keys, kind="stable")
+        sorted_keys = keys[self._order]
+        self._starts = np.flatnonzero(np.r_[True, sorted_keys[1:] != sorted_keys[:-1]])
+        unique = sorted_keys[self._starts]
+        self.n_nodes = n_nodes
+        self.indices = (unique % n_nodes).astype(np.int32)
+        self.indptr = np.searchsorted(unique // n_nodes, np.arange(n_nodes + 1)).astype(np.int32)
+
+    def _summed(self, values: np.ndarray) -> np.ndarray:
+        return np.add.reduceat(values[self._order], self._starts, axis=0)
+
+    def scalars(self, element: np.ndarray) -> sp.csr_matrix:
+        """Sum element matrices (elements, a, b) into a node-by-node matrix."""
+        data = self._summed(element.reshape(-1))
+        return sp.csr_matrix((data, self.indices, self.indptr), shape=(self.n_nodes, self.n_nodes))
+
+    def blocks(self, element: np.ndarray) -> sp.csr_matrix:
+        """Sum element matrices (elements, a, 3, b, 3) into a node-major matrix of 3x3 node blocks."""
+        per_pair = element.transpose(0, 1, 3, 2, 4).reshape(-1, 3, 3)
+        data = self._summed(per_pair)
+        n = 3 * self.n_nodes
+        matrix = sp.bsr_matrix((data, self.indices, self.indptr), shape=(n, n)).tocsr()
+        matrix.eliminate_zeros()  # entries of a block that cancel exactly
+        return matrix
 
 
 def _check_orientation(basis: skfem.CellBasis, source: str) -> None:
@@ -182,20 +225,3 @@ def _check_orientation(basis: skfem.CellBasis, source: str) -> None:
         )
     if negative.any():
         logger.debug("%s: %d mirrored (negatively oriented) elements; valid", source, negative.sum())
-
-
-def _node_major_permutation(vector_basis: skfem.CellBasis, mesh) -> np.ndarray | None:
-    """Permutation ``p`` with ``p[3*i + c]`` = scikit-fem DOF of component c at node i.
-
-    Every supported element has at most one scalar DOF per vertex, edge, face
-    or cell, so each of those entities carries one node. Returns None when
-    scikit-fem's numbering is node-major already (it is, in scikit-fem 12).
-    """
-    perm = np.empty(vector_basis.N, dtype=np.int64)
-    for kind in ("nodal_dofs", "edge_dofs", "facet_dofs", "interior_dofs"):
-        nodes = getattr(mesh.dofs, kind)
-        if nodes.shape[0]:
-            components = getattr(vector_basis.dofs, kind)
-            for c in range(3):
-                perm[3 * nodes[0] + c] = components[c]
-    return None if np.array_equal(perm, np.arange(perm.size)) else perm

@@ -143,12 +143,15 @@ def exudyn_cms_interface(link: ReducedLink, node_type: str = "NodeType.RotationE
     data = {key: link.ffrf[key] for key in FFRF_KEYS}
     data.update(
         modeBasis=link.mode_basis,
-        trigList=link.surface_triangles.tolist(),
+        trigList=[],
         postProcessingModes={},
         rigidBodyNodeType=node_type,
         infoList=np.array([link.n_modes, len(link.nodes), 3, n_rot, 3 + n_rot, 3 + n_rot + link.n_modes]),
     )
     cms.SetWithDictionary(data)
+    # Exudyn takes the triangles as an array as well; its own reader turns them into a list of lists,
+    # which cost more than the rest of adding a link to a scene
+    cms.trigList = link.surface_triangles
     return cms
 
 

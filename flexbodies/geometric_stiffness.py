@@ -47,7 +47,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import skfem
 
-from .assembly import _node_major_permutation, assemble
+from .assembly import assemble
 from .atomic import replacing
 from .cache import default_cache_dir
 from .frequencies import mounted_constraint_basis
@@ -157,13 +157,9 @@ def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Materi
         Stress, Pa.
     """
     mesh = link_mesh.mesh
-    basis = skfem.Basis(mesh, skfem.ElementVector(mesh.elem()), intorder=_INTORDER[type(mesh)])
-    perm = _node_major_permutation(basis, mesh)
-    values = np.asarray(displacement, dtype=float)
-    if perm is not None:
-        values = np.empty(basis.N)
-        values[perm] = displacement
-    grad = basis.interpolate(values).grad
+    scalar = skfem.Basis(mesh, mesh.elem(), intorder=_INTORDER[type(mesh)])  # scalar DOF i is node i
+    components = np.asarray(displacement, dtype=float).reshape(-1, 3).T
+    grad = np.stack([scalar.interpolate(component).grad for component in components])  # d u_c / d x_i
     strain = 0.5 * (grad + np.swapaxes(grad, 0, 1))
     trace = strain[0, 0] + strain[1, 1] + strain[2, 2]
     return 2 * material.shear_modulus * strain + material.lame_lambda * trace * np.eye(3)[:, :, None, None]

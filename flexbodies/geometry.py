@@ -4,7 +4,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-__all__ = ["LinkGeometry"]
+__all__ = ["LinkGeometry", "SIGNIFICANT_DIGITS"]
+
+#: Significant digits a dimension keeps: 1e-12 relative, far below any mesh size, far above round-off.
+SIGNIFICANT_DIGITS = 12
 
 
 @dataclass(frozen=True)
@@ -34,6 +37,11 @@ class LinkGeometry:
         Shank thickness along the bore axis (local z), m; at most
         ``thickness``.
 
+    Each dimension is kept to :data:`SIGNIFICANT_DIGITS` significant digits,
+    so that two links whose lengths differ only by round-off (one computed
+    from hinge points, one typed in) are the same link and share one
+    reduction.
+
     Raises
     ------
     ValueError
@@ -53,6 +61,7 @@ class LinkGeometry:
             value = getattr(self, field_name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
                 raise ValueError(f"link geometry: {field_name} must be a positive length in m, got {value!r}")
+            object.__setattr__(self, field_name, float(f"{value:.{SIGNIFICANT_DIGITS}g}"))
         if self.bore_radius >= self.eye_outer_radius:
             raise ValueError(
                 f"link geometry: the bore radius ({self.bore_radius} m) must be smaller than "

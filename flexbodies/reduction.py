@@ -4,7 +4,8 @@ Steps: tie the bores to master nodes (:mod:`~flexbodies.interfaces`),
 compute the reference frequencies of the coupled FE model
 (:mod:`~flexbodies.frequencies`), build the Craig-Bampton basis the mode
 decision asks for (:mod:`~flexbodies.craig_bampton`), orthonormalise it
-into elastic modes and let Exudyn compute the floating-frame invariants.
+into elastic modes and compute the floating-frame invariants
+(:mod:`~flexbodies.invariants`).
 """
 from __future__ import annotations
 
@@ -18,10 +19,11 @@ from .craig_bampton import CraigBamptonBasis, elastic_modes, fixed_interface_set
 from .frequencies import free_free_frequencies, mounted_frequencies
 from .interfaces import InterfaceCoupling, couple_interfaces
 from .interior import InteriorSolver
-from .reduced import FFRF_KEYS, ReducedLink
+from .invariants import ffrf_invariants
+from .reduced import ReducedLink
 from .selection import ModeDecision
 
-__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions", "ffrf_invariants"]
+__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions"]
 
 
 @dataclass(frozen=True)
@@ -61,39 +63,6 @@ def _padded(matrix: sp.spmatrix, extra: int) -> sp.csr_matrix:
     return sp.block_diag((matrix, sp.csr_matrix((extra, extra))), format="csr")
 
 
-def ffrf_invariants(nodes, mass, stiffness, mode_basis, triangles) -> dict:
-    """Floating-frame inertia invariants, computed by Exudyn.
-
-    Parameters
-    ----------
-    nodes : ndarray, shape (n, 3)
-        Node positions in the body frame, m.
-    mass, stiffness : scipy.sparse matrix, shape (3n, 3n)
-        Node-major mass (kg) and stiffness (N/m).
-    mode_basis : ndarray, shape (3n, m)
-        Elastic modes, no rigid-body motion.
-    triangles : ndarray of int, shape (k, 3)
-        Surface triangles for drawing.
-
-    Returns
-    -------
-    dict
-        The arrays of :data:`~flexbodies.reduced.FFRF_KEYS`.
-    """
-    from exudyn.FEM import FEMinterface, ObjectFFRFreducedOrderInterface
-
-    fem = FEMinterface()
-    fem.nodes = {"Position": np.asarray(nodes, dtype=float)}
-    # Exudyn needs scipy's csr_matrix, not csr_array.
-    fem.massMatrix = sp.csr_matrix(mass)
-    fem.stiffnessMatrix = sp.csr_matrix(stiffness)
-    fem.surface = [{"Name": "surface", "Trigs": np.asarray(triangles, dtype=int)}]
-    fem.modeBasis = {"matrix": np.asarray(mode_basis, dtype=float), "type": "HCBmodes"}
-    cms = ObjectFFRFreducedOrderInterface(fem)
-    data = cms.GetDictionary()
-    return {key: np.asarray(data[key], dtype=float) for key in FFRF_KEYS}
-
-
 def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeDecision, frequencies: dict,
                    info: dict) -> ReducedLink:
     """The reduced link of a Craig-Bampton basis: elastic modes, node-wise basis, floating-frame invariants.
@@ -123,10 +92,7 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     masters_t = coupling.master_dofs[:, :3]
     mode_basis = np.vstack([coupling.transform @ modes_q, modes_q[masters_t.ravel()]])
     nodes = np.vstack([fe.nodes, coupling.centres])
-    invariants = ffrf_invariants(
-        nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if),
-        mode_basis, fe.surface_triangles,
-    )
+    invariants = ffrf_invariants(nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if), mode_basis)
     info = dict(info)
     info.update(
         coupling=coupling.kind,

@@ -1,4 +1,12 @@
-"""How good is a static-modes-only link? Harmonic response against the full FE model.
+"""Checks against independent computations.
+
+:func:`exudyn_invariants` gives the floating-frame invariants as Exudyn's own
+``ObjectFFRFreducedOrderInterface`` computes them, the peer of
+:func:`flexbodies.invariants.ffrf_invariants`; :func:`scikit_fem_matrices`
+gives K and M by scikit-fem's own assembly of the weak forms, the peer of
+:func:`flexbodies.assembly.assemble`.
+
+How good is a static-modes-only link? Harmonic response against the full FE model.
 
 The check the seed study's low-frequency approximation rests on: a link
 clamped at eye A and forced harmonically at eye B's master node. Three
@@ -19,10 +27,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .assembly import INTEGRATION_ORDERS
 from .craig_bampton import craig_bampton
 from .eigen import factorize, free_dofs, natural_frequencies
+from .reduced import FFRF_KEYS
 
-__all__ = ["HarmonicCheck", "harmonic_response_check"]
+__all__ = ["HarmonicCheck", "harmonic_response_check", "exudyn_invariants", "scikit_fem_matrices"]
 
 #: Force directions at eye B, in the link frame.
 DIRECTIONS = {"axial": 0, "in-plane": 1, "out-of-plane": 2}
@@ -118,3 +128,70 @@ def harmonic_response_check(coupled, direction: str = "axial", ratios=(0.05, 0.1
         err_static.append(abs(reduced - full) / abs(full))
         err_quasi.append(abs(quasi_static - full) / abs(full))
     return HarmonicCheck(direction, f1, ratios, np.array(err_static), np.array(err_quasi))
+
+
+def exudyn_invariants(nodes, mass, stiffness, mode_basis, triangles) -> dict:
+    """Floating-frame invariants computed by Exudyn's ``ObjectFFRFreducedOrderInterface``.
+
+    Parameters
+    ----------
+    nodes : ndarray, shape (n, 3)
+        Node positions, m.
+    mass, stiffness : scipy.sparse matrix, shape (3n, 3n)
+        Node-major mass (kg) and stiffness (N/m).
+    mode_basis : ndarray, shape (3n, m)
+        Elastic modes.
+    triangles : ndarray of int, shape (k, 3)
+        Surface triangles (Exudyn wants a surface).
+
+    Returns
+    -------
+    dict
+        The arrays of :data:`~flexbodies.reduced.FFRF_KEYS`.
+    """
+    from exudyn.FEM import FEMinterface, ObjectFFRFreducedOrderInterface
+
+    fem = FEMinterface()
+    fem.nodes = {"Position": np.asarray(nodes, dtype=float)}
+    # Exudyn needs scipy's csr_matrix, not csr_array.
+    fem.massMatrix = sp.csr_matrix(mass)
+    fem.stiffnessMatrix = sp.csr_matrix(stiffness)
+    fem.surface = [{"Name": "surface", "Trigs": np.asarray(triangles, dtype=int)}]
+    fem.modeBasis = {"matrix": np.asarray(mode_basis, dtype=float), "type": "HCBmodes"}
+    data = ObjectFFRFreducedOrderInterface(fem).GetDictionary()
+    return {key: np.asarray(data[key], dtype=float) for key in FFRF_KEYS}
+
+
+def scikit_fem_matrices(mesh, material) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+    """Stiffness (N/m) and consistent mass (kg) by scikit-fem's assembly of the weak forms, node-major.
+
+    The elasticity form ``2 mu eps(u):eps(v) + lambda div u div v`` on the
+    vector element, the mass ``rho u v`` on the scalar element for each
+    component (``M = M_scalar (x) I3``), at the integration orders of
+    :data:`~flexbodies.assembly.INTEGRATION_ORDERS`; scikit-fem numbers the
+    vector element's DOF node-major.
+
+    Parameters
+    ----------
+    mesh : skfem.Mesh
+        A mesh of a type in :data:`~flexbodies.assembly.INTEGRATION_ORDERS`, m.
+    material : Material
+    """
+    import skfem
+
+    lam, mu, rho = material.lame_lambda, material.shear_modulus, material.density
+    k_order, m_order = INTEGRATION_ORDERS[type(mesh)]
+
+    @skfem.BilinearForm
+    def elasticity(u, v, _):
+        gu, gv = u.grad, v.grad
+        eps_u, eps_v = 0.5 * (gu + np.swapaxes(gu, 0, 1)), 0.5 * (gv + np.swapaxes(gv, 0, 1))
+        return 2 * mu * np.einsum("ij...,ij...->...", eps_u, eps_v) + lam * np.trace(gu) * np.trace(gv)
+
+    @skfem.BilinearForm
+    def inertia(u, v, _):
+        return rho * u * v
+
+    stiffness = skfem.asm(elasticity, skfem.Basis(mesh, skfem.ElementVector(mesh.elem()), intorder=k_order))
+    scalar_mass = skfem.asm(inertia, skfem.Basis(mesh, mesh.elem(), intorder=m_order))
+    return sp.csr_matrix(stiffness), sp.kron(scalar_mass, sp.identity(3), format="csr")

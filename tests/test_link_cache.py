@@ -186,3 +186,15 @@ def test_another_keys_entry_is_recomputed_with_one_warning(tmp_path, caplog, kin
     caplog.clear()
     assert reduce_link(titanium, 6, cache_dir=dirty).cache_hit
     assert not [r for r in caplog.records if r.levelno == logging.WARNING]
+
+
+def test_lengths_equal_up_to_round_off_are_one_link():
+    # 0.26 from hinge points comes out as 0.25999999999999995: the same link, one reduction
+    computed = LinkGeometry(length=0.13 + 0.13 - 5.551115123125783e-17, eye_outer_radius=0.025, bore_radius=0.012,
+                            thickness=0.020, shank_width=0.030, shank_thickness=0.020)
+    typed = LinkGeometry(length=0.26, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020, shank_width=0.030,
+                         shank_thickness=0.020)
+    near = LinkGeometry(length=0.26 * (1 + 1e-9), eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020,
+                        shank_width=0.030, shank_thickness=0.020)
+    assert computed == typed and _model(geometry=computed).key() == _model(geometry=typed).key()
+    assert _model(geometry=near).key() != _model(geometry=typed).key(), "a real change of length is a new link"

@@ -139,3 +139,26 @@ def test_one_reduction_serves_every_excitation():
                                atol=1e-9 * np.abs(alone.ffrf["stiffnessMatrixReduced"]).max())
     # the static reduction is the first block of the one with modes: its free-free frequencies lie above
     assert np.all(low.frequencies["reduced_hz"][:3] > high.frequencies["reduced_hz"][:3])
+
+
+def test_invariants_are_exudyns(fe_model):
+    """The floating-frame invariants equal those of Exudyn's own ObjectFFRFreducedOrderInterface."""
+    from flexbodies.invariants import ffrf_invariants
+    from flexbodies.reduced import FFRF_KEYS
+    from flexbodies.validation import exudyn_invariants
+
+    coupled = couple(fe_model, "RBE2")
+    cb = craig_bampton(coupled.stiffness, coupled.mass, coupled.coupling.boundary, count=4)
+    modes_q, _ = elastic_modes(cb, coupled.stiffness, coupled.mass)
+    basis = coupled.coupling.transform @ modes_q
+    ours = ffrf_invariants(fe_model.nodes, fe_model.mass, fe_model.stiffness, basis)
+    exudyns = exudyn_invariants(fe_model.nodes, fe_model.mass, fe_model.stiffness, basis, fe_model.surface_triangles)
+    # round-off scale: the elastic modes carry no momentum, so mPhitTPsi is ~1e-16 against sqrt(m) of a
+    # mass-normalised mode's products
+    scale = np.sqrt(float(exudyns["totalMass"]))
+    for key in FFRF_KEYS:
+        assert ours[key].shape == exudyns[key].shape, key
+        np.testing.assert_allclose(ours[key], exudyns[key], rtol=0, atol=1e-12 * max(np.abs(exudyns[key]).max(), scale),
+                                   err_msg=key)
+    for key in ("massMatrixReduced", "stiffnessMatrixReduced"):
+        assert np.array_equal(ours[key] == 0, exudyns[key] == 0), f"{key}: other entries rounded to zero"
