@@ -158,7 +158,7 @@ def _element_stiffness(basis: skfem.CellBasis, material: Material) -> np.ndarray
 
 def _element_mass(basis: skfem.CellBasis, density: float) -> np.ndarray:
     """Element mass of one displacement component, ``int rho a b``, shape (elements, functions, functions), kg."""
-    values = np.stack([field[0].value for field in basis.basis], axis=2)  # (elements, points, functions)
+    values = np.stack([np.asarray(field[0]) for field in basis.basis], axis=2)  # (elements, points, functions)
     element = density * np.matmul(np.swapaxes(values * basis.dx[:, :, None], 1, 2), values)
     return 0.5 * (element + np.swapaxes(element, 1, 2))
 
