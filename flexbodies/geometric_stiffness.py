@@ -53,12 +53,13 @@ from .cache import default_cache_dir
 from .frequencies import mounted_constraint_basis
 from .interior import InteriorSolver
 from .materials import Material
-from .meshing import LinkMesh, load_mesh, mesh_link
+from .meshing import LinkMesh
 from .reduced import ReducedLink
 from .reduction import couple
 
 __all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement",
-           "mesh_stiffening", "link_stiffening", "stiffened", "PINNED_FIXED_MODES"]
+           "mesh_stiffening", "coupled_stiffening", "link_stiffening", "has_stiffening", "save_stiffening", "stiffened",
+           "PINNED_FIXED_MODES"]
 
 #: Fixed-interface modes in the pinned-pinned model that gives the first
 #: mounted frequency and the buckling load (the link's own reduction may keep
@@ -241,8 +242,37 @@ def mesh_stiffening(link_mesh: LinkMesh, material: Material, interface: str = "R
     """
     coupled = couple(assemble(link_mesh, material), interface)
     solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+    return coupled_stiffening(link_mesh, coupled, solver, material, fixed_modes)
+
+
+def coupled_stiffening(link_mesh: LinkMesh, coupled, solver: InteriorSolver, material: Material,
+                       fixed_modes: int = PINNED_FIXED_MODES, rotation=None) -> LinkStiffening:
+    """The geometric stiffness of a link per newton of tension, from its coupled model and the
+    factorisation of its interior (those of its reduction, when the FE model is in the mesh's frame).
+
+    Parameters
+    ----------
+    link_mesh : LinkMesh
+        The mesh *coupled* was assembled from.
+    coupled : flexbodies.reduction.CoupledModel
+    solver : InteriorSolver
+        Of *coupled*.
+    material : Material
+    fixed_modes : int
+        Fixed-interface modes of the pinned-pinned model.
+    rotation : ndarray, shape (3, 3), optional
+        *coupled*'s frame against the mesh's: a vector v of the mesh is
+        ``rotation @ v`` in *coupled* (default: the same frame). The stress
+        is taken in the mesh's frame; ``K_G = G (x) I3`` is the same in both.
+
+    Returns
+    -------
+    LinkStiffening
+    """
     transform = coupled.coupling.transform
     displacement = transform @ unit_tension_displacement(solver)
+    if rotation is not None:
+        displacement = (displacement.reshape(-1, 3) @ np.asarray(rotation, dtype=float)).ravel()
     scalar = geometric_stiffness(link_mesh, stress_field(link_mesh, displacement, material))
     _, fixed = solver.fixed_interface_modes(fixed_modes)
     basis = np.hstack([solver.static_modes() @ mounted_constraint_basis(coupled.coupling), fixed])
@@ -295,20 +325,34 @@ def link_stiffening(model, *, cache_dir=None, use_cache: bool = True) -> LinkSti
         stored = _load(path)
         if stored is not None:
             return stored
-    if model.geometry is not None:
-        link_mesh = mesh_link(model.geometry, model.element_size)
-    else:
-        link_mesh = load_mesh(model.mesh.path, model.mesh.bores, scale=model.mesh.scale)
-    stiffening = mesh_stiffening(link_mesh, model.material, model.interface)
+    stiffening = mesh_stiffening(model.meshed(), model.material, model.interface)
     if use_cache:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        scalar = stiffening.scalar
-        with replacing(path) as temporary, open(temporary, "wb") as handle:
-            np.savez(handle, data=scalar.data, indices=scalar.indices, indptr=scalar.indptr,
-                     shape=np.array(scalar.shape), pinned_stiffness=stiffening.pinned_stiffness,
-                     pinned_mass=stiffening.pinned_mass, pinned_geometric=stiffening.pinned_geometric,
-                     buckling_load=np.float64(stiffening.buckling_load))
+        save_stiffening(model, stiffening, cache_dir=cache_dir)
     return stiffening
+
+
+def has_stiffening(model, *, cache_dir=None) -> bool:
+    """True when the geometric stiffness of the link model *model* is in the cache."""
+    return _path(model, cache_dir).is_file()
+
+
+def save_stiffening(model, stiffening: LinkStiffening, *, cache_dir=None) -> Path:
+    """Keep *stiffening*, the geometric stiffness of the link model *model*, in the cache.
+
+    Returns
+    -------
+    Path
+        The cache file.
+    """
+    path = _path(model, cache_dir)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    scalar = stiffening.scalar
+    with replacing(path) as temporary, open(temporary, "wb") as handle:
+        np.savez(handle, data=scalar.data, indices=scalar.indices, indptr=scalar.indptr,
+                 shape=np.array(scalar.shape), pinned_stiffness=stiffening.pinned_stiffness,
+                 pinned_mass=stiffening.pinned_mass, pinned_geometric=stiffening.pinned_geometric,
+                 buckling_load=np.float64(stiffening.buckling_load))
+    return path
 
 
 def stiffened(link: ReducedLink, stiffening: LinkStiffening, tension: float) -> ReducedLink:

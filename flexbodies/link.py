@@ -29,10 +29,11 @@ import numpy as np
 
 from .assembly import FEModel, assemble
 from .cache import LinkCache, default_cache_dir
+from .geometric_stiffness import coupled_stiffening, has_stiffening, save_stiffening
 from .geometry import LinkGeometry
 from .interior import InteriorSolver
 from .materials import STEEL, Material
-from .meshing import default_element_size, load_mesh, mesh_link
+from .meshing import LinkMesh, default_element_size, load_mesh, mesh_link
 from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
 from .reduction import couple, reduce_for_decisions
 from .selection import decide_modes
@@ -118,6 +119,12 @@ class LinkModel:
         """Hash of :meth:`fingerprint`: the key of the link's cache entries and of its lock."""
         return _hash(self.fingerprint())
 
+    def meshed(self) -> LinkMesh:
+        """The link's mesh: the parametric geometry meshed, or the mesh file read."""
+        if self.geometry is not None:
+            return mesh_link(self.geometry, self.element_size)
+        return load_mesh(self.mesh.path, self.mesh.bores, scale=self.mesh.scale)
+
 
 def _hash(record: dict) -> str:
     """Short SHA-256 of a JSON-able record (the key of a cache entry)."""
@@ -125,8 +132,9 @@ def _hash(record: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-def _in_link_frame(fe: FEModel) -> FEModel:
-    """The FE model rotated and shifted so that eye A is at the origin, eye B on +x, bore A's axis on z."""
+def _in_link_frame(fe: FEModel) -> tuple[FEModel, np.ndarray]:
+    """The FE model rotated and shifted so that eye A is at the origin, eye B on +x, bore A's axis on z,
+    and the rotation R (rows: the link axes in the model's coordinates; a link-frame vector is R v)."""
     a, b = fe.bores[0].centre, fe.bores[1].centre
     ex = (b - a) / np.linalg.norm(b - a)
     ez = fe.bores[0].axis - ex * (fe.bores[0].axis @ ex)
@@ -135,7 +143,7 @@ def _in_link_frame(fe: FEModel) -> FEModel:
     ez /= np.linalg.norm(ez)
     R = np.vstack([ex, np.cross(ez, ex), ez])  # rows: link axes in model coordinates
     if np.allclose(R, np.eye(3), atol=1e-12) and np.allclose(a, 0.0, atol=1e-12):
-        return fe
+        return fe, np.eye(3)
     import scipy.sparse as sp
 
     block = sp.kron(sp.identity(len(fe.nodes)), sp.csr_matrix(R), format="csr")
@@ -148,7 +156,7 @@ def _in_link_frame(fe: FEModel) -> FEModel:
         stiffness=(block @ fe.stiffness @ block.T).tocsr(),
         mass=(block @ fe.mass @ block.T).tocsr(),
         bores=bores,
-    )
+    ), R
 
 
 def build_fe_model(model: LinkModel) -> tuple[FEModel, dict]:
@@ -160,14 +168,18 @@ def build_fe_model(model: LinkModel) -> tuple[FEModel, dict]:
     timings : dict
         ``mesh_seconds`` and ``assembly_seconds``.
     """
+    fe, _, _, timings = _meshed_fe_model(model)
+    return fe, timings
+
+
+def _meshed_fe_model(model: LinkModel) -> tuple[FEModel, LinkMesh, np.ndarray, dict]:
+    """:func:`build_fe_model` with the link's mesh and the rotation from the mesh's frame to the link
+    frame (see :func:`_in_link_frame`)."""
     start = time.perf_counter()
-    if model.geometry is not None:
-        link_mesh = mesh_link(model.geometry, model.element_size)
-    else:
-        link_mesh = load_mesh(model.mesh.path, model.mesh.bores, scale=model.mesh.scale)
+    link_mesh = model.meshed()
     meshed = time.perf_counter()
-    fe = _in_link_frame(assemble(link_mesh, model.material))
-    return fe, {"mesh_seconds": meshed - start, "assembly_seconds": time.perf_counter() - meshed}
+    fe, rotation = _in_link_frame(assemble(link_mesh, model.material))
+    return fe, link_mesh, rotation, {"mesh_seconds": meshed - start, "assembly_seconds": time.perf_counter() - meshed}
 
 
 def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = None, *, cache_dir=None,
@@ -207,7 +219,7 @@ def _cached(cache: LinkCache, fe_hash: str, modes, excitations_hz) -> tuple:
 
 
 def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
-                    use_cache: bool = True) -> tuple:
+                    use_cache: bool = True, stiffening: bool = False) -> tuple:
     """Reduce a link for several excitations at once: one FE model, every decision served from it.
 
     Parameters
@@ -221,6 +233,11 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         Default :func:`default_cache_dir`.
     use_cache : bool
         False recomputes and does not read or write the cache.
+    stiffening : bool
+        Also keep the link's geometric stiffness in the cache
+        (:func:`flexbodies.geometric_stiffness.link_stiffening` then loads
+        it), computed from this reduction's FE model and factorisation when
+        the link is reduced now and the cache has none yet.
 
     Returns
     -------
@@ -239,11 +256,14 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         frequencies, decisions, keys, links = _cached(cache, fe_hash, modes, excitations_hz)
         if links is not None and all(link is not None for link in links):
             return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
-        fe, timings = build_fe_model(model)
+        fe, link_mesh, rotation, timings = _meshed_fe_model(model)
         coupled = couple(fe, model.interface)
         start = time.perf_counter()
         solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
         timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
+        if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
+            save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
+                            cache_dir=cache_dir)
         if frequencies is None:
             start = time.perf_counter()
             frequencies = solver.reference_frequencies()

@@ -8,7 +8,7 @@ import skfem
 from conftest import COARSE_ELEMENT_SIZE
 from excel_helpers import copy_reference, set_cells
 
-from flexbodies import LinkGeometry, LinkModel, reduce_link
+from flexbodies import LinkGeometry, LinkModel, reduce_link, reduce_link_set
 from flexbodies.geometric_stiffness import link_stiffening, mesh_stiffening, stiffened
 from flexbodies.materials import STEEL
 from flexbodies.meshing import Bore, LinkMesh
@@ -200,6 +200,23 @@ def test_the_geometric_stiffness_is_cached_and_a_damaged_entry_recomputed(tmp_pa
     np.testing.assert_allclose(pulled + pushed, 2 * base, rtol=1e-12, atol=1e-9 * np.abs(base).max())
     np.testing.assert_allclose(pulled, pulled.T, rtol=0, atol=1e-12 * np.abs(base).max())
     assert np.abs(pulled - base).max() > 1e-6 * np.abs(base).max()
+
+
+def test_the_reduction_keeps_the_geometric_stiffness_of_its_own_factorisation(tmp_path):
+    """Reduced with ``stiffening=True`` the link's geometric stiffness is cached from the reduction's
+    FE model and factorisation, equal to the one computed on its own; nothing is computed twice."""
+    model = LinkModel(geometry=LinkGeometry(length=0.20, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020,
+                                            shank_width=0.030, shank_thickness=0.020), element_size=0.02)
+    assert not list(tmp_path.glob("stiffening-*.npz"))
+    reduce_link_set(model, "static", (50.0,), cache_dir=tmp_path, stiffening=True)
+    (entry,) = tmp_path.glob("stiffening-*.npz")
+    kept = link_stiffening(model, cache_dir=tmp_path)
+    alone = link_stiffening(model, use_cache=False)
+    assert kept.buckling_load == pytest.approx(alone.buckling_load, rel=1e-9)
+    np.testing.assert_allclose(kept.pinned_geometric, alone.pinned_geometric, rtol=1e-7,
+                               atol=1e-9 * np.abs(alone.pinned_geometric).max())
+    difference = abs(kept.scalar - alone.scalar).max()
+    assert difference <= 1e-9 * abs(alone.scalar).max()
 
 
 @pytest.mark.slow

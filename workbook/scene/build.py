@@ -422,7 +422,8 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None
     frequencies = sorted({e.frequency for e in case.excitations} | {frequency})
     reduced = {}
     for link in case.links:
-        per_frequency = reduce_link_set(link.model, case.link_modes(link.name), frequencies)
+        stiffening = case.effects.stress_stiffening != "off" and case.link_is_flexible(link.name)
+        per_frequency = reduce_link_set(link.model, case.link_modes(link.name), frequencies, stiffening=stiffening)
         reduced[link.name] = per_frequency[frequencies.index(frequency)]
         if progress is not None:
             progress(len(reduced))
