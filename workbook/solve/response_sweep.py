@@ -1,9 +1,10 @@
 """Harmonic responses at many frequencies at once: one eigen-decomposition, then products.
 
 A sweep asks the same linearised scene (:class:`~workbook.solve.harmonic.HarmonicModel`)
-for ``z_hat = (K - w^2 M + i w D)^-1 B f_hat`` at hundreds of frequencies.
-In first-order form ``y = [z, z']`` the system matrix
-``A = [[0, I], [-M^-1 K, -M^-1 D]]`` is decomposed once, ``A = V diag(lambda) V^-1``,
+for ``z_hat = (K + i H - w^2 M + i w D)^-1 B f_hat`` at hundreds of frequencies
+(H the structural damping of the loss factors, frequency-independent, so
+``K + i H`` is one complex stiffness). In first-order form ``y = [z, z']`` the system matrix
+``A = [[0, I], [-M^-1 (K + i H), -M^-1 D]]`` is decomposed once, ``A = V diag(lambda) V^-1``,
 and then every frequency costs a division and a product:
 ``z_hat(w) = V_z diag(1 / (i w - lambda)) V^-1 [0; M^-1 B f_hat]``.
 
@@ -25,9 +26,15 @@ from workbook.solve.harmonic import FrequencyResponse, HarmonicModel
 
 __all__ = ["respond_many", "modal_motions", "SweepResponse", "ROUND_OFF"]
 
-#: Backward error accepted as exact: residual of ``(K - w^2 M + i w D) z = b`` over
-#: ``|K - w^2 M + i w D| |z| + |b|`` (a direct solve reaches about 1e-16).
+#: Backward error accepted as exact: residual of ``(K + i H - w^2 M + i w D) z = b`` over
+#: ``|K + i H| |z| + w^2 |M| |z| + w |D| |z| + |b|`` (a direct solve reaches about 1e-16).
 ROUND_OFF = 1e-13
+
+
+def _complex_stiffness(model: HarmonicModel) -> np.ndarray:
+    """``K + i H``: the stiffness with the structural damping of the loss factors (real K without any)."""
+    lin = model.linearization
+    return lin.stiffness if lin.structural is None else lin.stiffness + 1j * lin.structural
 
 
 class _Modal:
@@ -38,7 +45,7 @@ class _Modal:
         n = lin.mass.shape[0]
         mass_inverse = np.linalg.inv(lin.mass)
         system = np.block([[np.zeros((n, n)), np.eye(n)],
-                           [-mass_inverse @ lin.stiffness, -mass_inverse @ lin.damping]])
+                           [-mass_inverse @ _complex_stiffness(model), -mass_inverse @ lin.damping]])
         self.eigenvalues, vectors = np.linalg.eig(system)
         self.displacement = vectors[:n]              # V_z, shape (n, 2n)
         self.load = np.linalg.solve(vectors, np.vstack([np.zeros((n, n)), mass_inverse]))  # V^-1 [0; M^-1]
@@ -59,17 +66,17 @@ def _times(matrix: np.ndarray, values: np.ndarray) -> np.ndarray:
 
 
 def _residual(model: HarmonicModel, omegas, motion, loads):
-    """``b - (K - w^2 M + i w D) z`` for every frequency, shape (n, f)."""
+    """``b - (K + i H - w^2 M + i w D) z`` for every frequency, shape (n, f)."""
     lin = model.linearization
     n = lin.mass.shape[0]
-    products = _times(np.vstack([lin.stiffness, lin.mass, lin.damping]), motion)
-    return loads - (products[:n] - omegas ** 2 * products[n:2 * n] + 1j * omegas * products[2 * n:])
+    products = _times(np.vstack([lin.mass, lin.damping]), motion)
+    return loads - (_complex_stiffness(model) @ motion - omegas ** 2 * products[:n] + 1j * omegas * products[n:])
 
 
 def _backward_errors(model: HarmonicModel, omegas, motion, loads) -> np.ndarray:
     """Normwise backward error of each frequency's solution (Frobenius norms of the matrices)."""
     lin = model.linearization
-    size = (np.linalg.norm(lin.stiffness) + omegas ** 2 * np.linalg.norm(lin.mass)
+    size = (np.linalg.norm(_complex_stiffness(model)) + omegas ** 2 * np.linalg.norm(lin.mass)
             + omegas * np.linalg.norm(lin.damping))
     residual = np.linalg.norm(_residual(model, omegas, motion, loads), axis=0)
     return residual / (size * np.linalg.norm(motion, axis=0) + np.linalg.norm(loads, axis=0))
@@ -146,11 +153,13 @@ def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> SweepRes
     load = model.input_matrix(point) @ np.asarray(force, dtype=complex)
     motion, errors = modal_motions(model, omegas, load)
     lin = model.linearization
+    stiffness = _complex_stiffness(model)
     for j in np.flatnonzero(errors > ROUND_OFF):
-        dynamic = lin.stiffness - omegas[j] ** 2 * lin.mass + 1j * omegas[j] * lin.damping
+        dynamic = stiffness - omegas[j] ** 2 * lin.mass + 1j * omegas[j] * lin.damping
         motion[:, j] = sla.solve(dynamic, load, check_finite=False)
-    outputs = _times(np.vstack([model.stiffness_output, model.damping_output]), motion)
-    half = len(outputs) // 2
-    forces = (outputs[:half] + 1j * omegas * outputs[half:]).T.reshape(len(omegas), -1, 3)  # (f, h, 3)
+    outputs = _times(np.vstack([model.stiffness_output, model.structural_output, model.damping_output]), motion)
+    third = len(outputs) // 3
+    forces = (outputs[:third] + 1j * (outputs[third:2 * third] + omegas * outputs[2 * third:]))
+    forces = forces.T.reshape(len(omegas), -1, 3)  # (f, h, 3)
     hinges = dict(zip(model.hinge_names, np.moveaxis(forces, 1, 0)))
     return SweepResponse(frequencies_hz, list(model.hinge_names), forces, pylon_sum(hinges, model.pylon_hinges))
