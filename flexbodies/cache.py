@@ -231,7 +231,7 @@ class LinkCache:
             return None
         path = self.link_path(key)
         remembered = _memory.get((self.folder, key))
-        if remembered is not None and remembered[1] == _signature(path):
+        if remembered is not None and remembered[1] == file_signature(path):
             _memory.move_to_end((self.folder, key))
             return remembered[0]
         if not self.usable() or not path.exists():
@@ -254,7 +254,7 @@ class LinkCache:
 
     def _remember(self, key: str, link: ReducedLink) -> None:
         """Keep a link in memory while its file stays as it is now (or absent, without a store)."""
-        _memory[(self.folder, key)] = (link, _signature(self.link_path(key)))
+        _memory[(self.folder, key)] = (link, file_signature(self.link_path(key)))
         _memory.move_to_end((self.folder, key))
         while len(_memory) > MEMORY_ENTRIES:
             _memory.popitem(last=False)
@@ -350,7 +350,7 @@ class LinkCache:
         return len(files)
 
 
-def _signature(path: Path):
+def file_signature(path: Path):
     """What tells whether a file changed: inode, size and modification time, or None when absent."""
     try:
         stat = path.stat()

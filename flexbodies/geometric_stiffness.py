@@ -39,6 +39,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,7 +50,7 @@ import skfem
 
 from .assembly import assemble
 from .atomic import replacing
-from .cache import default_cache_dir
+from .cache import MEMORY_ENTRIES, default_cache_dir, file_signature
 from .frequencies import mounted_constraint_basis
 from .interior import InteriorSolver
 from .materials import Material
@@ -292,14 +293,29 @@ def _path(model, cache_dir) -> Path:
     return Path(cache_dir if cache_dir is not None else default_cache_dir()) / f"stiffening-{key}.npz"
 
 
+#: Cache file -> (LinkStiffening, signature of the file when read), most recent last: the runs of one
+#: process read each file once while it stays as it was.
+_memory: OrderedDict = OrderedDict()
+
+
 def _load(path: Path) -> LinkStiffening | None:
+    signature = file_signature(path)
+    remembered = _memory.get(path)
+    if remembered is not None and signature is not None and remembered[1] == signature:
+        _memory.move_to_end(path)
+        return remembered[0]
     try:
         with np.load(path, allow_pickle=False) as data:
             scalar = sp.csr_matrix((data["data"], data["indices"], data["indptr"]), shape=tuple(data["shape"]))
-            return LinkStiffening(scalar, data["pinned_stiffness"], data["pinned_mass"],
-                                  data["pinned_geometric"], float(data["buckling_load"]))
+            stiffening = LinkStiffening(scalar, data["pinned_stiffness"], data["pinned_mass"],
+                                        data["pinned_geometric"], float(data["buckling_load"]))
     except (OSError, ValueError, KeyError, EOFError):
         return None
+    _memory[path] = (stiffening, signature)
+    _memory.move_to_end(path)
+    while len(_memory) > MEMORY_ENTRIES:
+        _memory.popitem(last=False)
+    return stiffening
 
 
 def link_stiffening(model, *, cache_dir=None, use_cache: bool = True) -> LinkStiffening:

@@ -230,23 +230,24 @@ def modes_of(linearization: Linearization, *, gyroscopic: bool = True) -> list[M
     """
     lin = linearization if gyroscopic else dataclasses.replace(linearization, gyroscopic=None)
     squared_frequencies, vectors = _eigen(lin)
-    modes = []
-    for index, omega_squared in enumerate(squared_frequencies):
-        vector = vectors[:, index]
-        full = lin.basis @ vector
-        kinetic = float(np.real(np.conj(vector) @ lin.mass @ vector))
-        shares = {}
-        for body, coordinates in lin.body_coordinates.items():
-            part = full[coordinates]
-            shares[body] = float(np.real(np.conj(part) @ lin.full_mass[np.ix_(coordinates, coordinates)] @ part)
-                                 / kinetic)
-        engine = _real_shape(full[lin.body_coordinates[ENGINE]])
-        decay = float(np.real(np.conj(vector) @ lin.damping @ vector)) / (2 * kinetic)
-        if lin.structural is not None and omega_squared > 0:
-            decay += float(np.real(np.conj(vector) @ lin.structural @ vector)) / (2 * kinetic * np.sqrt(omega_squared))
-        modes.append(Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), decay, shares[ENGINE],
-                          engine, {b: s for b, s in shares.items() if b != ENGINE}, float(omega_squared)))
-    return modes
+
+    def energy(matrix, shapes):
+        """``Re(x^H A x)`` of every column x of *shapes*."""
+        return np.real(np.sum(np.conj(shapes) * (matrix @ shapes), axis=0))
+
+    full = lin.basis @ vectors
+    kinetic = energy(lin.mass, vectors)
+    shares = {body: energy(lin.full_mass[np.ix_(coordinates, coordinates)], full[coordinates]) / kinetic
+              for body, coordinates in lin.body_coordinates.items()}
+    decay = energy(lin.damping, vectors) / (2 * kinetic)
+    if lin.structural is not None:
+        stiff = squared_frequencies > 0
+        decay[stiff] += energy(lin.structural, vectors[:, stiff]) / (2 * kinetic[stiff] * np.sqrt(squared_frequencies[stiff]))
+    engine = full[lin.body_coordinates[ENGINE]]
+    return [Mode(float(np.sqrt(max(omega_squared, 0.0)) / (2 * np.pi)), float(decay[index]),
+                 float(shares[ENGINE][index]), _real_shape(engine[:, index]),
+                 {body: float(share[index]) for body, share in shares.items() if body != ENGINE}, float(omega_squared))
+            for index, omega_squared in enumerate(squared_frequencies)]
 
 
 def _real_shape(part: np.ndarray) -> np.ndarray:
