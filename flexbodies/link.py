@@ -262,8 +262,10 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
         timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
         if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
+            start = time.perf_counter()
             save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
                             cache_dir=cache_dir)
+            timings["stiffening_seconds"] = time.perf_counter() - start
         if frequencies is None:
             start = time.perf_counter()
             frequencies = solver.reference_frequencies()

@@ -12,7 +12,7 @@ from workbook.model.case import Case
 __all__ = ["link_table"]
 
 #: Stages whose times make up a reduction, as stored in ``ReducedLink.info``.
-_STAGES = ("mesh_seconds", "assembly_seconds", "frequency_seconds", "reduction_seconds")
+_STAGES = ("mesh_seconds", "assembly_seconds", "frequency_seconds", "reduction_seconds", "stiffening_seconds")
 
 
 def link_table(case: Case, reduced: dict) -> pd.DataFrame:
