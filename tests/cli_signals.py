@@ -13,11 +13,17 @@ import psutil
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _interruptible() -> None:
+    """In the child before it starts: Ctrl-C acts as on a terminal, even when the test runner was
+    started in the background of a shell, which leaves SIGINT ignored for every child."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(*args: str, cwd=None, env: dict | None = None) -> subprocess.Popen:
     """``mountwb -v ARGS`` with this tree on the path; stderr is read line by line."""
     environment = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1", **(env or {})}
     return subprocess.Popen([sys.executable, "-m", "workbook.cli.main", "-v", *args], cwd=cwd, env=environment,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_interruptible)
 
 
 def signal_at(process: subprocess.Popen, marker: str, signum: int = signal.SIGINT, timeout: float = 300):
