@@ -11,23 +11,38 @@ The pieces, in the order a link passes through them::
 :func:`reduce_link_set` does it once for several excitations (one
 factorisation per link serves them all).
 """
-from .assembly import FEModel, assemble
-from .craig_bampton import CraigBamptonBasis, craig_bampton, elastic_modes
-from .eigen import natural_frequencies
-from .exudyn_body import ExudynLink, add_link_to_exudyn, export_exudyn_file, link_rotation
-from .geometry import LinkGeometry
-from .interfaces import InterfaceCoupling, couple_interfaces
-from .link import LinkModel, MeshSource, build_fe_model, default_cache_dir, reduce_link, reduce_link_set
-from .materials import STEEL, TITANIUM, Material, material
-from .meshing import Bore, BoreSpec, LinkMesh, load_mesh, mesh_link
-from .reduced import ReducedLink, ReducedLinkFileError, load_reduced_link, save_reduced_link
-from .selection import ModeDecision, decide_modes
+import importlib
 
-__all__ = [
-    "FEModel", "assemble", "CraigBamptonBasis", "craig_bampton", "elastic_modes",
-    "natural_frequencies", "ExudynLink", "add_link_to_exudyn", "export_exudyn_file", "link_rotation",
-    "LinkGeometry", "InterfaceCoupling", "couple_interfaces", "LinkModel", "MeshSource",
-    "build_fe_model", "default_cache_dir", "reduce_link", "reduce_link_set", "STEEL", "TITANIUM", "Material",
-    "material", "Bore", "BoreSpec", "LinkMesh", "load_mesh", "mesh_link", "ReducedLink",
-    "ReducedLinkFileError", "load_reduced_link", "save_reduced_link", "ModeDecision", "decide_modes",
-]
+#: Where each name of the package's API lives. A name is imported on first use (PEP 562), so that
+#: ``import flexbodies.cache`` or a run whose links are all cached does not load gmsh and scikit-fem.
+_HOMES = {
+    "assembly": ("FEModel", "assemble"),
+    "eigen": ("natural_frequencies",),
+    "exudyn_body": ("ExudynLink", "add_link_to_exudyn", "export_exudyn_file", "link_rotation"),
+    "geometry": ("LinkGeometry",),
+    "interfaces": ("InterfaceCoupling", "couple_interfaces"),
+    "link": ("LinkModel", "MeshSource", "build_fe_model", "default_cache_dir", "reduce_link", "reduce_link_set"),
+    "materials": ("STEEL", "TITANIUM", "Material", "material"),
+    "meshing": ("Bore", "BoreSpec", "LinkMesh", "load_mesh", "mesh_link"),
+    "reduced": ("ReducedLink", "ReducedLinkFileError", "load_reduced_link", "save_reduced_link"),
+    "selection": ("ModeDecision", "decide_modes"),
+}
+_MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}
+
+# Imported at once: the function ``craig_bampton`` shares its name with its module, which would
+# otherwise stand in the package's namespace once any module imported it.
+from .craig_bampton import CraigBamptonBasis, craig_bampton, elastic_modes  # noqa: E402
+
+__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", *_MODULE_OF]
+
+
+def __getattr__(name: str):
+    if name not in _MODULE_OF:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_MODULE_OF[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

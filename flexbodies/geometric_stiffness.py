@@ -42,21 +42,21 @@ import json
 from collections import OrderedDict
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import skfem
 
-from .assembly import assemble
 from .atomic import replacing
 from .cache import MEMORY_ENTRIES, default_cache_dir, file_signature
 from .frequencies import mounted_constraint_basis
 from .interior import InteriorSolver
 from .materials import Material
-from .meshing import LinkMesh
 from .reduced import ReducedLink
-from .reduction import couple
+
+if TYPE_CHECKING:  # meshing and assembly load scikit-fem and gmsh: imported where a link is assembled
+    from .meshing import LinkMesh
 
 __all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement",
            "mesh_stiffening", "coupled_stiffening", "link_stiffening", "has_stiffening", "save_stiffening", "stiffened",
@@ -67,10 +67,10 @@ __all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tensio
 #: fewer): enough for the first two bending modes in both planes.
 PINNED_FIXED_MODES = 12
 
-#: Integration order of the initial-stress form per mesh type: exact for
-#: straight-sided elements (stress of degree p - 1 times two shape-function
+#: Integration order of the initial-stress form per scikit-fem mesh type: exact
+#: for straight-sided elements (stress of degree p - 1 times two shape-function
 #: gradients of degree p - 1).
-_INTORDER = {skfem.MeshTet2: 3, skfem.MeshTet1: 1, skfem.MeshHex2: 4, skfem.MeshHex1: 2}
+_INTORDER = {"MeshTet2": 3, "MeshTet1": 1, "MeshHex2": 4, "MeshHex1": 2}
 
 _FORMAT = "mountwb-link-stiffening-1"
 
@@ -158,8 +158,7 @@ def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Materi
     ndarray, shape (3, 3, n_elements, n_points)
         Stress, Pa.
     """
-    mesh = link_mesh.mesh
-    scalar = skfem.Basis(mesh, mesh.elem(), intorder=_INTORDER[type(mesh)])  # scalar DOF i is node i
+    scalar = _scalar_basis(link_mesh)
     components = np.asarray(displacement, dtype=float).reshape(-1, 3).T
     grad = np.stack([scalar.interpolate(component).grad for component in components])  # d u_c / d x_i
     strain = 0.5 * (grad + np.swapaxes(grad, 0, 1))
@@ -167,7 +166,18 @@ def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Materi
     return 2 * material.shear_modulus * strain + material.lame_lambda * trace * np.eye(3)[:, :, None, None]
 
 
-@skfem.BilinearForm
+def _scalar_basis(link_mesh: LinkMesh):
+    """The scalar element of the mesh at the initial-stress form's integration order (DOF i is node i).
+
+    scikit-fem is imported here, not with the module: a run that only loads
+    a link's geometric stiffness from the cache never needs it.
+    """
+    import skfem
+
+    mesh = link_mesh.mesh
+    return skfem.Basis(mesh, mesh.elem(), intorder=_INTORDER[type(mesh).__name__])
+
+
 def _initial_stress(u, v, w):
     return np.einsum("ij...,i...,j...->...", w["sigma"], u.grad, v.grad)
 
@@ -189,9 +199,9 @@ def geometric_stiffness(link_mesh: LinkMesh, stress: np.ndarray) -> sp.csr_matri
     scipy.sparse.csr_matrix, shape (n, n)
         N/m, symmetric; rows follow the finite element nodes.
     """
-    mesh = link_mesh.mesh
-    scalar = skfem.Basis(mesh, mesh.elem(), intorder=_INTORDER[type(mesh)])
-    matrix = skfem.asm(_initial_stress, scalar, sigma=stress)
+    import skfem
+
+    matrix = skfem.asm(skfem.BilinearForm(_initial_stress), _scalar_basis(link_mesh), sigma=stress)
     return sp.csr_matrix(0.5 * (matrix + matrix.T))
 
 
@@ -241,6 +251,9 @@ def mesh_stiffening(link_mesh: LinkMesh, material: Material, interface: str = "R
     -------
     LinkStiffening
     """
+    from .assembly import assemble
+    from .reduction import couple
+
     coupled = couple(assemble(link_mesh, material), interface)
     solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
     return coupled_stiffening(link_mesh, coupled, solver, material, fixed_modes)

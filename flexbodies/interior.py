@@ -71,6 +71,7 @@ class InteriorSolver:
         condensed = K_bb + self.K_ib.T @ self.psi
         #: Condensed (Guyan) boundary stiffness, symmetrised.
         self.condensed = 0.5 * (condensed + condensed.T)
+        self._fixed = None  # the largest set of fixed-interface modes computed so far
 
     @property
     def n_q(self) -> int:
@@ -88,12 +89,20 @@ class InteriorSolver:
         return vectors
 
     def fixed_interface_modes(self, count: int):
-        """The lowest ``count`` fixed-interface modes: frequencies (Hz) and mass-normalised shapes in ``q``."""
-        freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, self.factor, tol=_TOLERANCE,
-                                  ncv=2 * count + 5)
-        vectors = np.zeros((self.n_q, phi.shape[1]))
-        vectors[self.interior] = phi
-        return freqs, vectors
+        """The lowest ``count`` fixed-interface modes: frequencies (Hz) and mass-normalised shapes in ``q``.
+
+        The modes are nested, so the largest set computed so far serves every
+        smaller request (the stress stiffening's pinned model and the
+        reduction ask for them in turn).
+        """
+        if self._fixed is None or len(self._fixed[0]) < count:
+            freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, self.factor, tol=_TOLERANCE,
+                                      ncv=2 * count + 5)
+            vectors = np.zeros((self.n_q, phi.shape[1]))
+            vectors[self.interior] = phi
+            self._fixed = (freqs, vectors)
+        freqs, vectors = self._fixed
+        return freqs[:count], vectors[:, :count]
 
     def _bordered(self, basis: np.ndarray):
         """Solver of the stiffness with master motion ``basis @ r``, in ``[interior, r]`` coordinates."""

@@ -27,18 +27,17 @@ from pathlib import Path
 
 import numpy as np
 
-from .assembly import FEModel, assemble
 from .cache import LinkCache, default_cache_dir
-from .geometric_stiffness import coupled_stiffening, has_stiffening, save_stiffening
-from .geometry import LinkGeometry
-from .interior import InteriorSolver
+from .geometric_stiffness import has_stiffening
+from .geometry import LinkGeometry, default_element_size
 from .materials import STEEL, Material
-from .meshing import LinkMesh, default_element_size, load_mesh, mesh_link
 from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
-from .reduction import couple, reduce_for_decisions
 from .selection import decide_modes
 
-__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "build_fe_model", "default_cache_dir"]
+# The modules that mesh (gmsh, meshio), assemble (scikit-fem) and reduce a link are imported where a
+# link is reduced: a run whose links are all in the cache never loads them.
+
+__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "is_reduced", "build_fe_model", "default_cache_dir"]
 
 @dataclass(frozen=True)
 class MeshSource:
@@ -119,8 +118,11 @@ class LinkModel:
         """Hash of :meth:`fingerprint`: the key of the link's cache entries and of its lock."""
         return _hash(self.fingerprint())
 
-    def meshed(self) -> LinkMesh:
-        """The link's mesh: the parametric geometry meshed, or the mesh file read."""
+    def meshed(self):
+        """The link's mesh (a :class:`flexbodies.meshing.LinkMesh`): the parametric geometry meshed,
+        or the mesh file read."""
+        from .meshing import load_mesh, mesh_link
+
         if self.geometry is not None:
             return mesh_link(self.geometry, self.element_size)
         return load_mesh(self.mesh.path, self.mesh.bores, scale=self.mesh.scale)
@@ -132,9 +134,10 @@ def _hash(record: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
-def _in_link_frame(fe: FEModel) -> tuple[FEModel, np.ndarray]:
-    """The FE model rotated and shifted so that eye A is at the origin, eye B on +x, bore A's axis on z,
-    and the rotation R (rows: the link axes in the model's coordinates; a link-frame vector is R v)."""
+def _in_link_frame(fe):
+    """The FE model (a :class:`flexbodies.assembly.FEModel`) rotated and shifted so that eye A is at the
+    origin, eye B on +x, bore A's axis on z, and the rotation R (rows: the link axes in the model's
+    coordinates; a link-frame vector is R v)."""
     a, b = fe.bores[0].centre, fe.bores[1].centre
     ex = (b - a) / np.linalg.norm(b - a)
     ez = fe.bores[0].axis - ex * (fe.bores[0].axis @ ex)
@@ -159,12 +162,12 @@ def _in_link_frame(fe: FEModel) -> tuple[FEModel, np.ndarray]:
     ), R
 
 
-def build_fe_model(model: LinkModel) -> tuple[FEModel, dict]:
+def build_fe_model(model: LinkModel) -> tuple:
     """Mesh and assemble a link model in its link frame.
 
     Returns
     -------
-    fe_model : FEModel
+    fe_model : flexbodies.assembly.FEModel
     timings : dict
         ``mesh_seconds`` and ``assembly_seconds``.
     """
@@ -172,9 +175,11 @@ def build_fe_model(model: LinkModel) -> tuple[FEModel, dict]:
     return fe, timings
 
 
-def _meshed_fe_model(model: LinkModel) -> tuple[FEModel, LinkMesh, np.ndarray, dict]:
+def _meshed_fe_model(model: LinkModel) -> tuple:
     """:func:`build_fe_model` with the link's mesh and the rotation from the mesh's frame to the link
     frame (see :func:`_in_link_frame`)."""
+    from .assembly import assemble
+
     start = time.perf_counter()
     link_mesh = model.meshed()
     meshed = time.perf_counter()
@@ -218,6 +223,27 @@ def _cached(cache: LinkCache, fe_hash: str, modes, excitations_hz) -> tuple:
     return frequencies, decisions, keys, [cache.load_link(key) for key in keys]
 
 
+def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
+               stiffening: bool = False) -> bool:
+    """True when the cache holds all that :func:`reduce_link_set` would return for these arguments
+    (and the link's geometric stiffness when *stiffening*), so that the call only loads.
+
+    Parameters
+    ----------
+    model, modes, excitations_hz, cache_dir, stiffening
+        As for :func:`reduce_link_set`.
+
+    Returns
+    -------
+    bool
+    """
+    cache = LinkCache(cache_dir)
+    _, _, _, links = _cached(cache, _hash(model.fingerprint()), modes, list(excitations_hz))
+    if links is None or any(link is None for link in links):
+        return False
+    return not stiffening or has_stiffening(model, cache_dir=cache_dir)
+
+
 def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
                     use_cache: bool = True, stiffening: bool = False) -> tuple:
     """Reduce a link for several excitations at once: one FE model, every decision served from it.
@@ -256,6 +282,10 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         frequencies, decisions, keys, links = _cached(cache, fe_hash, modes, excitations_hz)
         if links is not None and all(link is not None for link in links):
             return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
+        from .geometric_stiffness import coupled_stiffening, save_stiffening
+        from .interior import InteriorSolver
+        from .reduction import couple, reduce_for_decisions
+
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
         coupled = couple(fe, model.interface)
         start = time.perf_counter()

@@ -31,7 +31,7 @@ import numpy as np
 import skfem
 from skfem.io.meshio import HEX_MAPPING
 
-from .geometry import LinkGeometry
+from .geometry import LinkGeometry, default_element_size
 
 __all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "default_element_size"]
 
@@ -245,29 +245,6 @@ class LinkMesh:
             cells=[(cell_type, np.ascontiguousarray(dofs.T))],
             point_sets={b.name: b.nodes.copy() for b in self.bores},
         )
-
-
-def default_element_size(geometry: LinkGeometry) -> float:
-    """Default element size of :func:`mesh_link`, m.
-
-    Four tenths of the smallest cross-section dimension (eye thickness,
-    shank width and thickness), but at most two thirds of the eye ring
-    width ``eye_outer_radius - bore_radius``. For the reference link
-    (25 mm thick, 15 mm ring) this is 10 mm, giving about 18k DOF with
-    quadratic tetrahedra.
-
-    Parameters
-    ----------
-    geometry : LinkGeometry
-
-    Returns
-    -------
-    float
-        Element size in m.
-    """
-    g = geometry
-    return min(0.4 * min(g.thickness, g.shank_width, g.shank_thickness),
-               2 / 3 * (g.eye_outer_radius - g.bore_radius))
 
 
 def mesh_link(geometry: LinkGeometry, element_size: float | None = None) -> LinkMesh:

@@ -20,8 +20,6 @@ import functools
 import math
 import re
 
-import pint
-
 from workbook.errors import UnitProblem
 
 __all__ = ["si_factor", "DIMENSIONLESS"]
@@ -33,12 +31,17 @@ _G_TOKEN = re.compile(r"(?<![A-Za-z_])g(?![A-Za-z_0-9])")
 
 
 @functools.lru_cache(maxsize=1)
-def registry() -> pint.UnitRegistry:
-    """The shared pint registry."""
+def registry():
+    """The shared pint registry (``pint.UnitRegistry``), made on first use: pint takes a
+    noticeable part of a short run's start-up, and a run without unit cells never needs it."""
+    import pint
+
     return pint.UnitRegistry()
 
 
-def _parse(text: str) -> pint.Quantity:
+def _parse(text: str):
+    import pint
+
     try:
         return registry().Quantity(1.0, text)
     except (pint.PintError, AssertionError, AttributeError, SyntaxError, TypeError, ValueError):
@@ -85,6 +88,8 @@ def si_factor(text: str, si_unit: str) -> float:
         root = quantity.to_root_units()
         if root.units == registry().Unit("radian / second"):
             quantity = quantity.to("turn / second").magnitude * registry().Unit("1 / second")
+    import pint
+
     try:
         factor = float(quantity.to(target).magnitude)
     except pint.DimensionalityError:

@@ -55,10 +55,11 @@ from workbook.model.case import (
 from workbook.scene.bearing import exudyn_bearing_function, hinge_matrix
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
+from workbook.scene.link_workers import LinkJob, reduce_in_workers
 from workbook.scene.structural_damping import equivalent_viscous_damping
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
-           "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links",
+           "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links", "link_jobs",
            "exudyn_name", "ignored_contact_stiffness", "loss_factors", "marker_bodies", "net_angular_momentum",
            "scene_warnings", "CANCELLED_MOMENTUM"]
 
@@ -394,40 +395,71 @@ def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | Non
     return max(frequencies) if frequencies else 0.0
 
 
+def link_jobs(case: Case, excitation: SingleFrequencyExcitation | None = None) -> dict:
+    """The distinct reductions the links of *case* need, each with the links it serves.
+
+    Parameters
+    ----------
+    case : Case
+    excitation : RotatingForce or HarmonicForce, optional
+        The run's excitation (default: the case's highest frequency).
+
+    Returns
+    -------
+    dict of LinkJob to list of str
+        Link names per job, in the case's order. Every job serves all the
+        case's excitation frequencies and the run's own.
+    """
+    frequencies = tuple(sorted({e.frequency for e in case.excitations} | {_reduction_frequency(case, excitation)}))
+    jobs = {}
+    for link in case.links:
+        stiffening = case.effects.stress_stiffening != "off" and case.link_is_flexible(link.name)
+        jobs.setdefault(LinkJob(link.model, case.link_modes(link.name), frequencies, stiffening), []).append(link.name)
+    return jobs
+
+
 def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None,
                  progress: Callable[[int], None] | None = None) -> dict:
     """Reduce every link of *case* (cached on disk and in memory by :mod:`flexbodies`).
 
     Flexible links keep the modes their ``modes`` field asks for, judged at the
     excitation's frequency (default: the case's highest); rigid links need
-    only their mass properties and take the static reduction. Each link is
-    reduced once for every excitation of the case (fixed-interface modes are
-    nested: one eigen-solve up to the highest need, truncated per
-    excitation), so the other excitations' runs load it.
+    only their mass properties and take the static reduction. Each distinct
+    link is reduced once for every excitation of the case (fixed-interface
+    modes are nested: one eigen-solve up to the highest need, truncated per
+    excitation), so the other excitations' runs load it; distinct links the
+    cache lacks are reduced side by side in worker processes
+    (:func:`workbook.scene.link_workers.reduce_in_workers`).
 
     Parameters
     ----------
     case : Case
     excitation : RotatingForce or HarmonicForce, optional
     progress : callable, optional
-        Called with the number of links reduced so far, after each link.
+        Called with the number of links reduced so far, as it grows.
 
     Returns
     -------
     dict of str to flexbodies.ReducedLink
     """
-    from flexbodies import reduce_link_set
-
     frequency = _reduction_frequency(case, excitation)
-    frequencies = sorted({e.frequency for e in case.excitations} | {frequency})
+    jobs = link_jobs(case, excitation)
+    shown = 0
+
+    def show(count: int) -> None:
+        nonlocal shown
+        if progress is not None and count > shown:
+            shown = count
+            progress(count)
+
+    reduce_in_workers(list(jobs), done=lambda job: show(shown + len(jobs[job])))
     reduced = {}
-    for link in case.links:
-        stiffening = case.effects.stress_stiffening != "off" and case.link_is_flexible(link.name)
-        per_frequency = reduce_link_set(link.model, case.link_modes(link.name), frequencies, stiffening=stiffening)
-        reduced[link.name] = per_frequency[frequencies.index(frequency)]
-        if progress is not None:
-            progress(len(reduced))
-    return reduced
+    for job, names in jobs.items():
+        per_frequency = job.reduce()
+        for name in names:
+            reduced[name] = per_frequency[job.excitations_hz.index(frequency)]
+        show(len(reduced))
+    return {link.name: reduced[link.name] for link in case.links}
 
 
 def _load_scale(case: Case, excitation: SingleFrequencyExcitation | None, link_mass: float) -> float:

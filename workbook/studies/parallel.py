@@ -18,7 +18,7 @@ Faults (local processes):
 - An interrupt (Ctrl-C, or SIGTERM raised as :class:`workbook.errors.Terminated`)
   stops every worker process of the study before it propagates; workers
   ignore Ctrl-C themselves, so only the parent decides. A worker whose
-  parent was killed outright (SIGKILL) ends within :data:`PARENT_CHECK_INTERVAL`.
+  parent was killed outright (SIGKILL) ends within :data:`workbook.processes.PARENT_CHECK_INTERVAL`.
 
 Every finished row is handed to ``record`` at once (the study table is
 written as rows finish), so an interrupt loses only the rows in flight.
@@ -29,7 +29,6 @@ import logging
 import multiprocessing
 import os
 import signal
-import threading
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -40,8 +39,9 @@ from typing import Callable
 from workbook.answers.isolation import efficiency
 from workbook.errors import interruption
 from workbook.model.case import DIRECTIONS, Case
+from workbook.processes import end_with_parent, stop_workers
 
-__all__ = ["RowOutcome", "prepare", "run_row", "run_rows", "SERIAL", "ROWS_PER_WORKER", "WORKER_STOP_TIMEOUT"]
+__all__ = ["RowOutcome", "prepare", "run_row", "run_rows", "SERIAL", "ROWS_PER_WORKER"]
 
 log = logging.getLogger(__name__)
 
@@ -55,10 +55,6 @@ SERIAL = 1
 #: reference mount left about 33 MB behind. Even at the 1 MB per run the
 #: memory tests allow, 200 rows keep a worker within 200 MB of its start.
 ROWS_PER_WORKER = 200
-#: Seconds a worker process gets to end after SIGTERM before it is killed.
-WORKER_STOP_TIMEOUT = 5.0
-#: Seconds between a worker's checks that its parent still lives.
-PARENT_CHECK_INTERVAL = 1.0
 
 
 @dataclass
@@ -240,13 +236,7 @@ def _worker_init(started) -> None:
     global _started
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _started = started
-    threading.Thread(target=_end_with_parent, args=(os.getppid(),), daemon=True).start()
-
-
-def _end_with_parent(parent: int) -> None:
-    while os.getppid() == parent:
-        time.sleep(PARENT_CHECK_INTERVAL)
-    os._exit(1)
+    end_with_parent()
 
 
 def _reported_row(index: int, case: Case) -> RowOutcome:
@@ -264,19 +254,6 @@ def _death(exitcode: int | None) -> str:
         except ValueError:
             return f"was killed by signal {-exitcode}"
     return f"exited with code {exitcode}"
-
-
-def _stop(workers: list) -> None:
-    """SIGTERM every worker process, then SIGKILL those still alive after :data:`WORKER_STOP_TIMEOUT`."""
-    for process in workers:
-        if process.is_alive():
-            process.terminate()
-    deadline = time.monotonic() + WORKER_STOP_TIMEOUT
-    for process in workers:
-        process.join(max(0.0, deadline - time.monotonic()))
-        if process.is_alive():
-            process.kill()
-            process.join()
 
 
 def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[dict, dict, dict]:
@@ -309,7 +286,7 @@ def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[d
     except BaseException:
         processes.update(set(multiprocessing.active_children()) - before)
         pool.shutdown(wait=False, cancel_futures=True)
-        _stop(list(processes))
+        stop_workers(processes)
         raise
     pool.shutdown(wait=True)
     pids = {}
