@@ -28,6 +28,7 @@ import numpy as np
 from workbook.errors import CaseError
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
+from workbook.model.pylon_mesh import MeshPylon
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
@@ -1171,6 +1172,10 @@ class Case:
     pylon_beam : BoxBeamPylon or None
         The pylon as a clamped box beam carrying the pins (None: a rigid
         pylon); frequency domain only, not with a pylon impedance.
+    pylon_mesh : MeshPylon or None
+        The pylon as a user's solid mesh, clamped on its root plane and
+        carrying the pins on its bores (None: a rigid pylon); frequency
+        domain only, the case's one pylon model.
     """
 
     name: str
@@ -1186,6 +1191,7 @@ class Case:
     rotors: tuple[Rotor, ...] = ()
     pylon_impedance: PylonImpedance | None = None
     pylon_beam: BoxBeamPylon | None = None
+    pylon_mesh: MeshPylon | None = None
 
     def __post_init__(self):
         _name(self.name, "case")
@@ -1215,6 +1221,12 @@ class Case:
             if self.pylon_impedance is not None:
                 raise CaseError("case", "pylon_beam", self.pylon_beam.name,
                                 "no pylon beam when a pylon impedance is given (one pylon model)")
+        if self.pylon_mesh is not None:
+            if not isinstance(self.pylon_mesh, MeshPylon):
+                raise CaseError("case", "pylon_mesh", self.pylon_mesh, "a MeshPylon or None")
+            if self.pylon_impedance is not None or self.pylon_beam is not None:
+                raise CaseError("case", "pylon_mesh", self.pylon_mesh.name,
+                                "no pylon mesh when a pylon impedance or a pylon beam is given (one pylon model)")
         links = self.link_map
         for hinge in self.hinges:
             for name in ("body_a", "body_b"):
@@ -1283,8 +1295,8 @@ class Case:
 
     @property
     def flexible_pylon(self) -> bool:
-        """True if the case gives a flexible pylon (an impedance table or a box beam)."""
-        return self.pylon_impedance is not None or self.pylon_beam is not None
+        """True if the case gives a flexible pylon (an impedance table, a box beam or a mesh)."""
+        return any(model is not None for model in (self.pylon_impedance, self.pylon_beam, self.pylon_mesh))
 
     @property
     def pylon_hinges(self) -> tuple[Hinge, ...]:

@@ -17,7 +17,7 @@ import numpy as np
 from flexbodies.materials import Material
 from workbook.errors import CaseError
 
-__all__ = ["BoxBeamPylon", "SectionProperties"]
+__all__ = ["BoxBeamPylon", "SectionProperties", "finite_point", "positive_number"]
 
 
 @dataclass(frozen=True)
@@ -41,7 +41,8 @@ class SectionProperties:
     torsion_constant: float
 
 
-def _positive(item: str, name: str, value) -> float:
+def positive_number(item: str, name: str, value) -> float:
+    """*value* as a finite float > 0, or a CaseError naming *item* and *name*."""
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -51,7 +52,8 @@ def _positive(item: str, name: str, value) -> float:
     return number
 
 
-def _point(item: str, name: str, value) -> tuple:
+def finite_point(item: str, name: str, value) -> tuple:
+    """*value* as three finite floats (x, y, z), or a CaseError naming *item* and *name*."""
     try:
         point = tuple(float(v) for v in value)
     except (TypeError, ValueError):
@@ -100,9 +102,9 @@ class BoxBeamPylon:
         item = f"pylon beam {self.name!r}"
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         for name in ("root", "tip", "up"):
-            set_(name, _point(item, name, getattr(self, name)))
+            set_(name, finite_point(item, name, getattr(self, name)))
         for name in ("width", "height", "wall"):
-            set_(name, _positive(item, name, getattr(self, name)))
+            set_(name, positive_number(item, name, getattr(self, name)))
         if self.wall >= min(self.width, self.height) / 2:
             raise CaseError(item, "wall", self.wall, f"less than half the width and height "
                                                      f"({min(self.width, self.height) / 2:g} m)")

@@ -1,4 +1,4 @@
-"""Runs on a flexible pylon: a point dynamic stiffness table or a box beam at the pins.
+"""Runs on a flexible pylon: a point dynamic stiffness table, a box beam or a mesh at the pins.
 
 The mount's four-pole set at the excitation's frequency
 (:func:`workbook.solve.four_pole.condense`, formed from the harmonic model
@@ -8,19 +8,21 @@ pylon, exactly in the frequency domain:
 - a :class:`~workbook.model.pylon_impedance.PylonImpedance` ``Z_p(f)`` per
   pin: ``(Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f``,
   ``x2 = -(K22 + Z_p)^-1 K21 x1``, the pylon loaded with ``Z_p x2``;
-- a :class:`~workbook.model.pylon_beam.BoxBeamPylon`: its compliance ``G``
-  at the pins, coupled through the beam (:mod:`workbook.solve.pylon_beam`):
+- a :class:`~workbook.model.pylon_beam.BoxBeamPylon` or a
+  :class:`~workbook.model.pylon_mesh.MeshPylon`: its compliance ``G`` at the
+  pins, coupled through the beam (:mod:`workbook.solve.pylon_beam`) or the
+  reduced mesh (:mod:`workbook.solve.pylon_mesh`):
   ``(Z_e + K11 - K12 G (I + K22 G)^-1 K21) x1 = B f``, the pylon loaded with
   ``-(I + K22 G)^-1 K21 x1``.
 
 The pylon force is the sum of the pin forces, whose amplitudes give T and
 eta as on a rigid pylon.
 
-The time domain refuses both: a dynamic stiffness known only at table
+The time domain refuses them all: a dynamic stiffness known only at table
 frequencies has no time-domain model here (a convolution kernel would need
 its causal, stable fit over all frequencies, which a table over a band does
-not give), and the box beam is built as a frequency-domain compliance, not
-as a body of the time-domain scene.
+not give), and the box beam and the mesh are built as a frequency-domain
+compliance, not as bodies of the time-domain scene.
 """
 from __future__ import annotations
 
@@ -38,6 +40,7 @@ from workbook.solve.harmonic import point_phasors
 from workbook.solve.method import MethodChoice
 from workbook.solve.modes import mounted_modes
 from workbook.solve.pylon_beam import beam_model
+from workbook.solve.pylon_mesh import mesh_pylon_model
 from workbook.solve.stages import link_warnings
 
 __all__ = ["PylonAt", "refuse_time_domain", "pylon_at", "solve_on_pylon"]
@@ -90,6 +93,11 @@ def refuse_time_domain(case: Case, reason: str) -> None:
                         f"no pylon beam in the time domain ({reason}): the box beam is built as the pylon's "
                         f"compliance in the frequency domain; run the frequency domain (method 'auto' or "
                         f"'frequency', no hinge clearance) or remove the pylon beam")
+    if case.pylon_mesh is not None:
+        raise CaseError(f"case {case.name!r}", "pylon_mesh", case.pylon_mesh.name,
+                        f"no pylon mesh in the time domain ({reason}): the mesh is reduced to the pylon's "
+                        f"compliance in the frequency domain; run the frequency domain (method 'auto' or "
+                        f"'frequency', no hinge clearance) or remove the pylon mesh")
 
 
 def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> PylonAt:
@@ -110,6 +118,16 @@ def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> Pylon
         effect = EffectEntry("flexible pylon (point dynamic stiffness)", True,
                              f"{impedance.describe()}; real and imaginary parts interpolated linearly in frequency")
         return PylonAt(stiffness, None, effect, time.perf_counter() - start)
+    if case.pylon_mesh is not None:
+        highest = max(x.frequency for x in case.single_frequency_excitations())  # one reduction serves every run
+        structure, facts = mesh_pylon_model(case.pylon_mesh, [position for position, _ in pins], highest)
+        modes = (f"{facts['modes']} fixed-interface modes up to {facts['highest_mode_hz']:.0f} Hz"
+                 if facts["modes"] else "static modes only")
+        effect = EffectEntry("flexible pylon (mesh)", True,
+                             f"{case.pylon_mesh.describe()}; {facts['fe_dof']} FE DOF reduced to "
+                             f"{facts['reduced_dof']} (Craig-Bampton on the pins, {modes}) in "
+                             f"{facts['seconds']:.2f} s, compliance at the pins")
+        return PylonAt(None, structure.compliance(frequencies), effect, time.perf_counter() - start)
     beam = case.pylon_beam
     model = beam_model(beam, [position for position, _ in pins])
     compliance = model.compliance(frequencies)

@@ -291,7 +291,7 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     -------
     MountResult
 
-    A case with a flexible pylon (``Case.pylon_impedance`` or
+    A case with a flexible pylon (``Case.pylon_impedance``, ``Case.pylon_mesh`` or
     ``Case.pylon_beam``) is answered on that pylon
     (:mod:`workbook.solve.flexible_pylon`), in the frequency domain only.
     """

@@ -6,12 +6,10 @@ three rotations) with the box's section constants
 (translation and the section's polar inertia), clamped at the root.
 Stations are placed at each pin's foot on the axis and at least
 ``elements`` intervals over the length; a pin moves with its station's
-cross-section through a rigid offset r, ``x_pin = u + theta x r``. With the
-structural loss factor eta, ``D(w) = K (1 + i eta) - w^2 M``, and the
-compliance (receptance) at the pins is ``G(w) = T D^-1 T^T``: pin motion
-per force on the pylon at the pins, coupled through the beam, shape
-(3 p, 3 p). Pins at one station are rigidly joined by their fitting, so G
-need not be invertible: the four-pole set closes it in its compliance form
+cross-section through a rigid offset r, ``x_pin = u + theta x r``. The
+compliance at the pins follows
+(:class:`workbook.solve.pylon_structure.PylonStructure`). Pins at one
+station are rigidly joined by their fitting, so G need not be invertible: the four-pole set closes it in its compliance form
 (:meth:`workbook.solve.four_pole.FourPole.respond`).
 """
 from __future__ import annotations
@@ -19,10 +17,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.errors import CaseError
 from workbook.model.pylon_beam import BoxBeamPylon
+from workbook.solve.pylon_structure import PylonStructure
 
 __all__ = ["BeamModel", "beam_model"]
 
@@ -61,34 +59,16 @@ def _element(beam: BoxBeamPylon, length: float) -> tuple[np.ndarray, np.ndarray]
 
 
 @dataclass(frozen=True)
-class BeamModel:
-    """The clamped beam's matrices and its pin map.
+class BeamModel(PylonStructure):
+    """The clamped beam's matrices and its pin map (:class:`PylonStructure`) and its stations.
 
     Attributes
     ----------
-    stiffness, mass : ndarray, shape (n, n)
-        Free DOF (the root's removed), N/m ... and kg ...
-    pin_map : ndarray, shape (3 p, n)
-        Pin translations per beam DOF.
-    loss_factor : float
     stations : ndarray
         Node positions along the axis from the root, m.
     """
 
-    stiffness: np.ndarray
-    mass: np.ndarray
-    pin_map: np.ndarray
-    loss_factor: float
     stations: np.ndarray
-
-    def compliance(self, frequencies_hz) -> np.ndarray:
-        """``G`` at each frequency, complex, shape (f, 3 p, 3 p), m/N."""
-        result = []
-        for frequency in np.atleast_1d(np.asarray(frequencies_hz, dtype=float)):
-            omega = 2 * np.pi * frequency
-            dynamic = self.stiffness * (1 + 1j * self.loss_factor) - omega ** 2 * self.mass
-            result.append(self.pin_map @ sla.solve(dynamic, self.pin_map.T.astype(complex), check_finite=False))
-        return np.array(result)
 
 
 def beam_model(beam: BoxBeamPylon, pins) -> BeamModel:
