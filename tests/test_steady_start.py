@@ -152,6 +152,17 @@ def test_a_bad_start_is_named():
         AnalysisSettings(start="sometimes")
 
 
+def test_the_case_sheet_sets_the_start(tmp_path):
+    from excel_helpers import copy_reference, set_cells
+
+    from workbook.excel.reader import read_workbook
+
+    path = copy_reference(tmp_path)
+    assert read_workbook(path).case.analysis.start == "auto"
+    set_cells(path, {("Case", "start", 3): "rest"})
+    assert read_workbook(path).case.analysis.start == "rest"
+
+
 @pytest.mark.slow
 def test_reference_mount_time_domain_from_the_steady_start_matches_the_frequency_domain(cache_dir):
     """The coarse reference mount with its loss-factor hinges (the mounted modes damped

@@ -458,9 +458,11 @@ def run_warnings(scene: Scene, plan: TimePlan, relative_change: float, extended_
             f"a linear scene in the frequency domain)")
         log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     if plan.undamped_hz:
+        started = ("the free vibration started by the ramp never decays and is part of the measured forces"
+                   if plan.start != STEADY else "the run started in the steady state, but any free vibration "
+                   "in them (from the integrator's error or a nonlinearity) never decays")
         warnings.append(
-            f"undamped mounted modes at {', '.join(f'{f:.4g}' for f in plan.undamped_hz)} Hz: the free vibration "
-            f"started by the ramp never decays and is part of the measured forces; the frequency domain gives "
-            f"the steady answer")
+            f"undamped mounted modes at {', '.join(f'{f:.4g}' for f in plan.undamped_hz)} Hz: {started}; the "
+            f"frequency domain gives the steady answer")
         log.info("%s, %s: %s", scene.case.name, scene.excitation.name, warnings[-1])
     return warnings
