@@ -62,6 +62,7 @@ def test_steady_start_meets_the_closed_form_in_its_two_windows(steady_runs, rati
     assert card.solver["steps"] == 2 * 20 * 80
     assert card.solver["start"].startswith("steady: auto: the scene is linear")
     assert card.solver["windows beyond the plan"] == "none"
+    assert card.solver["ramp"].startswith("none")
     assert card.to_dict()["solver"]["start"] == card.solver["start"]
 
 
