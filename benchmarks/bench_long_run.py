@@ -1,7 +1,7 @@
 """Memory and time of longer and longer runs: memory must not grow with the run.
 
-Each run is the reference mount's LP rotor case with rigid links and a fixed
-settle time, in a fresh process (so the peak resident memory belongs to that
+Each run is the reference mount's LP rotor case with rigid links, started
+from rest with a fixed settle time, in a fresh process (so the peak resident memory belongs to that
 run alone); its wall time and peak memory are printed against the number of
 steps. The time integration stores the hinge forces of the two measured
 windows only (``workbook.solve.time_domain``), so the peak memory should stay flat
@@ -21,7 +21,8 @@ import dataclasses, json, resource, sys, time
 from workbook.model.reference import LP_ROTOR, reference_case
 from workbook.solve.pipeline import run_excitation
 case = reference_case().with_rigid_links()
-case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, settle_time=float(sys.argv[1])))
+case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, settle_time=float(sys.argv[1]),
+                                                             start="rest"))
 start = time.perf_counter()
 result, card, _ = run_excitation(case, LP_ROTOR)
 print(json.dumps({"steps": card.solver["steps"], "wall": time.perf_counter() - start,

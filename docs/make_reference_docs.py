@@ -36,6 +36,7 @@ from workbook.scene.build import reduce_links  # noqa: E402
 from workbook.scene.structural_damping import equivalent_viscous_damping  # noqa: E402
 from workbook.solve.modes import mounted_modes  # noqa: E402
 from workbook.solve.pipeline import prepare, run_case  # noqa: E402
+from workbook.solve.steady_start import REST, STEADY  # noqa: E402
 from workbook.solve.time_domain import plan_run  # noqa: E402
 
 DOCS = Path(__file__).resolve().parent
@@ -63,12 +64,14 @@ def _mounted(case, reduced, excitation=HP_ROTOR):
 
 
 def _time_plan(case, excitation, reduced):
-    """The time-domain plan of one run of *case* (its scene built for the time domain), and its mounted modes."""
+    """The time-domain plan of one run of *case* from rest (its scene built for the time domain), its
+    mounted modes, and the plan of the same run from the steady start."""
     timed = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method="time"))
     prepared = prepare(timed, excitation, reduced=reduced, harmonic=False)
     with prepared.scene:
-        return plan_run(timed.analysis, prepared.scene.excitation.signal, prepared.modes), \
-            mounted_modes(prepared.modes)
+        signal = prepared.scene.excitation.signal
+        return plan_run(timed.analysis, signal, prepared.modes, start=REST), mounted_modes(prepared.modes), \
+            plan_run(timed.analysis, signal, prepared.modes, start=STEADY)
 
 
 def _rod_modes(modes):
@@ -250,11 +253,13 @@ def _time_domain_damping(case, plans, viscous_plans) -> str:
         + "), exact in the steady state there but far weaker at the mounted modes (the least damped: zeta "
         + ", ".join(f"{100 * least[r].damping_ratio:.2f} % at {least[r].frequency_hz:.1f} Hz in the {r.name} run"
                     for r in rotors)
-        + f"), so a time-domain run settles {constants:g} decay time constant(s) of "
+        + f"), so a time-domain run from rest would settle {constants:g} decay time constant(s) of "
         + " and ".join(f"{settle[r]:.0f} s ({r.name})" for r in rotors)
         + f" instead of {_range(former.values(), 1)} s with the former viscous damping: "
         + " and ".join(f"{steps[r]:.0f}" for r in rotors)
-        + " times the steps. The model card of each run says which form was built and at which frequency.")
+        + " times the steps. A run therefore starts, by default, in the steady state of its own linearised scene "
+        "(Time-domain method, below), which leaves nothing to settle. The model card of each run says which form "
+        "was built and at which frequency, and where the run started.")
 
 
 def _hinge_rows(case) -> str:
@@ -386,12 +391,18 @@ def _settings(case, plans) -> str:
     return (f"Settings: {analysis.steps_per_period} steps per period (generalized-alpha, spectral radius "
             f"{analysis.spectral_radius:g}, whose period error makes a mass-dominated T about "
             f"(2 pi / n)^2 / 6 = {100 * (2 * math.pi / analysis.steps_per_period) ** 2 / 6:.2f} % low), a "
-            f"{analysis.ramp_periods:g}-period smooth start, a settle time of {analysis.settle_time_constants:g} "
-            f"decay time constant(s) 1 / (zeta w) of the least damped mounted mode of the time-domain scene, then two "
-            f"windows of {analysis.measured_periods} periods; the run is steady when the two windows agree within "
-            f"{100 * analysis.steady_tolerance:g} %. For the reference (flexible links) that plans "
-            + " and ".join(f"{plan.steps:,} steps ({plan.end_time:.0f} s simulated) for the {rotor.name}".replace(",", " ")
-                           for rotor, (plan, _) in plans.items())
+            f"start in the steady state of the run's own linearised scene (`start` \"auto\": the scene is linear), "
+            f"then two windows of {analysis.measured_periods} periods; the run is steady when the complex amplitudes "
+            f"of the two windows agree within {100 * analysis.steady_tolerance:g} %, and goes on window by window "
+            f"while they do not, at most as long as a start from rest would settle. For the reference (flexible links) "
+            f"that plans "
+            + " and ".join(f"{steady.steps:,} steps ({steady.end_time:.2g} s simulated) for the {rotor.name}"
+                           .replace(",", " ") for rotor, (_, _, steady) in plans.items())
+            + f". From rest (`start` \"rest\": a {analysis.ramp_periods:g}-period smooth start and a settle time of "
+            f"{analysis.settle_time_constants:g} decay time constant(s) 1 / (zeta w) of the least damped mounted mode "
+            f"of the time-domain scene before the two windows, which must then agree in magnitude) it plans "
+            + " and ".join(f"{rest.steps:,} steps ({rest.end_time:.0f} s simulated) for the {rotor.name}"
+                           .replace(",", " ") for rotor, (rest, _, _) in plans.items())
             + ".")
 
 

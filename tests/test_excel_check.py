@@ -379,6 +379,8 @@ BAD_INPUTS = {
                                   ["sheet 'Links'", "cell AO3", "found -0.01", ">= 0"]),
     "link modal damping of one": (_edit({("Links", "modal damping", 3): 1.0}),
                                   ["sheet 'Links'", "cell AP3", "column 'modal damping'", "found 1", "< 1"]),
+    "unknown time-domain start": (_edit({("Case", "start", 3): "sometimes"}),
+                                  ["sheet 'Case'", "column 'start'", "sometimes", "steady"]),
 }
 
 

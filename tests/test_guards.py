@@ -50,7 +50,7 @@ def test_a_run_away_engine_stops_the_run():
 
 
 def test_the_time_budget_stops_a_long_run_with_an_estimate():
-    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(settle_time=2000.0, time_budget=0.5))
+    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(settle_time=2000.0, time_budget=0.5, start="rest"))
     with pytest.raises(TimeBudgetExceeded, match=r"time budget 0.5 s\) at t = [\d.]+ s of 2\d{3}(\.\d+)? s "
                                                  r"simulated; the whole run would need about [\d.e+]+ s") as caught:
         run_excitation(case, SHAKE)
@@ -58,7 +58,7 @@ def test_the_time_budget_stops_a_long_run_with_an_estimate():
 
 
 def test_an_absurd_plan_is_refused_before_integrating():
-    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(settle_time=1e7))
+    case = dataclasses.replace(SDOF, analysis=AnalysisSettings(settle_time=1e7, start="rest"))
     with pytest.raises(RunTooLong, match="time steps .* Add damping, set a fixed settle time"):
         run_excitation(case, SHAKE)
 
@@ -75,7 +75,9 @@ def test_the_command_line_reports_an_exhausted_time_budget_as_numerical_trouble(
     from workbook.model.codec import to_json
 
     path = tmp_path / "coarse.json"
-    path.write_text(to_json(coarse_reference))
+    # from rest: a run of many segments (a steady start integrates two windows in one)
+    path.write_text(to_json(dataclasses.replace(coarse_reference, analysis=dataclasses.replace(
+        coarse_reference.analysis, start="rest"))))
     assert main(["run", str(path), "--rigid", "--method", "time", "--no-progress", "--time-budget", "0.01"]) == 1
     error = capsys.readouterr().err
     assert "mountwb run: numerical trouble: case 'reference mount', run 'LP rotor': stopped after" in error

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["period_window", "harmonic_amplitude", "harmonic_amplitudes", "steady_amplitude", "SteadyAmplitude",
+           "relative_change",
            "amplitude_spectrum"]
 
 
@@ -155,7 +156,7 @@ class SteadyAmplitude:
 
 
 def steady_amplitude(time: np.ndarray, signals: np.ndarray, frequency_hz: float, periods: int,
-                     tolerance: float = 0.005) -> SteadyAmplitude:
+                     tolerance: float = 0.005, *, phase: bool = False) -> SteadyAmplitude:
     """Amplitude at *frequency_hz* over the last *periods* periods, with a steady-state check.
 
     Parameters
@@ -170,6 +171,11 @@ def steady_amplitude(time: np.ndarray, signals: np.ndarray, frequency_hz: float,
         Periods per window; the history must hold two windows.
     tolerance : float
         Allowed relative change between the two windows.
+    phase : bool
+        Compare the complex amplitudes (magnitude and phase against absolute
+        time) instead of the magnitudes only: stricter, since a slowly
+        decaying vibration at another frequency can leak into the
+        magnitudes of two windows alike but not with the same phase.
 
     Returns
     -------
@@ -179,11 +185,19 @@ def steady_amplitude(time: np.ndarray, signals: np.ndarray, frequency_hz: float,
     values = values[:, None] if values.ndim == 1 else values
     last = period_window(time, frequency_hz, periods)
     before = period_window(time, frequency_hz, periods, end=last.start)
-    amplitude = np.abs(harmonic_amplitude(time[last], values[last], frequency_hz))
-    previous = np.abs(harmonic_amplitude(time[before], values[before], frequency_hz))
-    scale = max(amplitude.max(), previous.max())
-    change = float(np.abs(amplitude - previous).max() / scale) if scale > 0 else 0.0
-    return SteadyAmplitude(amplitude, previous, change, tolerance, last)
+    complex_last = harmonic_amplitude(time[last], values[last], frequency_hz)
+    complex_before = harmonic_amplitude(time[before], values[before], frequency_hz)
+    amplitude, previous = np.abs(complex_last), np.abs(complex_before)
+    return SteadyAmplitude(amplitude, previous, relative_change(complex_last, complex_before, phase), tolerance, last)
+
+
+def relative_change(last: np.ndarray, before: np.ndarray, phase: bool = False) -> float:
+    """Largest change between the complex amplitudes *last* and *before* of two
+    windows relative to the largest magnitude: of the magnitudes, or with
+    *phase* of the complex amplitudes themselves."""
+    scale = max(np.abs(last).max(), np.abs(before).max())
+    difference = np.abs(last - before) if phase else np.abs(np.abs(last) - np.abs(before))
+    return float(difference.max() / scale) if scale > 0 else 0.0
 
 
 def amplitude_spectrum(time: np.ndarray, signal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -328,7 +328,9 @@ def _solver(scene, plan) -> dict[str, Any]:
     return {
         "integrator": f"generalized-alpha, spectral radius {analysis.spectral_radius:g}, modified Newton",
         "time step": f"{plan.step:.4g} s ({plan.steps_per_period} steps per period of {plan.frequency_hz:g} Hz)",
-        "ramp": f"{plan.ramp_periods} periods ({plan.ramp_periods / plan.frequency_hz:.3g} s), raised cosine",
+        "ramp": (f"{plan.ramp_periods} periods ({plan.ramp_periods / plan.frequency_hz:.3g} s), raised cosine"
+                 if plan.start == "rest" else "none: from the steady state the excitation acts in full from the "
+                 "first step"),
         "settle": f"{plan.settle_periods} periods ({plan.settle_periods / plan.frequency_hz:.3g} s): "
                   f"{plan.settle_reason}",
         "measured": f"2 windows of {plan.measured_periods} periods, steady if within "

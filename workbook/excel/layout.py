@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING
+from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING, TIME_STARTS
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -191,6 +191,10 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
     Column("stress_stiffening", "stress stiffening", "choice", choices=STRESS_STIFFENING,
            help="the flexible links' geometric stiffness of their axial preload, with a buckling check: on; off; "
                 "auto: on for a link whose preload moves its first pinned-pinned mode by more than 0.5 %"),
+    Column("start", "start", "choice", choices=TIME_STARTS,
+           help="where a time-domain run starts: steady: in the steady state of its linearised scene (two windows "
+                "suffice); rest: from rest with the smooth start and the settle time; auto: steady unless a "
+                "clearance makes the scene nonlinear"),
 ))
 
 ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(

@@ -42,6 +42,8 @@ ENGINE = "engine"
 DIRECTIONS = ("x", "y", "z")
 #: Analysis methods a case may ask for (AnalysisSettings.method).
 ANALYSIS_METHODS = ("time", "frequency", "auto")
+#: Starts a time-domain run may take (AnalysisSettings.start).
+TIME_STARTS = ("auto", "steady", "rest")
 #: Settings of ``Effects.stress_stiffening``.
 STRESS_STIFFENING = ("auto", "on", "off")
 _RESERVED = (PYLON, ENGINE)
@@ -1037,6 +1039,13 @@ class AnalysisSettings:
     divergence_displacement : float
         Engine centre-of-gravity displacement from the preloaded position
         above which the run stops as diverging, m.
+    start : {"auto", "steady", "rest"}
+        Where a time-domain run starts (:mod:`workbook.solve.steady_start`):
+        in the steady state of its linearised scene, the excitation in full
+        from the first step (``"steady"``); at rest, the excitation rising
+        over ``ramp_periods`` and the settle time after it (``"rest"``);
+        ``"auto"`` (the default): steady when the scene is linear, at rest
+        when a hinge clearance makes it nonlinear.
     """
 
     steps_per_period: int = 40
@@ -1052,9 +1061,12 @@ class AnalysisSettings:
     step_halvings: int = 4
     time_budget: float | None = None
     divergence_displacement: float = 0.05
+    start: str = "auto"
 
     def __post_init__(self):
         item = "analysis settings"
+        if self.start not in TIME_STARTS:
+            raise CaseError(item, "start", self.start, " or ".join(repr(s) for s in TIME_STARTS))
         if isinstance(self.step_halvings, bool) or not isinstance(self.step_halvings, int) \
                 or not 0 <= self.step_halvings <= 20:
             raise CaseError(item, "step_halvings", self.step_halvings, "a whole number from 0 to 20")

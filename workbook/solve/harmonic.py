@@ -150,14 +150,20 @@ class HarmonicModel:
         forces (one, or one per imbalance plane), shape (n,)."""
         return sum(self.input_matrix(point) @ phasor for point, phasor in point_phasors(excitation))
 
-    def respond_generalised(self, frequency_hz: float, load: np.ndarray) -> FrequencyResponse:
-        """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*."""
+    def motion(self, frequency_hz: float, load: np.ndarray) -> np.ndarray:
+        """Steady-state motion phasor ``z_hat`` (independent coordinates, shape (n,)) for the
+        generalised force phasor *load* (shape (n,)) at *frequency_hz*."""
         lin = self.linearization
         omega = 2 * np.pi * frequency_hz
         dynamic = lin.stiffness - omega ** 2 * lin.mass + 1j * omega * lin.damping
         if lin.structural is not None:
             dynamic = dynamic + 1j * lin.structural
-        motion = sla.solve(dynamic, load, check_finite=False)
+        return sla.solve(dynamic, load, check_finite=False)
+
+    def respond_generalised(self, frequency_hz: float, load: np.ndarray) -> FrequencyResponse:
+        """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*."""
+        omega = 2 * np.pi * frequency_hz
+        motion = self.motion(frequency_hz, load)
         outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
         forces = (outputs @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces))

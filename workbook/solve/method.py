@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 from workbook.model.case import Case
 
-__all__ = ["MethodChoice", "choose_method", "TIME", "FREQUENCY"]
+__all__ = ["MethodChoice", "choose_method", "clearance_hinges", "TIME", "FREQUENCY"]
 
 TIME, FREQUENCY = "time", "frequency"
 
@@ -43,7 +43,8 @@ class MethodChoice:
         return f"{self.method} domain"
 
 
-def _clearance_hinges(case: Case) -> list[str]:
+def clearance_hinges(case: Case) -> list[str]:
+    """Names of the hinges whose clearance law is built (they make the scene nonlinear)."""
     if not case.effects.clearance:
         return []
     return [h.name for h in case.hinges if h.radial_clearance > 0]
@@ -60,7 +61,7 @@ def choose_method(case: Case, *, sweep: bool = False) -> MethodChoice:
         answers it whatever the case asks.
     """
     asked = case.analysis.method
-    gaps = _clearance_hinges(case)
+    gaps = clearance_hinges(case)
     nonlinear = (f"hinge clearance on {', '.join(repr(g) for g in gaps)} makes the scene nonlinear"
                  if gaps else "")
     if sweep and not gaps:

@@ -39,8 +39,9 @@ from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
 from workbook.solve.preload import Preload, solve_preload
 from workbook.solve.simultaneous import extract_simultaneous, plan_simultaneous
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
+from workbook.solve.steady_start import STEADY, choose_start, steady_start
 from workbook.solve.stress_stiffening import stiffen_links
-from workbook.solve.time_domain import extract, integrate, plan_run
+from workbook.solve.time_domain import TimeHistories, extract, integrate, plan_run
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
            "RESONANCE_BAND"]
@@ -63,7 +64,8 @@ class PreparedScene:
     modes : list of Mode
         Every linearised mode, ascending.
     model : HarmonicModel or None
-        The harmonic model (None when prepared for the time domain).
+        The harmonic model (None when prepared for the time domain without
+        ``linear_model``).
     timings : dict of str to float
         Wall time per stage, s.
     """
@@ -88,7 +90,8 @@ def _reduce(case: Case, excitation: SingleFrequencyExcitation, reduce_for: Singl
 
 def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
             reduce_for: SingleFrequencyExcitation | None = None, reduced: dict | None = None,
-            progress: ProgressFactory | None = None, harmonic: bool = True) -> PreparedScene:
+            progress: ProgressFactory | None = None, harmonic: bool = True,
+            linear_model: bool = False) -> PreparedScene:
     """Reduce, build, preload and linearise the scene of *case* with *excitation*.
 
     Parameters
@@ -103,8 +106,13 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
     progress : callable, optional
         Progress factory for the link reduction (see :data:`ProgressFactory`).
     harmonic : bool
-        Build the harmonic model (frequency domain); False linearises for the
-        mounted modes only (time domain).
+        Build the scene for the frequency domain (loss factors left to the
+        harmonic model as complex stiffness) and its harmonic model; False
+        builds it for the time domain (their viscous equivalents built in)
+        and linearises it for the mounted modes only.
+    linear_model : bool
+        With ``harmonic=False``: build the harmonic model of that time-domain
+        scene too (its steady state is where a steady start begins).
 
     Raises
     ------
@@ -126,7 +134,7 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
         with timed(timings, "stress stiffening"):
             scene, preload = stiffen_links(case, excitation, scene, preload)
         model = None
-        if harmonic:
+        if harmonic or linear_model:
             with timed(timings, "linearisation"):
                 model = harmonic_model(scene)
         with timed(timings, "mounted modes"):
@@ -182,30 +190,50 @@ def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
     same run, see :mod:`workbook.solve.simultaneous`); see :func:`run_excitation`."""
     method = method or MethodChoice(TIME, "asked for directly (run_excitation)")
     refuse_time_domain(case, method.reason)
-    prepared = prepare(case, excitation, reduce_for=reduce_for, progress=progress, harmonic=False)
+    start = choose_start(case)
+    steady = start.start == STEADY
+    # from the steady state the excitation acts in full from the first step
+    built = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, ramp_periods=0.0)) if steady else case
+    prepared = prepare(built, excitation, reduce_for=reduce_for, progress=progress, harmonic=False,
+                       linear_model=steady)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
     together = isinstance(excitation, Simultaneous)
     with scene:
         where = run_label(case.name, excitation.name)
-        plan = (plan_simultaneous(case.analysis, excitation, prepared.modes, where) if together
-                else plan_run(case.analysis, scene.excitation.signal, prepared.modes, where=where))
-        log.info("%s / %s: %d steps of %.3g s", case.name, excitation.name, plan.steps, plan.step)
+        plan = (plan_simultaneous(case.analysis, excitation, prepared.modes, where, start.start) if together
+                else plan_run(case.analysis, scene.excitation.signal, prepared.modes, where, start.start))
+        if steady:
+            with timed(timings, "steady start"):
+                steady_start(prepared.model, excitation).apply(scene)
+        log.info("%s / %s: %d steps of %.3g s from %s", case.name, excitation.name, plan.steps, plan.step,
+                 start.start)
+
+        def extract_all(histories: TimeHistories) -> list[ExcitationResult]:
+            return (extract_simultaneous(scene, plan, histories, excitation) if together
+                    else [extract(scene, plan, histories)])
+
+        def settled(histories: TimeHistories) -> bool:
+            return all(result.steady for result in extract_all(histories))
+
         with timed(timings, "time integration"):
             if progress is None:
-                histories = integrate(scene, plan)
+                histories = integrate(scene, plan, steady=settled)
             else:
                 update, close = progress(f"{excitation.name} ({excitation.frequency:g} Hz)", plan.end_time)
                 try:
-                    histories = integrate(scene, plan, update)
+                    histories = integrate(scene, plan, update, steady=settled)
                 finally:
                     close()
         with timed(timings, "amplitude extraction"):
-            results = (extract_simultaneous(scene, plan, histories, excitation) if together
-                       else [extract(scene, plan, histories)])
+            results = extract_all(histories)
         for result in results:
             result.warnings.extend(link_warnings(case, scene.reduced))
         card = model_card(scene, prepared.preload, mounted, plan, timings, method)
+    card.solver["start"] = f"{start.start}: {start.reason}"
+    card.solver["windows beyond the plan"] = (
+        f"{histories.extended_periods} periods: the first windows disagreed" if histories.extended_periods
+        else "none")
     card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
     return results, card, prepared.preload
 

@@ -27,7 +27,7 @@ import math
 
 import numpy as np
 
-from workbook.answers.amplitude import harmonic_amplitudes, period_window
+from workbook.answers.amplitude import harmonic_amplitudes, period_window, relative_change
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.model.case import AnalysisSettings, Simultaneous
@@ -35,6 +35,7 @@ from workbook.scene.build import Scene
 from workbook.scene.excitation import ExcitationSignal
 from workbook.solve.guards import check_undamped_resonance
 from workbook.solve.modes import Mode
+from workbook.solve.steady_start import STEADY
 from workbook.solve.time_domain import TimeHistories, TimePlan, plan_run, run_warnings
 
 __all__ = ["plan_simultaneous", "extract_simultaneous"]
@@ -45,7 +46,8 @@ def _lowest_and_highest(item: Simultaneous):
     return parts[0], parts[-1]
 
 
-def plan_simultaneous(analysis: AnalysisSettings, item: Simultaneous, modes: list[Mode], where: str) -> TimePlan:
+def plan_simultaneous(analysis: AnalysisSettings, item: Simultaneous, modes: list[Mode], where: str,
+                      start: str = "rest") -> TimePlan:
     """The plan of one run of every part of *item* (see the module text).
 
     Raises
@@ -62,7 +64,7 @@ def plan_simultaneous(analysis: AnalysisSettings, item: Simultaneous, modes: lis
                                  f"{part.name!r} excites an undamped mode: its free vibration never decays")
     scaled = dataclasses.replace(analysis, ramp_periods=analysis.ramp_periods * ratio,
                                  measured_periods=math.ceil(analysis.measured_periods * ratio - 1e-9))
-    return plan_run(scaled, ExcitationSignal.of(highest, scaled.ramp_periods), modes, where)
+    return plan_run(scaled, ExcitationSignal.of(highest, scaled.ramp_periods), modes, where, start)
 
 
 def extract_simultaneous(scene: Scene, plan: TimePlan, histories: TimeHistories, item: Simultaneous
@@ -74,21 +76,22 @@ def extract_simultaneous(scene: Scene, plan: TimePlan, histories: TimeHistories,
     pylon = pylon_sum(histories.hinge_forces, scene.pylon_channels)
     last = period_window(time, plan.frequency_hz, plan.measured_periods)
     before = period_window(time, plan.frequency_hz, plan.measured_periods, end=last.start)
-    amplitude = np.abs(harmonic_amplitudes(time[last], pylon[last], frequencies))
-    previous = np.abs(harmonic_amplitudes(time[before], pylon[before], frequencies))
+    complex_last = harmonic_amplitudes(time[last], pylon[last], frequencies)
+    complex_before = harmonic_amplitudes(time[before], pylon[before], frequencies)
+    amplitude = np.abs(complex_last)
     hinges = {name: np.abs(harmonic_amplitudes(time[last], forces[last], frequencies))
               for name, forces in histories.hinge_forces.items()}
     results = []
     for j, part in enumerate(item.expand()):
-        scale = max(amplitude[j].max(), previous[j].max())
-        change = float(np.abs(amplitude[j] - previous[j]).max() / scale) if scale > 0 else 0.0
+        change = relative_change(complex_last[j], complex_before[j], phase=plan.start == STEADY)
         # the start of every part lasts ramp_periods periods of the lowest frequency
         signal = ExcitationSignal.of(part, analysis.ramp_periods * part.frequency / min(frequencies))
         results.append(ExcitationResult(
             name=part.name, frequency_hz=part.frequency, excitation_amplitude=part.force_amplitude,
             pylon_amplitude=amplitude[j], hinge_amplitudes={name: a[j] for name, a in hinges.items()},
             pylon_hinges=list(scene.pylon_channels), steady_change=change,
-            steady_tolerance=analysis.steady_tolerance, warnings=run_warnings(scene, plan, change), time=time,
+            steady_tolerance=analysis.steady_tolerance,
+            warnings=run_warnings(scene, plan, change, histories.extended_periods), time=time,
             hinge_histories=histories.hinge_forces, pylon_history=pylon, excitation_history=signal.force(time),
             window=last))
     return results
