@@ -209,3 +209,11 @@ def test_a_mesh_without_surface_at_an_eye_is_refused(tmp_path):
                   CasingInterface("bearing", (0.2, 0.0, 0.0), "bearing", 0.04))
     with pytest.raises(ValueError, match=r"tube.vtu: interface 'eye far away': no casing surface within 0.05 m"):
         reduce_casing(CasingModel(interfaces, mesh_file=str(path)), "static", 1.0, use_cache=False)
+
+
+def test_the_four_pole_set_refuses_a_flexible_engine(coarse_reference):
+    """The four-pole set (and a flexible pylon, which closes it) takes the rigid engine's points."""
+    from workbook.solve.four_pole import mount_case
+
+    with pytest.raises(CaseError, match="field 'casing'.*four-pole"):
+        mount_case(_with_casing(coarse_reference, COARSE_CASING))
