@@ -45,18 +45,19 @@ def main() -> None:
     flexible = dataclasses.replace(rigid, engine=dataclasses.replace(rigid.engine, casing=casing))
     model = casing.model(rigid.engine.center_of_mass,
                          [(eye_name(names), point) for point, names in flexible.engine_eyes()])
-    print(f"casing element size {args.element_size:g} m; cold reductions (no cache):")
+    print(f"casing element size {args.element_size:g} m; one cold reduction (no cache) for both rotors:")
     print("| rotor | FE DOF | casing DOF | modes | mesh (s) | assembly (s) | factorisation + modes (s) | "
-          "free-free (s) | total (s) |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for excitation in (LP_ROTOR, HP_ROTOR):
-        start = time.perf_counter()
-        reduced = reduce_casing(model, casing.modes, excitation.frequency, use_cache=False)
-        total = time.perf_counter() - start
-        info = reduced.info
-        print(f"| {excitation.name} | {info['fe_dof']} | {reduced.dof} | {reduced.n_fixed_interface} | "
+          "free-free (s) |")
+    print("|---|---|---|---|---|---|---|---|")
+    start = time.perf_counter()
+    reduced = reduce_casing(model, casing.modes, [LP_ROTOR.frequency, HP_ROTOR.frequency], use_cache=False)
+    total = time.perf_counter() - start
+    for excitation, one in zip((LP_ROTOR, HP_ROTOR), reduced):
+        info = one.info
+        print(f"| {excitation.name} | {info['fe_dof']} | {one.dof} | {one.n_fixed_interface} | "
               f"{info['mesh_seconds']:.2f} | {info['assembly_seconds']:.2f} | {info['reduction_seconds']:.2f} | "
-              f"{info['frequency_seconds']:.2f} | {total:.2f} |")
+              f"{info['frequency_seconds']:.2f} |")
+    print(f"total {total:.2f} s")
     print("\nwarm frequency-domain runs (medians):")
     print("| rotor | scene DOF rigid | scene DOF flexible | rigid (s) | flexible (s) | ratio |")
     print("|---|---|---|---|---|---|")

@@ -116,48 +116,56 @@ def _decide(modes, frequencies: dict, excitation_hz: float):
     return dataclasses.replace(decision, reason=decision.reason.replace(MOUNTED_BOUNDARY, FREE_FREE))
 
 
-def reduce_casing(model: CasingModel, modes="auto", excitation_hz: float | None = None, *, cache_dir=None,
-                  use_cache: bool = True) -> ReducedLink:
-    """Reduce a casing for one excitation frequency, reusing the cache where the inputs match.
+def reduce_casing(model: CasingModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
+                  use_cache: bool = True) -> tuple:
+    """Reduce a casing for several excitations at once (one FE model and factorisation serve
+    them all), reusing the cache where the inputs match.
 
     Parameters
     ----------
     model : CasingModel
     modes : {"auto", "static"} or int or float
-        See :func:`flexbodies.selection.decide_modes`; ``"auto"`` judges the
+        See :func:`flexbodies.selection.decide_modes`; ``"auto"`` judges each
         excitation against the casing's first free-free frequency.
-    excitation_hz : float, optional
-        Highest excitation frequency the casing must follow, Hz.
+    excitations_hz : sequence of float or None
+        The highest excitation frequency of each run that needs the casing, Hz.
     cache_dir : str or Path, optional
     use_cache : bool
 
     Returns
     -------
-    ReducedLink
-        In the casing frame; one master node per interface, in order.
-        ``frequencies["free_free_hz"]`` holds the six lowest elastic
-        free-free frequencies of the FE model (``"mounted_hz"`` is empty);
-        ``info`` the timings, s.
+    tuple of ReducedLink
+        One per excitation, in the casing frame; one master node per
+        interface, in order. ``frequencies["free_free_hz"]`` holds the six
+        lowest elastic free-free frequencies of the FE model
+        (``"mounted_hz"`` is empty); ``info`` the timings, s.
     """
+    excitations_hz = list(excitations_hz)
     cache = LinkCache(cache_dir, enabled=use_cache)
     fingerprint = model.fingerprint()
     fe_hash = _hash(fingerprint)
 
-    def cached():
-        frequencies = cache.read_summary(fe_hash)
-        if frequencies is None:
-            return None, None, None
-        decision = _decide(modes, frequencies, excitation_hz)
-        key = _hash({"fe": fe_hash, "modes": decision.key})
-        return decision, key, cache.load_link(key)
+    def cached(frequencies):
+        decisions = [_decide(modes, frequencies, f) for f in excitations_hz]
+        keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+        return decisions, keys, [cache.load_link(key) for key in keys]
 
-    decision, key, casing = cached()
-    if casing is not None:
-        return with_decision(casing, decision, cache_hit=True)
+    def answer(casings, decisions, made=None):
+        made = made or {}
+        return tuple(with_decision(c, d, cache_hit=True) if c is not None else with_decision(made[d.key], d, False)
+                     for c, d in zip(casings, decisions))
+
+    frequencies = cache.read_summary(fe_hash)
+    if frequencies is not None:
+        decisions, keys, casings = cached(frequencies)
+        if all(c is not None for c in casings):
+            return answer(casings, decisions)
     with cache.lock(fe_hash):
-        decision, key, casing = cached()
-        if casing is not None:
-            return with_decision(casing, decision, cache_hit=True)
+        frequencies = cache.read_summary(fe_hash)
+        if frequencies is not None:
+            decisions, keys, casings = cached(frequencies)
+            if all(c is not None for c in casings):
+                return answer(casings, decisions)
         start = time.perf_counter()
         casing_mesh = model.meshed()
         meshed = time.perf_counter()
@@ -167,17 +175,20 @@ def reduce_casing(model: CasingModel, modes="auto", excitation_hz: float | None 
         start = time.perf_counter()
         solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
         timings["reduction_seconds"] = time.perf_counter() - start
-        start = time.perf_counter()
-        # the store's summary holds the mounted frequencies of a link too: a casing has none
-        frequencies = {"free_free_hz": solver.free_free_frequencies(6), "mounted_hz": np.zeros(0)}
-        timings["frequency_seconds"] = time.perf_counter() - start
-        cache.write_summary(fe_hash, frequencies)
-        decision = _decide(modes, frequencies, excitation_hz)
-        key = _hash({"fe": fe_hash, "modes": decision.key})
-        info = {"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
-        (casing,) = reduce_for_decisions(coupled, solver, [decision], frequencies, [info])
-        cache.save_link(key, casing)
-        return with_decision(casing, decision, cache_hit=False)
+        if frequencies is None:
+            start = time.perf_counter()
+            # the store's summary holds the mounted frequencies of a link too: a casing has none
+            frequencies = {"free_free_hz": solver.free_free_frequencies(6), "mounted_hz": np.zeros(0)}
+            timings["frequency_seconds"] = time.perf_counter() - start
+            cache.write_summary(fe_hash, frequencies)
+            decisions, keys, casings = cached(frequencies)
+        missing = {d.key: (key, d) for key, d, c in zip(keys, decisions, casings) if c is None}
+        infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
+                 for key, _ in missing.values()]
+        made = reduce_for_decisions(coupled, solver, [d for _, d in missing.values()], frequencies, infos)
+        for (key, _), casing in zip(missing.values(), made):
+            cache.save_link(key, casing)
+        return answer(casings, decisions, dict(zip(missing, made)))
 
 
 @dataclass(frozen=True)

@@ -181,10 +181,10 @@ def _flexible_engine(scene) -> EffectEntry:
         return EffectEntry("flexible engine", False, "no engine casing given: the engine is one rigid body")
     casing, reduced = scene.case.engine.casing, items.reduced
     source = "parametric casing" if casing.geometry is not None else f"casing mesh {casing.mesh}"
-    timing = ("loaded from the cache" if reduced.cache_hit else
-              "reduced now: " + ", ".join(f"{key.removesuffix('_seconds')} {reduced.info[key]:.2f} s"
-                                          for key in ("mesh_seconds", "assembly_seconds", "reduction_seconds",
-                                                      "frequency_seconds") if key in reduced.info))
+    stages = ", ".join(f"{key.removesuffix('_seconds')} {reduced.info[key]:.2f} s"
+                       for key in ("mesh_seconds", "assembly_seconds", "reduction_seconds", "frequency_seconds")
+                       if key in reduced.info)
+    timing = f"reduction {'loaded from the cache (it took ' + stages + ')' if reduced.cache_hit else stages}"
     axial, radial = casing.bearing_stiffness
     return EffectEntry("flexible engine", True,
                        f"the case gives an engine casing: {source} ({reduced.info.get('fe_dof', 0)} FE DOF, "

@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from flexbodies.casing_reduction import add_casing_to_exudyn, reduce_casing
 from workbook.errors import CaseError
 from workbook.model.casing import CoreBody, bearing_name, casing_origin, parallel_axis, split_engine
 
@@ -74,7 +75,8 @@ def eye_name(hinges) -> str:
 
 
 def reduce_engine_casing(case, excitation_hz: float):
-    """The case's casing reduced for *excitation_hz* (Hz), from the cache where it matches.
+    """The case's casing reduced for *excitation_hz* (Hz), from the cache where it matches (a
+    reduction serves every excitation frequency of the case at once, from one factorisation).
 
     Raises
     ------
@@ -82,12 +84,11 @@ def reduce_engine_casing(case, excitation_hz: float):
         The mesh file cannot be read or has no surface at an interface, or two
         interfaces overlap (the message is the reduction's, naming the file).
     """
-    from flexbodies.casing_reduction import reduce_casing
-
     casing, engine = case.engine.casing, case.engine
     model = casing.model(engine.center_of_mass, [(eye_name(names), point) for point, names in case.engine_eyes()])
     try:
-        return reduce_casing(model, casing.modes, excitation_hz)
+        frequencies = sorted({e.frequency for e in case.excitations} | {excitation_hz})
+        return reduce_casing(model, casing.modes, frequencies)[frequencies.index(excitation_hz)]
     except (ValueError, OSError) as error:
         field_name = "mesh" if casing.mesh is not None else "geometry"
         raise CaseError("engine casing", field_name, casing.mesh or "the parametric casing",
@@ -114,8 +115,6 @@ def add_flexible_engine(mbs, case, excitation_hz: float, names) -> tuple[tuple[i
     items : CasingItems
     """
     import exudyn as exu
-
-    from flexbodies.casing_reduction import add_casing_to_exudyn
 
     eii = exu.itemInterface
     engine, casing = case.engine, case.engine.casing
