@@ -412,6 +412,13 @@ def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | Non
     return max(frequencies) if frequencies else 0.0
 
 
+def _served_frequency(case: Case, excitation: SingleFrequencyExcitation | None, reduced: dict) -> float:
+    """The frequency the scene's reductions serve, Hz: that the links were reduced for (a
+    sweep's highest), else the excitation's (:func:`_reduction_frequency`)."""
+    served = [link.decision.excitation_hz for link in reduced.values() if link.decision.excitation_hz]
+    return max(served) if served else _reduction_frequency(case, excitation)
+
+
 def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None,
                  progress: Callable[[int], None] | None = None) -> dict:
     """Reduce every link of *case* (cached on disk and in memory by :mod:`flexbodies`).
@@ -502,7 +509,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     if case.engine.casing is None:
         engine = _add_engine(mbs, case)
     else:
-        core, casing = add_flexible_engine(mbs, case, _reduction_frequency(case, excitation),
+        core, casing = add_flexible_engine(mbs, case, _served_frequency(case, excitation, reduced),
                                            lambda label: exudyn_name("scene", label))
         engine = EngineItems(*core)
     hinge_loss, link_loss = loss_factors(case)
