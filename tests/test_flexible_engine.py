@@ -7,15 +7,20 @@ import sys
 
 import numpy as np
 import pytest
+from excel_helpers import copy_reference, set_cells
+from openpyxl import load_workbook
 
-from flexbodies.casing import CasingGeometry, CasingInterface
+from flexbodies.casing import CasingGeometry, CasingInterface, mesh_casing
 from flexbodies.casing_reduction import CasingModel, reduce_casing
 from flexbodies.materials import STEEL, TITANIUM
-from workbook.errors import CaseError
+from workbook.errors import CaseError, WorkbookError
+from workbook.excel.reader import read_workbook
+from workbook.excel.template import case_workbook, write_workbook
 from workbook.model.casing import CASING, parallel_axis, split_engine
 from workbook.model.codec import to_json
-from workbook.model.reference import HP_ROTOR, LP_ROTOR, reference_casing
+from workbook.model.reference import HP_ROTOR, LP_ROTOR, reference_case, reference_casing
 from workbook.scene.build import build_scene
+from workbook.solve.four_pole import mount_case
 from workbook.solve.pipeline import prepare, run_case
 
 #: beta L of the first free-free bending mode of a uniform beam.
@@ -189,7 +194,7 @@ def _bad_json(coarse_reference, tmp_path, **changes):
                                                              "mount eye on the engine casing"]),
     ({"geometry": None, "mesh": "no-such-casing.msh"}, ["engine casing", "mesh", "no-such-casing.msh",
                                                           "an existing mesh file"]),
-    ({"bearing_planes": [0.35, 2.0]}, ["engine casing", "bearing_planes", "within the casing"]),
+    ({"bearing_planes": [0.35, 2.0]}, ["engine casing", "bearing_planes[1]", "within the casing"]),
 ])
 def test_bad_casing_input_names_the_field_and_exits_2(coarse_reference, tmp_path, changes, named):
     done = _run_cli(_bad_json(coarse_reference, tmp_path, **changes))
@@ -201,8 +206,6 @@ def test_bad_casing_input_names_the_field_and_exits_2(coarse_reference, tmp_path
 
 def test_a_mesh_without_surface_at_an_eye_is_refused(tmp_path):
     """A user's mesh that does not reach a mount eye: the error names the eye and the file."""
-    from flexbodies.casing import mesh_casing
-
     tube = mesh_casing(CasingGeometry(0.1, 0.02, 0.0, 0.4), 0.04)
     path = tmp_path / "tube.vtu"
     tube.to_meshio().write(path)
@@ -214,7 +217,40 @@ def test_a_mesh_without_surface_at_an_eye_is_refused(tmp_path):
 
 def test_the_four_pole_set_refuses_a_flexible_engine(coarse_reference):
     """The four-pole set (and a flexible pylon, which closes it) takes the rigid engine's points."""
-    from workbook.solve.four_pole import mount_case
-
     with pytest.raises(CaseError, match="field 'casing'.*four-pole"):
         mount_case(_with_casing(coarse_reference, COARSE_CASING))
+
+
+# --- the Excel case workbook ----------------------------------------------------------------------------------
+
+
+def test_a_casing_row_is_read_and_written_back(tmp_path):
+    """The Engine casing sheet: a case with the reference casing writes to it and reads back the same."""
+    case = _with_casing(reference_case(), reference_casing(element_size=0.12, modes="static"))
+    path = tmp_path / "casing.xlsx"
+    write_workbook(case_workbook(case, []), path)
+    wb = load_workbook(path)
+    wb["Runs"].append(["LP", "LP rotor"])
+    wb.save(path)
+    assert read_workbook(path).case.engine == case.engine
+
+
+@pytest.mark.parametrize("edits, named", [
+    ({("Engine casing", "bearing 2 x", 3): 3.0}, ["sheet 'Engine casing'", "cell L3", "column 'bearing 2 x'",
+                                                    "within the casing"]),
+    ({("Engine casing", "wall thickness", 3): -5}, ["sheet 'Engine casing'", "column 'wall thickness'", "> 0"]),
+])
+def test_a_bad_casing_cell_is_named(tmp_path, edits, named):
+    path = copy_reference(tmp_path)
+    row = {("Engine casing", header, 3): value for header, value in (
+        ("radius", 500), ("wall thickness", 25), ("x start", -1.8), ("x end", 0.7), ("front ring x", 0.0),
+        ("front ring width", 80), ("front ring radius", 620), ("rear ring x", -1.72), ("rear ring width", 80),
+        ("rear ring radius", 580), ("bearing 1 x", 0.35), ("bearing 2 x", -1.2), ("element size", 120),
+        ("bearing band", 40))}
+    set_cells(path, row)
+    assert read_workbook(path).case.engine.casing == reference_casing(element_size=0.12)
+    set_cells(path, edits)
+    with pytest.raises(WorkbookError) as error:
+        read_workbook(path)
+    for words in named:
+        assert words in str(error.value)

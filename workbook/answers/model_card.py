@@ -185,7 +185,7 @@ def _flexible_engine(scene) -> EffectEntry:
                        for key in ("mesh_seconds", "assembly_seconds", "reduction_seconds", "frequency_seconds")
                        if key in reduced.info)
     timing = f"reduction {'loaded from the cache (it took ' + stages + ')' if reduced.cache_hit else stages}"
-    axial, radial = casing.bearing_stiffness
+    radial, axial = casing.bearing_stiffness
     return EffectEntry("flexible engine", True,
                        f"the case gives an engine casing: {source} ({reduced.info.get('fe_dof', 0)} FE DOF, "
                        f"{items.casing.mass:.1f} kg of {scene.case.engine.mass:g} kg) reduced to {items.casing.dof} "

@@ -158,9 +158,9 @@ class EngineCasing:
             raise CaseError(_ITEM, "bearing_planes", self.bearing_planes, "two or more distinct x positions, m")
         if self.geometry is not None:
             g = self.geometry
-            for x in planes:
+            for k, x in enumerate(planes):
                 if not g.x_start <= x <= g.x_end:
-                    raise CaseError(_ITEM, "bearing_planes", x, f"a plane within the casing, x {g.x_start:g} to "
+                    raise CaseError(_ITEM, f"bearing_planes[{k}]", x, f"a plane within the casing, x {g.x_start:g} to "
                                                                f"{g.x_end:g} m")
         object.__setattr__(self, "bearing_planes", planes)
 

@@ -136,8 +136,8 @@ def add_flexible_engine(mbs, case, excitation_hz: float, names) -> tuple[tuple[i
     marker = mbs.AddMarker(eii.MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
     flexible = add_casing_to_exudyn(mbs, reduced, origin, modal_damping_ratio=casing.modal_damping,
                                     name=names("engine casing"))
-    axial, radial = casing.bearing_stiffness
-    axial_damping, radial_damping = casing.bearing_damping
+    radial, axial = casing.bearing_stiffness
+    radial_damping, axial_damping = casing.bearing_damping
     bearings = []
     for x in casing.bearing_planes:
         on_core = mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=body, localPosition=[x - cg[0], 0.0, 0.0]))
