@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from workbook.errors import CaseError
-from workbook.model.casing import EngineCasing
+from workbook.model.casing import CASING, EngineCasing
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 
@@ -1250,6 +1250,8 @@ class Case:
                                     f"an eye centre of link {body!r}: {links[body].end_a} or "
                                     f"{links[body].end_b}")
         if self.engine.casing is not None:
+            if CASING in links:
+                raise CaseError(f"link {CASING!r}", "name", CASING, "a name other than the flexible engine's casing")
             self.engine.casing.check(self.engine.mass, self.engine.center_of_mass,
                                      [(h.name, h.position) for h in self.hinges if ENGINE in h.bodies])
         if self.test_rig is not None:
