@@ -37,7 +37,7 @@ __all__ = ["EngineCasing", "CoreBody", "split_engine", "CASING", "MountRing", "C
 CASING = "engine casing"
 #: Radial and axial stiffness of each bearing connector, N/m: stiff enough that the
 #: core's modes on the casing lie above the rotor excitations of a turbofan
-#: (about 400 Hz for the reference engine's core on two planes).
+#: (the reference engine's core, 2474 kg, translates on its two bearings at sqrt(2e10 / 2474) / 2 pi = 450 Hz).
 DEFAULT_BEARING_STIFFNESS = (1.0e10, 1.0e10)
 #: Radius of the spider that ties a mount eye to the casing surface, m.
 DEFAULT_SPIDER_RADIUS = 0.08
