@@ -181,9 +181,9 @@ def _flexible_engine(scene) -> EffectEntry:
         return EffectEntry("flexible engine", False, "no engine casing given: the engine is one rigid body")
     casing, reduced = scene.case.engine.casing, items.reduced
     source = "parametric casing" if casing.geometry is not None else f"casing mesh {casing.mesh}"
-    stages = ", ".join(f"{key.removesuffix('_seconds')} {reduced.info[key]:.2f} s"
-                       for key in ("mesh_seconds", "assembly_seconds", "reduction_seconds", "frequency_seconds")
-                       if key in reduced.info)
+    stages = ", ".join(f"{words} {reduced.info[key]:.2f} s" for key, words in (
+        ("mesh_seconds", "mesh"), ("assembly_seconds", "assembly"), ("reduction_seconds", "factorisation and modes"),
+        ("frequency_seconds", "free-free frequencies")) if key in reduced.info)
     timing = f"reduction {'loaded from the cache (it took ' + stages + ')' if reduced.cache_hit else stages}"
     radial, axial = casing.bearing_stiffness
     return EffectEntry("flexible engine", True,
@@ -194,7 +194,7 @@ def _flexible_engine(scene) -> EffectEntry:
                        f"rotors' loads on the rigid core ({items.core.mass:.1f} kg), joined at "
                        f"{len(items.bearings)} bearing planes (RBE3; axial {axial:.3g}, radial {radial:.3g} N/m) "
                        f"and by a spin restraint at {casing.core_spin_hz:g} Hz; casing modal damping "
-                       f"{casing.modal_damping:g}; {timing} ({items.seconds:.2f} s in this build)")
+                       f"{casing.modal_damping:g}; {timing}; {items.seconds:.2f} s in this run's scene")
 
 
 def _effects(scene, preload, method) -> list[EffectEntry]:
