@@ -143,7 +143,7 @@ def _rbe3_rows(bore, nodes):
     )
 
 
-def couple_interfaces(fe_model, kind: str = "RBE2") -> InterfaceCoupling:
+def couple_interfaces(fe_model, kind="RBE2") -> InterfaceCoupling:
     """Tie every bore of an FE model to a master node at its centre.
 
     Parameters
@@ -151,24 +151,28 @@ def couple_interfaces(fe_model, kind: str = "RBE2") -> InterfaceCoupling:
     fe_model : FEModel
         Needs ``nodes`` (n, 3) in m and ``bores``, each with ``name``,
         ``centre`` (m), ``nodes`` (indices) and ``weights`` (m^2).
-    kind : {"RBE2", "RBE3"}
-        Rigid or averaging coupling.
+    kind : {"RBE2", "RBE3"} or sequence of them
+        Rigid or averaging coupling, for every bore or one per bore.
 
     Returns
     -------
     InterfaceCoupling
+        Its ``kind`` is the one kind, or the kinds per bore joined by ``"/"``.
     """
-    kind = str(kind).upper()
-    if kind not in COUPLINGS:
-        raise ValueError(f"unknown interface coupling {kind!r}; expected one of {', '.join(COUPLINGS)}")
+    bores = tuple(fe_model.bores)
+    kinds = [str(kind).upper()] * len(bores) if isinstance(kind, str) else [str(k).upper() for k in kind]
+    for one in kinds:
+        if one not in COUPLINGS:
+            raise ValueError(f"unknown interface coupling {one!r}; expected one of {', '.join(COUPLINGS)}")
+    if len(kinds) != len(bores):
+        raise ValueError(f"{len(kinds)} interface couplings for {len(bores)} bores")
     nodes = np.asarray(fe_model.nodes, dtype=float)
     ndof = 3 * len(nodes)
-    bores = tuple(fe_model.bores)
     all_bore_nodes = np.concatenate([b.nodes for b in bores])
     if len(np.unique(all_bore_nodes)) != len(all_bore_nodes):
         raise ValueError("two bores share FE nodes; interfaces must be disjoint")
-    rows_for = _rbe2_rows if kind == "RBE2" else _rbe3_rows
-    per_bore = [rows_for(b, nodes) for b in bores]
+    per_bore = [(_rbe2_rows if one == "RBE2" else _rbe3_rows)(b, nodes) for one, b in zip(kinds, bores)]
+    kind = str(kind).upper() if isinstance(kind, str) else "/".join(kinds)
 
     dependent = np.concatenate([p[0] for p in per_bore])
     retained = np.setdiff1d(np.arange(ndof), dependent)

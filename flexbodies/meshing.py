@@ -413,8 +413,16 @@ def _build_link_solid(g: LinkGeometry) -> None:
     occ.synchronize()
 
 
-def _generate_tet10(size: float) -> tuple[np.ndarray, np.ndarray]:
+def _generate_tet10(size: float, curvature_points: int = 16) -> tuple[np.ndarray, np.ndarray]:
     """Generate quadratic tetrahedra in the current gmsh model.
+
+    Parameters
+    ----------
+    size : float
+        Largest element edge, m.
+    curvature_points : int
+        Elements at least per full circle of a curved edge (gmsh's
+        ``Mesh.MeshSizeFromCurvature``).
 
     Returns
     -------
@@ -425,7 +433,7 @@ def _generate_tet10(size: float) -> tuple[np.ndarray, np.ndarray]:
 
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 16)
+    gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", curvature_points)
     gmsh.option.setNumber("Mesh.Algorithm", 6)  # Frontal-Delaunay 2-D
     gmsh.option.setNumber("Mesh.Algorithm3D", 1)  # Delaunay 3-D
     gmsh.option.setNumber("Mesh.ElementOrder", 2)

@@ -44,8 +44,8 @@ class CoupledModel:
     mass: sp.csr_matrix
 
 
-def couple(fe_model, kind: str = "RBE2") -> CoupledModel:
-    """Tie the bores of ``fe_model`` to master nodes (``"RBE2"`` or ``"RBE3"``)."""
+def couple(fe_model, kind="RBE2") -> CoupledModel:
+    """Tie the bores of ``fe_model`` to master nodes (``"RBE2"`` or ``"RBE3"``, for all or per bore)."""
     coupling = couple_interfaces(fe_model, kind)
     return CoupledModel(fe_model, coupling, coupling.reduce(fe_model.stiffness), coupling.reduce(fe_model.mass))
 

@@ -17,7 +17,8 @@ from workbook.solve.preload import solve_preload
 #: Every effect the model card accounts for (docs/physics.md, section 4).
 EFFECTS = {"link flexibility", "static preload", "hinge damping", "hinge loss factor",
            "hinge properties per direction", "link damping", "link modal damping", "link material loss factor", "hinge clearance",
-           "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance", "link stress stiffening",
+           "flexible engine", "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance",
+           "link stress stiffening",
            "time domain", "frequency domain", "imbalance planes", "simultaneous excitations"}
 
 
@@ -117,4 +118,5 @@ def test_the_model_card_lists_every_effect_with_its_reason(rigid):
     assert entries["hinge damping"].detail == "switched off"
     assert not entries["link flexibility"].on and "rigid" in entries["link flexibility"].detail
     assert not entries["link stress stiffening"].on and entries["link stress stiffening"].detail == "no flexible link"
+    assert not entries["flexible engine"].on and "rigid body" in entries["flexible engine"].detail
     assert all(e.detail for e in card.effects)

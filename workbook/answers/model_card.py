@@ -11,6 +11,8 @@ from typing import Any
 
 import numpy as np
 
+from workbook.model.case import ENGINE
+from workbook.model.casing import CASING
 from workbook.scene.build import Scene, loss_factors
 
 __all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
@@ -139,10 +141,8 @@ def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, fl
     solver : dict, optional
         Solver settings to record instead of those of *plan*.
     """
-    from workbook.model.case import ENGINE
-
     case = scene.case
-    bodies = [BodyEntry(ENGINE, "rigid body", 6, 0, case.engine.mass, "one rigid body: mass, CG and inertia from the case")]
+    bodies = _engine_bodies(scene)
     for link in case.links:
         reduced, item = scene.reduced[link.name], scene.links[link.name]
         if case.link_is_flexible(link.name):
@@ -160,6 +160,41 @@ def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, fl
                      [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings),
                      method.method, method.reason)
     return card
+
+
+def _engine_bodies(scene) -> list[BodyEntry]:
+    """The engine: one rigid body, or the rigid core and the flexible casing."""
+    engine, items = scene.case.engine, scene.casing
+    if items is None:
+        return [BodyEntry(ENGINE, "rigid body", 6, 0, engine.mass, "one rigid body: mass, CG and inertia from the case")]
+    reduced = items.reduced
+    return [BodyEntry(ENGINE, "rigid core", 6, 0, items.core.mass,
+                      "rotors and core: the engine's mass, CG and inertia less the casing's"),
+            BodyEntry(CASING, "flexible casing (Craig-Bampton)", items.casing.dof, reduced.n_fixed_interface,
+                      items.casing.mass, reduced.decision.reason)]
+
+
+def _flexible_engine(scene) -> EffectEntry:
+    """The flexible engine: why, its size, its first casing mode, the modes kept and the time it cost."""
+    items = scene.casing
+    if items is None:
+        return EffectEntry("flexible engine", False, "no engine casing given: the engine is one rigid body")
+    casing, reduced = scene.case.engine.casing, items.reduced
+    source = "parametric casing" if casing.geometry is not None else f"casing mesh {casing.mesh}"
+    stages = ", ".join(f"{words} {reduced.info[key]:.2f} s" for key, words in (
+        ("mesh_seconds", "mesh"), ("assembly_seconds", "assembly"), ("reduction_seconds", "factorisation and modes"),
+        ("frequency_seconds", "free-free frequencies")) if key in reduced.info)
+    timing = f"reduction {'loaded from the cache (it took ' + stages + ')' if reduced.cache_hit else stages}"
+    radial, axial = casing.bearing_stiffness
+    return EffectEntry("flexible engine", True,
+                       f"the case gives an engine casing: {source} ({reduced.info.get('fe_dof', 0)} FE DOF, "
+                       f"{items.casing.mass:.1f} kg of {scene.case.engine.mass:g} kg) reduced to {items.casing.dof} "
+                       f"DOF ({reduced.n_fixed_interface} fixed-interface modes); first free-free casing mode "
+                       f"{reduced.frequencies['free_free_hz'][0]:.1f} Hz; mount eyes on the casing (RBE2), the "
+                       f"rotors' loads on the rigid core ({items.core.mass:.1f} kg), joined at "
+                       f"{len(items.bearings)} bearing planes (RBE3; axial {axial:.3g}, radial {radial:.3g} N/m) "
+                       f"and by a spin restraint at {casing.core_spin_hz:g} Hz; casing modal damping "
+                       f"{casing.modal_damping:g}; {timing}; {items.seconds:.2f} s in this run's scene")
 
 
 def _effects(scene, preload, method) -> list[EffectEntry]:
@@ -204,6 +239,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                     if effects.clearance and gaps else
                     ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")
                     + _ignored_contact(case)),
+        _flexible_engine(scene),
         _spin_restraints(scene),
         _gyroscopics(scene),
         _rig_sensors(scene),

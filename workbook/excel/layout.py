@@ -22,7 +22,7 @@ from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING,
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
-           "EXCITATIONS", "ROTORS", "TEST_RIG", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
+           "EXCITATIONS", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
            "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES", "MAGNITUDE_LIMITS"]
 
 HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
@@ -310,6 +310,38 @@ TEST_RIG = Table("Test rig", single_row=True, optional=True,
     *_xyz("damping", "damping", "N*s/m", help="damping of each transducer (empty: 0)"),
 ))
 
+CASING_RINGS = ("front_ring", "rear_ring")
+CASING_BEARINGS = ("bearing_1", "bearing_2", "bearing_3")
+
+CASING = Table("Engine casing", single_row=True, optional=True,
+               help="the engine's casing as a flexible body, the rest a rigid core on bearings (empty: a rigid "
+                    "engine); positions x along the engine axis, see docs/flexible-engine.md", columns=(
+    _num("radius", "radius", "m", unit="mm", help="parametric casing: outer radius of the tube"),
+    _num("thickness", "wall thickness", "m", unit="mm", help="parametric casing: wall thickness"),
+    _num("x_start", "x start", "m", help="parametric casing: aft end"),
+    _num("x_end", "x end", "m", help="parametric casing: front end"),
+    *(column for ring in CASING_RINGS for column in (
+        _num(f"{ring}_x", f"{ring.replace('_', ' ')} x", "m", help="mount ring: mid-plane (empty: no ring)"),
+        _num(f"{ring}_width", f"{ring.replace('_', ' ')} width", "m", unit="mm", help="mount ring: axial width"),
+        _num(f"{ring}_radius", f"{ring.replace('_', ' ')} radius", "m", unit="mm",
+             help="mount ring: outer radius"))),
+    *(_num(key, f"bearing {k} x", "m", required=k <= 2, help="a bearing plane (the rotors' seat)")
+      for k, key in enumerate(CASING_BEARINGS, start=1)),
+    Column("material", "material", "choice", choices=("steel", "titanium"), help="preset material (empty: titanium)"),
+    _num("youngs_modulus", "E", "Pa", unit="GPa", help="Young's modulus overriding the preset"),
+    _num("poisson_ratio", "nu", help="Poisson's ratio overriding the preset"),
+    _num("density", "density", "kg/m^3", help="density overriding the preset"),
+    _num("element_size", "element size", "m", unit="mm", help="mesh size (empty: default)"),
+    _num("spider_radius", "spider radius", "m", unit="mm", help="casing surface tied to each mount eye (empty: 80 mm)"),
+    _num("bearing_band", "bearing band", "m", unit="mm", help="casing surface tied to each bearing plane"),
+    _num("bearing_axial", "bearing axial stiffness", "N/m", help="each bearing (empty: 1e10 N/m)"),
+    _num("bearing_radial", "bearing radial stiffness", "N/m", help="each bearing (empty: 1e10 N/m)"),
+    _num("modal_damping", "modal damping", help="damping ratio of each elastic casing mode (empty: 0.02)"),
+    Column("modes", "modes", "modes", help="auto, static or a mode count"),
+    Column("mesh_file", "mesh file", "text", help="mesh file, relative to the workbook (instead of a geometry)"),
+    Column("mesh_unit", "mesh unit", "unit", help="length unit of the mesh file (e.g. mm)"),
+))
+
 RUNS = Table("Runs", help="one run per row: an excitation and optional overrides", columns=(
     Column("name", "run", "text", required=True, help="unique run name"),
     Column("excitation", "excitation", "text", required=True, help="an excitation name"),
@@ -341,4 +373,4 @@ TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes, o
 ))
 
 #: The input tables in sheet order.
-TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, ROTORS, TEST_RIG, RUNS, TEST_DATA)
+TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, ROTORS, TEST_RIG, CASING, RUNS, TEST_DATA)

@@ -25,6 +25,7 @@ from workbook.excel.impedance_sheet import with_impedance_sheet
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import Record, SheetReader, open_workbook
 from workbook.model import case as cm
+from workbook.model.casing import DEFAULT_BEARING_STIFFNESS, CasingGeometry, EngineCasing, MountRing
 
 __all__ = ["CaseBook", "read_workbook"]
 
@@ -67,6 +68,13 @@ _MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density")
 _FIELD_COLUMNS = {
     "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
                "inertia": ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")},
+    "Engine casing": {"geometry": ("radius", "thickness", "x_start", "x_end"), "geometry.radius": ("radius",),
+                      "geometry.thickness": ("thickness",), "geometry.x_end": ("x_start", "x_end"),
+                      **{f"geometry.rings[{k}]": (f"{ring}_x", f"{ring}_width", f"{ring}_radius")
+                         for k, ring in enumerate(L.CASING_RINGS)},
+                      "bearing_planes": L.CASING_BEARINGS, "mesh": ("mesh_file",), "scale": ("mesh_unit",),
+                      **{f"bearing_planes[{k}]": (key,) for k, key in enumerate(L.CASING_BEARINGS)},
+                      "bearing_stiffness": ("bearing_radial", "bearing_axial")},
     "Excitations": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "phase_deg": ("phase",),
                     "frequencies_hz": ("sweep_from", "sweep_to"), "spacing": ("sweep_spacing",),
                     "start": ("sweep_from",), "stop": ("sweep_to",), "points": ("sweep_points",),
@@ -150,17 +158,17 @@ class _CaseReader(SheetReader):
 
     # -- one item per row --------------------------------------------------------------------------------
 
-    def engine(self, record: Record) -> cm.Engine | None:
+    def engine(self, record: Record, casing: EngineCasing | None = None) -> cm.Engine | None:
         get = record.get
         inertia = ((get("ixx"), get("ixy", 0.0), get("ixz", 0.0)),
                    (get("ixy", 0.0), get("iyy"), get("iyz", 0.0)),
                    (get("ixz", 0.0), get("iyz", 0.0), get("izz")))
-        return self.build(record, lambda: cm.Engine(get("mass"), record.vector("cg"), inertia))
+        return self.build(record, lambda: cm.Engine(get("mass"), record.vector("cg"), inertia, casing))
 
-    def material(self, record: Record):
+    def material(self, record: Record, preset: str = "steel"):
         import flexbodies
 
-        base = flexbodies.material(record.get("material", "steel"))
+        base = flexbodies.material(record.get("material", preset))
         overrides = {key: record.get(key) for key in _MATERIAL_KEYS if record.get(key) is not None}
         if not overrides:
             return base
@@ -346,6 +354,34 @@ class _CaseReader(SheetReader):
                  if value is not None}
         return self.build(record, lambda: cm.ForceTransducers(record.vector("stiffness"), **given))
 
+    def casing(self, record: Record) -> EngineCasing | None:
+        """The Engine casing row: a parametric casing, or a mesh file relative to the workbook."""
+        material = self.material(record, "titanium")
+        if material is None:
+            return None
+        get = record.get
+        shape = {}
+        if get("mesh_file") is not None:
+            path = self.path.parent / get("mesh_file")
+            problem = bounded_file_problem(path, MAX_MESH_BYTES)
+            if problem is not None:
+                self.record_problem(record, ("mesh_file",), get("mesh_file"),
+                                    f"a mesh file (relative to the workbook's folder; {problem})")
+                return None
+            shape = {"mesh": str(path), "scale": get("mesh_unit", 1.0)}
+        else:
+            rings = tuple(MountRing(get(f"{ring}_x"), get(f"{ring}_width"), get(f"{ring}_radius"))
+                          for ring in L.CASING_RINGS if get(f"{ring}_x") is not None)
+            shape = {"geometry": CasingGeometry(get("radius"), get("thickness"), get("x_start"), get("x_end"), rings)}
+        given = {name: get(key) for name, key in (("element_size", "element_size"), ("spider_radius", "spider_radius"),
+                                                  ("bearing_band", "bearing_band"), ("modal_damping", "modal_damping"),
+                                                  ("modes", "modes")) if get(key) is not None}
+        if get("bearing_radial") is not None or get("bearing_axial") is not None:
+            radial, axial = DEFAULT_BEARING_STIFFNESS
+            given["bearing_stiffness"] = (get("bearing_radial", radial), get("bearing_axial", axial))
+        planes = tuple(get(key) for key in L.CASING_BEARINGS if get(key) is not None)
+        return self.build(record, lambda: EngineCasing(planes, material=material, **shape, **given))
+
     def settings(self, record: Record):
         def given(cls):
             return {f.name: record.get(f.name) for f in dataclasses.fields(cls) if record.get(f.name) is not None}
@@ -365,7 +401,8 @@ class _CaseReader(SheetReader):
                 planes.setdefault(record.get("name"), record)
         # the plane rows of one imbalance share its name; its first row stands for it
         self.unique([r for r in tables["Excitations"] if r.get("type") != "imbalance plane" or planes[r.get("name")] is r])
-        engine = [self.engine(r) for r in tables["Engine"] if r.ok]
+        casing = [self.casing(r) for r in tables[L.CASING.sheet] if r.ok]
+        engine = [self.engine(r, casing[0] if casing else None) for r in tables["Engine"] if r.ok]
         settings = [self.settings(r) for r in tables["Case"] if r.ok]
         test_rig = [self.test_rig(r) for r in tables["Test rig"] if r.ok]
         items = {key: [(r, make(r) if r.ok else None) for r in tables[key]] for key, make in

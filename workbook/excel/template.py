@@ -24,6 +24,7 @@ from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.styling import print_setup
 from workbook.model import case as cm
+from workbook.model.casing import DEFAULT_CORE_SPIN_HZ
 from workbook.model.units import si_factor
 
 __all__ = ["case_rows", "case_workbook", "template_workbook", "reference_workbook", "write_workbook",
@@ -166,6 +167,35 @@ def _rows_for_test_rig(rig: cm.ForceTransducers | None) -> list[dict]:
     return [{**_vector("stiffness", rig.stiffness), "mass": rig.mass, **_vector("damping", rig.damping)}]
 
 
+def _rows_for_casing(casing) -> list[dict]:
+    """The Engine casing row of a parametric casing (none for a rigid engine)."""
+    import flexbodies
+
+    if casing is None:
+        return []
+    g = casing.geometry
+    if g is None:
+        raise ValueError("engine casing: only a parametric casing can be written (a mesh casing is written by hand)")
+    if len(g.rings) > len(L.CASING_RINGS) or len(casing.bearing_planes) > len(L.CASING_BEARINGS):
+        raise ValueError(f"engine casing: at most {len(L.CASING_RINGS)} rings and {len(L.CASING_BEARINGS)} bearing "
+                         "planes can be written")
+    if any(casing.bearing_damping) or casing.core_spin_hz != DEFAULT_CORE_SPIN_HZ:
+        raise ValueError("engine casing: bearing damping and a core spin frequency other than the default have no "
+                         "column; such a casing is given in Python or JSON")
+    base = flexbodies.material(casing.material.name.split(" ")[0])
+    radial, axial = casing.bearing_stiffness
+    row = {"radius": g.radius, "thickness": g.thickness, "x_start": g.x_start, "x_end": g.x_end,
+           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings)
+              for name, value in (("x", ring.x), ("width", ring.width), ("radius", ring.outer_radius))},
+           **dict(zip(L.CASING_BEARINGS, casing.bearing_planes)), "material": base.name,
+           **{key: getattr(casing.material, key) for key in ("youngs_modulus", "poisson_ratio", "density")
+              if getattr(casing.material, key) != getattr(base, key)},
+           "element_size": casing.element_size, "spider_radius": casing.spider_radius,
+           "bearing_band": casing.bearing_band, "bearing_radial": radial, "bearing_axial": axial,
+           "modal_damping": casing.modal_damping, "modes": casing.modes}
+    return [row]
+
+
 def _per_direction(hinge: cm.Hinge, key: str) -> dict:
     """A hinge's *key* as one cell, or three (radial 1 in *key*, then radial 2 and axial)."""
     values = hinge.values(key)
@@ -203,6 +233,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.EXCITATIONS.sheet: [row for e in case.excitations for row in _rows_for_excitation(e)],
         L.ROTORS.sheet: [_row_for_rotor(rotor) for rotor in case.rotors],
         L.TEST_RIG.sheet: _rows_for_test_rig(case.test_rig),
+        L.CASING.sheet: _rows_for_casing(case.engine.casing),
         L.RUNS.sheet: [dataclasses.asdict(run) for run in runs],
         L.TEST_DATA.sheet: [dataclasses.asdict(point) for point in tests],
     }

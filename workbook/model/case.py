@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from workbook.errors import CaseError
+from workbook.model.casing import CASING, EngineCasing
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_mesh import MeshPylon
@@ -147,7 +148,7 @@ def _set(obj: Any, name: str, value: Any) -> None:
 
 @dataclass(frozen=True)
 class Engine:
-    """The engine: one rigid body.
+    """The engine: one rigid body, or a flexible casing and a rigid core.
 
     Parameters
     ----------
@@ -157,11 +158,15 @@ class Engine:
         Centre of gravity in the global frame, m.
     inertia : 3x3 floats
         Inertia tensor about the centre of gravity, global axes, kg m^2.
+    casing : EngineCasing or None
+        The casing as a flexible body (None: the engine is one rigid body);
+        see :mod:`workbook.model.casing`.
     """
 
     mass: float
     center_of_mass: Vector3
     inertia: tuple[Vector3, Vector3, Vector3]
+    casing: EngineCasing | None = None
 
     def __post_init__(self):
         item = "engine"
@@ -182,6 +187,8 @@ class Engine:
                             "a positive definite tensor whose principal moments obey the "
                             "triangle inequality")
         _set(self, "inertia", rows)
+        if self.casing is not None and not isinstance(self.casing, EngineCasing):
+            raise CaseError(item, "casing", self.casing, "an EngineCasing or None")
 
     @property
     def inertia_matrix(self) -> np.ndarray:
@@ -517,6 +524,20 @@ class ForceTransducers:
 
 #: A test-rig transducer is named by this prefix and the pylon-side hinges it carries.
 TRANSDUCER_PREFIX = "transducer "
+
+
+def _points_of(hinges) -> list[tuple[Vector3, list[str]]]:
+    """The distinct positions of *hinges* (m), each with the names of the hinges
+    on it (hinges closer than the point tolerance share a point)."""
+    points: list[tuple[Vector3, list[str]]] = []
+    for hinge in hinges:
+        point = next((point for point in points
+                      if np.linalg.norm(np.subtract(point[0], hinge.position)) <= POINT_TOLERANCE), None)
+        if point is None:
+            points.append((hinge.position, [hinge.name]))
+        else:
+            point[1].append(hinge.name)
+    return points
 
 
 def transducer_name(carried) -> str:
@@ -1252,6 +1273,11 @@ class Case:
                     raise CaseError(f"hinge {hinge.name!r}", "position", hinge.position,
                                     f"an eye centre of link {body!r}: {links[body].end_a} or "
                                     f"{links[body].end_b}")
+        if self.engine.casing is not None:
+            if CASING in links:
+                raise CaseError(f"link {CASING!r}", "name", CASING, "a name other than the flexible engine's casing")
+            self.engine.casing.check(self.engine.mass, self.engine.center_of_mass,
+                                     [(h.name, h.position) for h in self.hinges if ENGINE in h.bodies])
         if self.test_rig is not None:
             for _, carried in self.pylon_pins():
                 name = transducer_name(carried)
@@ -1315,18 +1341,15 @@ class Case:
         """The pylon-side hinges, whose forces sum to the pylon force."""
         return tuple(h for h in self.hinges if h.on_pylon)
 
+    def engine_eyes(self) -> list[tuple[Vector3, list[str]]]:
+        """The mount eyes on the engine: each position (m) with the names of the
+        engine-side hinges on it (hinges closer than the point tolerance share an eye)."""
+        return _points_of([h for h in self.hinges if ENGINE in h.bodies])
+
     def pylon_pins(self) -> list[tuple[Vector3, list[str]]]:
         """The pylon pins: each position (m) with the names of the pylon-side
         hinges on it (hinges closer than the point tolerance share a pin)."""
-        pins: list[tuple[Vector3, list[str]]] = []
-        for hinge in self.pylon_hinges:
-            pin = next((pin for pin in pins
-                        if np.linalg.norm(np.subtract(pin[0], hinge.position)) <= POINT_TOLERANCE), None)
-            if pin is None:
-                pins.append((hinge.position, [hinge.name]))
-            else:
-                pin[1].append(hinge.name)
-        return pins
+        return _points_of(self.pylon_hinges)
 
     def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
         """Every run of the case: single excitations, expanded sweeps and the

@@ -16,8 +16,9 @@ import numpy as np
 
 from workbook.errors import CaseError
 from workbook.model.case import ENGINE, PYLON, AnalysisSettings, Case, Engine, Gravity, Hinge, Link, PointForce, RotatingForce, Rotor, Sweep
+from workbook.model.casing import CasingGeometry, EngineCasing, MountRing
 
-__all__ = ["reference_case", "reference_sweep", "HINGE_STIFFNESS", "HINGE_DAMPING_TIME", "HINGE_LOSS_FACTOR",
+__all__ = ["reference_case", "reference_sweep", "reference_casing", "HINGE_STIFFNESS", "HINGE_DAMPING_TIME", "HINGE_LOSS_FACTOR",
            "HINGE_DAMPING_MODELS",
            "LP_ROTOR", "HP_ROTOR", "LP_SPOOL", "HP_SPOOL"]
 
@@ -138,6 +139,39 @@ def _hinges(damping_model: str) -> tuple[Hinge, ...]:
             hinge(f"rear-down-{name}", ENGINE, f"rear-{name}", points[f"rear-{name}"][0]),
         ]
     return tuple(hinges)
+
+
+#: The reference casing: a titanium tube of 0.5 m outer radius and 25 mm wall (a
+#: smeared flanged and ribbed wall), 2.5 m long around the centre of gravity, with a
+#: front mount ring at the front mount plane and a rear one at the lateral link's
+#: plane; the rotors sit on it at the fan (LP imbalance plane) and aft of the HP
+#: rotor. The engine-side eyes are 0.46-0.64 m from the axis, so the casing is one
+#: of core size, not the 0.9 m fan case.
+CASING_GEOMETRY = dict(radius=0.5, thickness=0.025, x_start=-1.8, x_end=0.7)
+CASING_RINGS = ((FRONT_X, 0.08, 0.62), (LATERAL_X, 0.08, 0.58))
+CASING_BEARINGS = (0.35, -1.2)
+
+
+def reference_casing(element_size: float | None = 0.1, **changes):
+    """The reference engine's casing as a flexible body (``Engine.casing``).
+
+    Parameters
+    ----------
+    element_size : float, optional
+        Mesh size, m (None: the flexbodies default, two wall thicknesses).
+    **changes
+        Other :class:`~workbook.model.casing.EngineCasing` fields.
+
+    Returns
+    -------
+    EngineCasing
+    """
+    from flexbodies import TITANIUM
+
+    geometry = CasingGeometry(**CASING_GEOMETRY, rings=tuple(MountRing(*ring) for ring in CASING_RINGS))
+    fields = dict(geometry=geometry, material=TITANIUM, element_size=element_size, bearing_band=0.04)
+    fields.update(changes)
+    return EngineCasing(CASING_BEARINGS, **fields)
 
 
 def reference_sweep(points: int = 25) -> Sweep:

@@ -52,7 +52,9 @@ from workbook.model.case import (
     SingleFrequencyExcitation,
     transducer_name,
 )
+from workbook.model.casing import CASING
 from workbook.scene.bearing import exudyn_bearing_function, hinge_matrix
+from workbook.scene.engine_casing import CasingItems, add_flexible_engine
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 from workbook.scene.link_workers import LinkJob, reduce_in_workers
@@ -68,7 +70,7 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class EngineItems:
-    """Exudyn items of the engine.
+    """Exudyn items of the engine (of its core, when the casing is flexible).
 
     Attributes
     ----------
@@ -236,6 +238,9 @@ class Scene:
         built as their equivalent viscous damping (the time domain), Hz;
         None when they were not (no loss factor, no excitation, or the
         frequency domain adds them exactly, see :func:`loss_factors`).
+    casing : CasingItems or None
+        The flexible engine's casing, core and bearings
+        (:mod:`workbook.scene.engine_casing`); None: a rigid engine.
     """
 
     case: Case
@@ -252,6 +257,7 @@ class Scene:
     transducers: dict = field(default_factory=dict)
     gyroscopics: GyroscopicItems | None = None
     loss_factor_hz: float | None = None
+    casing: CasingItems | None = None
 
     def close(self) -> None:
         """Free Exudyn's system: reset the system container, whose memory
@@ -283,6 +289,8 @@ class Scene:
     def body_dof(self) -> dict[str, int]:
         """Degrees of freedom per body (engine, links, transducers)."""
         dof = {ENGINE: 6}
+        if self.casing is not None:
+            dof[CASING] = self.casing.casing.dof
         dof.update({name: link.dof for name, link in self.links.items()})
         dof.update({name: 3 for name in self.transducers})
         return dof
@@ -290,9 +298,19 @@ class Scene:
     def body_nodes(self) -> dict[str, tuple]:
         """Exudyn node numbers per body (engine, links, transducers)."""
         nodes = {ENGINE: (self.engine.node,)}
+        if self.casing is not None:
+            nodes[CASING] = tuple(self.casing.casing.nodes)
         nodes.update({name: tuple(link.nodes) for name, link in self.links.items()})
         nodes.update({name: (items.node,) for name, items in self.transducers.items()})
         return nodes
+
+    def body_masses(self) -> dict[int, float]:
+        """Mass of each Exudyn body of the engine and the links, kg."""
+        masses = {self.engine.body: self.case.engine.mass if self.casing is None else self.casing.core.mass}
+        if self.casing is not None:
+            masses[self.casing.casing.body] = self.casing.casing.mass
+        masses.update({link.body: link.mass for link in self.links.values()})
+        return masses
 
     @contextmanager
     def excitation_paused(self):
@@ -418,6 +436,13 @@ def link_jobs(case: Case, excitation: SingleFrequencyExcitation | None = None) -
     return jobs
 
 
+def _served_frequency(case: Case, excitation: SingleFrequencyExcitation | None, reduced: dict) -> float:
+    """The frequency the scene's reductions serve, Hz: that the links were reduced for (a
+    sweep's highest), else the excitation's (:func:`_reduction_frequency`)."""
+    served = [link.decision.excitation_hz for link in reduced.values() if link.decision.excitation_hz]
+    return max(served) if served else _reduction_frequency(case, excitation)
+
+
 def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None,
                  progress: Callable[[int], None] | None = None) -> dict:
     """Reduce every link of *case* (cached on disk and in memory by :mod:`flexbodies`).
@@ -512,7 +537,13 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     mbs = system.AddSystem()
 
     ground = mbs.AddObject(eii.ObjectGround(visualization=eii.VObjectGround(show=False)))
-    engine = _add_engine(mbs, case)
+    casing = None
+    if case.engine.casing is None:
+        engine = _add_engine(mbs, case)
+    else:
+        core, casing = add_flexible_engine(mbs, case, _served_frequency(case, excitation, reduced),
+                                           lambda label: exudyn_name("scene", label))
+        engine = EngineItems(*core)
     hinge_loss, link_loss = loss_factors(case)
     loss_hz = None if exact_loss_factors or excitation is None or not (hinge_loss or link_loss) \
         else excitation.frequency
@@ -540,6 +571,8 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
                 return next(items.markers[1] for items in transducers.values()
                             if _same_point(items.position, position))
             return mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=ground, localPosition=list(position)))
+        if body_name == ENGINE and casing is not None:
+            return casing.eye_marker(position)
         if body_name == ENGINE:
             local = np.subtract(position, case.engine.center_of_mass)
             return mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=engine.body, localPosition=list(local)))
@@ -578,7 +611,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
             outputVariableType=exu.OutputVariableType.Force))
         hinges[hinge.name] = HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
 
-    static_loads = _add_static_loads(mbs, case, engine, links) if case.effects.preload else {}
+    static_loads = _add_static_loads(mbs, case, engine, links, casing) if case.effects.preload else {}
     gyroscopics = _add_gyroscopics(mbs, case, engine) if gyroscopics_built(case) else None
 
     excitation_items = None
@@ -603,9 +636,9 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
     link_mass = sum(link.mass for link in links.values())
     scene = Scene(case, system, mbs, ground, engine, links, reduced, hinges, static_loads, excitation_items,
                   _load_scale(case, excitation, link_mass), transducers=transducers,
-                  gyroscopics=gyroscopics, loss_factor_hz=loss_hz)
+                  gyroscopics=gyroscopics, loss_factor_hz=loss_hz, casing=casing)
     log.info("scene of %r: %d bodies, %d hinges, %d transducers, %d ODE2 coordinates", case.name,
-             1 + len(links), len(hinges), len(transducers), mbs.systemData.ODE2Size())
+             1 + len(links) + (casing is not None), len(hinges), len(transducers), mbs.systemData.ODE2Size())
     return scene
 
 
@@ -658,8 +691,9 @@ def _add_engine(mbs, case: Case) -> EngineItems:
     return EngineItems(node, body, marker)
 
 
-def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict[str, list]:
-    """Static loads: forces and moments on the engine, gravity on every body."""
+def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict,
+                      casing: CasingItems | None = None) -> dict[str, list]:
+    """Static loads: forces and moments on the engine (its core), gravity on every body."""
     import exudyn as exu
 
     eii = exu.itemInterface
@@ -675,7 +709,7 @@ def _add_static_loads(mbs, case: Case, engine: EngineItems, links: dict) -> dict
                                                                 markerNumber=engine.marker_rigid,
                                                                 loadVector=list(load.moment)))]
         else:
-            bodies = [engine.body] + [link.body for link in links.values()]
+            bodies = [engine.body] + ([casing.casing.body] if casing else []) + [link.body for link in links.values()]
             loads[load.name] = [
                 mbs.AddLoad(eii.LoadMassProportional(
                     markerNumber=mbs.AddMarker(eii.MarkerBodyMass(bodyNumber=body)),

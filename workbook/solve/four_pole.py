@@ -405,8 +405,12 @@ def mount_case(case: Case) -> Case:
     Raises
     ------
     workbook.errors.CaseError
-        A hinge with a clearance law: the four-pole set is that of a linear mount.
+        A hinge with a clearance law: the four-pole set is that of a linear mount;
+        or a flexible engine: its engine-side points are on the rigid engine.
     """
+    if case.engine.casing is not None:
+        raise CaseError("engine", "casing", "a flexible casing", "None (a rigid engine) for the four-pole parameters "
+                        "and a flexible pylon: their engine-side points are those of a rigid engine")
     if case.effects.clearance:
         for hinge in case.hinges:
             if hinge.radial_clearance > 0:

@@ -106,8 +106,7 @@ def applied_static_force(scene: Scene) -> np.ndarray:
         For a mass-proportional load on a body whose mass is unknown.
     """
     mbs = scene.mbs
-    masses = {scene.engine.body: scene.case.engine.mass}
-    masses.update({link.body: link.mass for link in scene.links.values()})
+    masses = scene.body_masses()
     total = np.zeros(3)
     for index in range(mbs.systemData.NumberOfLoads()):
         load = mbs.GetLoad(index)
