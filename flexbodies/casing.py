@@ -20,10 +20,12 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .meshing import Bore, LinkMesh, _generate_tet10, _gmsh_model, _skfem_mesh
+if TYPE_CHECKING:  # meshing loads gmsh, meshio and scikit-fem: imported where a casing is meshed
+    from .meshing import LinkMesh
 
 __all__ = ["MountRing", "CasingGeometry", "CasingInterface", "mesh_casing", "casing_interfaces",
            "default_casing_element_size"]
@@ -153,11 +155,13 @@ def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> 
     """
     import gmsh
 
+    from .meshing import LinkMesh, generate_tet10, gmsh_model, skfem_mesh
+
     size = default_casing_element_size(geometry) if element_size is None else float(element_size)
     if not (math.isfinite(size) and size > 0):
         raise ValueError(f"casing element size must be a positive length in m, got {element_size!r}")
     g = geometry
-    with _gmsh_model("casing"):
+    with gmsh_model("casing"):
         occ = gmsh.model.occ
         solid = [(3, occ.addCylinder(g.x_start, 0, 0, g.length, 0, 0, g.radius))]
         rings = [(3, occ.addCylinder(ring.x - ring.width / 2, 0, 0, ring.width, 0, 0, ring.outer_radius))
@@ -167,8 +171,8 @@ def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> 
         bore = (3, occ.addCylinder(g.x_start - g.length, 0, 0, 3 * g.length, 0, 0, g.inner_radius))
         occ.cut(solid, [bore])
         occ.synchronize()
-        points, cells = _generate_tet10(size, curvature_points=_CURVATURE_POINTS)
-    mesh, _ = _skfem_mesh("tetra10", points, cells)
+        points, cells = generate_tet10(size, curvature_points=_CURVATURE_POINTS)
+    mesh, _ = skfem_mesh("tetra10", points, cells)
     return LinkMesh(mesh=mesh, bores=(), source=f"gmsh casing mesh, element size {size * 1e3:.4g} mm")
 
 
@@ -209,6 +213,9 @@ def casing_interfaces(casing_mesh: LinkMesh, interfaces, source: str) -> LinkMes
         gives the nearest boundary face's distance), or one whose nodes all
         belong to nearer interfaces; both name *source*.
     """
+    from .meshing import Bore
+
+
     mesh = casing_mesh.mesh
     facets = mesh.boundary_facets()
     centroids = mesh.doflocs[:, mesh.facets[:, facets]].mean(axis=1)  # (3, faces)

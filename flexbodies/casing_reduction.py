@@ -25,16 +25,15 @@ from pathlib import Path
 
 import numpy as np
 
-from .assembly import assemble
 from .cache import LinkCache
 from .casing import CasingGeometry, casing_interfaces, default_casing_element_size, mesh_casing
 from .exudyn_body import exudyn_cms_interface, modal_damping_matrix
-from .interior import InteriorSolver
 from .materials import TITANIUM, Material
-from .meshing import load_mesh
 from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
-from .reduction import couple, reduce_for_decisions
 from .selection import MOUNTED_BOUNDARY, decide_modes
+
+# Meshing (gmsh, meshio), assembly (scikit-fem) and the reduction load where a casing is reduced: a run
+# whose casing is in the cache never needs them.
 
 __all__ = ["CasingModel", "ExudynCasing", "reduce_casing", "add_casing_to_exudyn", "FREE_FREE"]
 
@@ -98,6 +97,8 @@ class CasingModel:
 
     def meshed(self):
         """The casing mesh with its interfaces resolved."""
+        from .meshing import load_mesh
+
         if self.geometry is not None:
             casing_mesh = mesh_casing(self.geometry, self.element_size)
         else:
@@ -166,6 +167,10 @@ def reduce_casing(model: CasingModel, modes="auto", excitations_hz=(None,), *, c
             decisions, keys, casings = cached(frequencies)
             if all(c is not None for c in casings):
                 return answer(casings, decisions)
+        from .assembly import assemble
+        from .interior import InteriorSolver
+        from .reduction import couple, reduce_for_decisions
+
         start = time.perf_counter()
         casing_mesh = model.meshed()
         meshed = time.perf_counter()

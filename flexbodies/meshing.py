@@ -33,7 +33,8 @@ from skfem.io.meshio import HEX_MAPPING
 
 from .geometry import LinkGeometry, default_element_size
 
-__all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "default_element_size"]
+__all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "default_element_size", "gmsh_model",
+           "generate_tet10", "skfem_mesh"]
 
 logger = logging.getLogger(__name__)
 
@@ -271,10 +272,10 @@ def mesh_link(geometry: LinkGeometry, element_size: float | None = None) -> Link
     size = default_element_size(geometry) if element_size is None else float(element_size)
     if not (math.isfinite(size) and size > 0):
         raise ValueError(f"element size must be a positive length in m, got {element_size!r}")
-    with _gmsh_model("link"):
+    with gmsh_model("link"):
         _build_link_solid(geometry)
-        points, cells = _generate_tet10(size)
-    mesh, _ = _skfem_mesh("tetra10", points, cells)
+        points, cells = generate_tet10(size)
+    mesh, _ = skfem_mesh("tetra10", points, cells)
     g = geometry
     specs = (
         BoreSpec("A", centre=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), radius=g.bore_radius),
@@ -336,7 +337,7 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
     points = np.asarray(data.points, dtype=float)
     if points.shape[1] != 3:
         raise ValueError(f"{path}: expected 3-D points, got {points.shape[1]} coordinates per point")
-    mesh, fe_index = _skfem_mesh(cell_type, points * scale, cells)
+    mesh, fe_index = skfem_mesh(cell_type, points * scale, cells)
     node_sets = _NodeSets(data, fe_index, path)
     resolved = tuple(_resolve_bore(mesh, spec, str(path), node_sets) for spec in bores)
     link = LinkMesh(mesh=mesh, bores=resolved, source=str(path))
@@ -348,7 +349,7 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
 
 
 @contextlib.contextmanager
-def _gmsh_model(name: str):
+def gmsh_model(name: str):
     """A private gmsh model, single-threaded and silent; gmsh is cleaned up after.
 
     If gmsh was not initialised, it is initialised here and finalised on exit
@@ -413,7 +414,7 @@ def _build_link_solid(g: LinkGeometry) -> None:
     occ.synchronize()
 
 
-def _generate_tet10(size: float, curvature_points: int = 16) -> tuple[np.ndarray, np.ndarray]:
+def generate_tet10(size: float, curvature_points: int = 16) -> tuple[np.ndarray, np.ndarray]:
     """Generate quadratic tetrahedra in the current gmsh model.
 
     Parameters
@@ -465,7 +466,7 @@ def _volume_cells(data: meshio.Mesh, path: Path) -> tuple[str, np.ndarray]:
     return cell_type, cells
 
 
-def _skfem_mesh(cell_type: str, points: np.ndarray, cells: np.ndarray):
+def skfem_mesh(cell_type: str, points: np.ndarray, cells: np.ndarray):
     """Build a scikit-fem mesh from meshio-ordered cells.
 
     Unused points are dropped and the node order is checked.
