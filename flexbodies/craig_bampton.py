@@ -10,6 +10,7 @@ Static modes make the reduced statics exact for loads at the masters.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -54,11 +55,16 @@ class CraigBamptonBasis:
         return 0.5 * (reduced + reduced.T)
 
 
+#: Margin on the mode count a cut-off is estimated to need (:func:`fixed_interface_set`).
+_BATCH_MARGIN = 1.25
+
+
 def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: float | None = None):
     """Lowest fixed-interface modes, by count or up to (and one past) a cut-off.
 
     With a cut-off the modes are computed in growing batches until the
-    highest one reaches ``cutoff_hz``, so the kept set spans at least up to it.
+    highest one reaches ``cutoff_hz``, so the kept set spans at least up to it;
+    each batch after the first is sized from the modal density of the last.
 
     Parameters
     ----------
@@ -79,7 +85,9 @@ def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: f
             return freqs, vec
         if np.any(freqs >= cutoff_hz) or k_eff == n - 2:
             return freqs, vec
-        k *= 2
+        # the next batch from the modal density so far (mode count taken as growing with the square of
+        # the frequency, with a margin), at least twice this one: each batch is a Lanczos run of its own
+        k = max(2 * k, math.ceil(_BATCH_MARGIN * k * (cutoff_hz / max(freqs[-1], 1e-300)) ** 2))
 
 
 def kept_count(frequencies_hz, count: int | None = None, cutoff_hz: float | None = None) -> int:
