@@ -17,9 +17,10 @@ Measured, each the median of its repeats:
   relative difference of every frequency;
 - both rotors in the frequency domain (the case's own links) against the
   seed study's complete-MNF model (every link with 20 fixed-interface
-  modes, time domain + DFT), as the accuracy study times its rungs (links
-  from the cache), with the largest difference of T; on the reference with
-  the seed study's viscous hinge dampers (``hinge_damping="viscous"``);
+  modes, time domain + DFT) run as the seed study ran it, from rest, as the
+  accuracy study times its rungs (links from the cache), with the largest
+  difference of T; on the reference with the seed study's viscous hinge
+  dampers (``hinge_damping="viscous"``);
 - a 1000-point sweep (2 to 300 Hz) after the model is built: every point
   at once from one eigen-decomposition, and point by point.
 
@@ -98,12 +99,16 @@ def cold_reduction(case, repeats: int) -> dict:
 
 
 def frequency_against_seed(case, repeats: int, seed_repeats: int) -> dict:
-    """The accuracy study's frequency-domain rung and its complete-MNF rung: wall times and T."""
+    """The accuracy study's frequency-domain rung and its complete-MNF rung run as the seed study ran it
+    (from rest, its transient integrated away before the DFT): wall times and T."""
+    import dataclasses
+
     from workbook.studies.accuracy import FREQUENCY_RUNG, SEED_RUNG, ladder, run_rung
 
     rungs = {rung.label: rung for rung in ladder()}
     frequency = run_rung(case, rungs[FREQUENCY_RUNG], repeats)
-    seed = run_rung(case, rungs[SEED_RUNG], seed_repeats)
+    from_rest = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, start="rest"))
+    seed = run_rung(from_rest, rungs[SEED_RUNG], seed_repeats)
     difference = max(float(np.abs(np.asarray(t) / seed.transmissibility[name] - 1).max())
                      for name, t in frequency.transmissibility.items())
     return {"frequency": frequency.wall_time, "seed": seed.wall_time, "difference": difference,
@@ -170,7 +175,8 @@ def main(argv=None):
         ("  now in one process; its speed-up", f"{reduction['alone']:.1f} s; "
          f"{reduction['before'] / reduction['alone']:.2f}x", r, "", None),
         (f"both rotors, frequency domain ({seed['frequency DOF']} DOF)", f"{seed['frequency']:.2f} s", r, "", None),
-        (f"both rotors, complete-MNF time domain ({seed['seed DOF']} DOF)", f"{seed['seed']:.1f} s", s, "", None),
+        (f"both rotors, complete-MNF time domain from rest, as the seed study ({seed['seed DOF']} DOF)",
+         f"{seed['seed']:.1f} s", s, "", None),
         ("  speed-up; largest difference of T", f"{seed['seed'] / seed['frequency']:.0f}x; "
          f"{100 * seed['difference']:.2f} %", "", ">= 100x; <= 1 %",
          seed["seed"] / seed["frequency"] >= 100 and seed["difference"] <= 0.01),

@@ -20,6 +20,7 @@ links are reduced in the calling process only.
 from __future__ import annotations
 
 import logging
+import math
 import multiprocessing
 import os
 import signal
@@ -28,6 +29,7 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 from flexbodies.cache import LinkCache
+from flexbodies.geometry import default_element_size
 from flexbodies.link import LinkModel, is_reduced, reduce_link_set
 from workbook.processes import end_with_parent, stop_workers
 
@@ -61,6 +63,16 @@ class LinkJob:
     def reduce(self) -> tuple:
         """Reduce (or load) the link in this process: one ``ReducedLink`` per excitation frequency."""
         return reduce_link_set(self.model, self.modes, self.excitations_hz, stiffening=self.stiffening)
+
+    def expected_work(self) -> float:
+        """A rough measure of the job's cost, to start the largest first: the parametric link's
+        volume in elements of its mesh size (a mesh file's jobs count as the largest)."""
+        geometry = self.model.geometry
+        if geometry is None:
+            return math.inf
+        size = self.model.element_size or default_element_size(geometry)
+        eyes = 2 * math.pi * geometry.eye_outer_radius ** 2 * geometry.thickness
+        return (geometry.length * geometry.shank_width * geometry.shank_thickness + eyes) / size ** 3
 
     def cached(self) -> bool:
         """True when the cache already holds everything this job would compute."""
@@ -130,7 +142,8 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
     if (limit < 2 or "fork" not in multiprocessing.get_all_start_methods() or multiprocessing.current_process().daemon
             or not LinkCache().writable()):
         return 0
-    pending = [job for job in jobs if not job.cached()]
+    # the largest first: a long job started last would decide when the workers are done
+    pending = sorted((job for job in jobs if not job.cached()), key=LinkJob.expected_work, reverse=True)
     if len(pending) < 2:
         return 0
     context = multiprocessing.get_context("fork")
