@@ -28,6 +28,7 @@ from flexbodies.casing import CasingGeometry, CasingInterface, MountRing, defaul
 from flexbodies.casing_reduction import CasingModel
 from flexbodies.materials import TITANIUM, Material
 from workbook.errors import CaseError
+from workbook.model.fields import positive_number
 
 __all__ = ["EngineCasing", "CoreBody", "split_engine", "CASING", "MountRing", "CasingGeometry",
            "DEFAULT_BEARING_STIFFNESS", "parallel_axis", "casing_origin", "bearing_name",
@@ -48,16 +49,6 @@ DEFAULT_CORE_SPIN_HZ = 2000.0
 #: casing dissipates about 1-2 % of critical; 0.02 is its upper end.
 DEFAULT_CASING_DAMPING = 0.02
 _ITEM = "engine casing"
-
-
-def _positive(name: str, value) -> float:
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if isinstance(value, bool) or not (math.isfinite(number) and number > 0):
-        raise CaseError(_ITEM, name, value, "a finite number > 0")
-    return number
 
 
 def _pair(name: str, value, *, strictly: bool) -> tuple[float, float]:
@@ -136,12 +127,12 @@ class EngineCasing:
         else:
             if not Path(str(self.mesh)).is_file():
                 raise CaseError(_ITEM, "mesh", self.mesh, "an existing mesh file (meshio: .msh, .inp, .vtu, ...)")
-            object.__setattr__(self, "scale", _positive("scale", self.scale))
+            object.__setattr__(self, "scale", positive_number(_ITEM, "scale", self.scale))
         if not isinstance(self.material, Material):
             raise CaseError(_ITEM, "material", self.material, "a flexbodies Material")
         for name in ("spider_radius", "core_spin_hz") + (("element_size",) if self.element_size is not None else ()) \
                 + (("bearing_band",) if self.bearing_band is not None else ()):
-            object.__setattr__(self, name, _positive(name, getattr(self, name)))
+            object.__setattr__(self, name, positive_number(_ITEM, name, getattr(self, name)))
         object.__setattr__(self, "bearing_stiffness", _pair("bearing_stiffness", self.bearing_stiffness, strictly=True))
         object.__setattr__(self, "bearing_damping", _pair("bearing_damping", self.bearing_damping, strictly=False))
         zeta = self.modal_damping

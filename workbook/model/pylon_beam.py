@@ -16,8 +16,9 @@ import numpy as np
 
 from flexbodies.materials import Material
 from workbook.errors import CaseError
+from workbook.model.fields import finite_point, positive_number
 
-__all__ = ["BoxBeamPylon", "SectionProperties", "finite_point", "positive_number"]
+__all__ = ["BoxBeamPylon", "SectionProperties"]
 
 
 @dataclass(frozen=True)
@@ -39,28 +40,6 @@ class SectionProperties:
     second_moment_2: float
     second_moment_3: float
     torsion_constant: float
-
-
-def positive_number(item: str, name: str, value) -> float:
-    """*value* as a finite float > 0, or a CaseError naming *item* and *name*."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = math.nan
-    if isinstance(value, bool) or not (math.isfinite(number) and number > 0):
-        raise CaseError(item, name, value, "a finite number > 0")
-    return number
-
-
-def finite_point(item: str, name: str, value) -> tuple:
-    """*value* as three finite floats (x, y, z), or a CaseError naming *item* and *name*."""
-    try:
-        point = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        point = ()
-    if len(point) != 3 or not all(math.isfinite(v) for v in point):
-        raise CaseError(item, name, value, "three finite numbers (x, y, z), m")
-    return point
 
 
 @dataclass(frozen=True)

@@ -18,7 +18,7 @@ import numpy as np
 
 from flexbodies.materials import Material
 from workbook.errors import CaseError
-from workbook.model.pylon_beam import finite_point, positive_number
+from workbook.model.fields import finite_point, positive_number
 
 __all__ = ["MeshPylon"]
 
