@@ -18,15 +18,15 @@ from workbook.model.reference import LP_ROTOR, reference_case
 from workbook.studies.parallel import RowOutcome
 from workbook.studies.sensitivity import StudyTable, read_finished, table_path
 
-#: Six rows of a few seconds each (rigid links, LP rotor, time domain).
+#: Six rows of a few seconds each (rigid links, LP rotor, time domain from rest).
 STIFFNESS = "1e7:3.5e7:6"
 #: CPU time after which a worker is surely running its row, s (its start-up took about 0.3 s).
 WORKING_CPU_S = 1.5
 
 
 def _time_domain(case):
-    """*case* answered in the time domain (rows that take seconds, so a signal finds them running)."""
-    return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method="time"))
+    """*case* answered in the time domain from rest (rows that take seconds, so a signal finds them running)."""
+    return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method="time", start="rest"))
 
 
 @pytest.fixture()
@@ -115,7 +115,8 @@ def _busy(pid: int, exclude=()) -> list[psutil.Process]:
 @pytest.mark.slow
 def test_a_killed_worker_is_retried_and_a_twice_killed_row_is_marked_failed(tmp_path):
     case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
-    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method="time", steps_per_period=400))
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method="time", steps_per_period=400,
+                                                                  start="rest"))
     case_file = tmp_path / "long.json"
     case_file.write_text(to_json(case))
     output = tmp_path / "out"
