@@ -25,6 +25,7 @@ def _three_distinct_jobs():
     return case, jobs
 
 
+@pytest.mark.slow
 def test_workers_fill_the_cache_with_the_links_a_serial_reduction_gives(fresh_cache):
     _, jobs = _three_distinct_jobs()
     finished = []

@@ -80,6 +80,7 @@ def test_a_clamped_bar_has_the_cantilevers_static_compliance_at_its_pin(tmp_path
     assert facts["reduced_dof"] == 6 + facts["modes"]
 
 
+@pytest.mark.slow
 def test_the_reduced_compliance_is_the_full_fe_compliance_below_the_cutoff(tmp_path):
     """Craig-Bampton with modes up to 4 x the highest frequency against a reduction keeping far more."""
     pylon = _bar(tmp_path, size=0.02)
