@@ -119,6 +119,14 @@ def _num(key, header, si_unit=DIMENSIONLESS, *, unit=None, required=False, help=
     return Column(key, header, "number", si_unit, unit, required, help=help)
 
 
+def _material_columns(preset_help: str) -> tuple:
+    """The material columns of a sheet: a preset, and E, nu and density overriding it."""
+    return (Column("material", "material", "choice", choices=("steel", "titanium"), help=preset_help),
+            _num("youngs_modulus", "E", "Pa", unit="GPa", help="Young's modulus overriding the preset"),
+            _num("poisson_ratio", "nu", help="Poisson's ratio overriding the preset"),
+            _num("density", "density", "kg/m^3", help="density overriding the preset"))
+
+
 @dataclass(frozen=True)
 class Table:
     """An input sheet.
@@ -210,10 +218,7 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     *_xyz("end_a", "end A", "m", required=True, help="centre of eye A"),
     *_xyz("end_b", "end B", "m", required=True, help="centre of eye B"),
     _num("length", "length", "m", help="eye distance; empty: from the ends, given: checked against them"),
-    Column("material", "material", "choice", choices=("steel", "titanium"), help="preset material"),
-    _num("youngs_modulus", "E", "Pa", unit="GPa", help="Young's modulus overriding the preset"),
-    _num("poisson_ratio", "nu", help="Poisson's ratio overriding the preset"),
-    _num("density", "density", "kg/m^3", help="density overriding the preset"),
+    *_material_columns("preset material"),
     _num("eye_outer_radius", "eye outer radius", "m", unit="mm", help="parametric link: eye outer radius"),
     _num("bore_radius", "bore radius", "m", unit="mm", help="bore radius (parametric link or mesh bores)"),
     _num("thickness", "eye thickness", "m", unit="mm", help="parametric link: eye thickness"),
@@ -327,10 +332,7 @@ CASING = Table("Engine casing", single_row=True, optional=True,
              help="mount ring: outer radius"))),
     *(_num(key, f"bearing {k} x", "m", required=k <= 2, help="a bearing plane (the rotors' seat)")
       for k, key in enumerate(CASING_BEARINGS, start=1)),
-    Column("material", "material", "choice", choices=("steel", "titanium"), help="preset material (empty: titanium)"),
-    _num("youngs_modulus", "E", "Pa", unit="GPa", help="Young's modulus overriding the preset"),
-    _num("poisson_ratio", "nu", help="Poisson's ratio overriding the preset"),
-    _num("density", "density", "kg/m^3", help="density overriding the preset"),
+    *_material_columns("preset material (empty: titanium)"),
     _num("element_size", "element size", "m", unit="mm", help="mesh size (empty: default)"),
     _num("spider_radius", "spider radius", "m", unit="mm", help="casing surface tied to each mount eye (empty: 80 mm)"),
     _num("bearing_band", "bearing band", "m", unit="mm", help="casing surface tied to each bearing plane"),
