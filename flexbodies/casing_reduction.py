@@ -17,19 +17,19 @@ under that hash and the mode decision.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from .cache import LinkCache
+from .cached_reduction import cached_reductions
 from .casing import CasingGeometry, casing_interfaces, default_casing_element_size, mesh_casing
 from .exudyn_body import exudyn_cms_interface, modal_damping_matrix
 from .materials import TITANIUM, Material
-from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
+from .reduced import SCHEMA_VERSION, ReducedLink
 from .selection import MOUNTED_BOUNDARY, decide_modes
 
 # Meshing (gmsh, meshio), assembly (scikit-fem) and the reduction load where a casing is reduced: a run
@@ -106,11 +106,6 @@ class CasingModel:
         return casing_interfaces(casing_mesh, self.interfaces, self.source())
 
 
-def _hash(record: dict) -> str:
-    text = json.dumps(record, sort_keys=True, default=lambda v: np.asarray(v).tolist())
-    return hashlib.sha256(text.encode()).hexdigest()[:24]
-
-
 def _decide(modes, frequencies: dict, excitation_hz: float):
     """The mode decision on the casing's free-free fundamental (the reason says so)."""
     decision = decide_modes(modes, frequencies["free_free_hz"][0], excitation_hz)
@@ -141,35 +136,10 @@ def reduce_casing(model: CasingModel, modes="auto", excitations_hz=(None,), *, c
         lowest elastic free-free frequencies of the FE model
         (``"mounted_hz"`` is empty); ``info`` the timings, s.
     """
-    excitations_hz = list(excitations_hz)
-    cache = LinkCache(cache_dir, enabled=use_cache)
-    fingerprint = model.fingerprint()
-    fe_hash = _hash(fingerprint)
-
-    def cached(frequencies):
-        decisions = [_decide(modes, frequencies, f) for f in excitations_hz]
-        keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
-        return decisions, keys, [cache.load_link(key) for key in keys]
-
-    def answer(casings, decisions, made=None):
-        made = made or {}
-        return tuple(with_decision(c, d, cache_hit=True) if c is not None else with_decision(made[d.key], d, False)
-                     for c, d in zip(casings, decisions))
-
-    frequencies = cache.read_summary(fe_hash)
-    if frequencies is not None:
-        decisions, keys, casings = cached(frequencies)
-        if all(c is not None for c in casings):
-            return answer(casings, decisions)
-    with cache.lock(fe_hash):
-        frequencies = cache.read_summary(fe_hash)
-        if frequencies is not None:
-            decisions, keys, casings = cached(frequencies)
-            if all(c is not None for c in casings):
-                return answer(casings, decisions)
+    def prepare(frequencies):
         from .assembly import assemble
         from .interior import InteriorSolver
-        from .reduction import couple, reduce_for_decisions
+        from .reduction import couple
 
         start = time.perf_counter()
         casing_mesh = model.meshed()
@@ -185,15 +155,10 @@ def reduce_casing(model: CasingModel, modes="auto", excitations_hz=(None,), *, c
             # the store's summary holds the mounted frequencies of a link too: a casing has none
             frequencies = {"free_free_hz": solver.free_free_frequencies(6), "mounted_hz": np.zeros(0)}
             timings["frequency_seconds"] = time.perf_counter() - start
-            cache.write_summary(fe_hash, frequencies)
-            decisions, keys, casings = cached(frequencies)
-        missing = {d.key: (key, d) for key, d, c in zip(keys, decisions, casings) if c is None}
-        infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
-                 for key, _ in missing.values()]
-        made = reduce_for_decisions(coupled, solver, [d for _, d in missing.values()], frequencies, infos)
-        for (key, _), casing in zip(missing.values(), made):
-            cache.save_link(key, casing)
-        return answer(casings, decisions, dict(zip(missing, made)))
+        return coupled, solver, frequencies, timings
+
+    return cached_reductions(model.fingerprint(), functools.partial(_decide, modes), excitations_hz, prepare, cache_dir=cache_dir,
+                             use_cache=use_cache)
 
 
 @dataclass(frozen=True)

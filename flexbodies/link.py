@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import json
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -28,10 +27,11 @@ from pathlib import Path
 import numpy as np
 
 from .cache import LinkCache, default_cache_dir
+from .cached_reduction import cached_reductions, record_hash, stored_reductions
 from .geometric_stiffness import has_stiffening
 from .geometry import LinkGeometry, default_element_size
 from .materials import STEEL, Material
-from .reduced import SCHEMA_VERSION, ReducedLink, package_version, with_decision
+from .reduced import SCHEMA_VERSION, ReducedLink
 from .selection import decide_modes
 
 # The modules that mesh (gmsh, meshio), assemble (scikit-fem) and reduce a link are imported where a
@@ -116,7 +116,7 @@ class LinkModel:
 
     def key(self) -> str:
         """Hash of :meth:`fingerprint`: the key of the link's cache entries and of its lock."""
-        return _hash(self.fingerprint())
+        return record_hash(self.fingerprint())
 
     def meshed(self):
         """The link's mesh (a :class:`flexbodies.meshing.LinkMesh`): the parametric geometry meshed,
@@ -126,12 +126,6 @@ class LinkModel:
         if self.geometry is not None:
             return mesh_link(self.geometry, self.element_size)
         return load_mesh(self.mesh.path, self.mesh.bores, scale=self.mesh.scale)
-
-
-def _hash(record: dict) -> str:
-    """Short SHA-256 of a JSON-able record (the key of a cache entry)."""
-    text = json.dumps(record, sort_keys=True, default=lambda v: np.asarray(v).tolist())
-    return hashlib.sha256(text.encode()).hexdigest()[:24]
 
 
 def _in_link_frame(fe):
@@ -213,14 +207,9 @@ def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = No
     return link
 
 
-def _cached(cache: LinkCache, fe_hash: str, modes, excitations_hz) -> tuple:
-    """The stored frequencies, the decisions, their keys and the stored links (None where missing)."""
-    frequencies = cache.read_summary(fe_hash)
-    if frequencies is None:
-        return None, None, None, None
-    decisions = [decide_modes(modes, frequencies["mounted_hz"][0], f) for f in excitations_hz]
-    keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
-    return frequencies, decisions, keys, [cache.load_link(key) for key in keys]
+def _decider(modes):
+    """The mode decision of a link for one excitation, judged on its first mounted frequency."""
+    return lambda frequencies, excitation_hz: decide_modes(modes, frequencies["mounted_hz"][0], excitation_hz)
 
 
 def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
@@ -238,7 +227,7 @@ def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_
     bool
     """
     cache = LinkCache(cache_dir)
-    _, _, _, links = _cached(cache, _hash(model.fingerprint()), modes, list(excitations_hz))
+    _, _, _, links = stored_reductions(cache, record_hash(model.fingerprint()), _decider(modes), list(excitations_hz))
     if links is None or any(link is None for link in links):
         return False
     return not stiffening or has_stiffening(model, cache_dir=cache_dir)
@@ -270,21 +259,10 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
     tuple of ReducedLink
         One per excitation, in order, each carrying its own decision.
     """
-    excitations_hz = list(excitations_hz)
-    cache = LinkCache(cache_dir, enabled=use_cache)
-    fingerprint = model.fingerprint()
-    fe_hash = _hash(fingerprint)  # model.key(), without reading a mesh file twice
-    frequencies, decisions, keys, links = _cached(cache, fe_hash, modes, excitations_hz)
-    if links is not None and all(link is not None for link in links):
-        return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
-    with cache.lock(fe_hash):
-        # another process may have computed the entries while this one waited
-        frequencies, decisions, keys, links = _cached(cache, fe_hash, modes, excitations_hz)
-        if links is not None and all(link is not None for link in links):
-            return tuple(with_decision(link, d, cache_hit=True) for link, d in zip(links, decisions))
+    def prepare(frequencies):
         from .geometric_stiffness import coupled_stiffening, save_stiffening
         from .interior import InteriorSolver
-        from .reduction import couple, reduce_for_decisions
+        from .reduction import couple
 
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
         coupled = couple(fe, model.interface)
@@ -300,15 +278,7 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
             start = time.perf_counter()
             frequencies = solver.reference_frequencies()
             timings["frequency_seconds"] = time.perf_counter() - start
-            cache.write_summary(fe_hash, frequencies)
-            decisions = [decide_modes(modes, frequencies["mounted_hz"][0], f) for f in excitations_hz]
-            keys = [_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
-            links = [None] * len(decisions)
-        missing = {key: decision for key, decision, link in zip(keys, decisions, links) if link is None}
-        infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
-                 for key in missing]
-        made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos)))
-        for key, link in made.items():
-            cache.save_link(key, link)
-        return tuple(with_decision(link, d, cache_hit=True) if link is not None else with_decision(made[key], d, False)
-                     for link, d, key in zip(links, decisions, keys))
+        return coupled, solver, frequencies, timings
+
+    return cached_reductions(model.fingerprint(), _decider(modes), excitations_hz, prepare, cache_dir=cache_dir,
+                             use_cache=use_cache)

@@ -45,21 +45,23 @@ def test_four_pole_doc_is_current(cache_dir):
     assert not failures, "\n\n".join(failures)
 
 
+def _untimed_failures(name: str) -> list[str]:
+    """Differences of every section of docs script *name* but its measured wall times (``TIMED``)."""
+    script = importlib.import_module(name)
+    generated = {section_name: content for section_name, content in script.sections().items()
+                 if section_name != script.TIMED}
+    return _differences(script.DOCUMENT, f"{name}.py", generated)
+
+
 @pytest.mark.slow
 def test_stress_stiffening_doc_is_current(cache_dir):
-    """Every section but the measured wall times."""
-    script = importlib.import_module("make_stiffening_docs")
-    generated = {name: content for name, content in script.sections().items() if name != script.TIMED}
-    failures = _differences(script.DOCUMENT, "make_stiffening_docs.py", generated)
+    failures = _untimed_failures("make_stiffening_docs")
     assert not failures, "\n\n".join(failures)
 
 
 @pytest.mark.slow
 def test_flexible_engine_doc_is_current(cache_dir):
-    """Every section but the measured wall times."""
-    script = importlib.import_module("make_flexible_engine_docs")
-    generated = {name: content for name, content in script.sections().items() if name != script.TIMED}
-    failures = _differences(script.DOCUMENT, "make_flexible_engine_docs.py", generated)
+    failures = _untimed_failures("make_flexible_engine_docs")
     assert not failures, "\n\n".join(failures)
 
 

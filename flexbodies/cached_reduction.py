@@ -1,0 +1,120 @@
+"""A body's Craig-Bampton reductions for several excitations, from the cache or made once.
+
+Links (:mod:`flexbodies.link`) and the engine casing
+(:mod:`flexbodies.casing_reduction`) share this path:
+
+1. the body's inputs (its fingerprint) hash to the key of its FE summary,
+   the reference frequencies its mode decisions are judged on;
+2. each excitation's decision keys one stored reduction;
+3. what is missing is made under the body's cache lock (another process may
+   have made it while this one waited, so the cache is read again there),
+   from one FE model and one factorisation of its interior for every
+   missing decision (:func:`flexbodies.reduction.reduce_for_decisions`).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+from typing import Callable
+
+import numpy as np
+
+from .cache import LinkCache
+from .reduced import package_version, with_decision
+
+__all__ = ["record_hash", "stored_reductions", "cached_reductions"]
+
+
+def record_hash(record: dict) -> str:
+    """Short SHA-256 of a JSON-able record (the key of a cache entry)."""
+    text = json.dumps(record, sort_keys=True, default=lambda v: np.asarray(v).tolist())
+    return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def stored_reductions(cache: LinkCache, fe_hash: str, decide: Callable, excitations_hz) -> tuple:
+    """The stored frequencies, the decisions, their keys and the stored reductions (None where missing).
+
+    Parameters
+    ----------
+    cache : LinkCache
+    fe_hash : str
+        :func:`record_hash` of the body's fingerprint.
+    decide : callable
+        ``decide(frequencies, excitation_hz)`` gives the ModeDecision of one excitation.
+    excitations_hz : sequence of float or None
+
+    Returns
+    -------
+    tuple
+        ``(None, None, None, None)`` when the cache has no FE summary.
+    """
+    frequencies = cache.read_summary(fe_hash)
+    if frequencies is None:
+        return None, None, None, None
+    decisions = [decide(frequencies, f) for f in excitations_hz]
+    keys = [record_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+    return frequencies, decisions, keys, [cache.load_link(key) for key in keys]
+
+
+def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepare: Callable, *, cache_dir=None,
+                      use_cache: bool = True) -> tuple:
+    """One reduction per excitation, loaded or made from one FE model.
+
+    Parameters
+    ----------
+    fingerprint : dict
+        Every input of the body, JSON-able.
+    decide : callable
+        ``decide(frequencies, excitation_hz)`` gives the ModeDecision of one excitation.
+    excitations_hz : sequence of float or None
+    prepare : callable
+        ``prepare(frequencies)`` meshes, assembles and couples the body and
+        factorises its interior: it returns ``(coupled, solver, frequencies,
+        timings)``, computing the reference frequencies (Hz) when given None
+        and returning those given otherwise; ``timings`` holds its stages, s.
+    cache_dir : str or Path, optional
+    use_cache : bool
+        False recomputes and does not read or write the cache.
+
+    Returns
+    -------
+    tuple of ReducedLink
+        One per excitation, in order, each carrying its own decision;
+        ``cache_hit`` tells whether it was loaded.
+    """
+    from .reduction import reduce_for_decisions
+
+    excitations_hz = list(excitations_hz)
+    cache = LinkCache(cache_dir, enabled=use_cache)
+    fe_hash = record_hash(fingerprint)
+
+    def complete(stored):
+        links = stored[3]
+        return links is not None and all(link is not None for link in links)
+
+    def answer(decisions, keys, links, made):
+        return tuple(with_decision(link, d, cache_hit=True) if link is not None else with_decision(made[key], d, False)
+                     for link, d, key in zip(links, decisions, keys))
+
+    frequencies, decisions, keys, links = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
+    if complete(stored):
+        return answer(decisions, keys, links, {})
+    with cache.lock(fe_hash):
+        # another process may have made the entries while this one waited
+        frequencies, decisions, keys, links = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
+        if complete(stored):
+            return answer(decisions, keys, links, {})
+        known = frequencies is not None
+        coupled, solver, frequencies, timings = prepare(frequencies)
+        if not known:
+            cache.write_summary(fe_hash, frequencies)
+            decisions = [decide(frequencies, f) for f in excitations_hz]
+            keys = [record_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+            links = [None] * len(decisions)
+        missing = {key: decision for key, decision, link in zip(keys, decisions, links) if link is None}
+        infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
+                 for key in missing]
+        made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos)))
+        for key, link in made.items():
+            cache.save_link(key, link)
+        return answer(decisions, keys, links, made)
