@@ -19,11 +19,23 @@ def _interruptible() -> None:
     signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 
-def start(*args: str, cwd=None, env: dict | None = None) -> subprocess.Popen:
-    """``mountwb -v ARGS`` with this tree on the path; stderr is read line by line."""
+def _interruptible_group() -> None:
+    """As :func:`_interruptible`, and the child leads a process group of its own (as a job a shell,
+    ``timeout`` or a scheduler starts), so that a signal can go to it and every worker at once."""
+    _interruptible()
+    os.setpgid(0, 0)
+
+
+def start(*args: str, cwd=None, env: dict | None = None, group: bool = False) -> subprocess.Popen:
+    """``mountwb -v ARGS`` with this tree on the path; stderr is read line by line.
+
+    With *group*, the process leads a process group of its own: ``os.killpg(process.pid, signum)``
+    signals it and its workers together.
+    """
     environment = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1", **(env or {})}
     return subprocess.Popen([sys.executable, "-m", "workbook.cli.main", "-v", *args], cwd=cwd, env=environment,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, preexec_fn=_interruptible)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_interruptible_group if group else _interruptible)
 
 
 def signal_at(process: subprocess.Popen, marker: str, signum: int = signal.SIGINT, timeout: float = 300):

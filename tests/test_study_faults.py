@@ -4,13 +4,18 @@ worker outlives the study, and --resume runs only the missing rows."""
 from __future__ import annotations
 
 import dataclasses
+import json
+import os
 import signal
+import subprocess
+import sys
+import textwrap
 import time
 
 import pandas as pd
 import psutil
 import pytest
-from cli_signals import SIGNAL_EXIT, alive, descendants, files_in, start
+from cli_signals import ROOT, SIGNAL_EXIT, alive, descendants, files_in, start
 
 from workbook.errors import EXIT_FAILED_ROWS, UsageError
 from workbook.model.codec import to_json
@@ -37,9 +42,9 @@ def case_file(tmp_path):
     return path
 
 
-def _study(case_file, output, *extra):
+def _study(case_file, output, *extra, group=False):
     return start("study", "params", str(case_file), "--output", str(output), f"--vary=hinge_stiffness={STIFFNESS}",
-                 *extra, cwd=case_file.parent)
+                 *extra, cwd=case_file.parent, group=group)
 
 
 def _table(output) -> pd.DataFrame:
@@ -98,6 +103,60 @@ def test_an_interrupted_study_stops_its_workers_keeps_its_rows_and_resumes(case_
     assert list(final["row"]) == list(range(6)) and set(final["status"]) == {"ok"}
     # the kept rows were not run again: every value, their wall times too, as written before the interrupt
     pd.testing.assert_frame_equal(final.set_index("row").loc[table["row"]], table.set_index("row"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_to_the_whole_process_group_ends_the_study_within_seconds(case_file, tmp_path, signum):
+    """As ``timeout``, a job scheduler or Ctrl-C at a terminal do: the signal reaches the workers too."""
+    output = tmp_path / "out"
+    process = _study(case_file, output, "--workers", "2", group=True)
+    _wait(lambda: len(_table(output)) >= 1, what="a finished row")
+    family = descendants(process.pid)
+    sent = time.monotonic()
+    os.killpg(process.pid, signum)
+    _, stderr = process.communicate(timeout=60)
+    assert time.monotonic() - sent < 15, "the study took more than 15 s to end after the signal"
+    assert process.returncode == SIGNAL_EXIT[signum]
+    assert "Traceback" not in stderr
+    _wait(lambda: not alive(family), timeout=10, what=f"the study's processes {alive(family)} to end")
+    kept = len(_table(output))
+    assert 1 <= kept < 6
+    assert f"{kept} of 6 rows finished and kept in" in stderr.strip().splitlines()[-1]
+
+
+#: A study of more rows than ``workers * rows_per_worker``: three chunks, each in a fresh pool.
+_CHUNKED_STUDY = textwrap.dedent("""
+    import dataclasses, json, sys
+    from workbook.model.reference import LP_ROTOR, reference_case
+    from workbook.studies.parallel import run_rows
+    from workbook.studies.parametric import grid, linear_range, study_cases
+
+    if __name__ == "__main__":
+        case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+        cases = study_cases(case, grid({"hinge_stiffness": linear_range(1e7, 3e7, 9)}))
+        workers = int(sys.argv[1])
+        outcomes = run_rows(cases, workers=workers, rows_per_worker=2)
+        print(json.dumps([[o.status, o.runs[0]["T z"] if o.runs else None] for o in outcomes]))
+""")
+
+
+@pytest.mark.slow
+def test_a_study_of_more_rows_than_its_workers_chunk_finishes(tmp_path):
+    """Nine rows on two workers of two rows each: the chunks run in fresh pools and give the serial answers."""
+    script = tmp_path / "chunked.py"
+    script.write_text(_CHUNKED_STUDY)
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    answers = {}
+    for workers in ("2", "1"):
+        done = subprocess.run([sys.executable, str(script), workers], env=environment, capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+        answers[workers] = json.loads(done.stdout.strip().splitlines()[-1])
+    assert [status for status, _ in answers["2"]] == ["ok"] * 9
+    assert answers["2"] == answers["1"]
+    t_z = [t for _, t in answers["1"]]
+    assert len(set(t_z)) == 9        # every row ran with its own stiffness
 
 
 def _busy(pid: int, exclude=()) -> list[psutil.Process]:

@@ -7,9 +7,11 @@ the rows are every combination. With ``--lhs N`` every ``--vary`` gives
 bounds ``low:high`` and the rows are N samples of a Latin hypercube. Runs go
 to local processes (``--workers``, default: every core) or to the Dask
 scheduler at ``--dask ADDRESS``; the table (CSV or Parquet, and a sheet) and
-the sensitivity plot go to ``--output``.
+the sensitivity plot go to ``--output``. A progress line on stderr every
+:data:`workbook.studies.progress.PROGRESS_INTERVAL` s gives the rows done,
+rows per second and the time left.
 
-The table file is rewritten as each row finishes, so an interrupted study
+The table file is kept up to date as rows finish, so an interrupted study
 keeps every finished row; ``--resume`` runs only the rows the table does not
 hold. A study whose rows all ran but some failed exits with
 :data:`workbook.errors.EXIT_FAILED_ROWS` after a summary line.
@@ -101,10 +103,10 @@ def run_parameter_study(args) -> int:
     import matplotlib
 
     matplotlib.use("Agg")
-    from tqdm import tqdm
 
     from workbook.studies.parallel import run_rows
     from workbook.studies.parametric import study_cases
+    from workbook.studies.progress import StudyProgress
     from workbook.studies.sensitivity import StudyTable, read_finished, table_path, write_study
 
     rows = parse_vary(args.vary, args.lhs, args.seed)
@@ -116,11 +118,13 @@ def run_parameter_study(args) -> int:
     kept = f" ({len(finished)} already in {path})" if args.resume else ""
     print(f"{case.name}: {len(rows)} study rows{kept} on {where}", file=sys.stderr)
     try:
-        with tqdm(total=len(rows), desc="study rows", file=sys.stderr, disable=None) as bar:
+        with StudyProgress(len(rows), len(finished), stream=sys.stderr) as progress:
             outcomes = run_rows(study_cases(case, rows), workers=args.workers, dask=args.dask, finished=finished,
-                                record=table.add, progress=lambda done, total: bar.update(done - bar.n))
+                                record=table.add, progress=progress.update)
+            table.flush()
     except KeyboardInterrupt as interrupt:
-        raise type(interrupt)(f"{len(table.outcomes)} of {len(rows)} rows finished and kept in {path}; "
+        table.flush()
+        raise type(interrupt)(f"{table.kept} of {len(rows)} rows finished and kept in {path}; "
                               f"--resume runs the rest") from None
     frame = table.frame()
     print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}"))

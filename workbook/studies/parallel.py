@@ -9,6 +9,12 @@ it never raises for a row's own trouble: a failing row comes back with its
 error while the others complete. Results are the same whichever way they
 ran (BLAS is single-threaded inside every run).
 
+Local processes run the rows in chunks of ``workers * rows_per_worker``
+rows, each chunk in a fresh pool that is shut down before the next starts:
+that bounds the memory a worker process can gather. (The process pool's own
+worker replacement, ``max_tasks_per_child``, deadlocks on the Python
+versions supported once the first worker retires, so it is not used.)
+
 Faults (local processes):
 
 - A worker process that dies (killed, out of memory) takes its pool down.
@@ -25,6 +31,7 @@ written as rows finish), so an interrupt loses only the rows in flight.
 """
 from __future__ import annotations
 
+import itertools
 import logging
 import multiprocessing
 import os
@@ -47,13 +54,13 @@ log = logging.getLogger(__name__)
 
 #: ``workers`` value that runs every row in this process.
 SERIAL = 1
-#: Rows a worker process runs before a fresh process replaces it: a bound on
-#: memory a run might still leave behind. Measured with
+#: Rows per worker process in one chunk of rows; each chunk runs in a fresh
+#: pool, which bounds the memory a run might still leave behind. Measured with
 #: ``benchmarks/bench_memory.py`` (worker mode, reference mount): a worker's
 #: resident memory did not grow over 30 rows (125.3 MB after 5 rows, 120.8 MB
 #: after 30) now that scenes free Exudyn's system; before, a run of the
 #: reference mount left about 33 MB behind. Even at the 1 MB per run the
-#: memory tests allow, 200 rows keep a worker within 200 MB of its start.
+#: memory tests allow, a chunk keeps a worker within about 200 MB of its start.
 ROWS_PER_WORKER = 200
 
 
@@ -171,7 +178,8 @@ def run_row(index: int, case: Case) -> RowOutcome:
 def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: str | None = None,
              progress: Callable[[int, int], None] | None = None,
              finished: dict[int, RowOutcome] | None = None,
-             record: Callable[[RowOutcome], None] | None = None) -> list[RowOutcome]:
+             record: Callable[[RowOutcome], None] | None = None,
+             rows_per_worker: int = ROWS_PER_WORKER) -> list[RowOutcome]:
     """Run the rows' cases and return their outcomes in row order.
 
     Parameters
@@ -188,6 +196,8 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         Rows already done (a resumed study): not run again, returned as they are.
     record : callable, optional
         ``record(outcome)`` as soon as each row finishes, in finishing order.
+    rows_per_worker : int
+        Local processes: rows per worker in one chunk of rows (a fresh pool each chunk).
 
     Returns
     -------
@@ -222,7 +232,7 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         for index, case in pending.items():
             done(run_row(index, case))
     else:
-        _run_processes(pending, workers, done)
+        _run_processes(pending, workers, done, rows_per_worker)
     return [outcomes[i] for i in range(total)]
 
 
@@ -271,7 +281,7 @@ def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[d
     started = context.SimpleQueue()
     before = set(multiprocessing.active_children())
     pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
-                               max_tasks_per_child=ROWS_PER_WORKER, initializer=_worker_init, initargs=(started,))
+                               initializer=_worker_init, initargs=(started,))
     processes = set()
     broken = {}
     try:
@@ -299,11 +309,16 @@ def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[d
     return lost, {i: case for i, case in broken.items() if i not in pids}, deaths
 
 
-def _run_processes(pending: dict, workers: int, done: Callable) -> None:
+def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker: int) -> None:
+    if rows_per_worker < 1:
+        raise ValueError(f"rows_per_worker must be at least 1, got {rows_per_worker}")
     context = multiprocessing.get_context("spawn")
     suspects = {}
     while pending:
-        lost, pending, _ = _pool_round(pending, workers, done, context)
+        chunk = dict(itertools.islice(pending.items(), workers * rows_per_worker))
+        later = {i: case for i, case in pending.items() if i not in chunk}
+        lost, unstarted, _ = _pool_round(chunk, workers, done, context)
+        pending = {**unstarted, **later}
         if lost:
             log.warning("a worker process died; rows %s, which were running, are retried one at a time",
                         ", ".join(map(str, sorted(lost))))
