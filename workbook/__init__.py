@@ -1,1 +1,66 @@
-"""Engine mount vibration isolation: cases, Exudyn scenes, answers and workbooks."""
+"""Engine mount vibration isolation: cases, Exudyn scenes, answers and workbooks.
+
+The public API is what ``import workbook as wb`` gives (the names of
+``__all__``), the errors of :mod:`workbook.errors`, and the package
+:mod:`flexbodies`; every other module is internal and may change. A script
+reads::
+
+    import workbook as wb
+
+    result = wb.run_case(wb.reference_case())
+    print(result.table())
+
+Each name is imported on first use (PEP 562), so ``import workbook`` is
+fast and a name's heavy dependencies (Exudyn, scikit-fem, openpyxl) load
+only when it is used.
+"""
+import importlib
+
+__version__ = "0.1.0"
+
+#: Where each public name lives: its module, under the package.
+_HOMES = {
+    "model.case": ("Case", "Engine", "Link", "Hinge", "PointForce", "PointMoment", "Gravity", "StaticLoad",
+                   "RotatingForce", "HarmonicForce", "Sweep", "RunUp", "Imbalance", "ImbalancePlane", "Rotor",
+                   "Simultaneous", "AnalysisSettings", "Effects", "ForceTransducers", "DIRECTIONS"),
+    "model.reference": ("reference_case", "reference_sweep", "reference_casing", "LP_ROTOR", "HP_ROTOR"),
+    "model.casing": ("EngineCasing",),
+    "model.pylon_impedance": ("PylonImpedance", "read_impedance_csv"),
+    "model.pylon_beam": ("BoxBeamPylon",),
+    "model.pylon_mesh": ("MeshPylon",),
+    "model.codec": ("to_json", "from_json", "to_dict", "from_dict"),
+    "model.drawing": ("plot_layout",),
+    "solve.pipeline": ("run_case", "run_excitation", "prepare", "PreparedScene"),
+    "solve.sweep": ("run_sweep", "SweepAnswer"),
+    "solve.run_up": ("run_up", "RunUpAnswer"),
+    "solve.four_pole_set": ("four_pole",),
+    "solve.four_pole": ("FourPole", "frequency_grid"),
+    "solve.modes": ("mounted_modes", "Mode"),
+    "answers.results": ("MountResult", "ExcitationResult"),
+    "answers.isolation": ("transmissibility", "efficiency", "level_db"),
+    "excel.reader": ("read_workbook", "CaseBook"),
+    "excel.writer": ("write_results", "RunResult"),
+    "excel.report": ("write_report",),
+    "excel.template": ("template_workbook", "reference_workbook"),
+    "rig.records": ("RigRecord", "read_record", "write_record"),
+    "studies.parametric": ("PARAMETERS", "grid", "latin_hypercube", "study_cases"),
+    "studies.parallel": ("run_rows", "RowOutcome"),
+    "errors": ("CaseError", "WorkbookError", "RecordError", "UsageError", "SimulationError", "MechanismError",
+               "EquilibriumError", "ResonanceError", "FourPoleError", "UnstablePreloadError", "BucklingError",
+               "Terminated"),
+}
+_MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}
+
+__all__ = ["__version__", *_MODULE_OF]
+
+
+def __getattr__(name: str):
+    if name not in _MODULE_OF:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f".{_MODULE_OF[name]}", __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
