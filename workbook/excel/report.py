@@ -39,7 +39,7 @@ from openpyxl.utils import get_column_letter
 from workbook.answers.isolation import efficiency, level_db
 from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.reader import CaseBook
-from workbook.excel.styling import FORMATS, print_setup
+from workbook.excel.styling import FORMATS, print_setup, style_series, write_text_lines
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
@@ -55,6 +55,8 @@ PACKAGES = ("engine-mount-workbook", "exudyn", "scikit-fem", "numpy", "scipy", "
             "matplotlib")
 
 _HEADER_FILL = PatternFill("solid", fgColor="DDEBF7")
+#: Row of the caption of the first table below a sheet's chart (the chart fills the rows above).
+_TABLE_TOP = 29
 #: Printed characters per unit of column width, and the widest column, characters.
 _MAX_WIDTH = 60
 
@@ -172,7 +174,7 @@ def _log_log_chart(title: str, y_title: str) -> ScatterChart:
     chart.title, chart.x_axis.title, chart.y_axis.title = title, "frequency (Hz)", y_title
     chart.x_axis.scaling.logBase = 10
     chart.y_axis.scaling.logBase = 10
-    chart.style = 13
+    chart.scatterStyle = "lineMarker"             # straight lines between the points, not splines
     chart.width, chart.height = 24, 12
     return chart
 
@@ -186,8 +188,8 @@ def _transmissibility(ws, runs: list[RunResult]) -> None:
         groups.append(("single-frequency runs", singles))
     chart = _log_log_chart("Pylon transmissibility", "T (-)")
     ws.add_chart(chart, "A4")
-    row = 30
-    for name, points in groups:
+    row = _TABLE_TOP + 1
+    for group, (name, points) in enumerate(groups):
         ws.cell(row - 1, 1, name).font = Font(bold=True)
         columns = [("frequency (Hz)", "Hz"), *_directions("T (-)", "T"), *_directions("level (dB)", "dB"),
                    *_directions("eta (%)", "eta")]
@@ -197,14 +199,11 @@ def _transmissibility(ws, runs: list[RunResult]) -> None:
         for i, d in enumerate(DIRECTIONS):
             series = Series(Reference(ws, min_col=2 + i, min_row=row + 1, max_row=row + len(points)), x,
                             title=f"{name}: {d}")
-            if name == "single-frequency runs":
-                series.marker.symbol, series.graphicalProperties.line.noFill = "circle", True
-            else:
-                series.marker.symbol = "none"
+            style_series(series, d, group, markers=name == "single-frequency runs")
             chart.series.append(series)
         row += len(points) + 3
     _show_axes(chart)
-    print_setup(ws)
+    print_setup(ws, table_below=_TABLE_TOP)
 
 
 def _modes(ws, runs: list[RunResult]) -> None:
@@ -215,8 +214,9 @@ def _modes(ws, runs: list[RunResult]) -> None:
         card = next(iter(run.result.model_cards.values()))    # the points of a sweep share the model
         rows += [[run.spec.name, number, frequency, 100 * zeta, description]
                  for number, (frequency, zeta, description) in enumerate(card.mounted_modes, start=1)]
-    _table(ws, 3, [("run", "text"), ("mode", "text"), ("frequency (Hz)", "Hz"), ("zeta (%)", "zeta"),
-                   ("engine motion", "text")], rows)
+    last = _table(ws, 3, [("run", "text"), ("mode", "text"), ("frequency (Hz)", "Hz"), ("zeta (%)", "zeta"),
+                          ("engine motion", "text")], rows)
+    ws.column_dimensions["E"].width = max([len(row[4]) + 2 for row in rows] + [20])    # one line each, printed in full
     first = runs[0].spec.name if runs else None
     count = sum(row[0] == first for row in rows)
     if count:
@@ -227,7 +227,7 @@ def _modes(ws, runs: list[RunResult]) -> None:
         chart.set_categories(Reference(ws, min_col=2, min_row=4, max_row=3 + count))
         chart.width, chart.height, chart.legend = 16, 7.5, None
         _show_axes(chart)
-        ws.add_chart(chart, "G3")
+        ws.add_chart(chart, f"A{last + 3}")               # below the table: the page is as wide as the table
     print_setup(ws, header_rows=3)
 
 
@@ -284,9 +284,7 @@ def _plots(ws, runs: list[RunResult]) -> None:
 
 
 def _model_cards(ws, runs: list[RunResult]) -> None:
-    for row, line in enumerate(card_lines(runs), start=1):
-        ws.cell(row, 1, line).font = Font(name="Consolas", size=9, bold=line.startswith("Run '"))
-    ws.column_dimensions["A"].width = 120
+    write_text_lines(ws, card_lines(runs))
     print_setup(ws)
 
 
@@ -299,21 +297,25 @@ def four_pole_sheet(ws, pole) -> None:
     _title(ws, f"{pole.case_name}: four-pole parameters of the mount",
            "K11, K22: driving-point dynamic stiffness at the engine and at the pylon pins; K21: blocked transfer "
            "dynamic stiffness (both other terminals blocked)")
-    columns = [("frequency (Hz)", "Hz")] + [(name.replace(" N/m", " (N/m)").replace(" deg", " (deg)"), "number")
-                                             for name in table.columns]
-    top = 30
+    columns = [("frequency (Hz)", "Hz")] + [(name.replace(" N/m", " (N/m)").replace(" deg", " (deg)"),
+                                              "N/m" if name.endswith(" N/m") else "deg") for name in table.columns]
+    top = _TABLE_TOP + 1
+    ws.cell(_TABLE_TOP, 1, "four-pole parameters").font = Font(bold=True)
     _table(ws, top, columns, [[frequency, *row] for frequency, row in zip(table.index, table.to_numpy())])
     chart = _log_log_chart("Dynamic stiffness", "|K| (N/m)")
     x = Reference(ws, min_col=1, min_row=top + 1, max_row=top + len(table))
-    for col, name in enumerate(table.columns, start=2):
-        if name.startswith("|"):
-            series = Series(Reference(ws, min_col=col, min_row=top + 1, max_row=top + len(table)), x,
-                            title=name.strip("|").replace("| N/m", ""))
-            series.marker.symbol = "none"
-            chart.series.append(series)
+    magnitudes = {col: name[1:name.index("|", 1)].split() for col, name in enumerate(table.columns, start=2)
+                  if name.startswith("|")}                                  # "|K11 x| N/m": K11, x
+    quantities = list(dict.fromkeys(quantity for quantity, _ in magnitudes.values()))
+    for col, (quantity, direction) in magnitudes.items():
+        series = Series(Reference(ws, min_col=col, min_row=top + 1, max_row=top + len(table)), x,
+                        title=f"{quantity} {direction}")
+        style_series(series, direction, group=quantities.index(quantity))
+        chart.series.append(series)
     _show_axes(chart)
     ws.add_chart(chart, "A4")
-    print_setup(ws)
+    print_setup(ws, table_below=_TABLE_TOP)
+    ws.page_setup.fitToWidth, ws.print_title_cols = 2, "A:A"     # 19 columns: two pages wide, each with its frequencies
 
 
 def _sha256(path: Path) -> str:

@@ -5,21 +5,37 @@ written back into a case workbook, the report workbook and the template.
 """
 from __future__ import annotations
 
+import textwrap
+
+from openpyxl.chart import Series
+from openpyxl.styles import Alignment, Font, PatternFill
+from openpyxl.utils import get_column_letter
+from openpyxl.worksheet.pagebreak import Break
 from openpyxl.worksheet.properties import PageSetupProperties
 
-__all__ = ["FORMATS", "quantity_of", "print_setup"]
+__all__ = ["FORMATS", "DIRECTION_COLOURS", "quantity_of", "print_setup", "style_series", "write_text_lines",
+           "write_frame"]
 
 #: Number format of each quantity: eta and errors in %, T in four decimals (scientific below 0.01),
-#: levels in dB with one decimal, frequencies in Hz with two, forces in N.
+#: levels in dB with one decimal, frequencies in Hz with two, forces in N, dynamic stiffness in N/m
+#: with four digits, phases in degrees with one decimal, plain numbers with five significant digits,
+#: wall times in s with three decimals.
 FORMATS = {"eta": '0.00" %"', "T": "[<0.01]0.000E+00;0.0000", "dB": "0.0", "Hz": "0.00", "N": "0.000",
-           "error": '0.0" %"', "zeta": '0.00" %"'}
+           "error": '0.0" %"', "zeta": '0.00" %"', "N/m": "0.000E+00", "deg": "0.0", "number": "0.0000E+00", "s": "0.000"}
+#: Line and marker colour of each direction in the charts, as in the pictures (matplotlib's first three).
+DIRECTION_COLOURS = {"x": "1F77B4", "y": "FF7F0E", "z": "2CA02C"}
+#: Dash of the lines of the first, second, ... curve group of a chart.
+_DASHES = ("solid", "dash", "sysDot", "dashDot", "lgDash")
+#: Width of a text sheet's column (characters of the default font), the characters of its monospaced
+#: lines wrapped within it, their font size and line height, pt: one A4 landscape page wide.
+_TEXT_WIDTH, _TEXT_CHARACTERS, _TEXT_SIZE, _TEXT_LINE_HEIGHT = 130, 135, 8, 10.5
 
 
 def quantity_of(header: str) -> str | None:
     """The :data:`FORMATS` key of a result column from its header (None: text or a plain number).
 
     Headers name their unit: ``frequency Hz``, ``T x``, ``eta % y``, ``dB``,
-    ``amplitude N``, ``error %``.
+    ``amplitude N``, ``error %``, ``wall time s``.
     """
     words = str(header).split()
     if not words:
@@ -36,10 +52,13 @@ def quantity_of(header: str) -> str | None:
         return "error"
     if words[-1] == "N":
         return "N"
+    if words[-1] == "s":
+        return "s"
     return None
 
 
-def print_setup(ws, header_rows: int = 0, one_page: bool = False, freeze: bool = True) -> None:
+def print_setup(ws, header_rows: int = 0, one_page: bool = False, freeze: bool = True,
+                table_below: int = 0) -> None:
     """Print *ws* landscape on A4, one page wide (and tall for *one_page*).
 
     Parameters
@@ -47,6 +66,10 @@ def print_setup(ws, header_rows: int = 0, one_page: bool = False, freeze: bool =
     header_rows : int
         Rows repeated at the top of every printed page (and frozen on screen
         if *freeze*).
+    table_below : int
+        Row of the caption of a table below a chart (its header is the next
+        row): the table starts a new page, and its caption and header are
+        repeated on every page it continues on.
     """
     ws.page_setup.orientation = "landscape"
     ws.page_setup.paperSize = ws.PAPERSIZE_A4
@@ -59,3 +82,86 @@ def print_setup(ws, header_rows: int = 0, one_page: bool = False, freeze: bool =
         if freeze:
             ws.freeze_panes = f"A{header_rows + 1}"
         ws.print_title_rows = f"1:{header_rows}"
+    if table_below:
+        ws.row_breaks.append(Break(id=table_below - 1))
+        ws.print_title_rows = f"{table_below}:{table_below + 1}"
+
+
+def style_series(series: Series, direction: str, group: int = 0, markers: bool = False) -> None:
+    """Draw a chart curve readably on screen and paper: straight lines, its direction's colour, its group's dash.
+
+    Parameters
+    ----------
+    series : openpyxl.chart.Series
+    direction : str
+        ``x``, ``y`` or ``z`` (:data:`DIRECTION_COLOURS`).
+    group : int
+        Number of the curve's group (a run) in the chart: its dash.
+    markers : bool
+        Filled markers and no line (points that are not a curve), else a line and no markers.
+    """
+    colour = DIRECTION_COLOURS[direction]
+    series.smooth = False
+    line = series.graphicalProperties.line
+    if markers:
+        series.marker.symbol, series.marker.size = "circle", 7
+        series.marker.graphicalProperties.solidFill = colour
+        series.marker.graphicalProperties.line.solidFill = colour
+        line.noFill = True
+    else:
+        series.marker.symbol = "none"
+        line.solidFill, line.width = colour, 19050        # 1.5 pt
+        line.dashStyle = _DASHES[group % len(_DASHES)]
+
+
+def write_text_lines(ws, lines: list[str], top: int = 1) -> None:
+    """Write text *lines* one per row from row *top*, wrapped to one printed page width.
+
+    A line longer than the page wraps within its row as a paragraph, its
+    continuation indented under its text (the row is as high as its
+    lines); a monospaced font keeps the columns of tabular lines aligned; a
+    line starting with ``Run '`` is bold.
+    """
+    for row, line in enumerate(lines, start=top):
+        indent = " " * (len(line) - len(line.lstrip()) + 2)
+        paragraph = textwrap.wrap(line, _TEXT_CHARACTERS, subsequent_indent=indent, drop_whitespace=False) or [""]
+        cell = ws.cell(row, 1, "\n".join(part.rstrip() for part in paragraph))
+        cell.font = Font(name="Consolas", size=_TEXT_SIZE, bold=line.startswith("Run '"))
+        cell.alignment = Alignment(wrap_text=True, vertical="top")
+        if len(paragraph) > 1:
+            ws.row_dimensions[row].height = _TEXT_LINE_HEIGHT * len(paragraph)
+    ws.column_dimensions["A"].width = _TEXT_WIDTH
+
+
+def write_frame(ws, frame, top: int = 1, fill: PatternFill | None = None, quantities: dict | None = None) -> None:
+    """Write a table (a pandas DataFrame) with its header in row *top*, each number formatted by its quantity.
+
+    The header is bold (on *fill*), frozen and repeated on every printed
+    page; each column is as wide as its header and its texts; a missing
+    value is an empty cell.
+
+    Parameters
+    ----------
+    quantities : dict of str to str, optional
+        :data:`FORMATS` key per column header, where :func:`quantity_of` does not tell it.
+    """
+    import pandas as pd
+
+    formats = [FORMATS.get((quantities or {}).get(name) or quantity_of(name) or "") for name in frame.columns]
+    for col, name in enumerate(frame.columns, start=1):
+        cell = ws.cell(top, col, name)
+        cell.font = Font(bold=True)
+        if fill is not None:
+            cell.fill = fill
+        texts = [str(v) for v in frame[name] if isinstance(v, str)]
+        ws.column_dimensions[get_column_letter(col)].width = max([11, len(str(name)) + 2, *(len(t) + 2 for t in texts)])
+    for row, values in enumerate(frame.itertuples(index=False), start=top + 1):
+        for col, value in enumerate(values, start=1):
+            if isinstance(value, float) and not pd.notna(value):
+                value = None
+            elif hasattr(value, "item"):
+                value = value.item()
+            cell = ws.cell(row, col, value)
+            if formats[col - 1] is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
+                cell.number_format = formats[col - 1]
+    print_setup(ws, header_rows=top)

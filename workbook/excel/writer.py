@@ -36,7 +36,6 @@ from pathlib import Path
 import pandas as pd
 from openpyxl import Workbook, load_workbook
 from openpyxl.styles import Font, PatternFill
-from openpyxl.utils import get_column_letter
 
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
@@ -54,7 +53,7 @@ from workbook.excel.files import (
 )
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.sheets import peek, stored_cells
-from workbook.excel.styling import FORMATS, print_setup, quantity_of
+from workbook.excel.styling import print_setup, write_frame, write_text_lines
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
@@ -204,23 +203,7 @@ def is_result_sheet(ws) -> bool:
 
 def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
     ws.cell(1, 1, note).font = Font(italic=True)
-    formats = [FORMATS.get(quantity_of(name)) for name in frame.columns]
-    for col, name in enumerate(frame.columns, start=1):
-        cell = ws.cell(2, col, name)
-        cell.font, cell.fill = Font(bold=True), _HEADER_FILL
-        texts = [str(v) for v in frame[name] if isinstance(v, str)]
-        ws.column_dimensions[get_column_letter(col)].width = max([11, len(str(name)) + 2,
-                                                                  *(len(t) + 2 for t in texts)])
-    for row, values in enumerate(frame.itertuples(index=False), start=3):
-        for col, value in enumerate(values, start=1):
-            if isinstance(value, float) and not pd.notna(value):
-                value = None
-            elif hasattr(value, "item"):
-                value = value.item()
-            cell = ws.cell(row, col, value)
-            if formats[col - 1] is not None and isinstance(value, (int, float)):
-                cell.number_format = formats[col - 1]
-    print_setup(ws, header_rows=2)
+    write_frame(ws, frame, top=2, fill=_HEADER_FILL)
     _mark(ws)
 
 
@@ -256,10 +239,8 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
     for name, frame in frames.items():
         _write_frame(workbook.create_sheet(_sheet_title(name)), frame, f"{_NOTES[name]}. {stamp}")
     ws = workbook.create_sheet(_sheet_title("model card"))
-    for row, line in enumerate(card_lines(runs), start=2):
-        ws.cell(row, 1, line).font = Font(name="Consolas", bold=line.startswith("Run '"))
+    write_text_lines(ws, card_lines(runs), top=2)
     ws.cell(1, 1, stamp).font = Font(italic=True)
-    ws.column_dimensions["A"].width = 120
     print_setup(ws)
     _mark(ws)
     return result_sheet_names(frames)

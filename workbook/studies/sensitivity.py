@@ -234,6 +234,22 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
     return finished
 
 
+def _study_workbook(frame, parameters: list[str]):
+    """The study table as a workbook that prints readably: each parameter headed by its words and
+    unit (``hinge stiffness N/m``), every number formatted by its quantity, the header on every page."""
+    from openpyxl import Workbook
+
+    from workbook.excel.styling import write_frame
+
+    headers = {name: f"{name.replace('_', ' ')} {PARAMETERS[name].unit}" for name in parameters
+               if PARAMETERS[name].numeric}
+    workbook = Workbook()
+    workbook.active.title = "Parameter study"
+    write_frame(workbook.active, frame.rename(columns=headers),
+                quantities={header: "number" for header in headers.values()})
+    return workbook
+
+
 def write_study(frame, parameters: list[str], folder: str | Path, table_format: str = "csv") -> list[Path]:
     """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot, each all at once.
 
@@ -247,7 +263,7 @@ def write_study(frame, parameters: list[str], folder: str | Path, table_format: 
     _write_table(frame, table)
     sheet = table.with_suffix(".xlsx")
     with replacing(sheet, suffix=".xlsx.tmp") as temporary:
-        frame.to_excel(temporary, sheet_name="Parameter study", index=False, engine="openpyxl")
+        _study_workbook(frame, parameters).save(temporary)
     plot = table.with_suffix(".png")
     figure = plot_sensitivity(frame, parameters)
     save_figure(figure, plot, dpi=120)
