@@ -18,13 +18,14 @@ import importlib
 _HOMES = {
     "assembly": ("FEModel", "assemble"),
     "eigen": ("natural_frequencies",),
+    "errors": ("LinkModelError", "ReducedLinkFileError"),
     "exudyn_body": ("ExudynLink", "add_link_to_exudyn", "export_exudyn_file", "link_rotation"),
     "geometry": ("LinkGeometry",),
     "interfaces": ("InterfaceCoupling", "couple_interfaces"),
     "link": ("LinkModel", "MeshSource", "build_fe_model", "default_cache_dir", "reduce_link", "reduce_link_set"),
     "materials": ("STEEL", "TITANIUM", "Material", "material"),
     "meshing": ("Bore", "BoreSpec", "LinkMesh", "load_mesh", "mesh_link"),
-    "reduced": ("ReducedLink", "ReducedLinkFileError", "load_reduced_link", "save_reduced_link"),
+    "reduced": ("ReducedLink", "load_reduced_link", "save_reduced_link"),
     "selection": ("ModeDecision", "decide_modes"),
 }
 _MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}

@@ -14,6 +14,7 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
+from .errors import LinkModelError
 from .materials import Material
 from .meshing import Bore, LinkMesh
 
@@ -218,7 +219,7 @@ def _check_orientation(basis: skfem.CellBasis, source: str) -> None:
     positive, negative = (det > 0).all(axis=1), (det < 0).all(axis=1)
     bad = np.flatnonzero(~(positive | negative))
     if bad.size:
-        raise ValueError(
+        raise LinkModelError(
             f"{source}: {bad.size} of {det.shape[0]} elements are tangled or degenerate (the Jacobian "
             f"determinant vanishes or changes sign inside; first: element {bad[0]}); check the element "
             "node order (meshio's order is expected) and the mesh quality"

@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .errors import LinkModelError
+
 if TYPE_CHECKING:  # meshing loads gmsh, meshio and scikit-fem: imported where a casing is meshed
     from .meshing import LinkMesh
 
@@ -159,7 +161,7 @@ def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> 
 
     size = default_casing_element_size(geometry) if element_size is None else float(element_size)
     if not (math.isfinite(size) and size > 0):
-        raise ValueError(f"casing element size must be a positive length in m, got {element_size!r}")
+        raise LinkModelError(f"casing element size must be a positive length in m, got {element_size!r}")
     g = geometry
     with gmsh_model("casing"):
         occ = gmsh.model.occ
@@ -227,8 +229,8 @@ def casing_interfaces(casing_mesh: LinkMesh, interfaces, source: str) -> LinkMes
         if not hit.any():
             what = (f"within {interface.reach:g} m of the eye point {point.tolist()} m" if interface.kind == "eye"
                     else f"within {interface.reach:g} m of the bearing plane x = {point[0]:g} m")
-            raise ValueError(f"{source}: interface {interface.name!r}: no casing surface {what} "
-                             f"(the nearest surface face is {_reach(interface, centroids).min():.4g} m away)")
+            raise LinkModelError(f"{source}: interface {interface.name!r}: no casing surface {what} "
+                                 f"(the nearest surface face is {_reach(interface, centroids).min():.4g} m away)")
         nodes, weights = _tributary(mesh, facets[hit])
         bores.append(Bore(interface.name, point, axis, interface.reach, nodes, weights))
     nodes = np.concatenate([bore.nodes for bore in bores])
@@ -242,8 +244,8 @@ def casing_interfaces(casing_mesh: LinkMesh, interfaces, source: str) -> LinkMes
         for k, (interface, bore) in enumerate(zip(interfaces, bores)):
             keep = owner[bore.nodes] == k
             if not keep.any():
-                raise ValueError(f"{source}: interface {interface.name!r}: every surface node within its reach "
-                                 f"is nearer to another interface; move them apart or reduce the reach")
+                raise LinkModelError(f"{source}: interface {interface.name!r}: every surface node within its reach "
+                                     f"is nearer to another interface; move them apart or reduce the reach")
             bores[k] = dataclasses.replace(bore, nodes=bore.nodes[keep], weights=bore.weights[keep])
     return dataclasses.replace(casing_mesh, bores=tuple(bores))
 

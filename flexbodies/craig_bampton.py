@@ -18,6 +18,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .eigen import factorize, lowest_modes
+from .errors import LinkModelError
 
 __all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "fixed_interface_set", "kept_count"]
 
@@ -166,7 +167,7 @@ def elastic_modes(cb: CraigBamptonBasis, stiffness, mass):
     freqs = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
     n_rigid = int(np.sum(freqs < _RIGID_FRACTION * freqs[-1]))
     if n_rigid != 6:
-        raise ValueError(
+        raise LinkModelError(
             f"expected 6 rigid-body modes in the free link, found {n_rigid}: "
             "the interfaces do not see the body as one free solid"
         )

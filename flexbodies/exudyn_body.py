@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import LinkModelError
 from .reduced import ReducedLink
 
 __all__ = ["ExudynLink", "add_link_to_exudyn", "exudyn_cms_interface", "modal_damping_matrix", "export_exudyn_file",
@@ -104,7 +105,7 @@ def link_rotation(end_a, end_b, bore_axis=None) -> np.ndarray:
     ez = ez - ex * (ez @ ex)
     norm = np.linalg.norm(ez)
     if norm < 1e-6:
-        raise ValueError(f"bore axis {list(bore_axis)} is parallel to the link axis {list(np.round(ex, 6))}")
+        raise LinkModelError(f"bore axis {list(bore_axis)} is parallel to the link axis {list(np.round(ex, 6))}")
     ez /= norm
     return np.column_stack([ex, np.cross(ez, ex), ez])
 
@@ -261,12 +262,12 @@ def add_link_to_exudyn(
     end_b = np.asarray(end_b, dtype=float)
     distance = float(np.linalg.norm(end_b - end_a))
     if abs(distance - link.length) > LENGTH_TOLERANCE:
-        raise ValueError(
+        raise LinkModelError(
             f"link {name!r}: its eyes are {link.length * 1e3:.3f} mm apart but its end points "
             f"are {distance * 1e3:.3f} mm apart"
         )
     if not spin_frequency_hz > 0:
-        raise ValueError(f"link {name!r}: spin_frequency_hz must be > 0, got {spin_frequency_hz}")
+        raise LinkModelError(f"link {name!r}: spin_frequency_hz must be > 0, got {spin_frequency_hz}")
     rotation = link_rotation(end_a, end_b, bore_axis)
     if flexible:
         body, nodes, markers = _add_flexible(mbs, link, end_a, rotation, stiffness_damping, mass_damping,

@@ -4,6 +4,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .errors import LinkModelError
+
 __all__ = ["LinkGeometry", "SIGNIFICANT_DIGITS", "default_element_size"]
 
 #: Significant digits a dimension keeps: 1e-12 relative, far below any mesh size, far above round-off.
@@ -60,25 +62,25 @@ class LinkGeometry:
                            "shank_width", "shank_thickness"):
             value = getattr(self, field_name)
             if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"link geometry: {field_name} must be a positive length in m, got {value!r}")
+                raise LinkModelError(f"link geometry: {field_name} must be a positive length in m, got {value!r}")
             object.__setattr__(self, field_name, float(f"{value:.{SIGNIFICANT_DIGITS}g}"))
         if self.bore_radius >= self.eye_outer_radius:
-            raise ValueError(
+            raise LinkModelError(
                 f"link geometry: the bore radius ({self.bore_radius} m) must be smaller than "
                 f"the eye outer radius ({self.eye_outer_radius} m)"
             )
         if self.shank_width >= 2 * self.eye_outer_radius:
-            raise ValueError(
+            raise LinkModelError(
                 f"link geometry: the shank width ({self.shank_width} m) must be smaller than "
                 f"the eye diameter ({2 * self.eye_outer_radius} m)"
             )
         if self.shank_thickness > self.thickness:
-            raise ValueError(
+            raise LinkModelError(
                 f"link geometry: the shank thickness ({self.shank_thickness} m) must not exceed "
                 f"the eye thickness ({self.thickness} m)"
             )
         if self.length <= 2 * self.eye_outer_radius:
-            raise ValueError(
+            raise LinkModelError(
                 f"link geometry: the eyes overlap; the distance between eye centres "
                 f"({self.length} m) must exceed twice the eye outer radius ({2 * self.eye_outer_radius} m)"
             )

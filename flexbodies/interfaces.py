@@ -26,6 +26,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from .errors import LinkModelError
+
 __all__ = ["InterfaceCoupling", "couple_interfaces", "COUPLINGS"]
 
 COUPLINGS = ("RBE2", "RBE3")
@@ -121,11 +123,11 @@ def _rbe3_rows(bore, nodes):
     # Corner nodes of 6-node triangles carry zero weight, up to round-off.
     weights = np.where(np.abs(weights) <= 1e-12 * np.abs(weights).max(initial=0.0), 0.0, weights)
     if np.any(weights < 0) or weights.sum() <= 0:
-        raise ValueError(f"bore {bore.name}: RBE3 weights must be non-negative with a positive sum")
+        raise LinkModelError(f"bore {bore.name}: RBE3 weights must be non-negative with a positive sum")
     G = rigid_motion_rows(offsets)
     A = np.einsum("k,kia,kib->ab", weights, G, G)
     if np.linalg.cond(A) > 1e12:
-        raise ValueError(
+        raise LinkModelError(
             f"bore {bore.name}: its {len(bore.nodes)} weighted nodes do not determine a rigid "
             "motion (are they collinear?); RBE3 needs a surface"
         )
@@ -163,14 +165,14 @@ def couple_interfaces(fe_model, kind="RBE2") -> InterfaceCoupling:
     kinds = [str(kind).upper()] * len(bores) if isinstance(kind, str) else [str(k).upper() for k in kind]
     for one in kinds:
         if one not in COUPLINGS:
-            raise ValueError(f"unknown interface coupling {one!r}; expected one of {', '.join(COUPLINGS)}")
+            raise LinkModelError(f"unknown interface coupling {one!r}; expected one of {', '.join(COUPLINGS)}")
     if len(kinds) != len(bores):
-        raise ValueError(f"{len(kinds)} interface couplings for {len(bores)} bores")
+        raise LinkModelError(f"{len(kinds)} interface couplings for {len(bores)} bores")
     nodes = np.asarray(fe_model.nodes, dtype=float)
     ndof = 3 * len(nodes)
     all_bore_nodes = np.concatenate([b.nodes for b in bores])
     if len(np.unique(all_bore_nodes)) != len(all_bore_nodes):
-        raise ValueError("two bores share FE nodes; interfaces must be disjoint")
+        raise LinkModelError("two bores share FE nodes; interfaces must be disjoint")
     per_bore = [(_rbe2_rows if one == "RBE2" else _rbe3_rows)(b, nodes) for one, b in zip(kinds, bores)]
     kind = str(kind).upper() if isinstance(kind, str) else "/".join(kinds)
 

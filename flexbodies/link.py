@@ -28,6 +28,7 @@ import numpy as np
 
 from .cache import LinkCache, default_cache_dir
 from .cached_reduction import cached_reductions, record_hash, stored_reductions
+from .errors import LinkModelError
 from .geometric_stiffness import has_stiffening
 from .geometry import LinkGeometry, default_element_size
 from .materials import STEEL, Material
@@ -60,7 +61,7 @@ class MeshSource:
     def __post_init__(self):
         object.__setattr__(self, "bores", tuple(self.bores))
         if len(self.bores) != 2:
-            raise ValueError(f"mesh {self.path}: a link needs exactly two bores (A and B), got {len(self.bores)}")
+            raise LinkModelError(f"mesh {self.path}: a link needs exactly two bores (A and B), got {len(self.bores)}")
 
 
 @dataclass(frozen=True)
@@ -88,7 +89,7 @@ class LinkModel:
 
     def __post_init__(self):
         if (self.geometry is None) == (self.mesh is None):
-            raise ValueError("a link model needs exactly one of geometry and mesh")
+            raise LinkModelError("a link model needs exactly one of geometry and mesh")
 
     def fingerprint(self) -> dict:
         """JSON-able description of every input; a mesh file enters by its SHA-256."""
@@ -136,7 +137,7 @@ def _in_link_frame(fe):
     ex = (b - a) / np.linalg.norm(b - a)
     ez = fe.bores[0].axis - ex * (fe.bores[0].axis @ ex)
     if np.linalg.norm(ez) < 1e-6:
-        raise ValueError("the bore axis of eye A runs along the link axis; a link's bores must be across it")
+        raise LinkModelError("the bore axis of eye A runs along the link axis; a link's bores must be across it")
     ez /= np.linalg.norm(ez)
     R = np.vstack([ex, np.cross(ez, ex), ez])  # rows: link axes in model coordinates
     if np.allclose(R, np.eye(3), atol=1e-12) and np.allclose(a, 0.0, atol=1e-12):

@@ -4,6 +4,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .errors import LinkModelError
+
 __all__ = ["Material", "STEEL", "TITANIUM", "material"]
 
 
@@ -38,7 +40,7 @@ class Material:
         _check_positive(self.name, "density", self.density, "kg/m^3")
         nu = self.poisson_ratio
         if not (math.isfinite(nu) and -1.0 < nu < 0.5):
-            raise ValueError(
+            raise LinkModelError(
                 f"material {self.name!r}: Poisson's ratio must lie strictly between -1 and 0.5 "
                 f"(0.5 would be incompressible), got {nu!r}"
             )
@@ -57,7 +59,7 @@ class Material:
 
 def _check_positive(name: str, what: str, value: float, unit: str) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-        raise ValueError(f"material {name!r}: {what} must be a positive number in {unit}, got {value!r}")
+        raise LinkModelError(f"material {name!r}: {what} must be a positive number in {unit}, got {value!r}")
 
 
 STEEL = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
@@ -92,4 +94,4 @@ def material(name: str) -> Material:
         return _PRESETS[key]
     except KeyError:
         known = ", ".join(sorted(_PRESETS))
-        raise ValueError(f"unknown material {name!r}; known materials: {known}") from None
+        raise LinkModelError(f"unknown material {name!r}; known materials: {known}") from None

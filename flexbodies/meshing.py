@@ -31,6 +31,7 @@ import numpy as np
 import skfem
 from skfem.io.meshio import HEX_MAPPING
 
+from .errors import LinkModelError
 from .geometry import LinkGeometry, default_element_size
 
 __all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "default_element_size", "gmsh_model",
@@ -137,18 +138,18 @@ class BoreSpec:
         geometric = [self.centre is not None, self.axis is not None, self.radius is not None]
         if self.node_set is not None:
             if any(geometric):
-                raise ValueError(f"bore {self.name!r}: give either node_set or centre/axis/radius, not both")
+                raise LinkModelError(f"bore {self.name!r}: give either node_set or centre/axis/radius, not both")
             return
         if not all(geometric):
-            raise ValueError(f"bore {self.name!r}: a geometric bore needs centre, axis and radius (or give node_set)")
+            raise LinkModelError(f"bore {self.name!r}: a geometric bore needs centre, axis and radius (or give node_set)")
         if np.shape(self.centre) != (3,) or np.shape(self.axis) != (3,):
-            raise ValueError(f"bore {self.name!r}: centre and axis must each have 3 components")
+            raise LinkModelError(f"bore {self.name!r}: centre and axis must each have 3 components")
         if not np.linalg.norm(np.asarray(self.axis, dtype=float)) > 0:
-            raise ValueError(f"bore {self.name!r}: the axis must be a non-zero vector")
+            raise LinkModelError(f"bore {self.name!r}: the axis must be a non-zero vector")
         if not (math.isfinite(self.radius) and self.radius > 0):
-            raise ValueError(f"bore {self.name!r}: the radius must be a positive length in m, got {self.radius!r}")
+            raise LinkModelError(f"bore {self.name!r}: the radius must be a positive length in m, got {self.radius!r}")
         if self.tolerance is not None and not self.tolerance > 0:
-            raise ValueError(f"bore {self.name!r}: the tolerance must be positive, got {self.tolerance!r}")
+            raise LinkModelError(f"bore {self.name!r}: the tolerance must be positive, got {self.tolerance!r}")
 
 
 @dataclass(frozen=True)
@@ -271,7 +272,7 @@ def mesh_link(geometry: LinkGeometry, element_size: float | None = None) -> Link
     """
     size = default_element_size(geometry) if element_size is None else float(element_size)
     if not (math.isfinite(size) and size > 0):
-        raise ValueError(f"element size must be a positive length in m, got {element_size!r}")
+        raise LinkModelError(f"element size must be a positive length in m, got {element_size!r}")
     with gmsh_model("link"):
         _build_link_solid(geometry)
         points, cells = generate_tet10(size)
@@ -323,20 +324,20 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
     """
     path = Path(path)
     if not (math.isfinite(scale) and scale > 0):
-        raise ValueError(f"{path}: scale must be a positive factor from file units to m, got {scale!r}")
+        raise LinkModelError(f"{path}: scale must be a positive factor from file units to m, got {scale!r}")
     if not path.is_file():
         raise FileNotFoundError(f"mesh file {path} does not exist")
     try:
         data = meshio.read(path, file_format=file_format)
     except (Exception, SystemExit) as exc:  # meshio raises many types, even SystemExit
-        raise ValueError(f"cannot read mesh file {path}: {type(exc).__name__}: {exc}") from exc
+        raise LinkModelError(f"cannot read mesh file {path}: {type(exc).__name__}: {exc}") from exc
     cell_type, cells = _volume_cells(data, path)
     if cell_type in _LINEAR_TYPES:
         logger.warning("%s: linear %s elements are too stiff in bending (shear locking); "
                        "prefer quadratic elements (tetra10)", path, cell_type)
     points = np.asarray(data.points, dtype=float)
     if points.shape[1] != 3:
-        raise ValueError(f"{path}: expected 3-D points, got {points.shape[1]} coordinates per point")
+        raise LinkModelError(f"{path}: expected 3-D points, got {points.shape[1]} coordinates per point")
     mesh, fe_index = skfem_mesh(cell_type, points * scale, cells)
     node_sets = _NodeSets(data, fe_index, path)
     resolved = tuple(_resolve_bore(mesh, spec, str(path), node_sets) for spec in bores)
@@ -456,11 +457,11 @@ def _volume_cells(data: meshio.Mesh, path: Path) -> tuple[str, np.ndarray]:
     volume = [t for t in _CELL_TYPES if t in found]
     if not volume:
         listed = ", ".join(sorted(found)) or "no cells at all"
-        raise ValueError(f"{path}: no supported volume cells (tetra10, hexahedron27, tetra, hexahedron); "
-                         f"the file holds {listed}")
+        raise LinkModelError(f"{path}: no supported volume cells (tetra10, hexahedron27, tetra, hexahedron); "
+                             f"the file holds {listed}")
     if len(volume) > 1:
-        raise ValueError(f"{path}: mixed volume cell types {', '.join(volume)} are not supported; "
-                         "use one element type")
+        raise LinkModelError(f"{path}: mixed volume cell types {', '.join(volume)} are not supported; "
+                             "use one element type")
     cell_type = volume[0]
     cells = np.concatenate([b.data for b in data.cells if b.type == cell_type]).astype(np.int64)
     return cell_type, cells
@@ -493,16 +494,16 @@ def _check_node_order(mesh, points, fe_index, cell_type) -> None:
     """Check that every input point landed on one FE node and edge nodes sit mid-edge."""
     used = np.flatnonzero(fe_index >= 0)
     if not np.array_equal(mesh.doflocs[:, fe_index[used]], points[used].T):
-        raise ValueError(f"{cell_type} cells: inconsistent higher-order node numbering "
-                         "(two cells disagree about a shared edge or face node)")
+        raise LinkModelError(f"{cell_type} cells: inconsistent higher-order node numbering "
+                             "(two cells disagree about a shared edge or face node)")
     if mesh.doflocs.shape[1] == mesh.nvertices:
         return
     a, b = (mesh.doflocs[:, mesh.edges[k]] for k in (0, 1))
     mid = mesh.doflocs[:, mesh.nvertices + np.arange(mesh.nedges)]
     off = np.linalg.norm(mid - (a + b) / 2, axis=0) / np.linalg.norm(b - a, axis=0)
     if off.max() > 0.25:
-        raise ValueError(f"{cell_type} cells: edge nodes are not near their edge midpoints "
-                         f"(worst offset {off.max():.2f} edge lengths); unsupported node order")
+        raise LinkModelError(f"{cell_type} cells: edge nodes are not near their edge midpoints "
+                             f"(worst offset {off.max():.2f} edge lengths); unsupported node order")
 
 
 # --- bores ------------------------------------------------------------------
@@ -527,8 +528,8 @@ class _NodeSets:
         matches = [n for n in names if n == name] or [n for n in names if n.lower() == name.lower()]
         if len(matches) != 1:
             listed = ", ".join(names) if names else "none"
-            raise ValueError(f"bore {bore!r}: node set {name!r} not found in {self._path}; "
-                             f"node sets in the file: {listed}")
+            raise LinkModelError(f"bore {bore!r}: node set {name!r} not found in {self._path}; "
+                                 f"node sets in the file: {listed}")
         points = self._points(matches[0])
         nodes = self._fe_index[points]
         return np.unique(nodes[nodes >= 0])
@@ -553,13 +554,13 @@ def _resolve_bore(mesh, spec: BoreSpec, source: str, node_sets) -> Bore:
     corners = mesh.doflocs[:, mesh.facets[:, facets]]  # (3, corners per face, faces)
     if spec.node_set is not None:
         if node_sets is None:
-            raise ValueError(f"bore {spec.name!r}: node sets need a mesh file (use load_mesh)")
+            raise LinkModelError(f"bore {spec.name!r}: node sets need a mesh file (use load_mesh)")
         in_set = np.zeros(mesh.doflocs.shape[1], dtype=bool)
         in_set[node_sets.get(spec.node_set, spec.name)] = True
         facets = facets[in_set[mesh.facets[:, facets]].all(axis=0)]
         if facets.size == 0:
-            raise ValueError(f"bore {spec.name!r}: node set {spec.node_set!r} of {source} contains "
-                             "no complete boundary face")
+            raise LinkModelError(f"bore {spec.name!r}: node set {spec.node_set!r} of {source} contains "
+                                 "no complete boundary face")
         return _bore_from_facets(mesh, spec.name, facets, None)
     centre = np.asarray(spec.centre, dtype=float)
     axis = np.asarray(spec.axis, dtype=float) / np.linalg.norm(spec.axis)
@@ -567,7 +568,7 @@ def _resolve_bore(mesh, spec: BoreSpec, source: str, node_sets) -> Bore:
     dist = _distance_to_axis(corners, centre, axis)
     hit = (np.abs(dist - spec.radius) <= tol).all(axis=0)
     if not hit.any():
-        raise ValueError(_no_bore_message(spec, source, tol, dist, centre, axis))
+        raise LinkModelError(_no_bore_message(spec, source, tol, dist, centre, axis))
     return _bore_from_facets(mesh, spec.name, facets[hit], (centre, axis, spec.radius))
 
 

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from .atomic import replacing
+from .errors import ReducedLinkFileError
 from .selection import ModeDecision
 
 __all__ = ["ReducedLink", "ReducedLinkFileError", "save_reduced_link", "load_reduced_link", "SCHEMA", "SCHEMA_VERSION"]
@@ -37,10 +38,6 @@ FFRF_KEYS = (
     "totalMass", "chiU", "chiUtilde", "mPsiTildePsi", "mPsiTildePsiTilde",
     "mPhitTPsi", "mPhitTPsiTilde", "mXRefTildePsi", "mXRefTildePsiTilde",
 )
-
-
-class ReducedLinkFileError(ValueError):
-    """A reduced-link file that cannot be trusted: unreadable, incomplete, altered or of another version."""
 
 
 def package_version() -> str:

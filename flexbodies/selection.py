@@ -14,6 +14,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from .errors import LinkModelError
+
 __all__ = ["ModeDecision", "decide_modes", "LOW_FREQUENCY_RATIO", "MOUNTED_BOUNDARY"]
 
 #: The low-frequency rule holds when f_exc / f1 is below this ratio.
@@ -90,18 +92,18 @@ def _parse_request(modes):
         word = modes.strip().lower()
         if word in ("auto", "static"):
             return word, None
-        raise ValueError(f"unknown mode selection {modes!r}; expected 'auto', 'static', a count or a cut-off in Hz")
+        raise LinkModelError(f"unknown mode selection {modes!r}; expected 'auto', 'static', a count or a cut-off in Hz")
     if isinstance(modes, bool):
-        raise ValueError("mode selection must be 'auto', 'static', an int count or a float cut-off in Hz")
+        raise LinkModelError("mode selection must be 'auto', 'static', an int count or a float cut-off in Hz")
     if isinstance(modes, int):
         if modes < 0:
-            raise ValueError(f"mode count must be >= 0, got {modes}")
+            raise LinkModelError(f"mode count must be >= 0, got {modes}")
         return "count", modes
     if isinstance(modes, float):
         if not modes > 0:
-            raise ValueError(f"mode cut-off must be a positive frequency in Hz, got {modes}")
+            raise LinkModelError(f"mode cut-off must be a positive frequency in Hz, got {modes}")
         return "cutoff", modes
-    raise ValueError(f"mode selection must be 'auto', 'static', an int count or a float cut-off in Hz, got {modes!r}")
+    raise LinkModelError(f"mode selection must be 'auto', 'static', an int count or a float cut-off in Hz, got {modes!r}")
 
 
 def decide_modes(modes, fundamental_hz: float, excitation_hz: float | None = None) -> ModeDecision:
@@ -134,7 +136,7 @@ def decide_modes(modes, fundamental_hz: float, excitation_hz: float | None = Non
             f"fixed-interface modes up to {value:g} Hz, as requested",
         )
     if excitation_hz is None or not excitation_hz > 0:
-        raise ValueError("mode selection 'auto' needs the highest excitation frequency (Hz > 0)")
+        raise LinkModelError("mode selection 'auto' needs the highest excitation frequency (Hz > 0)")
     ratio = excitation_hz / f1
     if ratio < LOW_FREQUENCY_RATIO:
         reason = (

@@ -1,18 +1,25 @@
 """Every error the package raises on purpose, and the exit code of each.
 
-Two kinds, each with its command-line exit code (:func:`exit_code`):
+Every such error derives from one root, :class:`MountwbError`, and carries
+its command-line exit code as the class attribute ``exit_code``
+(:func:`exit_code`). Two kinds:
 
-- **bad input** (exit 2): the case, a workbook, a rig record or a unit
-  cannot be used. The message names the file, sheet, cell, row or field,
-  what was found and what was expected. Nothing was written.
+- **bad input** (exit 2, :class:`InputError` and its subclasses): the case,
+  a workbook, a rig record, a link model or a unit cannot be used. The
+  message names the file, sheet, cell, row or field, what was found and
+  what was expected. Nothing was written. An :class:`OSError` (a file that
+  cannot be read or written) is bad input too.
 - **numerical trouble** (exit 1, :class:`SimulationError` and its
   subclasses): a mechanism, a failed equilibrium, a resonance without
   damping, a failed or diverging integration, an exhausted time budget. The
   message says when and why, in plain words.
 
-An interrupt exits with 130 (Ctrl-C, SIGINT) or 143 (SIGTERM,
-:class:`Terminated`); a parameter study whose every row ran but some failed
-exits with 3 (:data:`EXIT_FAILED_ROWS`).
+Any other exception is a defect of the package, not of the input: the
+command line exits with 1, says "internal error" and writes the traceback
+to a log file. An interrupt exits with 130 (Ctrl-C, SIGINT) or 143
+(SIGTERM, :class:`Terminated`); a parameter study whose every row ran but
+some failed exits with 3 (:data:`EXIT_FAILED_ROWS`). The errors of
+:mod:`flexbodies` (``flexbodies.errors``) derive from :class:`InputError`.
 """
 from __future__ import annotations
 
@@ -20,7 +27,8 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-__all__ = ["CaseError", "UnitProblem", "Problem", "WorkbookError", "TableError", "RecordError", "SimulationError",
+__all__ = ["MountwbError", "InputError", "CaseFileError", "UnwritableCase",
+           "CaseError", "UnitProblem", "Problem", "WorkbookError", "TableError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
            "MechanismError", "EquilibriumError", "FourPoleError", "UnstablePreloadError", "BucklingError", "UsageError",
            "BAD_INPUT",
@@ -36,7 +44,36 @@ class Terminated(KeyboardInterrupt):
     that cleans up after Ctrl-C cleans up after it too."""
 
 
-class CaseError(ValueError):
+class MountwbError(Exception):
+    """The root of every error the package raises on purpose.
+
+    Attributes
+    ----------
+    exit_code : int
+        Exit code of the command line for this error (a class attribute).
+    """
+
+    exit_code = EXIT_TROUBLE
+
+
+class InputError(MountwbError, ValueError):
+    """Bad input (exit 2): something the user gave that cannot be used; the
+    message says what was found and what was expected."""
+
+    exit_code = EXIT_BAD_INPUT
+
+
+class CaseFileError(InputError):
+    """A JSON case whose content is not a case: an unknown item type, unknown
+    or missing fields, or a value of the wrong kind."""
+
+
+class UnwritableCase(InputError):
+    """A case that a case workbook cannot hold (a mesh link or casing, a
+    simultaneous excitation, ...): it is given in Python or JSON."""
+
+
+class CaseError(InputError):
     """An invalid case.
 
     Attributes
@@ -56,7 +93,7 @@ class CaseError(ValueError):
         super().__init__(f"{item}, field '{field}': found {value!r}, expected {expected}")
 
 
-class UnitProblem(ValueError):
+class UnitProblem(InputError):
     """A unit text that cannot be used in its column.
 
     Attributes
@@ -107,7 +144,7 @@ class Problem:
         return f"{', '.join(where)}: found {found}, expected {self.expected}"
 
 
-class WorkbookError(ValueError):
+class WorkbookError(InputError):
     """A workbook that cannot be used; :attr:`problems` lists every problem found."""
 
     def __init__(self, problems: list[Problem]):
@@ -120,7 +157,7 @@ class TableError(WorkbookError):
     names the file, sheet, row and column of each problem."""
 
 
-class RecordError(ValueError):
+class RecordError(InputError):
     """A rig record that cannot be used.
 
     Attributes
@@ -140,8 +177,10 @@ class RecordError(ValueError):
         super().__init__(f"{path}{where}: {message}")
 
 
-class SimulationError(RuntimeError):
-    """A run stopped for a numerical or physical reason given in the message."""
+class SimulationError(MountwbError, RuntimeError):
+    """A run stopped for a numerical or physical reason given in the message (exit 1)."""
+
+    exit_code = EXIT_TROUBLE
 
 
 class NewtonFailure(SimulationError):
@@ -269,12 +308,12 @@ class BucklingError(SimulationError):
             f"shorter link).")
 
 
-class UsageError(ValueError):
+class UsageError(InputError):
     """A command-line option or argument that cannot be used, with what it takes."""
 
 
 #: The errors that are the user's input, not the solution (exit 2).
-BAD_INPUT = (CaseError, UnitProblem, WorkbookError, RecordError, UsageError)
+BAD_INPUT = (InputError,)
 
 
 def interruption(error: BaseException) -> KeyboardInterrupt | None:
@@ -300,24 +339,21 @@ def interruption(error: BaseException) -> KeyboardInterrupt | None:
 
 
 def exit_code(error: BaseException) -> int:
-    """The command-line exit code of *error*: 1 numerical trouble, 2 bad input
-    (also a file that cannot be read, :class:`OSError`, and a link model
-    that :mod:`flexbodies` refuses, :class:`ValueError`), 130 interrupted,
-    143 terminated (also when Exudyn wrapped the interrupt, :func:`interruption`).
-
-    Raises
-    ------
-    TypeError
-        *error* is none of these: a defect of the package, not of the input.
+    """The command-line exit code of *error*: its ``exit_code`` for an error
+    of the package (:class:`MountwbError`: 1 numerical trouble, 2 bad input),
+    2 for a file that cannot be read or written (:class:`OSError`), 130
+    interrupted, 143 terminated (also when Exudyn wrapped the interrupt,
+    :func:`interruption`), and 1 for any other exception: a defect of the
+    package, not of the input.
     """
     interrupt = interruption(error)
     if interrupt is not None:
         return EXIT_TERMINATED if isinstance(interrupt, Terminated) else EXIT_INTERRUPTED
-    if isinstance(error, SimulationError):
-        return EXIT_TROUBLE
-    if isinstance(error, BAD_INPUT + (ValueError, OSError)):
+    if isinstance(error, MountwbError):
+        return error.exit_code
+    if isinstance(error, OSError):
         return EXIT_BAD_INPUT
-    raise TypeError(f"no exit code for {type(error).__name__}")
+    return EXIT_TROUBLE
 
 
 class FourPoleError(SimulationError):

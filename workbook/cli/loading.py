@@ -37,6 +37,8 @@ def _json_case(path: str) -> Case:
                          f"or a JSON case") from None
     except json.JSONDecodeError as error:
         raise UsageError(f"{path}: not a JSON case: {error}") from None
+    except OSError as error:
+        raise UsageError(f"{path}: the case cannot be read ({error.strerror or error})") from None
     if not isinstance(case, Case):
         raise CaseError(path, "type", type(case).__name__, "a JSON case (type 'Case')")
     return case

@@ -6,18 +6,29 @@ Exit codes (:mod:`workbook.errors`, ``docs/reliability.md``): 0 done, 1
 numerical trouble, 2 bad input (nothing written), 3 a parameter study with
 failed rows, 130 interrupted (Ctrl-C), 143 terminated (SIGTERM). An interrupt
 or SIGTERM anywhere prints one line, no traceback.
+
+Only an error of the package (:class:`workbook.errors.MountwbError`, whose
+class carries its exit code) is reported as the user's input or as
+numerical trouble, in one line; so is a file that cannot be read or written
+(:class:`OSError`, exit 2). Any other exception is a defect of ``mountwb``:
+exit 1, one line saying "internal error", and the traceback in a log file
+whose path the line gives.
 """
 from __future__ import annotations
 
 import argparse
 import logging
+import os
 import signal
 import sys
+import tempfile
+import time
+import traceback
 
 from threadpoolctl import threadpool_limits
 
 from workbook.cli import cache, four_pole, layout, links, rig, run, run_up, study, workbooks
-from workbook.errors import SimulationError, Terminated, exit_code, interruption
+from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
 
@@ -64,6 +75,39 @@ def _interrupted(command: str, interrupt: KeyboardInterrupt) -> int:
     return exit_code(interrupt)
 
 
+def _internal_error(command: str, error: Exception, argv: list[str]) -> int:
+    """Report a defect of the package: the traceback to a log file, one line to stderr; exit 1.
+
+    Parameters
+    ----------
+    command : str
+        The command that failed.
+    error : Exception
+        An exception that is not an error of the package (:class:`workbook.errors.MountwbError`).
+    argv : list of str
+        The command's arguments, for the log.
+
+    Returns
+    -------
+    int
+        :data:`workbook.errors.EXIT_TROUBLE` (1).
+    """
+    text = "".join(traceback.format_exception(type(error), error, error.__traceback__))
+    try:
+        handle, path = tempfile.mkstemp(prefix=f"mountwb-internal-error-{time.strftime('%Y%m%d-%H%M%S')}-",
+                                        suffix=".log")
+        with os.fdopen(handle, "w", encoding="utf-8") as log:
+            log.write(f"mountwb {' '.join(argv)}\nPython {sys.version.split()[0]}\n\n{text}")
+        where = f"the traceback is in {path}"
+    except OSError:
+        print(text, file=sys.stderr, end="")
+        where = "the traceback is above"
+    first = (str(error).splitlines() or [""])[0]
+    print(f"mountwb {command}: internal error (a bug of mountwb, not of your input): "
+          f"{type(error).__name__}: {first}; {where}", file=sys.stderr)
+    return exit_code(error)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``mountwb`` console script; returns the exit code."""
     # SIGTERM unwinds like Ctrl-C: temporary files are removed, study workers stopped.
@@ -86,8 +130,10 @@ def _main(argv: list[str] | None) -> int:
         interrupt = interruption(error)  # also when Exudyn wrapped it into an error of its own
         if interrupt is not None:
             return _interrupted(args.command, interrupt)
-        if not isinstance(error, (SimulationError, ValueError, OSError)):
+        if not isinstance(error, Exception):
             raise
+        if not isinstance(error, (MountwbError, OSError)):
+            return _internal_error(args.command, error, sys.argv[1:] if argv is None else list(argv))
         trouble = "numerical trouble: " if isinstance(error, SimulationError) else ""
         print(f"mountwb {args.command}: {trouble}{error}", file=sys.stderr)
         return exit_code(error)

@@ -20,6 +20,7 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.datavalidation import DataValidation
 
 import workbook.excel.layout as L
+from workbook.errors import UnwritableCase
 from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.styling import print_setup
@@ -87,7 +88,7 @@ def _display(value: float, factor: float) -> float:
 def _row_for_link(link: cm.Link) -> dict:
     model = link.model
     if model.geometry is None:
-        raise ValueError(f"link {link.name!r}: only parametric links can be written (a mesh link is written by hand)")
+        raise UnwritableCase(f"link {link.name!r}: only parametric links can be written (a mesh link is written by hand)")
     import flexbodies
 
     row = {"name": link.name, **_vector("end_a", link.end_a), **_vector("end_b", link.end_b),
@@ -115,8 +116,8 @@ def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
     (the first with the speed, the axis and any sweep or run-up)."""
     row = {"name": excitation.name}
     if isinstance(excitation, cm.Simultaneous):
-        raise ValueError(f"excitation {excitation.name!r}: simultaneous excitations have no Excitations row; "
-                         f"run them from Python or a JSON case")
+        raise UnwritableCase(f"excitation {excitation.name!r}: simultaneous excitations have no Excitations row; "
+                             f"run them from Python or a JSON case")
     if isinstance(excitation, cm.RunUp):
         f = excitation.frequencies_hz
         row.update(sweep_from=f[0], sweep_to=f[-1], sweep_points=len(f), run_up=excitation.speed_unit)
@@ -126,7 +127,7 @@ def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
         spacing = next((name for name, space in (("log", np.geomspace), ("linear", np.linspace))
                         if np.allclose(space(f[0], f[-1], len(f)), f, rtol=1e-12)), None)
         if spacing is None:
-            raise ValueError(f"excitation {excitation.name!r}: only log or linear sweeps can be written")
+            raise UnwritableCase(f"excitation {excitation.name!r}: only log or linear sweeps can be written")
         row.update(sweep_from=f[0], sweep_to=f[-1], sweep_points=len(f), sweep_spacing=spacing)
         template = excitation.template
     else:
@@ -157,7 +158,7 @@ def _row_for_load(load: cm.StaticLoad) -> dict:
 def _row_for_rotor(rotor: cm.Rotor) -> dict:
     axis = {vector: letter for letter, vector in L.AXES.items()}.get(rotor.axis)
     if axis is None:
-        raise ValueError(f"rotor {rotor.name!r}: only rotors spinning about +x, +y or +z can be written")
+        raise UnwritableCase(f"rotor {rotor.name!r}: only rotors spinning about +x, +y or +z can be written")
     return {"name": rotor.name, "polar_inertia": rotor.polar_inertia, "frequency_hz": rotor.frequency, "axis": axis}
 
 
@@ -175,13 +176,13 @@ def _rows_for_casing(casing) -> list[dict]:
         return []
     g = casing.geometry
     if g is None:
-        raise ValueError("engine casing: only a parametric casing can be written (a mesh casing is written by hand)")
+        raise UnwritableCase("engine casing: only a parametric casing can be written (a mesh casing is written by hand)")
     if len(g.rings) > len(L.CASING_RINGS) or len(casing.bearing_planes) > len(L.CASING_BEARINGS):
-        raise ValueError(f"engine casing: at most {len(L.CASING_RINGS)} rings and {len(L.CASING_BEARINGS)} bearing "
-                         "planes can be written")
+        raise UnwritableCase(f"engine casing: at most {len(L.CASING_RINGS)} rings and {len(L.CASING_BEARINGS)} bearing "
+                             "planes can be written")
     if any(casing.bearing_damping) or casing.core_spin_hz != DEFAULT_CORE_SPIN_HZ:
-        raise ValueError("engine casing: bearing damping and a core spin frequency other than the default have no "
-                         "column; such a casing is given in Python or JSON")
+        raise UnwritableCase("engine casing: bearing damping and a core spin frequency other than the default have no "
+                             "column; such a casing is given in Python or JSON")
     base = flexbodies.material(casing.material.name.split(" ")[0])
     radial, axial = casing.bearing_stiffness
     row = {"radius": g.radius, "thickness": g.thickness, "x_start": g.x_start, "x_end": g.x_end,

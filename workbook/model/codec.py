@@ -12,6 +12,7 @@ import dataclasses
 import json
 from typing import Any
 
+from workbook.errors import CaseFileError
 from workbook.model import case as _case
 from workbook.model.casing import CasingGeometry, EngineCasing, MountRing
 from workbook.model.pylon_beam import BoxBeamPylon
@@ -69,16 +70,16 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
             return {key: from_dict(value, classes) for key, value in data.items()}
         kind = data["type"]
         if kind not in classes:
-            raise ValueError(f"unknown item type {kind!r}; expected one of {', '.join(sorted(classes))}")
+            raise CaseFileError(f"unknown item type {kind!r}; expected one of {', '.join(sorted(classes))}")
         cls = classes[kind]
         known = {f.name for f in dataclasses.fields(cls)}
         unknown = set(data) - known - {"type"}
         if unknown:
-            raise ValueError(f"{kind}: unknown fields {sorted(unknown)}; expected {sorted(known)}")
+            raise CaseFileError(f"{kind}: unknown fields {sorted(unknown)}; expected {sorted(known)}")
         missing = sorted(f.name for f in dataclasses.fields(cls) if f.name not in data
                          and f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)
         if missing:
-            raise ValueError(f"{kind}: fields {missing} missing; expected {sorted(known)}")
+            raise CaseFileError(f"{kind}: fields {missing} missing; expected {sorted(known)}")
         fields = {key: from_dict(value, classes) for key, value in data.items() if key != "type"}
         if cls is _case.Link and isinstance(fields.get("modes"), float):
             fields["modes"] = _case.ModeCutoff(fields["modes"])     # a number with a fraction: a cut-off, Hz
@@ -86,7 +87,7 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
             return cls(**fields)
         except (TypeError, AttributeError) as error:
             # a value of the wrong kind (a list where a number belongs, ...)
-            raise ValueError(f"{kind}: a field holds a value of the wrong kind ({error})") from None
+            raise CaseFileError(f"{kind}: a field holds a value of the wrong kind ({error})") from None
     return data
 
 

@@ -39,6 +39,7 @@ import numpy as np
 from flexbodies.atomic import replacing
 from flexbodies.selection import MODE_MARGIN
 from workbook.answers.saving import save_figure, save_text
+from workbook.errors import InputError
 from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
 from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
@@ -365,7 +366,7 @@ def run_study(case: Case, *, repeats: int = 3, rungs: list | None = None,
     if REFERENCE_RUNG not in [r.label for r in rungs]:
         raise ValueError(f"the ladder must hold the reference rung {REFERENCE_RUNG!r}")
     if not case.single_frequency_excitations():
-        raise ValueError(f"case {case.name!r} has no excitation to study")
+        raise InputError(f"case {case.name!r} has no excitation to study")
     results = []
     for rung in rungs:
         if progress is not None:

@@ -31,7 +31,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from workbook.errors import CaseError
+from workbook.errors import CaseError, InputError
 from workbook.model.case import Case, HarmonicForce, RotatingForce
 
 __all__ = ["Parameter", "PARAMETERS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases"]
@@ -130,7 +130,7 @@ PARAMETERS = {p.name: p for p in (
 def _check_names(names) -> None:
     unknown = [n for n in names if n not in PARAMETERS]
     if unknown:
-        raise ValueError(f"unknown study parameter(s) {', '.join(map(repr, unknown))}; "
+        raise InputError(f"unknown study parameter(s) {', '.join(map(repr, unknown))}; "
                          f"known: {', '.join(PARAMETERS)}")
 
 
@@ -154,7 +154,7 @@ def grid(values: dict[str, list]) -> tuple[dict, ...]:
 def linear_range(start: float, stop: float, points: int) -> list[float]:
     """*points* evenly spaced values from *start* to *stop*."""
     if points < 1:
-        raise ValueError(f"a range needs at least one point, got {points}")
+        raise InputError(f"a range needs at least one point, got {points}")
     return [float(v) for v in np.linspace(start, stop, points)]
 
 
@@ -178,9 +178,9 @@ def latin_hypercube(bounds: dict[str, tuple[float, float]], samples: int, seed: 
     _check_names(bounds)
     text = [n for n in bounds if not PARAMETERS[n].numeric]
     if text:
-        raise ValueError(f"a Latin hypercube needs numeric ranges; {', '.join(text)} takes a list")
+        raise InputError(f"a Latin hypercube needs numeric ranges; {', '.join(text)} takes a list")
     if samples < 1:
-        raise ValueError(f"a Latin hypercube needs at least one sample, got {samples}")
+        raise InputError(f"a Latin hypercube needs at least one sample, got {samples}")
     unit = qmc.LatinHypercube(d=len(bounds), seed=seed).random(samples)
     low, high = np.array(list(bounds.values()), dtype=float).T
     points = qmc.scale(unit, low, high) if len(bounds) else unit

@@ -1,0 +1,22 @@
+"""The errors :mod:`flexbodies` raises on purpose.
+
+Both are bad input (exit 2 of the ``mountwb`` command line): they derive
+from :class:`workbook.errors.InputError`, the bad-input branch of the one
+root of the package's errors, and from :class:`ValueError`. Any other
+exception out of :mod:`flexbodies` is a defect, not the user's input.
+"""
+from __future__ import annotations
+
+from workbook.errors import InputError
+
+__all__ = ["LinkModelError", "ReducedLinkFileError"]
+
+
+class LinkModelError(InputError):
+    """A link or engine-casing model that cannot be used: its geometry,
+    material, mesh (file, cells, bores, node sets), interfaces or mode
+    selection. The message names the item and what was expected."""
+
+
+class ReducedLinkFileError(InputError):
+    """A reduced-link file that cannot be trusted: unreadable, incomplete, altered or of another version."""
