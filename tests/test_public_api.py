@@ -20,7 +20,7 @@ import flexbodies
 import workbook
 
 #: Modules a user may import; their names are the API.
-PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies")
+PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.errors")
 
 #: Modules of the implementation: importable, but their names may change between versions.
 INTERNAL_MODULES = (

@@ -45,7 +45,7 @@ _HOMES = {
     "rig.records": ("RigRecord", "read_record", "write_record"),
     "studies.parametric": ("PARAMETERS", "grid", "latin_hypercube", "study_cases"),
     "studies.parallel": ("run_rows", "RowOutcome"),
-    "errors": ("CaseError", "WorkbookError", "RecordError", "UsageError", "SimulationError", "MechanismError",
+    "errors": ("MountwbError", "InputError", "CaseError", "WorkbookError", "RecordError", "UsageError", "SimulationError", "MechanismError",
                "EquilibriumError", "ResonanceError", "FourPoleError", "UnstablePreloadError", "BucklingError",
                "Terminated"),
 }
