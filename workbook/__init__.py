@@ -36,6 +36,7 @@ _HOMES = {
     "solve.four_pole_set": ("four_pole",),
     "solve.four_pole": ("FourPole", "frequency_grid"),
     "solve.modes": ("mounted_modes", "Mode"),
+    "solve.campbell": ("campbell", "CampbellDiagram"),
     "answers.results": ("MountResult", "ExcitationResult"),
     "answers.isolation": ("transmissibility", "efficiency", "level_db"),
     "excel.reader": ("read_workbook", "CaseBook"),

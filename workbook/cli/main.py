@@ -27,7 +27,7 @@ import traceback
 
 from threadpoolctl import threadpool_limits
 
-from workbook.cli import cache, four_pole, layout, links, rig, run, run_up, study, workbooks
+from workbook.cli import cache, campbell, four_pole, layout, links, rig, run, run_up, study, workbooks
 from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
@@ -49,6 +49,8 @@ COMMANDS = {
     "run-up": ("a rotor imbalance over a speed range (force U w^2): pylon force and T per direction against speed, "
                "the mounted modes marked", run_up.arguments),
     "four-pole": ("the mount's four-pole parameters (dynamic stiffness) against frequency", four_pole.arguments),
+    "campbell": ("the Campbell diagram: mounted modes against rotor speed, gyroscopic whirl, critical speeds",
+                 campbell.arguments),
     "cache": ("the store of reduced links: info, verify (keys and checksums), clear", cache.arguments),
 }
 

@@ -39,7 +39,7 @@ from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
 
-__all__ = ["Linearization", "Mode", "linearize", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
+__all__ = ["Linearization", "Mode", "linearize", "eigenpairs", "modes_from", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
            "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
 
 #: Modes below this frequency count as free motions (mechanisms), Hz. The
@@ -190,7 +190,7 @@ def linearize(scene: Scene) -> Linearization:
                          gyroscopic)
 
 
-def _eigen(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
+def eigenpairs(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
     """Squared circular frequencies (rad^2/s^2) and mode vectors, by ascending frequency.
 
     Without rotors: ``K x = w^2 M x``. With rotors: the undamped gyroscopic
@@ -206,8 +206,11 @@ def _eigen(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
         return eigenvalues.real[order], vectors[:, order]
     size = lin.mass.shape[0]
     identity, zero = np.eye(size), np.zeros((size, size))
-    eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]),
-                                   np.block([[identity, zero], [zero, lin.mass]]))
+    if np.array_equal(lin.mass, identity):       # a mass-orthonormal basis: a standard eigenproblem, faster
+        eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]))
+    else:
+        eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]),
+                                       np.block([[identity, zero], [zero, lin.mass]]))
     tolerance = 1e-9 * np.abs(eigenvalues).max()
     half_plane = np.where(eigenvalues.imag > tolerance, 0, np.where(eigenvalues.imag < -tolerance, 2, 1))
     keep = np.lexsort((-eigenvalues.real, half_plane))[:size]
@@ -229,7 +232,11 @@ def modes_of(linearization: Linearization, *, gyroscopic: bool = True) -> list[M
         0 Hz although nothing is free).
     """
     lin = linearization if gyroscopic else dataclasses.replace(linearization, gyroscopic=None)
-    squared_frequencies, vectors = _eigen(lin)
+    return modes_from(lin, *eigenpairs(lin))
+
+
+def modes_from(lin: Linearization, squared_frequencies: np.ndarray, vectors: np.ndarray) -> list[Mode]:
+    """The modes of the eigenpairs of *lin* (:func:`eigenpairs`): their energies, shares and shapes."""
 
     def energy(matrix, shapes):
         """``Re(x^H A x)`` of every column x of *shapes*."""
