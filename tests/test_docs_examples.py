@@ -20,7 +20,7 @@ PAGES = sorted(ROOT.glob("docs/*.md")) + [ROOT / "README.md"]
 BLOCK = re.compile(r"^```python[ \t]*\n(.*?)^```[ \t]*$", re.DOTALL | re.MULTILINE)
 
 #: Pages whose blocks take more than about 5 s with an empty reduction cache.
-SLOW_PAGES = {"flexible-links.md", "four-pole.md", "reference-mount.md", "rig-sensors.md", "README.md"}
+SLOW_PAGES = {"flexible-links.md", "four-pole.md", "index.md", "reference-mount.md", "rig-sensors.md", "README.md"}
 
 
 def python_blocks(page: Path) -> list[str]:
