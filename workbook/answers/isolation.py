@@ -50,7 +50,7 @@ def pylon_sum(forces: Mapping[str, np.ndarray], channels: Iterable[str]) -> np.n
 
 
 def transmissibility(amplitude: np.ndarray, excitation_amplitude: float) -> np.ndarray:
-    """T = |F| / |F_exc| per direction (amplitudes in N)."""
+    """``T = |F| / |F_exc|`` per direction (amplitudes in N)."""
     return np.asarray(amplitude) / excitation_amplitude
 
 
