@@ -11,10 +11,10 @@ link is cached (``~/.cache/mountwb`` or ``MOUNTWB_CACHE``), so a second call
 only loads it.
 """
 
+import workbook as wb
 from flexbodies import reduce_link
-from workbook.model.reference import reference_case
 
-link = next(link for link in reference_case().links if link.name == "thrust-left")
+link = next(link for link in wb.reference_case().links if link.name == "thrust-left")
 reduced = reduce_link(link.model, modes="auto", excitation_hz=248.5)
 
 # %%

@@ -9,11 +9,10 @@ quickest answer the package gives, and the first rung of the accuracy study.
 rotor excitation; the scene is linear, so the frequency domain answers it.
 """
 
-from workbook.model.reference import reference_case
-from workbook.solve.pipeline import run_case
+import workbook as wb
 
-case = reference_case().with_rigid_links()
-result = run_case(case)
+case = wb.reference_case().with_rigid_links()
+result = wb.run_case(case)
 
 # %%
 # Isolation efficiency eta = (1 - T) x 100 % of the pylon force, per direction:

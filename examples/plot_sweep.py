@@ -10,11 +10,10 @@ the scene once and solves every frequency in the frequency domain; the answer
 holds T per direction of the pylon force and the mounted modes in the band.
 """
 
-from workbook.model.reference import reference_case, reference_sweep
-from workbook.solve.sweep import run_sweep
+import workbook as wb
 
-sweep = reference_sweep(points=40)
-answer = run_sweep(reference_case(), sweep)
+sweep = wb.reference_sweep(points=40)
+answer = wb.run_sweep(wb.reference_case(), sweep)
 
 # %%
 # The mounted modes in the band: the engine's six rigid-body modes on its
