@@ -9,18 +9,15 @@ from __future__ import annotations
 
 import csv
 import re
-import shutil
-import subprocess
 import zipfile
 
 import pytest
-from excel_helpers import copy_reference, make_cheap, sha256
+from excel_helpers import SOFFICE, copy_reference, make_cheap, sha256, soffice_convert
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
 from workbook.excel.styling import FORMATS
 
-SOFFICE = shutil.which("soffice")
 pytestmark = [pytest.mark.skipif(SOFFICE is None, reason="LibreOffice (soffice) is not on PATH: "
                                                           "apt-get install libreoffice-calc-nogui"),
               pytest.mark.slow]
@@ -29,14 +26,6 @@ REFERENCE_SWEEP_POINTS = 25
 #: Printed pages the whole reference report may take.
 MAX_REPORT_PAGES = 12
 _CSV = "Text - txt - csv (StarCalc):44,34,76,1,,0,false,true,{shown},false,false{sheets}"
-
-
-def _convert(folder, target: str, *files, outdir):
-    """``soffice --headless --convert-to TARGET`` with a profile of its own in *folder*."""
-    profile = (folder / "lo-profile").as_uri()
-    result = subprocess.run([SOFFICE, "--headless", f"-env:UserInstallation={profile}", "--convert-to", target,
-                             "--outdir", str(outdir), *map(str, files)], capture_output=True, text=True, timeout=300)
-    assert result.returncode == 0, result.stderr
 
 
 def _pages(pdf) -> int:
@@ -58,10 +47,10 @@ def reference_run(tmp_path_factory):
     report = folder / "report.xlsx"
     assert main(["run", str(case), "--no-progress", "--report", str(report)]) == 0
     out = folder / "converted"
-    _convert(folder, "pdf", case, report, outdir=out)
-    _convert(folder, "ods", report, outdir=out)
-    _convert(folder, "csv:" + _CSV.format(shown="false", sheets=",-1"), case, report, outdir=out / "raw")
-    _convert(folder, "csv:" + _CSV.format(shown="true", sheets=",-1"), report, outdir=out / "shown")
+    soffice_convert(folder, "pdf", case, report, outdir=out)
+    soffice_convert(folder, "ods", report, outdir=out)
+    soffice_convert(folder, "csv:" + _CSV.format(shown="false", sheets=",-1"), case, report, outdir=out / "raw")
+    soffice_convert(folder, "csv:" + _CSV.format(shown="true", sheets=",-1"), report, outdir=out / "shown")
     return case, report, out
 
 

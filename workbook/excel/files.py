@@ -67,9 +67,13 @@ _APP_PROPERTY = re.compile(rb"<(?:\w+:)?(" + b"|".join(p.encode() for p in _APP_
 _NOTE = re.compile(rb'<(?:\w+:)?shape\b[^>]*?style="([^"]*)"[^>]*>(?:(?!</(?:\w+:)?shape>).)*?ObjectType="Note"', re.S)
 #: Box of a comment as openpyxl writes it (Excel's default too): 144 x 79 px = 108 x 59.25 pt, hidden.
 _NOTE_BOX_PT = (108.0, 59.25)
-#: Parts whose loss is harmless: Excel rebuilds the calculation chain and the thumbnail, and the
-#: printer-driver settings are device data (the page setup itself is kept).
-_REBUILT_TYPES = ("calcChain+xml", "printerSettings", "image/jpeg")
+#: Parts whose loss is harmless: Excel rebuilds the calculation chain and the thumbnail, the
+#: printer-driver settings are device data (the page setup itself is kept), and the shared-strings
+#: table (Excel and LibreOffice write one) is rewritten into the cells as their text.
+_REBUILT_TYPES = ("calcChain+xml", "printerSettings", "image/jpeg", "sharedStrings+xml")
+#: Custom document properties: openpyxl keeps them; a part without any (LibreOffice writes one) holds nothing.
+_CUSTOM_PROPERTIES = "custom-properties+xml"
+_CUSTOM_PROPERTY = re.compile(rb"<(?:\w+:)?property\b")
 #: Worksheet extensions (extLst) openpyxl drops.
 _EXTENSIONS = (
     (re.compile(rb"<x14:dataValidations?\b"), "data-validation extensions (lists from other sheets)"),
@@ -153,7 +157,9 @@ def lost_parts(before: bytes, after: bytes) -> list[str]:
     """Parts of the workbook *before* of a kind the rewritten workbook *after* no longer has.
 
     A safety net under :func:`unsupported_content`: any kind of part (by
-    content type) that the rewrite dropped, except those Excel rebuilds.
+    content type) that the rewrite dropped, except those Excel rebuilds, the
+    shared strings (their text is kept in the cells) and custom document
+    properties that hold none.
 
     Returns
     -------
@@ -161,8 +167,10 @@ def lost_parts(before: bytes, after: bytes) -> list[str]:
         ``"<part name> (<content type>)"`` for each part lost.
     """
     kept = set(_content_types(after).values())
-    return [f"{name} ({kind})" for name, kind in _content_types(before).items()
-            if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)]
+    with zipfile.ZipFile(io.BytesIO(before)) as archive:
+        return [f"{name} ({kind})" for name, kind in _content_types(before).items()
+                if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)
+                and not (kind.endswith(_CUSTOM_PROPERTIES) and not _CUSTOM_PROPERTY.search(archive.read(name)))]
 
 
 def lock_file(path: str | Path) -> Path | None:
