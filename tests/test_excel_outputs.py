@@ -67,3 +67,30 @@ def test_a_chart_the_user_made_still_keeps_the_workbook_from_being_rewritten(fol
     assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
     assert "content this program cannot keep (charts" in capsys.readouterr().out
     assert sha256(path) == digest and len(_names(folder)) == 2
+
+
+def _rows(path, sheet):
+    return list(load_workbook(path)[sheet].iter_rows(min_row=3, values_only=True))
+
+
+@needs_libreoffice
+def test_a_run_of_one_row_keeps_the_results_of_the_other_runs(folder, tmp_path):
+    """HP rotor and the sweep, saved by LibreOffice, then LP rotor alone: the others' rows and cards stay."""
+    path = copy_reference(folder)
+    make_cheap(path, sweep_points=2)
+    assert main(["run", str(path), "--no-progress", "--run", "HP rotor", "--run", "sweep"]) == 0
+    save_in_libreoffice(path, tmp_path)
+    before = {sheet: _rows(path, sheet) for sheet in ("Result efficiency", "Result hinges", "Result sweep")}
+    note = load_workbook(path)["Result sweep"]["A1"].value
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert _names(folder) == ["case.xlsx"]
+    wb = load_workbook(path)
+    assert wb["Result sweep"]["A1"].value == note and _rows(path, "Result sweep") == before["Result sweep"]
+    for sheet in ("Result efficiency", "Result hinges"):
+        rows = _rows(path, sheet)
+        assert [row for row in rows if row[0] != "LP rotor"] == before[sheet]
+        assert {row[0] for row in rows} == {"LP rotor", "HP rotor", "sweep"}
+    assert "the results of 'HP rotor', 'sweep' are from an earlier run" in wb["Result efficiency"]["A1"].value
+    card = [cell.value for cell in wb["Result model card"]["A"]]
+    assert [line for line in card if str(line).startswith("Run '")] == ["Run 'HP rotor'", "Run 'sweep'",
+                                                                         "Run 'LP rotor'"]
