@@ -8,8 +8,13 @@ on PATH.
 """
 from __future__ import annotations
 
+import os
+import shutil
+import stat
+
 import pytest
-from excel_helpers import SOFFICE, copy_reference, make_cheap, save_in_libreoffice, sha256
+from cli_signals import start
+from excel_helpers import SOFFICE, copy_reference, make_cheap, save_in_libreoffice, set_cells, sha256
 from openpyxl import load_workbook
 from openpyxl.chart import BarChart, Reference
 
@@ -94,3 +99,66 @@ def test_a_run_of_one_row_keeps_the_results_of_the_other_runs(folder, tmp_path):
     card = [cell.value for cell in wb["Result model card"]["A"]]
     assert [line for line in card if str(line).startswith("Run '")] == ["Run 'HP rotor'", "Run 'sweep'",
                                                                          "Run 'LP rotor'"]
+
+
+def _mountwb(*args):
+    """``mountwb ARGS`` in a process of its own (stderr with the -v log, line by line)."""
+    return start(*map(str, args))
+
+
+@needs_libreoffice
+def test_two_runs_at_once_keep_both_results(folder, tmp_path):
+    """The second to write finds the workbook changed and writes its results beside it, and says so."""
+    path = save_in_libreoffice(_cheap_case(folder), tmp_path)
+    processes = {run: _mountwb("run", path, "--no-progress", "--run", run) for run in ("LP rotor", "HP rotor")}
+    outputs = {run: process.communicate(timeout=300) for run, process in processes.items()}
+    assert all(process.returncode == 0 for process in processes.values()), outputs
+    into = [run for run, (out, _) in outputs.items() if f"results written to {path}\n" in out]
+    beside = [run for run, (out, _) in outputs.items() if "case.xlsx was not overwritten: it changed on disk" in out]
+    assert len(into) == 1 and len(beside) == 1, outputs
+    assert _result_runs(path) == set(into)
+    side = [p for p in folder.iterdir() if p.name.startswith("case-results-")]
+    assert len(side) == 1 and _result_runs(side[0]) == set(beside)
+
+
+@needs_libreoffice
+def test_a_save_that_lands_while_the_results_are_built_is_kept(folder, tmp_path):
+    """The user saves the workbook (an edited copy LibreOffice saved, renamed over it) while mountwb builds the
+    new file: the check just before the rename finds it, the user's save stays and the results go beside."""
+    path = _cheap_case(folder)
+    edited = tmp_path / "edited" / "case.xlsx"
+    edited.parent.mkdir()
+    shutil.copyfile(path, edited)
+    set_cells(edited, {("Engine", "mass", 3): 3600})
+    save_in_libreoffice(edited, tmp_path)
+    digest = sha256(edited)
+    process = _mountwb("run", path, "--no-progress", "--run", "LP rotor")
+    for line in process.stderr:
+        if "building the new case.xlsx" in line:
+            os.replace(edited, path)
+            break
+    out, _ = process.communicate(timeout=300)
+    assert process.returncode == 0
+    assert "case.xlsx was not overwritten: it changed on disk while the results were being written" in out
+    assert sha256(path) == digest
+    side = [p for p in folder.iterdir() if p.name.startswith("case-results-")]
+    assert len(side) == 1 and _result_runs(side[0]) == {"LP rotor"}
+
+
+@needs_libreoffice
+def test_a_read_only_workbook_is_not_replaced(folder, tmp_path, capsys):
+    path = save_in_libreoffice(_cheap_case(folder), tmp_path)
+    report = folder / "report.xlsx"
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
+    for protected in (path, report):
+        os.chmod(protected, 0o444)
+    digests = [sha256(path), sha256(report)]
+    capsys.readouterr()
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
+    out = capsys.readouterr().out
+    assert "case.xlsx was not overwritten: it is read-only (mode 444)" in out
+    assert f"{report} was not overwritten: it is read-only (mode 444)" in out
+    assert [sha256(path), sha256(report)] == digests
+    assert all(stat.S_IMODE(p.stat().st_mode) == 0o444 for p in (path, report))
+    assert len([p for p in folder.iterdir() if p.name.startswith("case-results-")]) == 1
+    assert len([p for p in folder.iterdir() if p.name.startswith("report-report-")]) == 1

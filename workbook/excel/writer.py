@@ -22,7 +22,10 @@ workbook beside it, and the reason is given) when:
   and manager properties, ...), or the rewritten file would lack any kind
   of part the original has (:func:`~workbook.excel.files.lost_parts`);
 - a sheet named like a result sheet exists that is not ours;
-- it changed on disk while the runs were computed.
+- the user cannot write it (read-only, e.g. mode 444);
+- it changed on disk while the runs were computed, or while the new file
+  was built (checked again just before the rename; other ``mountwb``
+  processes writing it wait for a lock on it meanwhile).
 
 Every save is atomic (temporary file in the same folder, then rename).
 """
@@ -44,10 +47,13 @@ import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
 from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.excel.files import (
+    ChangedOnDisk,
+    held,
     lock_file,
     lock_message,
     lost_parts,
     name_beside,
+    read_only_message,
     restore_formula_values,
     save_atomic,
     unsupported_content,
@@ -345,6 +351,9 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
     lock = lock_file(path)
     if lock is not None:
         return lock_message(lock), None
+    refused = read_only_message(path)
+    if refused is not None:
+        return refused, None
     if hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
         return "it changed on disk while the runs were computed", None
     dropped = unsupported_content(path)
@@ -395,14 +404,19 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
     titles = result_sheet_names(result_frames(runs, tests))
-    reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
-    if reason is None:
-        add_result_sheets(workbook, runs, tests, stamp)
-        data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
-        lost = lost_parts(path.read_bytes(), data)
-        if not lost:
-            return WriteOutcome(write_atomic(path, data), None)
-        reason = f"it holds content this program cannot keep ({', '.join(lost)})"
+    with held(path):
+        reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
+        if reason is None:
+            log.info("building the new %s with the results", path.name)
+            add_result_sheets(workbook, runs, tests, stamp)
+            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
+            lost = lost_parts(path.read_bytes(), data)
+            reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
+        if reason is None:
+            try:
+                return WriteOutcome(write_atomic(path, data, unchanged=sha256), None)
+            except ChangedOnDisk:
+                reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
     add_result_sheets(separate, runs, tests, stamp)
