@@ -38,6 +38,7 @@ from xml.sax.saxutils import escape
 from openpyxl.utils.datetime import to_excel
 
 from flexbodies.atomic import replacing
+from workbook.answers.saving import record_written
 
 try:
     import fcntl
@@ -462,6 +463,7 @@ def write_atomic(path: str | Path, data: bytes, unchanged: str | None = None) ->
         with replacing(path, suffix=".saving") as temporary:
             temporary.write_bytes(data)
             _still(path, unchanged)
+    record_written(path)
     log.info("saved %s", path)
     return path
 
