@@ -8,9 +8,11 @@ on PATH.
 """
 from __future__ import annotations
 
+import dataclasses
 import os
 import shutil
 import stat
+from pathlib import Path
 
 import pytest
 from cli_signals import start
@@ -19,6 +21,9 @@ from openpyxl import load_workbook
 from openpyxl.chart import BarChart, Reference
 
 from workbook.cli.main import main
+from workbook.errors import EXIT_BAD_INPUT
+from workbook.model.codec import to_json
+from workbook.model.reference import LP_ROTOR, reference_case
 
 needs_libreoffice = pytest.mark.skipif(SOFFICE is None, reason="LibreOffice (soffice) is not on PATH: "
                                                                 "apt-get install libreoffice-calc-nogui")
@@ -162,3 +167,109 @@ def test_a_read_only_workbook_is_not_replaced(folder, tmp_path, capsys):
     assert all(stat.S_IMODE(p.stat().st_mode) == 0o444 for p in (path, report))
     assert len([p for p in folder.iterdir() if p.name.startswith("case-results-")]) == 1
     assert len([p for p in folder.iterdir() if p.name.startswith("report-report-")]) == 1
+
+
+# -- outputs never replace the user's files ----------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def saved_case(tmp_path_factory):
+    """A cheap case workbook as the user saved it in LibreOffice."""
+    folder = tmp_path_factory.mktemp("saved-case")
+    return save_in_libreoffice(_cheap_case(folder), folder / "scratch")
+
+
+@pytest.fixture
+def user_case(saved_case, folder):
+    """A copy of the user's case workbook in a folder of its own."""
+    return Path(shutil.copyfile(saved_case, folder / "case.xlsx"))
+
+
+def _json_case(folder):
+    path = folder / "case.json"
+    path.write_text(to_json(dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))))
+    return path
+
+
+@needs_libreoffice
+@pytest.mark.parametrize("argv, option, expected", [
+    (["four-pole", "{case}", "--csv", "{case}"], "--csv", ".csv"),
+    (["run-up", "{case}", "--csv", "{case}"], "--csv", ".csv"),
+    (["four-pole", "{case}", "--plot", "plot.pdf"], "--plot", ".png"),
+    (["four-pole", "{case}", "--xlsx", "table.csv"], "--xlsx", ".xlsx"),
+    (["run", "{case}", "--report", "report.pdf"], "--report", ".xlsx"),
+    (["run", "{case}", "--report", "report.ods"], "--report", ".xlsx"),
+    (["layout", "{case}", "-o", "{case}"], "--output", ".png"),
+    (["template", "case.ods"], "output", ".xlsx or .xlsm"),
+    (["rig", "synthesize", "{case}", "{case}"], "output", ".csv"),
+])
+def test_an_output_with_the_wrong_ending_is_refused_before_anything_runs(user_case, folder, capsys, argv, option,
+                                                                         expected):
+    digest = sha256(user_case)
+    argv = [arg.format(case=user_case) if "{" in arg else str(folder / arg) if "." in arg else arg for arg in argv]
+    assert main(argv) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"{option} " in err and f"expected a file ending in {expected}, found" in err
+    assert sha256(user_case) == digest and _names(folder) == ["case.xlsx"]
+
+
+@needs_libreoffice
+def test_the_report_may_not_be_the_case_workbook(user_case, folder, capsys):
+    digest = sha256(user_case)
+    assert main(["run", str(user_case), "--run", "LP rotor", "--report", str(user_case)]) == EXIT_BAD_INPUT
+    assert f"--report {user_case}: that is an input of this command" in capsys.readouterr().err
+    assert sha256(user_case) == digest and _names(folder) == ["case.xlsx"]
+
+
+@needs_libreoffice
+def test_a_report_the_user_annotated_is_kept(user_case, folder, tmp_path, capsys):
+    """A report saved in LibreOffice keeps its keywords, but it is the user's now: the next report goes beside it."""
+    report = folder / "report.xlsx"
+    assert main(["run", str(user_case), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
+    wb = load_workbook(report)
+    wb["Summary"]["A30"] = "checked against the rig on Monday"
+    wb.save(report)
+    save_in_libreoffice(report, tmp_path)
+    assert "mountwb report" in str(load_workbook(report).properties.keywords)
+    digest = sha256(report)
+    capsys.readouterr()
+    assert main(["run", str(user_case), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
+    out = capsys.readouterr().out
+    assert f"{report} was not overwritten: report.xlsx exists and is not a report this program wrote, or was " \
+           "changed since" in out
+    assert sha256(report) == digest
+    beside = [p for p in folder.iterdir() if p.name.startswith("report-report-")]
+    assert len(beside) == 1 and f"report written to {beside[0]}" in out
+
+
+@needs_libreoffice
+def test_four_pole_outputs_keep_existing_files(folder, tmp_path, capsys):
+    """The user's workbook and table of the same names are kept; the four-pole workbook it wrote is replaced."""
+    workbook = save_in_libreoffice(_cheap_case(folder, "table.xlsx"), tmp_path)
+    table = folder / "table.csv"
+    table.write_text("the user's own table\n")
+    digests = [sha256(workbook), sha256(table)]
+    argv = ["four-pole", "--rigid", "--points", "3", "--xlsx", str(workbook), "--csv", str(table)]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "table.xlsx was not overwritten" in out and "table.csv was not overwritten: table.csv exists" in out
+    assert [sha256(workbook), sha256(table)] == digests
+    ours = [p for p in folder.iterdir() if p.name.startswith("table-four-pole-") and p.suffix == ".xlsx"]
+    assert len(ours) == 1 and len(_names(folder)) == 4
+    assert main(["four-pole", "--rigid", "--points", "3", "--xlsx", str(ours[0])]) == 0
+    assert f"workbook written to {ours[0]}" in capsys.readouterr().out and len(_names(folder)) == 4
+
+
+def test_a_second_study_keeps_the_first(folder, capsys):
+    case = _json_case(folder)
+    output = folder / "out"
+    argv = ["study", "params", str(case), "--output", str(output), "--workers", "1", "--vary=hinge_stiffness=1e7,2e7"]
+    assert main(argv) == 0
+    first = {name: sha256(output / name) for name in _names(output)}
+    assert sorted(first) == ["parameter-study.csv", "parameter-study.png", "parameter-study.xlsx"]
+    assert main(argv[:-1] + ["--vary=hinge_stiffness=3e7,4e7"]) == 0
+    assert {name: sha256(output / name) for name in first} == first
+    assert _names(output) == sorted([*first, "parameter-study-2.csv", "parameter-study-2.png",
+                                     "parameter-study-2.xlsx"])
+    assert str(output / "parameter-study-2.csv") in capsys.readouterr().out
+

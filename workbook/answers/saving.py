@@ -13,7 +13,7 @@ from pathlib import Path
 
 from flexbodies.atomic import replacing
 
-__all__ = ["save_figure", "save_csv", "save_text", "recording_writes", "record_written"]
+__all__ = ["save_figure", "save_csv", "save_text", "recording_writes", "record_written", "free_stem"]
 
 #: The lists of :func:`recording_writes` blocks open now.
 _RECORDERS: list[list[Path]] = []
@@ -82,3 +82,17 @@ def save_text(text: str, path: str | Path) -> Path:
         temporary.write_text(text, encoding="utf-8")
     record_written(path)
     return path
+
+
+def free_stem(folder: str | Path, stem: str, suffixes: tuple[str, ...]) -> str:
+    """*stem*, or the first of ``stem-2``, ``stem-3``, ... with none of ``<stem><suffix>`` in *folder*.
+
+    A set of files written together (a table, its sheet, its plot) gets new
+    names all at once when any of them exists.
+    """
+    folder = Path(folder)
+    name, number = stem, 1
+    while any((folder / f"{name}{suffix}").exists() for suffix in suffixes):
+        number += 1
+        name = f"{stem}-{number}"
+    return name

@@ -47,7 +47,7 @@ except ImportError:  # Windows: no advisory locks
 
 __all__ = ["save_atomic", "lock_file", "lock_message", "unsupported_content", "restore_formula_values",
            "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem", "lost_parts", "write_atomic",
-           "ChangedOnDisk", "held", "read_only_message"]
+           "ChangedOnDisk", "held", "read_only_message", "signed", "untouched"]
 
 log = logging.getLogger(__name__)
 
@@ -258,16 +258,44 @@ def _still(path: Path, sha256: str | None) -> None:
         raise ChangedOnDisk(f"{path.name} changed on disk after it was read")
 
 
-def name_beside(path: str | Path, label: str) -> Path:
-    """A new file name beside *path*: ``<stem>-<label>-<date-time>.xlsx`` (``-2``, ``-3``... if taken)."""
+def name_beside(path: str | Path, label: str, suffix: str = ".xlsx") -> Path:
+    """A new file name beside *path*: ``<stem>-<label>-<date-time><suffix>`` (``-2``, ``-3``... if taken)."""
     path = Path(path)
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    candidate = path.with_name(f"{path.stem}-{label}-{stamp}.xlsx")
+    candidate = path.with_name(f"{path.stem}-{label}-{stamp}{suffix}")
     number = 1
     while candidate.exists():
         number += 1
-        candidate = path.with_name(f"{path.stem}-{label}-{stamp}-{number}.xlsx")
+        candidate = path.with_name(f"{path.stem}-{label}-{stamp}-{number}{suffix}")
     return candidate
+
+
+def _members_digest(archive: zipfile.ZipFile) -> str:
+    """SHA-256 of the names, sizes and CRCs of the members of *archive*: any save by another program changes it."""
+    text = "\n".join(f"{info.filename} {info.file_size} {info.CRC:08x}" for info in archive.infolist())
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def signed(data: bytes, label: str) -> bytes:
+    """The workbook *data* (a zip archive) with a comment saying this program wrote it as a *label*.
+
+    The comment holds a digest of the archive's members: a file another
+    program saved (Excel, LibreOffice), or that was edited, no longer
+    matches it (:func:`untouched`).
+    """
+    buffer = io.BytesIO(data)
+    with zipfile.ZipFile(buffer, "a") as archive:
+        archive.comment = f"mountwb {label} {_members_digest(archive)}".encode()
+    return buffer.getvalue()
+
+
+def untouched(path: str | Path, label: str) -> bool:
+    """True if the file at *path* is a *label* this program wrote (:func:`signed`) and nobody saved it since."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            return archive.comment.decode("ascii", "replace") == f"mountwb {label} {_members_digest(archive)}"
+    except (OSError, zipfile.BadZipFile):
+        return False
 
 
 def bounded_file_problem(path: Path, limit: int) -> str | None:
@@ -286,12 +314,14 @@ def bounded_file_problem(path: Path, limit: int) -> str | None:
     return None
 
 
-def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], bool]):
-    """Where a new workbook the user named goes: *path*, or a new name beside it, and why.
+def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], bool] | None = None):
+    """Where a new file the user named goes: *path*, or a new name beside it, and why.
 
     An existing file is replaced only when ``replaceable(path)`` says it may
-    be (a report this package wrote), it is not open in Excel or LibreOffice
-    and it is not read-only; otherwise the new workbook goes to :func:`name_beside`.
+    be (a report this package wrote, :func:`untouched`; None: no file may
+    be), it is not open in
+    Excel or LibreOffice and it is not read-only; otherwise the new file goes
+    to :func:`name_beside`, with the ending of *path*.
 
     Returns
     -------
@@ -304,9 +334,12 @@ def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], 
         return name_beside(path, label), lock_message(lock)
     refused = read_only_message(path)
     if refused is not None:
-        return name_beside(path, label), refused
+        return name_beside(path, label, path.suffix), refused
+    if path.exists() and replaceable is None:
+        return name_beside(path, label, path.suffix), f"{path.name} exists; it is kept"
     if path.exists() and not replaceable(path):
-        return name_beside(path, label), f"{path.name} exists and is not a {label} this program wrote; it is kept"
+        return name_beside(path, label, path.suffix), (f"{path.name} exists and is not a {label} this program "
+                                                       "wrote, or was changed since; it is kept")
     return path, None
 
 
