@@ -273,3 +273,10 @@ def test_a_second_study_keeps_the_first(folder, capsys):
                                      "parameter-study-2.xlsx"])
     assert str(output / "parameter-study-2.csv") in capsys.readouterr().out
 
+
+def test_workbook_options_are_refused_for_a_json_case(folder, capsys):
+    case = _json_case(folder)
+    assert main(["run", str(case), "--report", str(folder / "R.xlsx"), "--run", "LP rotor"]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "--run and --report are for a case workbook (.xlsx)" in err and "nothing was run" in err
+    assert _names(folder) == ["case.json"]
