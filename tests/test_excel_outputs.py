@@ -19,6 +19,7 @@ from cli_signals import start
 from excel_helpers import SOFFICE, copy_reference, make_cheap, save_in_libreoffice, set_cells, sha256
 from openpyxl import load_workbook
 from openpyxl.chart import BarChart, Reference
+from openpyxl.comments import Comment
 
 from workbook.cli.main import main
 from workbook.errors import EXIT_BAD_INPUT
@@ -53,8 +54,13 @@ def _result_runs(path, sheet="Result efficiency"):
 
 @needs_libreoffice
 def test_a_workbook_saved_by_libreoffice_gets_its_results_written_into_it(folder, tmp_path, capsys):
-    """Saved by LibreOffice (shared strings, an empty custom-properties part), run, saved again, run again."""
-    path = save_in_libreoffice(_cheap_case(folder), tmp_path)
+    """Saved by LibreOffice (shared strings, an empty custom-properties part, its own comment box), run, saved
+    again, run again."""
+    path = _cheap_case(folder)
+    wb = load_workbook(path)
+    wb["Hinges"]["A4"].comment = Comment("supplier's drawing rev. C", "J. Doe")
+    wb.save(path)
+    save_in_libreoffice(path, tmp_path)
     assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
     assert f"results written to {path}" in capsys.readouterr().out
     assert _names(folder) == ["case.xlsx"] and _result_runs(path) == {"LP rotor"}
@@ -62,6 +68,7 @@ def test_a_workbook_saved_by_libreoffice_gets_its_results_written_into_it(folder
     assert main(["run", str(path), "--no-progress", "--run", "HP rotor"]) == 0
     assert f"results written to {path}" in capsys.readouterr().out
     assert _names(folder) == ["case.xlsx"] and "HP rotor" in _result_runs(path)
+    assert load_workbook(path)["Hinges"]["A4"].comment.text.startswith("supplier's drawing rev. C")
 
 
 @needs_libreoffice
