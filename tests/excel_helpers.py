@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import hashlib
 import shutil
+import subprocess
 import zipfile
 from pathlib import Path
 
@@ -11,6 +12,8 @@ from openpyxl import load_workbook
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "cases" / "reference.xlsx"
 TEMPLATE = ROOT / "templates" / "case-template.xlsx"
+#: LibreOffice's command line, or None when it is not installed.
+SOFFICE = shutil.which("soffice")
 
 
 def column_of(ws, header: str) -> int:
@@ -117,3 +120,23 @@ def compound_file(streams: dict) -> bytes:
                              starts[i - 1], streams[name]))
     directory = b"".join(entries) + bytes(128) * (4 - len(entries))
     return header + struct.pack("<128I", *fat) + directory + data
+
+
+def soffice_convert(folder: Path, target: str, *files, outdir) -> None:
+    """``soffice --headless --convert-to TARGET`` with a profile of its own in *folder*."""
+    profile = (Path(folder) / "lo-profile").as_uri()
+    result = subprocess.run([SOFFICE, "--headless", f"-env:UserInstallation={profile}", "--convert-to", target,
+                             "--outdir", str(outdir), *map(str, files)], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+
+
+def save_in_libreoffice(path: Path, scratch: Path) -> Path:
+    """Open the workbook at *path* in LibreOffice and save it in place as .xlsx, as a user would.
+
+    LibreOffice's profile and its output go to the folder *scratch* (not beside *path*).
+    """
+    path = Path(path)
+    outdir = Path(scratch) / "libreoffice-saved"
+    soffice_convert(scratch, "xlsx", path, outdir=outdir)
+    shutil.move(outdir / path.name, path)
+    return path

@@ -38,6 +38,11 @@ def test_links_command_prints_every_link_and_reuses_the_cache(coarse_reference, 
     for link in case.links:
         assert f"{link.name}: low-frequency rule" in output
         assert (tmp_path / f"{link.name}.npz").is_file()
+    exported = {path.name: path.read_bytes() for path in tmp_path.glob("*.npz")}
+    assert main(["links", str(coarse_case_file), "--export", str(tmp_path)]) == 0    # a second export keeps the first
+    assert f"{case.links[0].name}.npz was not overwritten" in capsys.readouterr().out
+    assert {name: (tmp_path / name).read_bytes() for name in exported} == exported
+    assert len(list(tmp_path.glob("*.npz"))) == 2 * len(exported)
     assert main(["links", str(coarse_case_file)]) == 0
     rows = [line for line in capsys.readouterr().out.splitlines() if line.split()[:1] in ([link.name] for link in case.links)]
     assert len(rows) == len(case.links) and all(row.rstrip().endswith("hit") for row in rows)

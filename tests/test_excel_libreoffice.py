@@ -10,18 +10,15 @@ from __future__ import annotations
 import csv
 import math
 import re
-import shutil
-import subprocess
 import zipfile
 
 import pytest
-from excel_helpers import copy_reference, make_cheap, sha256
+from excel_helpers import SOFFICE, copy_reference, make_cheap, sha256, soffice_convert
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
 from workbook.excel.styling import FORMATS
 
-SOFFICE = shutil.which("soffice")
 pytestmark = [pytest.mark.skipif(SOFFICE is None, reason="LibreOffice (soffice) is not on PATH: "
                                                           "apt-get install libreoffice-calc-nogui"),
               pytest.mark.slow]
@@ -33,14 +30,6 @@ MAX_REPORT_PAGES = 18
 #: The smallest printed text allowed anywhere, pt.
 MIN_FONT_PT = 6.0
 _CSV = "Text - txt - csv (StarCalc):44,34,76,1,,0,false,true,{shown},false,false{sheets}"
-
-
-def _convert(folder, target: str, *files, outdir):
-    """``soffice --headless --convert-to TARGET`` with a profile of its own in *folder*."""
-    profile = (folder / "lo-profile").as_uri()
-    result = subprocess.run([SOFFICE, "--headless", f"-env:UserInstallation={profile}", "--convert-to", target,
-                             "--outdir", str(outdir), *map(str, files)], capture_output=True, text=True, timeout=300)
-    assert result.returncode == 0, result.stderr
 
 
 def _pages(pdf) -> int:
@@ -62,10 +51,10 @@ def reference_run(tmp_path_factory):
     report = folder / "report.xlsx"
     assert main(["run", str(case), "--no-progress", "--report", str(report)]) == 0
     out = folder / "converted"
-    _convert(folder, "pdf", case, report, outdir=out)
-    _convert(folder, "ods", report, outdir=out)
-    _convert(folder, "csv:" + _CSV.format(shown="false", sheets=",-1"), case, report, outdir=out / "raw")
-    _convert(folder, "csv:" + _CSV.format(shown="true", sheets=",-1"), report, outdir=out / "shown")
+    soffice_convert(folder, "pdf", case, report, outdir=out)
+    soffice_convert(folder, "ods", report, outdir=out)
+    soffice_convert(folder, "csv:" + _CSV.format(shown="false", sheets=",-1"), case, report, outdir=out / "raw")
+    soffice_convert(folder, "csv:" + _CSV.format(shown="true", sheets=",-1"), report, outdir=out / "shown")
     return case, report, out
 
 
@@ -108,7 +97,7 @@ def test_the_four_pole_and_study_workbooks_print_readably(tmp_path):
     from workbook.model.reference import LP_ROTOR, reference_case
     from workbook.studies.parallel import run_rows
     from workbook.studies.parametric import grid, study_cases
-    from workbook.studies.sensitivity import study_frame, write_study
+    from workbook.studies.sensitivity import study_frame, table_path, write_study
 
     case = tmp_path / "case.json"
     rigid = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
@@ -117,7 +106,8 @@ def test_the_four_pole_and_study_workbooks_print_readably(tmp_path):
     assert main(["four-pole", str(case), "--points", "60", "--xlsx", str(pole)]) == 0
     rows = grid({"hinge_stiffness": [2e7, 4e7]})
     frame = study_frame(rows, run_rows(study_cases(rigid, rows)))
-    sheet = next(p for p in write_study(frame, ["hinge_stiffness"], tmp_path / "study") if p.suffix == ".xlsx")
+    (tmp_path / "study").mkdir()
+    sheet = next(p for p in write_study(frame, ["hinge_stiffness"], table_path(tmp_path / "study")) if p.suffix == ".xlsx")
     out = tmp_path / "pdf"
     _convert(tmp_path, "pdf", pole, sheet, outdir=out)
     _assert_readable(out / "four-pole.pdf")

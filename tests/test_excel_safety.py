@@ -109,14 +109,18 @@ def test_template_never_replaces_a_file_unless_asked(tmp_path, capsys):
 
 def test_a_workbook_open_in_libreoffice_is_not_overwritten(cheap_ran, tmp_path, capsys):
     path = _copy(cheap_ran, tmp_path)
-    (tmp_path / ".~lock.case.xlsx#").write_text(",engineer,host,22.11.2026 21:00,file:///home/engineer/.config;")
-    digest = sha256(path)
-    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(path)]) == 0
+    report = tmp_path / "report.xlsx"
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
+    for name in ("case.xlsx", "report.xlsx"):
+        (tmp_path / f".~lock.{name}#").write_text(",engineer,host,22.11.2026 21:00,file:///home/engineer/.config;")
+    digests = [sha256(path), sha256(report)]
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--report", str(report)]) == 0
     out = capsys.readouterr().out
     assert "open in LibreOffice (lock file .~lock.case.xlsx# present)" in out
-    assert sha256(path) == digest
+    assert "open in LibreOffice (lock file .~lock.report.xlsx# present)" in out
+    assert [sha256(path), sha256(report)] == digests
     assert len([p for p in tmp_path.iterdir() if p.name.startswith("case-results-")]) == 1
-    assert len([p for p in tmp_path.iterdir() if p.name.startswith("case-report-")]) == 1
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith("report-report-")]) == 1
 
 
 def test_a_report_replaces_only_a_report(cheap_ran, tmp_path, capsys):
@@ -326,4 +330,4 @@ def test_a_workbook_named_through_a_link_stays_linked(cheap_ran, tmp_path):
     assert main(["run", str(link), "--no-progress", "--run", "HP rotor"]) == 0
     assert link.is_symlink() and sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx", "stored.xlsx"]
     rows = load_workbook(target)["Result efficiency"].iter_rows(min_row=3, values_only=True)
-    assert {row[0] for row in rows} == {"HP rotor"}
+    assert {row[0] for row in rows} == {"LP rotor", "HP rotor"}

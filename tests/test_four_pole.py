@@ -203,7 +203,8 @@ def test_command_line_writes_csv_and_plot(tmp_path, capsys):
     assert "K21" in out and "rigid pylon" in out
     pole = four_pole(sdof_case(()), np.geomspace(2, 50, 5))
     loss = pole.insertion_loss(3e6 - (2 * np.pi * pole.frequencies_hz) ** 2 * 40)
-    assert f"{loss[-1, 2]:9.2f}" in out.split("insertion loss")[1].splitlines()[-1]
+    assert f"{loss[-1, 2]:9.2f}" in out.split("insertion loss")[1].split("table written to")[0].splitlines()[-1]
+    assert f"table written to {csv}" in out and f"plot written to {png}" in out and f"workbook written to {xlsx}" in out
     from openpyxl import load_workbook
 
     sheet = load_workbook(xlsx)["Four-pole"]

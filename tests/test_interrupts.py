@@ -91,3 +91,16 @@ def test_a_signal_during_a_workbook_run_leaves_the_workbook_as_it_was(tmp_path, 
     assert code == SIGNAL_EXIT[signum]
     _one_line(rest, signum)
     assert files_in(tmp_path) == before
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_while_the_report_is_written_names_the_workbook_already_written(tmp_path, signum):
+    """The results are in the case workbook when the signal comes: the line says so, and no report is left."""
+    book = copy_reference(tmp_path)
+    make_cheap(book)
+    process = start("run", str(book), "--no-progress", "--run", "LP rotor", "--report", "report.xlsx", cwd=tmp_path)
+    code, rest = signal_at(process, f"saved {book}", signum)
+    assert code == SIGNAL_EXIT[signum]
+    line = _one_line(rest, signum)
+    assert line.endswith(f"; {book} was written before it, no other file was changed"), rest
+    assert sorted(files_in(tmp_path)) == ["case.xlsx"]

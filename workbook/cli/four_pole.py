@@ -5,15 +5,18 @@ blocked transfer dynamic stiffness per direction, see
 :mod:`workbook.solve.four_pole`), and the rigid-pylon transmissibility of
 each of the case's excitations that follows from them; with a pylon point
 stiffness per pin (``--pylon-stiffness``, ``--pylon-mass``) the insertion loss
-of the mount on that pylon. Everything is computed before a file is written.
+of the mount on that pylon. Everything is computed before a file is written;
+an existing file is kept (the new one gets a new name) unless it is a
+workbook this command wrote and nobody changed (:mod:`workbook.cli.outputs`).
 """
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Callable
 
+from workbook.answers.saving import save_csv, save_figure
 from workbook.cli.loading import load_case
+from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
 from workbook.solve.four_pole import REPORT_GRID
 
@@ -29,9 +32,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--points", type=int, default=REPORT_GRID[2],
                         help=f"frequencies, log-spaced (default {REPORT_GRID[2]})")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
-    parser.add_argument("--csv", metavar="OUT", help="write the table as CSV")
+    parser.add_argument("--csv", metavar="OUT.csv", help="write the table as CSV")
     parser.add_argument("--plot", metavar="OUT.png", help="write the magnitude plot as PNG")
-    parser.add_argument("--xlsx", metavar="OUT", help="write the table and a native chart as a workbook (.xlsx)")
+    parser.add_argument("--xlsx", metavar="OUT.xlsx", help="write the table and a native chart as a workbook (.xlsx)")
     parser.add_argument("--pylon-stiffness", type=float, metavar="N/M",
                         help="pylon point stiffness at each pin in x, y and z, N/m: print the insertion loss")
     parser.add_argument("--pylon-mass", type=float, default=0.0, metavar="KG",
@@ -47,10 +50,11 @@ def run(args) -> int:
     from workbook.solve.four_pole_set import four_pole
     from workbook.solve.harmonic import excitation_phasor
 
+    for option, path, suffix in (("--csv", args.csv, ".csv"), ("--plot", args.plot, ".png"),
+                                 ("--xlsx", args.xlsx, ".xlsx")):
+        check_output(option, path, (suffix,), [args.case])
     frequencies = frequency_grid(args.start, args.stop, args.points)
     pylon = _pylon(args, frequencies)
-    if args.xlsx and args.case and Path(args.xlsx).resolve() == Path(args.case).resolve():
-        raise UsageError(f"--xlsx {args.xlsx}: that is the case file; give a new file name")
     case = load_case(args.case, rigid=args.rigid)
     pole = four_pole(case, frequencies)
     table = pole.table()
@@ -77,19 +81,21 @@ def run(args) -> int:
         for frequency, row in zip(frequencies, loss):
             print(f"{frequency:12.4g}  " + "  ".join(f"{v:9.2f}" for v in row))
     if args.csv:
-        table.to_csv(args.csv)
+        write_output(args.csv, "table", "four-pole", lambda target: save_csv(table, target))
     if figure is not None:
-        figure.savefig(args.plot, dpi=120)
+        write_output(args.plot, "plot", "four-pole", lambda target: save_figure(figure, target, dpi=120))
     if args.xlsx:
         from openpyxl import Workbook
 
-        from workbook.excel.files import save_atomic
+        from workbook.excel.files import save_atomic, signed, untouched
         from workbook.excel.report import FOUR_POLE_SHEET, four_pole_sheet
 
         book = Workbook()
         book.active.title = FOUR_POLE_SHEET
         four_pole_sheet(book.active, pole)
-        save_atomic(book, args.xlsx)
+        write_output(args.xlsx, "workbook", "four-pole",
+                     lambda target: save_atomic(book, target, finish=lambda data: signed(data, "four-pole")),
+                     replaceable=lambda existing: untouched(existing, "four-pole"))
     return 0
 
 

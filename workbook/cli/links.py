@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
+from workbook.cli.outputs import write_output
 
 __all__ = ["arguments"]
 
@@ -18,7 +19,8 @@ __all__ = ["arguments"]
 def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     parser.add_argument("--export", metavar="FOLDER",
-                        help="also write each reduced link in Exudyn's own format (FOLDER/<link>.npz)")
+                        help="also write each reduced link in Exudyn's own format (FOLDER/<link>.npz; an existing "
+                             "file is kept: a new name)")
     return links
 
 
@@ -39,5 +41,6 @@ def links(args) -> int:
         print(f"{name}: {reason}")
     if args.export:
         for name, link in reduced.items():
-            print(export_exudyn_file(link, Path(args.export) / name))
+            write_output(str(Path(args.export) / f"{name}.npz"), f"link {name}", "export",
+                         lambda target, link=link: export_exudyn_file(link, target))
     return 0

@@ -27,6 +27,7 @@ import traceback
 
 from threadpoolctl import threadpool_limits
 
+from workbook.answers.saving import recording_writes
 from workbook.cli import cache, campbell, four_pole, layout, links, rig, run, run_up, study, workbooks
 from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
@@ -69,10 +70,20 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
-def _interrupted(command: str, interrupt: KeyboardInterrupt) -> int:
-    """Print the one line of an interrupt and return its exit code."""
+def _interrupted(command: str, interrupt: KeyboardInterrupt, written: list) -> int:
+    """Print the one line of an interrupt and return its exit code.
+
+    The line gives the interrupt's own message (a study's rows kept), or the
+    files the command wrote before it, or says that no file was changed.
+    """
     how = "terminated (SIGTERM)" if isinstance(interrupt, Terminated) else "interrupted (Ctrl-C)"
-    detail = f": {interrupt}" if str(interrupt) else "; no file was changed"
+    if str(interrupt):
+        detail = f": {interrupt}"
+    elif written:
+        files = ", ".join(str(path) for path in dict.fromkeys(written))
+        detail = f"; {files} {'was' if len(set(written)) == 1 else 'were'} written before it, no other file was changed"
+    else:
+        detail = "; no file was changed"
     print(f"mountwb {command}: {how}{detail}", file=sys.stderr)
     return exit_code(interrupt)
 
@@ -126,19 +137,20 @@ def _main(argv: list[str] | None) -> int:
     args = build_parser().parse_args(argv)
     level = {0: logging.WARNING, 1: logging.INFO}.get(args.verbose, logging.DEBUG)
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
-    try:
-        return args.handler(args)
-    except BaseException as error:
-        interrupt = interruption(error)  # also when Exudyn wrapped it into an error of its own
-        if interrupt is not None:
-            return _interrupted(args.command, interrupt)
-        if not isinstance(error, Exception):
-            raise
-        if not isinstance(error, (MountwbError, OSError)):
-            return _internal_error(args.command, error, sys.argv[1:] if argv is None else list(argv))
-        trouble = "numerical trouble: " if isinstance(error, SimulationError) else ""
-        print(f"mountwb {args.command}: {trouble}{error}", file=sys.stderr)
-        return exit_code(error)
+    with recording_writes() as written:
+        try:
+            return args.handler(args)
+        except BaseException as error:
+            interrupt = interruption(error)  # also when Exudyn wrapped it into an error of its own
+            if interrupt is not None:
+                return _interrupted(args.command, interrupt, written)
+            if not isinstance(error, Exception):
+                raise
+            if not isinstance(error, (MountwbError, OSError)):
+                return _internal_error(args.command, error, sys.argv[1:] if argv is None else list(argv))
+            trouble = "numerical trouble: " if isinstance(error, SimulationError) else ""
+            print(f"mountwb {args.command}: {trouble}{error}", file=sys.stderr)
+            return exit_code(error)
 
 
 if __name__ == "__main__":

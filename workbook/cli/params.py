@@ -7,7 +7,9 @@ the rows are every combination. With ``--lhs N`` every ``--vary`` gives
 bounds ``low:high`` and the rows are N samples of a Latin hypercube. Runs go
 to local processes (``--workers``, default: every core) or to the Dask
 scheduler at ``--dask ADDRESS``; the table (CSV or Parquet, and a sheet) and
-the sensitivity plot go to ``--output``. A progress line on stderr every
+the sensitivity plot go to ``--output`` (``parameter-study.*``, or
+``parameter-study-2.*``... beside an earlier study's files, which are kept;
+``--resume`` continues ``parameter-study.*``). A progress line on stderr every
 :data:`workbook.studies.progress.PROGRESS_INTERVAL` s gives the rows done,
 rows per second and the time left.
 
@@ -107,11 +109,11 @@ def run_parameter_study(args) -> int:
     from workbook.studies.parallel import run_rows
     from workbook.studies.parametric import study_cases
     from workbook.studies.progress import StudyProgress
-    from workbook.studies.sensitivity import StudyTable, read_finished, table_path, write_study
+    from workbook.studies.sensitivity import StudyTable, new_study_table, read_finished, table_path, write_study
 
     rows = parse_vary(args.vary, args.lhs, args.seed)
     case = load_case(args.case, run=args.run, rigid=args.rigid)
-    path = table_path(args.output, args.format)
+    path = table_path(args.output, args.format) if args.resume else new_study_table(args.output, args.format)
     finished = read_finished(path, rows) if args.resume else {}
     table = StudyTable(path, rows, finished)
     where = f"Dask scheduler {args.dask}" if args.dask else f"{args.workers} local process(es)"
@@ -131,7 +133,7 @@ def run_parameter_study(args) -> int:
     failed = [outcome for outcome in outcomes if outcome.status != "ok"]
     for outcome in failed:
         print(f"row {outcome.index} failed: {outcome.error}")
-    for written in write_study(frame, list(rows[0]) if rows else [], args.output, args.format):
+    for written in write_study(frame, list(rows[0]) if rows else [], path):
         print(written)
     print(f"{len(rows) - len(failed)} of {len(rows)} rows ok, {len(failed)} failed"
           + (f" (rows {', '.join(str(o.index) for o in failed)}; exit code {EXIT_FAILED_ROWS})" if failed else ""))

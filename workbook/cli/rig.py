@@ -21,6 +21,7 @@ from typing import Callable
 from workbook.answers.results import ExcitationResult
 from workbook.answers.saving import save_csv
 from workbook.cli.loading import load_case
+from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
 from workbook.model.case import AnalysisSettings, Case
 
@@ -91,6 +92,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         from workbook.rig.correlation import PEAK_SEARCH, comparison_frame, measure
         from workbook.rig.records import read_record
 
+        check_output("--csv", getattr(args, "csv", None), (".csv",), [args.record, getattr(args, "case", None)])
         record = read_record(args.record)
         if args.mode == "compare":
             case = load_case(args.case, rigid=args.rigid)
@@ -106,8 +108,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         table = comparison_frame(measurement, simulate_run(case, record.run))
         print(table.to_string(float_format=lambda v: f"{v:10.5g}"))
         if args.csv:
-            save_csv(table, args.csv)
-            print(args.csv)
+            write_output(args.csv, "validation table", "rig", lambda target: save_csv(table, target))
         return 0
 
     return rig
@@ -117,6 +118,7 @@ def _synthesize(args) -> int:
     from workbook.rig.records import write_record
     from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, synthetic_record
 
+    check_output("output", args.output, (".csv",), [args.case])
     case = load_case(args.case, rigid=args.rigid)
     result = simulate_run(case, args.run, histories=True)
     pylon = sorted(h.name for h in case.pylon_hinges)
@@ -125,5 +127,5 @@ def _synthesize(args) -> int:
     transducers = REFERENCE_TRANSDUCERS if pylon == reference else {name: (name,) for name in pylon}
     record = synthetic_record(result, transducers, sample_rate_hz=args.rate, duration=args.duration,
                               noise=args.noise, drift=args.drift, seed=args.seed)
-    print(write_record(args.output, record))
+    write_output(args.output, "rig record", "rig", lambda target: write_record(target, record))
     return 0

@@ -45,6 +45,11 @@ def run(args) -> int:
     if args.four_pole:
         raise UsageError("--four-pole adds a sheet to a case workbook's --report; for a JSON case or the reference "
                          "mount use mountwb four-pole")
+    workbook_only = [option for option, value in (("--run", args.runs), ("--report", args.report)) if value]
+    if workbook_only:
+        raise UsageError(f"{' and '.join(workbook_only)} {'are' if len(workbook_only) > 1 else 'is'} for a case "
+                         f"workbook (.xlsx), and {args.case or 'the reference mount'} is not one: a JSON case runs "
+                         "every excitation it has and prints its answers (--json: as JSON); nothing was run")
     case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget, method=args.method,
                      pylon_impedance=args.pylon_impedance)
     result = run_case(case, progress=None if args.no_progress else progress_factory())

@@ -7,7 +7,8 @@ Without ``--from``/``--to`` the case's own run-ups run (an Excitations row
 with a run-up speed unit, or a :class:`~workbook.model.case.RunUp` in a JSON
 case); with them, the imbalance ``--excitation`` (a rotating force or an
 imbalance given by its unbalance, or made one with ``--unbalance``) is run
-up over that range. Everything is computed before a file is written.
+up over that range. Everything is computed before a file is written, and an
+existing file is kept (the new one gets a new name, :mod:`workbook.cli.outputs`).
 """
 from __future__ import annotations
 
@@ -15,7 +16,9 @@ import argparse
 import dataclasses
 from typing import Callable
 
+from workbook.answers.saving import save_csv, save_figure
 from workbook.cli.loading import load_case
+from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
 from workbook.model.case import SPEED_UNITS, Case, RotatingForce, RunUp
 
@@ -34,7 +37,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--unbalance", type=float, metavar="KG_M",
                         help="unbalance of a rotating force given by its amplitude, kg m (replaces the amplitude)")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
-    parser.add_argument("--csv", metavar="OUT", help="write the table as CSV (one run-up)")
+    parser.add_argument("--csv", metavar="OUT.csv", help="write the table as CSV (one run-up)")
     parser.add_argument("--plot", metavar="OUT.png", help="write the plot as PNG (one run-up)")
     return run
 
@@ -70,6 +73,8 @@ def _run_ups(case: Case, args) -> list[RunUp]:
 def run(args) -> int:
     from workbook.solve.run_up import run_up
 
+    check_output("--csv", args.csv, (".csv",), [args.case])
+    check_output("--plot", args.plot, (".png",), [args.case])
     case = load_case(args.case, rigid=args.rigid)
     items = _run_ups(case, args)
     if (args.csv or args.plot) and len(items) > 1:
@@ -90,7 +95,7 @@ def run(args) -> int:
             where = names[0] if len(names) == 1 else f"{len(names)} speeds from {names[0]} to {names[-1]}"
             print(f"\nWARNING {where}: {warning}")
     if args.csv:
-        answers[0].frame().to_csv(args.csv)
+        write_output(args.csv, "table", "run-up", lambda target: save_csv(answers[0].frame(), target))
     if figure is not None:
-        figure.savefig(args.plot, dpi=120)
+        write_output(args.plot, "plot", "run-up", lambda target: save_figure(figure, target, dpi=120))
     return 0

@@ -11,6 +11,7 @@ import sys
 from typing import Callable
 
 from workbook.cli.loading import progress_factory
+from workbook.cli.outputs import check_output, print_written
 from workbook.errors import EXIT_BAD_INPUT, EXIT_OK, EXIT_TROUBLE
 
 __all__ = ["check_arguments", "template_arguments", "add_run_arguments", "run_workbook"]
@@ -22,14 +23,6 @@ def _report_problems(error) -> int:
     for problem in problems:
         print(f"  {problem}", file=sys.stderr)
     return EXIT_BAD_INPUT
-
-
-def _print_written(named, what: str, target, reason) -> None:
-    """Where a workbook went: the file named, or beside it with the reason."""
-    if reason is None:
-        print(f"{what} written to {target}")
-    else:
-        print(f"{named} was not overwritten: {reason}.\n{what} written to {target}")
 
 
 def check_arguments(parser: argparse.ArgumentParser) -> Callable:
@@ -64,9 +57,10 @@ def template_arguments(parser: argparse.ArgumentParser) -> Callable:
     def template(args) -> int:
         from workbook.excel.template import reference_workbook, template_workbook, write_workbook
 
+        check_output("output", args.output, (".xlsx", ".xlsm"))
         target, reason = write_workbook(reference_workbook() if args.reference else template_workbook(),
                                         args.output, args.replace)
-        _print_written(args.output, "template", target, reason)
+        print_written(args.output, "template", target, reason)
         return EXIT_OK
 
     return template
@@ -111,6 +105,7 @@ def run_workbook(args) -> int:
         print("mountwb run: --json, --rigid, --method and --time-budget are for JSON cases; a workbook sets its "
               "runs' fidelity in its Runs sheet and its method and time budget in its Case sheet", file=sys.stderr)
         return EXIT_BAD_INPUT
+    check_output("--report", args.report, (".xlsx",), [args.case])
     if args.four_pole and not args.report:
         print("mountwb run: --four-pole adds a sheet to the report: give --report OUT.xlsx", file=sys.stderr)
         return EXIT_BAD_INPUT
@@ -133,12 +128,12 @@ def run_workbook(args) -> int:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)
         return EXIT_TROUBLE
-    _print_written(book.path.name, "results", outcome.path, outcome.reason)
+    print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
             report = write_report(args.report, book, runs, outcome, four_pole=pole)
         except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE
-        _print_written(args.report, "report", report.path, report.reason)
+        print_written(args.report, "report", report.path, report.reason)
     return EXIT_OK

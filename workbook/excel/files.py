@@ -7,6 +7,13 @@ old file or the new one. Where the system allows (Linux), the new file has
 no name until it is complete, so a kill during the save leaves nothing
 behind.
 
+A file the user cannot write (no write permission, e.g. mode 444) is never
+replaced, even where the folder would allow it. A save that is told what
+the file held when it was read checks it again just before the rename and
+replaces nothing when the file changed meanwhile (:class:`ChangedOnDisk`);
+:func:`held` makes the ``mountwb`` processes writing one workbook take
+turns.
+
 openpyxl rewrites a whole workbook from what it understood; content it does
 not understand is dropped silently. :func:`unsupported_content` looks inside
 the .xlsx (a zip archive) for such content, so that a run can refuse to
@@ -15,12 +22,15 @@ overwrite the file and write its results elsewhere instead.
 from __future__ import annotations
 
 import datetime
+import errno
+import hashlib
 import io
 import logging
 import os
 import re
 import stat
 import zipfile
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Callable
 from xml.sax.saxutils import escape
@@ -28,9 +38,16 @@ from xml.sax.saxutils import escape
 from openpyxl.utils.datetime import to_excel
 
 from flexbodies.atomic import replacing
+from workbook.answers.saving import record_written
+
+try:
+    import fcntl
+except ImportError:  # Windows: no advisory locks
+    fcntl = None
 
 __all__ = ["save_atomic", "lock_file", "lock_message", "unsupported_content", "restore_formula_values",
-           "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem", "lost_parts", "write_atomic"]
+           "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem", "lost_parts", "write_atomic",
+           "ChangedOnDisk", "held", "read_only_message", "signed", "untouched"]
 
 log = logging.getLogger(__name__)
 
@@ -67,9 +84,13 @@ _APP_PROPERTY = re.compile(rb"<(?:\w+:)?(" + b"|".join(p.encode() for p in _APP_
 _NOTE = re.compile(rb'<(?:\w+:)?shape\b[^>]*?style="([^"]*)"[^>]*>(?:(?!</(?:\w+:)?shape>).)*?ObjectType="Note"', re.S)
 #: Box of a comment as openpyxl writes it (Excel's default too): 144 x 79 px = 108 x 59.25 pt, hidden.
 _NOTE_BOX_PT = (108.0, 59.25)
-#: Parts whose loss is harmless: Excel rebuilds the calculation chain and the thumbnail, and the
-#: printer-driver settings are device data (the page setup itself is kept).
-_REBUILT_TYPES = ("calcChain+xml", "printerSettings", "image/jpeg")
+#: Parts whose loss is harmless: Excel rebuilds the calculation chain and the thumbnail, the
+#: printer-driver settings are device data (the page setup itself is kept), and the shared-strings
+#: table (Excel and LibreOffice write one) is rewritten into the cells as their text.
+_REBUILT_TYPES = ("calcChain+xml", "printerSettings", "image/jpeg", "sharedStrings+xml")
+#: Custom document properties: openpyxl keeps them; a part without any (LibreOffice writes one) holds nothing.
+_CUSTOM_PROPERTIES = "custom-properties+xml"
+_CUSTOM_PROPERTY = re.compile(rb"<(?:\w+:)?property\b")
 #: Worksheet extensions (extLst) openpyxl drops.
 _EXTENSIONS = (
     (re.compile(rb"<x14:dataValidations?\b"), "data-validation extensions (lists from other sheets)"),
@@ -153,7 +174,9 @@ def lost_parts(before: bytes, after: bytes) -> list[str]:
     """Parts of the workbook *before* of a kind the rewritten workbook *after* no longer has.
 
     A safety net under :func:`unsupported_content`: any kind of part (by
-    content type) that the rewrite dropped, except those Excel rebuilds.
+    content type) that the rewrite dropped, except those Excel rebuilds, the
+    shared strings (their text is kept in the cells) and custom document
+    properties that hold none.
 
     Returns
     -------
@@ -161,8 +184,10 @@ def lost_parts(before: bytes, after: bytes) -> list[str]:
         ``"<part name> (<content type>)"`` for each part lost.
     """
     kept = set(_content_types(after).values())
-    return [f"{name} ({kind})" for name, kind in _content_types(before).items()
-            if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)]
+    with zipfile.ZipFile(io.BytesIO(before)) as archive:
+        return [f"{name} ({kind})" for name, kind in _content_types(before).items()
+                if kind not in kept and not any(harmless in kind for harmless in _REBUILT_TYPES)
+                and not (kind.endswith(_CUSTOM_PROPERTIES) and not _CUSTOM_PROPERTY.search(archive.read(name)))]
 
 
 def lock_file(path: str | Path) -> Path | None:
@@ -183,16 +208,94 @@ def lock_message(lock: Path) -> str:
     return f"it is open in {application} (lock file {lock.name} present); close it and run again to write into it"
 
 
-def name_beside(path: str | Path, label: str) -> Path:
-    """A new file name beside *path*: ``<stem>-<label>-<date-time>.xlsx`` (``-2``, ``-3``... if taken)."""
+class ChangedOnDisk(Exception):
+    """The file changed on disk after it was read (another save landed): it was not replaced."""
+
+
+def read_only_message(path: str | Path) -> str | None:
+    """Why the existing file at *path* may not be replaced (None: it may be, or it does not exist).
+
+    A file without any write permission (mode 444) is read-only even for a
+    user the system would let write it (the owner of the folder, root).
+    """
+    try:
+        mode = stat.S_IMODE(Path(path).stat().st_mode)
+    except FileNotFoundError:
+        return None
+    if mode & 0o222 and os.access(path, os.W_OK):
+        return None
+    return f"it is read-only (mode {mode:o}); make it writable to write into it"
+
+
+@contextmanager
+def held(path: str | Path):
+    """Hold an exclusive lock on the file at *path* while it is checked and replaced.
+
+    Another ``mountwb`` process writing the same file waits for the lock,
+    then finds the file changed. The lock is advisory: Excel and LibreOffice
+    do not take it (their saves are caught by the check before the rename).
+    Where the system has no locks, nothing is held.
+    """
+    try:
+        handle = os.open(path, os.O_RDONLY)
+    except OSError:
+        handle = None
+    try:
+        if handle is not None and fcntl is not None:
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX)
+            except OSError as error:  # a file system without locks
+                log.info("cannot lock %s (%s); writing without the lock", path, error)
+        yield
+    finally:
+        if handle is not None:
+            os.close(handle)
+
+
+def _still(path: Path, sha256: str | None) -> None:
+    """Raise :class:`ChangedOnDisk` unless the file at *path* still has the SHA-256 *sha256* (None: no check)."""
+    if sha256 is not None and hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
+        raise ChangedOnDisk(f"{path.name} changed on disk after it was read")
+
+
+def name_beside(path: str | Path, label: str, suffix: str = ".xlsx") -> Path:
+    """A new file name beside *path*: ``<stem>-<label>-<date-time><suffix>`` (``-2``, ``-3``... if taken)."""
     path = Path(path)
     stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
-    candidate = path.with_name(f"{path.stem}-{label}-{stamp}.xlsx")
+    candidate = path.with_name(f"{path.stem}-{label}-{stamp}{suffix}")
     number = 1
     while candidate.exists():
         number += 1
-        candidate = path.with_name(f"{path.stem}-{label}-{stamp}-{number}.xlsx")
+        candidate = path.with_name(f"{path.stem}-{label}-{stamp}-{number}{suffix}")
     return candidate
+
+
+def _members_digest(archive: zipfile.ZipFile) -> str:
+    """SHA-256 of the names, sizes and CRCs of the members of *archive*: any save by another program changes it."""
+    text = "\n".join(f"{info.filename} {info.file_size} {info.CRC:08x}" for info in archive.infolist())
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def signed(data: bytes, label: str) -> bytes:
+    """The workbook *data* (a zip archive) with a comment saying this program wrote it as a *label*.
+
+    The comment holds a digest of the archive's members: a file another
+    program saved (Excel, LibreOffice), or that was edited, no longer
+    matches it (:func:`untouched`).
+    """
+    buffer = io.BytesIO(data)
+    with zipfile.ZipFile(buffer, "a") as archive:
+        archive.comment = f"mountwb {label} {_members_digest(archive)}".encode()
+    return buffer.getvalue()
+
+
+def untouched(path: str | Path, label: str) -> bool:
+    """True if the file at *path* is a *label* this program wrote (:func:`signed`) and nobody saved it since."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            return archive.comment.decode("ascii", "replace") == f"mountwb {label} {_members_digest(archive)}"
+    except (OSError, zipfile.BadZipFile):
+        return False
 
 
 def bounded_file_problem(path: Path, limit: int) -> str | None:
@@ -211,12 +314,14 @@ def bounded_file_problem(path: Path, limit: int) -> str | None:
     return None
 
 
-def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], bool]):
-    """Where a new workbook the user named goes: *path*, or a new name beside it, and why.
+def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], bool] | None = None):
+    """Where a new file the user named goes: *path*, or a new name beside it, and why.
 
     An existing file is replaced only when ``replaceable(path)`` says it may
-    be (a report this package wrote) and it is not open in Excel or
-    LibreOffice; otherwise the new workbook goes to :func:`name_beside`.
+    be (a report this package wrote, :func:`untouched`; None: no file may
+    be), it is not open in
+    Excel or LibreOffice and it is not read-only; otherwise the new file goes
+    to :func:`name_beside`, with the ending of *path*.
 
     Returns
     -------
@@ -227,8 +332,14 @@ def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], 
     lock = lock_file(path)
     if lock is not None:
         return name_beside(path, label), lock_message(lock)
+    refused = read_only_message(path)
+    if refused is not None:
+        return name_beside(path, label, path.suffix), refused
+    if path.exists() and replaceable is None:
+        return name_beside(path, label, path.suffix), f"{path.name} exists; it is kept"
     if path.exists() and not replaceable(path):
-        return name_beside(path, label), f"{path.name} exists and is not a {label} this program wrote; it is kept"
+        return name_beside(path, label, path.suffix), (f"{path.name} exists and is not a {label} this program "
+                                                       "wrote, or was changed since; it is kept")
     return path, None
 
 
@@ -317,8 +428,11 @@ def _mode(path: Path) -> int:
         return 0o666 & ~umask
 
 
-def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
-    """Write *data* to a file without a name, then name it *path* (False: the system cannot)."""
+def _replace_unnamed(path: Path, data: bytes, mode: int, unchanged: str | None) -> bool:
+    """Write *data* to a file without a name, then name it *path* (False: the system cannot).
+
+    *unchanged*: the SHA-256 *path* must still have just before the rename (None: no check).
+    """
     flag = getattr(os, "O_TMPFILE", None)
     if flag is None:
         return False
@@ -338,6 +452,7 @@ def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
         finally:
             os.close(handle)
         try:
+            _still(path, unchanged)
             os.replace(linked, path.name, src_dir_fd=folder, dst_dir_fd=folder)
         except BaseException:
             os.unlink(linked, dir_fd=folder)
@@ -347,21 +462,41 @@ def _replace_unnamed(path: Path, data: bytes, mode: int) -> bool:
     return True
 
 
-def write_atomic(path: str | Path, data: bytes) -> Path:
+def write_atomic(path: str | Path, data: bytes, unchanged: str | None = None) -> Path:
     """Write *data* to *path* all at once, with the permissions of the file it replaces.
 
     A symbolic link stays a link: the file it points to is replaced.
 
+    Parameters
+    ----------
+    path : str or Path
+    data : bytes
+    unchanged : str, optional
+        SHA-256 (hex) the file at *path* must still have just before the
+        rename: the content it had when it was read.
+
     Returns
     -------
     Path
+
+    Raises
+    ------
+    PermissionError
+        *path* is read-only (:func:`read_only_message`); nothing is written.
+    ChangedOnDisk
+        *path* no longer has the SHA-256 *unchanged*; nothing is replaced.
     """
     path = Path(path).resolve()
+    refused = read_only_message(path)
+    if refused is not None:
+        raise PermissionError(errno.EACCES, f"{path.name}: {refused}")
     path.parent.mkdir(parents=True, exist_ok=True)
     mode = _mode(path)
-    if not _replace_unnamed(path, data, mode):
+    if not _replace_unnamed(path, data, mode, unchanged):
         with replacing(path, suffix=".saving") as temporary:
             temporary.write_bytes(data)
+            _still(path, unchanged)
+    record_written(path)
     log.info("saved %s", path)
     return path
 

@@ -26,7 +26,6 @@ import datetime
 import hashlib
 import io
 import platform
-import zipfile
 from importlib import metadata
 from pathlib import Path
 
@@ -37,7 +36,7 @@ from openpyxl.styles import Alignment, Font, PatternFill
 from openpyxl.utils import get_column_letter
 
 from workbook.answers.isolation import efficiency, level_db
-from workbook.excel.files import new_file_target, save_atomic
+from workbook.excel.files import new_file_target, save_atomic, signed, untouched
 from workbook.excel.reader import CaseBook
 from workbook.excel.styling import FORMATS, print_setup, style_series, write_text_lines
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
@@ -45,7 +44,7 @@ from workbook.model.case import DIRECTIONS
 
 __all__ = ["write_report", "is_report", "four_pole_sheet", "FOUR_POLE_SHEET", "PACKAGES", "REPORT_KEYWORDS"]
 
-#: Document keywords that mark a report workbook (an existing report may be replaced).
+#: Document keywords of a report workbook.
 REPORT_KEYWORDS = "mountwb report"
 #: The report's sheet of the mount's four-pole parameters (asked for with ``mountwb run --four-pole``).
 FOUR_POLE_SHEET = "Four-pole"
@@ -347,22 +346,22 @@ def _metadata(ws, book: CaseBook, runs: list[RunResult], written: WriteOutcome |
 
 
 def is_report(path: Path) -> bool:
-    """True if the file at *path* is a report workbook this module wrote (its keywords say so)."""
-    try:
-        with zipfile.ZipFile(path) as archive:
-            core = archive.read("docProps/core.xml")
-    except (OSError, KeyError, zipfile.BadZipFile):
-        return False
-    return f"<cp:keywords>{REPORT_KEYWORDS}</cp:keywords>".encode() in core
+    """True if the file at *path* is a report workbook this module wrote and nobody saved since.
+
+    A report someone annotated and saved (in Excel or LibreOffice, which keep
+    its keywords) is theirs: it is not replaced.
+    """
+    return untouched(path, "report")
 
 
 def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
                  written: WriteOutcome | None = None, *, four_pole=None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
-    An existing *path* is replaced only if it is a report this module wrote
-    and not open in Excel or LibreOffice; otherwise (the case workbook
-    itself, any other file) the report goes to a new name beside it.
+    An existing *path* is replaced only if it is a report this module wrote,
+    unchanged since (:func:`is_report`), not read-only and not open in Excel
+    or LibreOffice; otherwise (the case workbook itself, a report someone
+    annotated, any other file) the report goes to a new name beside it.
 
     Parameters
     ----------
@@ -395,4 +394,4 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     if four_pole is not None:
         four_pole_sheet(workbook.create_sheet(FOUR_POLE_SHEET), four_pole)
     _metadata(workbook.create_sheet("Metadata"), book, runs, written)
-    return WriteOutcome(save_atomic(workbook, target), reason)
+    return WriteOutcome(save_atomic(workbook, target, finish=lambda data: signed(data, "report")), reason)

@@ -114,6 +114,12 @@ def style_series(series: Series, direction: str, group: int = 0, markers: bool =
         line.dashStyle = _DASHES[group % len(_DASHES)]
 
 
+def _unwrapped(line: str) -> str:
+    """A line as it was before :func:`write_text_lines` wrapped it (a sheet's lines read back and written again)."""
+    first, *rest = line.split("\n")
+    return " ".join([first.rstrip(), *(part.strip() for part in rest)]) if rest else line
+
+
 def write_text_lines(ws, lines: list[str], top: int = 1) -> None:
     """Write text *lines* one per row from row *top*, wrapped to one printed page width.
 
@@ -123,6 +129,7 @@ def write_text_lines(ws, lines: list[str], top: int = 1) -> None:
     line starting with ``Run '`` is bold.
     """
     for row, line in enumerate(lines, start=top):
+        line = _unwrapped(line)
         indent = " " * (len(line) - len(line.lstrip()) + 2)
         paragraph = textwrap.wrap(line, _TEXT_CHARACTERS, subsequent_indent=indent, drop_whitespace=False) or [""]
         cell = ws.cell(row, 1, "\n".join(part.rstrip() for part in paragraph))

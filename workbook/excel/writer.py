@@ -2,8 +2,10 @@
 
 Result sheets are named ``Result efficiency``, ``Result hinges``, ``Result
 sweep`` and ``Result model card``; each carries, in a hidden cell, a marker
-naming the sheet it was written as. A later run replaces a sheet only when
-its name is one of these and its marker names that same sheet: a copy of a
+naming the sheet it was written as. A later run rewrites a sheet only when
+its name is one of these and its marker names that same sheet, and only the
+rows of the runs it computed: the rows of the workbook's other runs stay as
+they were, and the sheet's note names them. A copy of a
 result sheet (``Result efficiency (2)``) or a renamed one (``Result LP
 baseline``) is the user's and is kept, like any sheet of the user's that
 happens to share a name. The input sheets are left as openpyxl read them (values,
@@ -20,7 +22,10 @@ workbook beside it, and the reason is given) when:
   and manager properties, ...), or the rewritten file would lack any kind
   of part the original has (:func:`~workbook.excel.files.lost_parts`);
 - a sheet named like a result sheet exists that is not ours;
-- it changed on disk while the runs were computed.
+- the user cannot write it (read-only, e.g. mode 444);
+- it changed on disk while the runs were computed, or while the new file
+  was built (checked again just before the rename; other ``mountwb``
+  processes writing it wait for a lock on it meanwhile).
 
 Every save is atomic (temporary file in the same folder, then rename).
 """
@@ -41,10 +46,13 @@ import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
 from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.excel.files import (
+    ChangedOnDisk,
+    held,
     lock_file,
     lock_message,
     lost_parts,
     name_beside,
+    read_only_message,
     restore_formula_values,
     save_atomic,
     unsupported_content,
@@ -224,26 +232,95 @@ def result_sheet_names(frames: dict) -> list[str]:
     return [_sheet_title(name) for name in frames] + [_sheet_title("model card")]
 
 
+def _merged(earlier: list[tuple], fresh: list[tuple], computed: set[str]) -> list:
+    """Items ``(run, item)`` of an earlier write with those of the runs *computed* replaced by *fresh*.
+
+    The fresh items of a run take the place of its first earlier item; the
+    items of runs written for the first time come last.
+    """
+    by_run: dict[str, list] = {}
+    for run, item in fresh:
+        by_run.setdefault(run, []).append(item)
+    items, placed = [], set()
+    for run, item in earlier:
+        if run not in computed:
+            items.append(item)
+        elif run not in placed:
+            items += by_run.get(run, [])
+            placed.add(run)
+    for run, fresh_items in by_run.items():
+        if run not in placed:
+            items += fresh_items
+    return items
+
+
+def _earlier_rows(ws) -> tuple[list[str], list[tuple[str, dict]]]:
+    """The header and the rows ``(run, {header: value})`` of a result table written before."""
+    header = [value for value in next(ws.iter_rows(min_row=2, max_row=2, values_only=True), ()) if value]
+    rows = [(values[0], dict(zip(header, values))) for values in ws.iter_rows(min_row=3, values_only=True)
+            if values and values[0] is not None]
+    return header, rows
+
+
+def _earlier_cards(ws) -> list[tuple[str, list[str]]]:
+    """The model card of each run, ``(run, lines)``, of a model-card sheet written before."""
+    blocks: list[tuple[str, list[str]]] = []
+    for (line,) in ws.iter_rows(min_row=2, max_col=1, values_only=True):
+        line = "" if line is None else str(line)
+        if line.startswith("Run '") and line.endswith("'"):
+            blocks.append((line[len("Run '"):-1], []))
+        if blocks:
+            blocks[-1][1].append(line)
+    return blocks
+
+
+def _kept_note(earlier: list[tuple], computed: set[str]) -> str:
+    kept = list(dict.fromkeys(run for run, _ in earlier if run not in computed))
+    return f"; the results of {', '.join(repr(run) for run in kept)} are from an earlier run" if kept else ""
+
+
 def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str) -> list[str]:
-    """Add the result sheets to an openpyxl *workbook* (the ones it wrote before are removed first).
+    """Add the result sheets of *runs* to an openpyxl *workbook*.
+
+    The result sheets a write made before are rewritten: the rows and model
+    cards of the runs just computed are replaced, those of every other run
+    are kept as they were (the sheet's note names them).
 
     Returns
     -------
     list of str
         The sheet titles written.
     """
-    for ws in list(workbook.worksheets):
-        if is_result_sheet(ws):
-            workbook.remove(ws)
+    earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)}
+    computed = {run.spec.name for run in runs}
     frames = result_frames(runs, tests)
-    for name, frame in frames.items():
-        _write_frame(workbook.create_sheet(_sheet_title(name)), frame, f"{_NOTES[name]}. {stamp}")
+    tables = {}
+    for name, note in _NOTES.items():
+        title = _sheet_title(name)
+        header, rows = _earlier_rows(earlier[title]) if title in earlier else ([], [])
+        frame = frames.get(name)
+        columns = header if frame is None else list(frame.columns)
+        fresh = [] if frame is None else [(record["run"], record) for record in frame.to_dict("records")]
+        records = _merged(rows, fresh, computed)
+        if records:
+            # a table without fresh rows keeps the note of the write that made it
+            note = f"{note}. {stamp}{_kept_note(rows, computed)}" if fresh else peek(earlier[title], "A1")
+            tables[title] = (pd.DataFrame([[record.get(column) for column in columns] for record in records],
+                                          columns=columns), note)
+    title = _sheet_title("model card")
+    cards = _earlier_cards(earlier[title]) if title in earlier else []
+    fresh = [(run.spec.name, card_lines([run])) for run in runs]
+    lines = [line for block in _merged(cards, fresh, computed) for line in block]
+    for ws in earlier.values():
+        workbook.remove(ws)
+    for title, (frame, note) in tables.items():
+        _write_frame(workbook.create_sheet(title), frame, note)
     ws = workbook.create_sheet(_sheet_title("model card"))
-    write_text_lines(ws, card_lines(runs), top=2)
-    ws.cell(1, 1, stamp).font = Font(italic=True)
+    write_text_lines(ws, lines, top=2)
+    ws.cell(1, 1, stamp + _kept_note(cards, computed)).font = Font(italic=True)
     print_setup(ws)
     _mark(ws)
-    return result_sheet_names(frames)
+    return [*tables, ws.title]
 
 
 def _conflicts(workbook, titles: list[str]) -> list[str]:
@@ -255,6 +332,9 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
     lock = lock_file(path)
     if lock is not None:
         return lock_message(lock), None
+    refused = read_only_message(path)
+    if refused is not None:
+        return refused, None
     if hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
         return "it changed on disk while the runs were computed", None
     dropped = unsupported_content(path)
@@ -305,14 +385,19 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
     titles = result_sheet_names(result_frames(runs, tests))
-    reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
-    if reason is None:
-        add_result_sheets(workbook, runs, tests, stamp)
-        data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
-        lost = lost_parts(path.read_bytes(), data)
-        if not lost:
-            return WriteOutcome(write_atomic(path, data), None)
-        reason = f"it holds content this program cannot keep ({', '.join(lost)})"
+    with held(path):
+        reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
+        if reason is None:
+            log.info("building the new %s with the results", path.name)
+            add_result_sheets(workbook, runs, tests, stamp)
+            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
+            lost = lost_parts(path.read_bytes(), data)
+            reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
+        if reason is None:
+            try:
+                return WriteOutcome(write_atomic(path, data, unchanged=sha256), None)
+            except ChangedOnDisk:
+                reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
     add_result_sheets(separate, runs, tests, stamp)

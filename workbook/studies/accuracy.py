@@ -38,7 +38,7 @@ import numpy as np
 
 from flexbodies.atomic import replacing
 from flexbodies.selection import MODE_MARGIN
-from workbook.answers.saving import save_figure, save_text
+from workbook.answers.saving import free_stem, save_figure, save_text
 from workbook.errors import InputError
 from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
@@ -328,10 +328,7 @@ class AccuracyStudy:
 
         folder = Path(folder)
         folder.mkdir(parents=True, exist_ok=True)
-        name, number = stem, 1
-        while any((folder / f"{name}{suffix}").exists() for suffix in (".md", ".png", ".xlsx")):
-            number += 1
-            name = f"{stem}-{number}"
+        name = free_stem(folder, stem, (".md", ".png", ".xlsx"))
         paths = [folder / f"{name}{suffix}" for suffix in (".md", ".png", ".xlsx")]
         save_text(self.to_markdown(), paths[0])
         figure = self.plot()

@@ -22,14 +22,14 @@ import time
 from pathlib import Path
 
 from flexbodies.atomic import replacing
-from workbook.answers.saving import save_csv, save_figure
+from workbook.answers.saving import free_stem, save_csv, save_figure
 from workbook.errors import UsageError
 from workbook.model.case import DIRECTIONS
 from workbook.studies.parallel import RowOutcome
 from workbook.studies.parametric import PARAMETERS
 
 __all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "StudyTable", "table_path",
-           "read_finished", "WRITE_INTERVAL"]
+           "new_study_table", "STUDY_STEM", "read_finished", "WRITE_INTERVAL"]
 
 #: File formats of the study table.
 TABLE_FORMATS = ("csv", "parquet")
@@ -111,11 +111,21 @@ def plot_sensitivity(frame, parameters: list[str]):
     return fig
 
 
-def table_path(folder: str | Path, table_format: str = "csv") -> Path:
-    """The study table's file in *folder*: ``parameter-study.<csv|parquet>``."""
+#: Name of a study's files, before ``-2``, ``-3``... (another study's files in the folder) and the ending.
+STUDY_STEM = "parameter-study"
+
+
+def table_path(folder: str | Path, table_format: str = "csv", stem: str = STUDY_STEM) -> Path:
+    """The study table's file in *folder*: ``<stem>.<csv|parquet>`` (``parameter-study.csv``)."""
     if table_format not in TABLE_FORMATS:
         raise ValueError(f"table format must be one of {', '.join(TABLE_FORMATS)}, got {table_format!r}")
-    return Path(folder) / f"parameter-study.{table_format}"
+    return Path(folder) / f"{stem}.{table_format}"
+
+
+def new_study_table(folder: str | Path, table_format: str = "csv") -> Path:
+    """The table file of a new study in *folder*: ``parameter-study``, or ``parameter-study-2``... when a file of
+    an earlier study (its table, sheet or plot) is there, which is kept."""
+    return table_path(folder, table_format, free_stem(folder, STUDY_STEM, (f".{table_format}", ".xlsx", ".png")))
 
 
 def _write_table(frame, path: Path) -> None:
@@ -250,16 +260,22 @@ def _study_workbook(frame, parameters: list[str]):
     return workbook
 
 
-def write_study(frame, parameters: list[str], folder: str | Path, table_format: str = "csv") -> list[Path]:
+def write_study(frame, parameters: list[str], table: str | Path) -> list[Path]:
     """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot, each all at once.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+    parameters : list of str
+    table : str or Path
+        The table file (:func:`table_path`); the sheet and the plot go beside it under its name.
 
     Returns
     -------
     list of Path
-        ``parameter-study.<csv|parquet>``, ``parameter-study.xlsx``,
-        ``parameter-study.png`` in *folder*.
+        ``<table>``, ``<table stem>.xlsx``, ``<table stem>.png``.
     """
-    table = table_path(folder, table_format)
+    table = Path(table)
     _write_table(frame, table)
     sheet = table.with_suffix(".xlsx")
     with replacing(sheet, suffix=".xlsx.tmp") as temporary:
