@@ -109,7 +109,7 @@ def test_the_four_pole_and_study_workbooks_print_readably(tmp_path):
     (tmp_path / "study").mkdir()
     sheet = next(p for p in write_study(frame, ["hinge_stiffness"], table_path(tmp_path / "study")) if p.suffix == ".xlsx")
     out = tmp_path / "pdf"
-    _convert(tmp_path, "pdf", pole, sheet, outdir=out)
+    soffice_convert(tmp_path, "pdf", pole, sheet, outdir=out)
     _assert_readable(out / "four-pole.pdf")
     _assert_readable(out / "parameter-study.pdf")
     assert _pages(out / "four-pole.pdf") >= 3                      # the chart, then the table over pages
