@@ -77,6 +77,7 @@ class CasingModel:
             size = self.element_size if self.element_size is not None else default_casing_element_size(self.geometry)
             shape = {"geometry": dataclasses.asdict(self.geometry), "element_size": size}
         else:
+            assert self.mesh_file is not None
             path = Path(self.mesh_file)
             try:
                 digest = hashlib.sha256(path.read_bytes()).hexdigest()

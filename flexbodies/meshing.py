@@ -141,6 +141,7 @@ class BoreSpec:
             return
         if not all(geometric):
             raise ValueError(f"bore {self.name!r}: a geometric bore needs centre, axis and radius (or give node_set)")
+        assert self.centre is not None and self.axis is not None and self.radius is not None
         if np.shape(self.centre) != (3,) or np.shape(self.axis) != (3,):
             raise ValueError(f"bore {self.name!r}: centre and axis must each have 3 components")
         if not np.linalg.norm(np.asarray(self.axis, dtype=float)) > 0:
@@ -561,6 +562,7 @@ def _resolve_bore(mesh, spec: BoreSpec, source: str, node_sets) -> Bore:
             raise ValueError(f"bore {spec.name!r}: node set {spec.node_set!r} of {source} contains "
                              "no complete boundary face")
         return _bore_from_facets(mesh, spec.name, facets, None)
+    assert spec.axis is not None and spec.radius is not None
     centre = np.asarray(spec.centre, dtype=float)
     axis = np.asarray(spec.axis, dtype=float) / np.linalg.norm(spec.axis)
     tol = spec.tolerance if spec.tolerance is not None else _DEFAULT_RELATIVE_TOLERANCE * spec.radius

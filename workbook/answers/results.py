@@ -30,6 +30,9 @@ class PylonAnswers:
     and ``excitation_amplitude`` (N): a simulated run or a rig measurement.
     """
 
+    pylon_amplitude: np.ndarray
+    excitation_amplitude: float
+
     @property
     def transmissibility(self) -> np.ndarray:
         """Pylon-force transmissibility per direction x, y, z."""
@@ -290,7 +293,7 @@ class MountResult:
         return fig
 
 
-def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float]]:
+def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float | None]]:
     t = transmissibility(amplitude, reference)
     answers = {}
     for axis, a, ti in zip(DIRECTIONS, amplitude, t):

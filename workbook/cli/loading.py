@@ -74,6 +74,7 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         from workbook.excel.execute import select_runs
         from workbook.excel.reader import read_workbook
 
+        assert path is not None
         book = read_workbook(path)
         case = book.case if run is None else book.run_case(select_runs(book, [run])[0])
     elif run is not None:

@@ -132,7 +132,7 @@ def _summary(ws, book: CaseBook, runs: list[RunResult]) -> None:
         sweep_rows = []
         for run in sweeps:
             points = run.result.runs
-            peaks = [max(points, key=lambda p, i=i: p.transmissibility[i]) for i in range(len(DIRECTIONS))]
+            peaks = [max(points, key=lambda p, i=i: p.transmissibility[i]) for i in range(len(DIRECTIONS))]  # type: ignore[misc]
             sweep_rows.append([run.spec.name, points[0].frequency_hz, points[-1].frequency_hz,
                                *(p.transmissibility[i] for i, p in enumerate(peaks)), *(p.frequency_hz for p in peaks)])
         row = _table(ws, row, sweep_columns, sweep_rows) + 2

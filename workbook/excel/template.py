@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import datetime
 from pathlib import Path
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 from openpyxl import Workbook
@@ -113,7 +113,7 @@ def _vector(key: str, values) -> dict:
 def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
     """The Excitations rows of one excitation: one row, or one per imbalance plane
     (the first with the speed, the axis and any sweep or run-up)."""
-    row = {"name": excitation.name}
+    row: dict[str, Any] = {"name": excitation.name}
     if isinstance(excitation, cm.Simultaneous):
         raise ValueError(f"excitation {excitation.name!r}: simultaneous excitations have no Excitations row; "
                          f"run them from Python or a JSON case")
@@ -239,7 +239,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
     }
 
 
-def _column_unit(column: L.Column, values: list) -> tuple[str, float]:
+def _column_unit(column: L.Column, values: list) -> tuple[str | None, float]:
     """Unit text and factor of a column: the display unit if every value reads back identically."""
     if not column.has_unit or column.kind != "number":
         return column.template_unit, 1.0

@@ -116,7 +116,7 @@ def _long_frame(runs: list[RunResult], tests: tuple) -> pd.DataFrame:
         frames.append(frame)
     frame = pd.concat(frames, ignore_index=True)
     test_amplitude, test_error = [], []
-    by_key = {}
+    by_key: dict = {}
     for test in tests:
         by_key.setdefault((test.run, test.location, test.direction), []).append(test)
     for row in frame.to_dict("records"):
@@ -204,7 +204,7 @@ def is_result_sheet(ws) -> bool:
 
 def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
     ws.cell(1, 1, note).font = Font(italic=True)
-    formats = [FORMATS.get(quantity_of(name)) for name in frame.columns]
+    formats = [FORMATS.get(quantity_of(name) or "") for name in frame.columns]
     for col, name in enumerate(frame.columns, start=1):
         cell = ws.cell(2, col, name)
         cell.font, cell.fill = Font(bold=True), _HEADER_FILL
@@ -294,7 +294,7 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         values = load_workbook(path, data_only=True)
-    cached = {}
+    cached: dict[int, dict[str, object]] = {}
     for number, ws in enumerate(workbook.worksheets, start=1):
         if ws.title not in values.sheetnames:
             continue

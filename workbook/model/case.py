@@ -294,7 +294,7 @@ class Link:
 HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
 
 
-def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | Vector3:
+def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | tuple[float, ...]:
     """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
 
     A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
@@ -565,6 +565,9 @@ def _direction(value: Any, item: str, name: str) -> Vector3:
 class _OneFrequency:
     """The frequency of an excitation given as ``frequency_hz`` or ``rpm``."""
 
+    frequency_hz: float | None
+    rpm: float | None
+
     @property
     def frequency(self) -> float:
         """Excitation frequency, Hz."""
@@ -624,6 +627,7 @@ class RotatingForce(_OneFrequency):
         """Force amplitude, N."""
         if self.amplitude is not None:
             return self.amplitude
+        assert self.unbalance is not None
         return self.unbalance * (2 * math.pi * self.frequency) ** 2
 
     def force_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
@@ -1354,7 +1358,7 @@ class Case:
     def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
         """Every run of the case: single excitations, expanded sweeps and the
         parts of simultaneous excitations."""
-        runs = []
+        runs: list[SingleFrequencyExcitation] = []
         for excitation in self.excitations:
             runs.extend(excitation.expand() if isinstance(excitation, (Sweep, Simultaneous)) else (excitation,))
         return tuple(runs)

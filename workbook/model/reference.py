@@ -12,6 +12,8 @@ y lateral, z up (right-handed, so +y is the engine's left seen from behind).
 """
 from __future__ import annotations
 
+from typing import Any, cast
+
 import numpy as np
 
 from workbook.errors import CaseError
@@ -117,7 +119,7 @@ def _hinges(damping_model: str) -> tuple[Hinge, ...]:
         raise CaseError("reference case", "hinge_damping", damping_model, " or ".join(map(repr, HINGE_DAMPING_MODELS)))
     points = _link_points()
     viscous = damping_model == "viscous"
-    damping = {"damping": HINGE_DAMPING_TIME * HINGE_STIFFNESS} if viscous else {"loss_factor": HINGE_LOSS_FACTOR}
+    damping: dict[str, Any] = {"damping": HINGE_DAMPING_TIME * HINGE_STIFFNESS} if viscous else {"loss_factor": HINGE_LOSS_FACTOR}
 
     def hinge(name: str, body_a: str, body_b: str, point) -> Hinge:
         return Hinge(name, body_a, body_b, point, HINGE_STIFFNESS, **damping)
@@ -207,7 +209,7 @@ def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = N
     Case
     """
     inertia = ENGINE_MASS * np.diag([ROLL_GYRATION ** 2, PITCH_GYRATION ** 2, PITCH_GYRATION ** 2])
-    engine = Engine(ENGINE_MASS, ENGINE_CG, tuple(map(tuple, inertia)))
+    engine = Engine(ENGINE_MASS, ENGINE_CG, cast(Any, tuple(map(tuple, inertia))))
     static_loads = (PointForce("thrust", force=(23_000.0, 0.0, 0.0), point=(ENGINE_CG[0], 0.0, 0.0)),
                     Gravity("gravity", (0.0, 0.0, -9.81)))
     excitations = (LP_ROTOR, HP_ROTOR) + ((reference_sweep(),) if sweep else ())

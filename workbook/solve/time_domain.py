@@ -299,7 +299,7 @@ def _solve_segment(scene: Scene, settings, plan: TimePlan, first: int, last: int
         integration.numberOfSteps = (last - first) * 2 ** halving
         solver = exu.MainSolverImplicitSecondOrder()
         with solver_output():
-            solved = solver.SolveSystem(scene.mbs, settings)
+            solved = solver.SolveSystem(scene.mbs, settings)  # type: ignore[call-arg]
         if solved:
             _advance_initial_state(scene.mbs)
             if halving:
@@ -363,6 +363,7 @@ def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | 
     import exudyn as exu
 
     analysis = scene.case.analysis
+    assert scene.excitation is not None
     where = run_label(scene.case.name, scene.excitation.name)
     settings = _simulation_settings(scene, plan)
     preloaded = np.asarray(scene.mbs.GetNodeOutput(scene.engine.node, exu.OutputVariableType.Position,
@@ -371,7 +372,7 @@ def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | 
     # full from the first step, is still zero, so the equations of motion there would not give them
     settings.timeIntegration.generalizedAlpha.computeInitialAccelerations = plan.start != STEADY
     began = wall_clock.perf_counter()
-    retries = []
+    retries: list = []
     window = plan.measured_periods * plan.steps_per_period
     limit = plan.steps + plan.extension_periods * plan.steps_per_period
     segments = plan.segments()
@@ -394,6 +395,7 @@ def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | 
             histories.extended_periods = (last - plan.steps) // plan.steps_per_period
             if steady is not None and last + window <= limit and not steady(histories):
                 segments.append((last, last + window, True))
+    assert histories is not None
     return histories
 
 
@@ -417,6 +419,7 @@ def _stored_histories(scene: Scene, before: TimeHistories | None, samples: int, 
 def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> ExcitationResult:
     """Amplitudes at the excitation frequency, the steady-state check and warnings."""
     analysis = scene.case.analysis
+    assert scene.excitation is not None and scene.excitation.signal is not None
     signal = scene.excitation.signal
     time = histories.time
     pylon = pylon_sum(histories.hinge_forces, scene.pylon_channels)
@@ -438,6 +441,7 @@ def run_warnings(scene: Scene, plan: TimePlan, relative_change: float, extended_
     """The warnings of a time run: not steady (the pylon amplitudes of the two
     windows differ by *relative_change*, after *extended_periods* periods
     beyond the plan), a coarse step, undamped modes."""
+    assert scene.excitation is not None
     analysis = scene.case.analysis
     warnings = []
     if relative_change > analysis.steady_tolerance:

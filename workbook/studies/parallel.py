@@ -112,7 +112,7 @@ def prepare(cases: dict[int, Case | BaseException]) -> dict[int, Case | RowOutco
     """
     from flexbodies import reduce_link
 
-    reduced, prepared = set(), {}
+    reduced, prepared = set(), dict[int, Case | RowOutcome]()
     for index, case in cases.items():
         if isinstance(case, BaseException):
             prepared[index] = _failed(index, case)
@@ -250,6 +250,7 @@ def _worker_init(started) -> None:
 
 
 def _reported_row(index: int, case: Case) -> RowOutcome:
+    assert _started is not None
     _started.put((index, os.getpid()))
     return run_row(index, case)
 

@@ -208,7 +208,7 @@ def study_cases(case: Case, rows: tuple) -> list:
     -------
     list of Case or CaseError
     """
-    cases = []
+    cases: list[Case | CaseError] = []
     for index, row in enumerate(rows):
         try:
             cases.append(row_case(case, row, index))

@@ -229,8 +229,8 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
              **{f"T {d}": float(r[f"T {d}"]) for d in DIRECTIONS},
              **{f"eta % {d}": float(r[f"eta % {d}"]) for d in DIRECTIONS},
              "steady": str(r["steady"]).lower() == "true"} for _, r in table.iterrows()]
-        error = "" if pd.isna(first["error"]) else str(first["error"])
-        finished[index] = RowOutcome(index, runs, status, error, float(first["wall time s"]))
+        message = "" if pd.isna(first["error"]) else str(first["error"])
+        finished[index] = RowOutcome(index, runs, status, message, float(first["wall time s"]))
     return finished
 
 
