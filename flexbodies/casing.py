@@ -239,7 +239,7 @@ def casing_interfaces(casing_mesh: LinkMesh, interfaces, source: str) -> LinkMes
         for k, bore in enumerate(bores):
             reach[k, ~np.isin(shared, bore.nodes)] = np.inf
         owner[shared] = np.argmin(reach, axis=0)
-        for k, (interface, bore) in enumerate(zip(interfaces, bores)):
+        for k, (interface, bore) in enumerate(zip(interfaces, bores, strict=True)):
             keep = owner[bore.nodes] == k
             if not keep.any():
                 raise ValueError(f"{source}: interface {interface.name!r}: every surface node within its reach "

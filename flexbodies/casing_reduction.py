@@ -217,5 +217,5 @@ def add_casing_to_exudyn(mbs, casing: ReducedLink, position, *, modal_damping_ra
         mbs.SetObjectParameter(body, "dampingMatrixReduced", damping)
     markers = {interface: mbs.AddMarker(eii.MarkerSuperElementPosition(
         bodyNumber=body, meshNodeNumbers=[int(node)], weightingFactors=[1.0]))
-        for interface, node in zip(casing.interface_names, casing.master_nodes)}
+        for interface, node in zip(casing.interface_names, casing.master_nodes, strict=True)}
     return ExudynCasing(body, (items["nRigidBody"], items["nGenericODE2"]), markers, casing.dof, casing.mass)

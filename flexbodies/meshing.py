@@ -539,12 +539,12 @@ class _NodeSets:
         if name in d.point_sets:
             return np.asarray(d.point_sets[name], dtype=np.int64)
         if name in d.cell_sets:
-            blocks = zip(d.cells, d.cell_sets[name])
+            blocks = zip(d.cells, d.cell_sets[name], strict=True)
             return np.unique(np.concatenate([b.data[idx].ravel() for b, idx in blocks if idx is not None]
                                             or [np.zeros(0, dtype=np.int64)]))
         tag = d.field_data[name][0]
         physical = d.cell_data.get("gmsh:physical", [None] * len(d.cells))
-        return np.unique(np.concatenate([b.data[tags == tag].ravel() for b, tags in zip(d.cells, physical)
+        return np.unique(np.concatenate([b.data[tags == tag].ravel() for b, tags in zip(d.cells, physical, strict=True)
                                          if tags is not None] or [np.zeros(0, dtype=np.int64)]))
 
 

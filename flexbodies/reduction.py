@@ -155,7 +155,7 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     static = solver.static_modes()
     shared = time.perf_counter() - start
     links = []
-    for decision, info in zip(decisions, infos):
+    for decision, info in zip(decisions, infos, strict=True):
         keep = kept_count(fixed_hz, decision.count, decision.cutoff_hz)
         cb = CraigBamptonBasis(np.hstack([static, fixed[:, :keep]]), solver.masters, fixed_hz[:keep])
         links.append(reduce_coupled(coupled, cb, decision, frequencies,

@@ -125,7 +125,7 @@ def _custom_note(style: bytes) -> bool:
     fields = dict(item.split(":", 1) for item in style.decode().replace(" ", "").split(";") if ":" in item)
     if fields.get("visibility", "hidden") != "hidden":
         return True
-    for key, default in zip(("width", "height"), _NOTE_BOX_PT):
+    for key, default in zip(("width", "height"), _NOTE_BOX_PT, strict=True):
         text = fields.get(key, "")
         match = re.fullmatch(r"([0-9.]+)(pt|px|in|cm|mm)?", text)
         if not match:
@@ -274,8 +274,11 @@ def restore_formula_values(data: bytes, cached: dict[int, dict[str, object]]) ->
             if typed is None:
                 continue
             pattern = re.compile(rf'<c r="{cell}"([^>]*)>(<f\b[^>]*/>|<f\b[^>]*>.*?</f>)<v\s*/>(</c>)', re.S)
-            text = pattern.sub(lambda m: f'<c r="{cell}"{m.group(1)}{typed[0]}>{m.group(2)}<v>{typed[1]}</v></c>',
-                               text)
+
+            def filled(m: re.Match, cell: str = cell, typed: tuple = typed) -> str:
+                return f'<c r="{cell}"{m.group(1)}{typed[0]}>{m.group(2)}<v>{typed[1]}</v></c>'
+
+            text = pattern.sub(filled, text)
         return text.encode("utf-8")
 
     return _edit_members(data, edit)

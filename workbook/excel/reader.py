@@ -216,7 +216,7 @@ class _CaseReader(SheetReader):
             keys = (*L.LINKS.vector_keys(f"mesh_bore_{eye}"), *L.LINKS.vector_keys("mesh_bore_axis"), "bore_radius")
             if not self.require(record, keys, f"bore {eye.upper()} of a mesh link without a node set"):
                 return None
-            bores.append(self.build(record, lambda: flexbodies.BoreSpec(
+            bores.append(self.build(record, lambda eye=eye: flexbodies.BoreSpec(
                 f"bore {eye.upper()}", centre=record.vector(f"mesh_bore_{eye}"),
                 axis=record.vector("mesh_bore_axis"), radius=record.get("bore_radius")), keys))
         if None in bores:
@@ -510,7 +510,7 @@ class _CaseReader(SheetReader):
                                     f"own unbalance or force)")
                 continue
             run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
-            if self.build(record, lambda: case_for_run(case, run)) is not None:
+            if self.build(record, lambda run=run: case_for_run(case, run)) is not None:
                 runs.append((record, run))
         return runs
 

@@ -107,7 +107,7 @@ def _row_for_link(link: cm.Link) -> dict:
 
 
 def _vector(key: str, values) -> dict:
-    return {f"{key}_{axis}": value for axis, value in zip("xyz", values)}
+    return {f"{key}_{axis}": value for axis, value in zip("xyz", values, strict=True)}
 
 
 def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
@@ -185,9 +185,9 @@ def _rows_for_casing(casing) -> list[dict]:
     base = flexbodies.material(casing.material.name.split(" ")[0])
     radial, axial = casing.bearing_stiffness
     row = {"radius": g.radius, "thickness": g.thickness, "x_start": g.x_start, "x_end": g.x_end,
-           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings)
+           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings, strict=True)
               for name, value in (("x", ring.x), ("width", ring.width), ("radius", ring.outer_radius))},
-           **dict(zip(L.CASING_BEARINGS, casing.bearing_planes)), "material": base.name,
+           **dict(zip(L.CASING_BEARINGS, casing.bearing_planes, strict=False)), "material": base.name,
            **{key: getattr(casing.material, key) for key in ("youngs_modulus", "poisson_ratio", "density")
               if getattr(casing.material, key) != getattr(base, key)},
            "element_size": casing.element_size, "spider_radius": casing.spider_radius,
@@ -299,7 +299,7 @@ def _write_instructions(ws) -> None:
             for col, text in enumerate((table.sheet, column.header, column.template_unit, kind,
                                         "yes" if column.required else "", column.help), start=1):
                 ws.cell(row, col, text or None)
-    for letter, width in zip("ABCDEF", (14, 22, 10, 22, 9, 90)):
+    for letter, width in zip("ABCDEF", (14, 22, 10, 22, 9, 90), strict=True):
         ws.column_dimensions[letter].width = width
     ws.cell(1, 1).alignment = Alignment(vertical="top")
     print_setup(ws)

@@ -306,7 +306,7 @@ def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float
         raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
                                            f"{len(values)} given")
     return tuple(_number(v, item, f"{name}[{direction}]", minimum=0.0, strictly=strictly)
-                 for v, direction in zip(values, HINGE_DIRECTIONS))
+                 for v, direction in zip(values, HINGE_DIRECTIONS, strict=True))
 
 
 def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
@@ -872,7 +872,7 @@ class Sweep:
                                 for f in self.frequencies_hz)
         except TypeError:
             raise CaseError(item, "frequencies_hz", self.frequencies_hz, "a list of frequencies") from None
-        if not frequencies or any(b <= a for a, b in zip(frequencies, frequencies[1:])):
+        if not frequencies or any(b <= a for a, b in zip(frequencies, frequencies[1:], strict=False)):
             raise CaseError(item, "frequencies_hz", self.frequencies_hz, "ascending frequencies")
         _set(self, "frequencies_hz", frequencies)
 

@@ -219,7 +219,7 @@ def _read_table(path, lines: list[str], start: int) -> tuple[list, dict]:
     if not np.isfinite(values).all():
         index, j = np.argwhere(~np.isfinite(values))[0]
         raise RecordError(path, "not a finite number", line=start + 1 + int(index), column=headers[j])
-    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors))}
+    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors, strict=True))}
 
 
 def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:

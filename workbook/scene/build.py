@@ -325,7 +325,7 @@ class Scene:
         try:
             yield
         finally:
-            for load, function in zip(self.excitation.loads, self.excitation.functions):
+            for load, function in zip(self.excitation.loads, self.excitation.functions, strict=True):
                 self.mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
 
     @contextmanager
@@ -590,7 +590,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
             stiffness[:] = hinge.gap_contact_stiffness
         damping = (hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)) \
             + [viscous(eta, k) for eta, k in zip(hinge.values("loss_factor") if hinge.name in hinge_loss
-                                                 else np.zeros(3), stiffness)]
+                                                 else np.zeros(3), stiffness, strict=True)]
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
             name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
             damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))

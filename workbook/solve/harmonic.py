@@ -166,7 +166,7 @@ class HarmonicModel:
         motion = self.motion(frequency_hz, load)
         outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
         forces = (outputs @ motion).reshape(-1, 3)
-        hinges = dict(zip(self.hinge_names, forces))
+        hinges = dict(zip(self.hinge_names, forces, strict=True))
         pylon = pylon_sum(hinges, self.pylon_hinges)
         return FrequencyResponse(frequency_hz, hinges, pylon)
 

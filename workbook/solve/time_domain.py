@@ -155,7 +155,7 @@ class TimePlan:
         per_segment = max(1, math.ceil(transient / TRANSIENT_SEGMENTS))
         bounds = list(range(0, transient, per_segment)) + [transient]
         segments = [(a * self.steps_per_period, b * self.steps_per_period, False)
-                    for a, b in zip(bounds, bounds[1:])]
+                    for a, b in zip(bounds, bounds[1:], strict=False)]
         return segments + [(transient * self.steps_per_period, self.steps, True)]
 
 
