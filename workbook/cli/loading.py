@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from workbook.errors import CaseError, UsageError
-from workbook.model.case import Case
+from workbook.model.case import AnalysisMethod, Case
 from workbook.model.codec import from_json
 from workbook.model.pylon_impedance import read_impedance_csv
 from workbook.model.reference import reference_case
@@ -43,7 +43,7 @@ def _json_case(path: str) -> Case:
 
 
 def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = False,
-              time_budget: float | None = None, method: str | None = None,
+              time_budget: float | None = None, method: AnalysisMethod | None = None,
               pylon_impedance: str | None = None) -> Case:
     """The case a command works on.
 

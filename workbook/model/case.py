@@ -21,7 +21,7 @@ import dataclasses
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -41,12 +41,15 @@ __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link"
 PYLON = "pylon"
 ENGINE = "engine"
 DIRECTIONS = ("x", "y", "z")
+AnalysisMethod = Literal["time", "frequency", "auto"]
 #: Analysis methods a case may ask for (AnalysisSettings.method).
-ANALYSIS_METHODS = ("time", "frequency", "auto")
+ANALYSIS_METHODS: tuple[AnalysisMethod, ...] = get_args(AnalysisMethod)
+TimeStart = Literal["auto", "steady", "rest"]
 #: Starts a time-domain run may take (AnalysisSettings.start).
-TIME_STARTS = ("auto", "steady", "rest")
+TIME_STARTS: tuple[TimeStart, ...] = get_args(TimeStart)
+StressStiffening = Literal["auto", "on", "off"]
 #: Settings of ``Effects.stress_stiffening``.
-STRESS_STIFFENING = ("auto", "on", "off")
+STRESS_STIFFENING: tuple[StressStiffening, ...] = get_args(StressStiffening)
 _RESERVED = (PYLON, ENGINE)
 # Two points closer than this (m) are the same point (a hinge on a link eye).
 POINT_TOLERANCE = 1e-6
@@ -843,6 +846,10 @@ class Rotor(_OneFrequency):
         return self.polar_inertia * 2 * math.pi * self.frequency * np.asarray(self.axis)
 
 
+#: Spacings of the frequencies of :meth:`Sweep.band`.
+SweepSpacing = Literal["log", "linear"]
+
+
 @dataclass(frozen=True)
 class Sweep:
     """A stepped sweep: one excitation template run at each of several frequencies.
@@ -878,7 +885,7 @@ class Sweep:
 
     @classmethod
     def band(cls, name: str, template: SingleFrequencyExcitation, start_hz: float, stop_hz: float,
-             points: int, spacing: str = "log") -> "Sweep":
+             points: int, spacing: SweepSpacing = "log") -> "Sweep":
         """A sweep of *points* frequencies from *start_hz* to *stop_hz* (``"log"`` or ``"linear"``)."""
         if spacing not in ("log", "linear"):
             raise CaseError(f"excitation {name!r}", "spacing", spacing, "'log' or 'linear'")
@@ -899,6 +906,8 @@ class Sweep:
 
 #: Speed units of a run-up and their factor to Hz.
 SPEED_UNITS = {"rpm": 1.0 / 60.0, "Hz": 1.0}
+#: The keys of :data:`SPEED_UNITS`.
+SpeedUnit = Literal["rpm", "Hz"]
 
 
 @dataclass(frozen=True)
@@ -922,7 +931,7 @@ class RunUp(Sweep):
         The unit the speeds are tabulated and plotted in.
     """
 
-    speed_unit: str = "rpm"
+    speed_unit: SpeedUnit = "rpm"
 
     def __post_init__(self):
         super().__post_init__()
@@ -937,7 +946,7 @@ class RunUp(Sweep):
 
     @classmethod
     def speeds(cls, name: str, template: SingleFrequencyExcitation, start: float, stop: float, points: int,
-               unit: str = "rpm") -> "RunUp":
+               unit: SpeedUnit = "rpm") -> "RunUp":
         """A run-up over *points* evenly spaced speeds from *start* to *stop*, in *unit* (rpm or Hz)."""
         item = f"excitation {name!r}"
         if unit not in SPEED_UNITS:
@@ -1082,11 +1091,11 @@ class AnalysisSettings:
     spectral_radius: float = 0.9
     newton_tolerance: float = 1e-6
     equilibrium_tolerance: float = 1e-6
-    method: str = "auto"
+    method: AnalysisMethod = "auto"
     step_halvings: int = 4
     time_budget: float | None = None
     divergence_displacement: float = 0.05
-    start: str = "auto"
+    start: TimeStart = "auto"
 
     def __post_init__(self):
         item = "analysis settings"
@@ -1160,7 +1169,7 @@ class Effects:
     clearance: bool = True
     rig_sensors: bool = True
     gyroscopics: bool = True
-    stress_stiffening: str = "auto"
+    stress_stiffening: StressStiffening = "auto"
 
     def __post_init__(self):
         for item in dataclasses.fields(self):

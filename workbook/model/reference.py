@@ -12,7 +12,7 @@ y lateral, z up (right-handed, so +y is the engine's left seen from behind).
 """
 from __future__ import annotations
 
-from typing import Any, cast
+from typing import Any, Literal, cast, get_args
 
 import numpy as np
 
@@ -44,8 +44,9 @@ HINGE_LOSS_FACTOR = 0.05
 #: The former viscous hinge damping as a stiffness-proportional time constant,
 #: d = HINGE_DAMPING_TIME * k, s (``reference_case(hinge_damping="viscous")``).
 HINGE_DAMPING_TIME = 1.0e-3
+HingeDamping = Literal["loss factor", "viscous"]
 #: The hinge damping models of :func:`reference_case`.
-HINGE_DAMPING_MODELS = ("loss factor", "viscous")
+HINGE_DAMPING_MODELS: tuple[HingeDamping, ...] = get_args(HingeDamping)
 
 FRONT_X, REAR_X, LATERAL_X, THRUST_FORWARD_X = 0.0, -1.60, -1.72, -0.55
 
@@ -113,7 +114,7 @@ def _links(element_size: float | None) -> tuple[Link, ...]:
     return tuple(links)
 
 
-def _hinges(damping_model: str) -> tuple[Hinge, ...]:
+def _hinges(damping_model: HingeDamping) -> tuple[Hinge, ...]:
     """16 spring-damper hinges; up = pylon side, down = engine side."""
     if damping_model not in HINGE_DAMPING_MODELS:
         raise CaseError("reference case", "hinge_damping", damping_model, " or ".join(map(repr, HINGE_DAMPING_MODELS)))
@@ -184,7 +185,7 @@ def reference_sweep(points: int = 25) -> Sweep:
 
 def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = None,
                    element_size: float | None = None, rotors: bool = False,
-                   hinge_damping: str = "loss factor") -> Case:
+                   hinge_damping: HingeDamping = "loss factor") -> Case:
     """The reference mount with the LP and HP rotor cases.
 
     Parameters

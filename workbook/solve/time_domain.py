@@ -64,7 +64,7 @@ from workbook.scene.build import Scene
 from workbook.scene.excitation import ExcitationSignal
 from workbook.solve.guards import MAX_STEPS, UNDAMPED_RATIO, check_undamped_resonance, newton_cause, run_label, solver_output
 from workbook.solve.modes import Mode, mounted_modes
-from workbook.solve.steady_start import STEADY
+from workbook.solve.steady_start import STEADY, Start
 from workbook.solve.step_accuracy import ACCURACY_LIMIT, ACCURACY_TARGET, amplitude_error, steps_for_accuracy
 
 __all__ = ["TimePlan", "plan_run", "integrate", "extract", "run_warnings", "TimeHistories", "TRANSIENT_SEGMENTS"]
@@ -122,7 +122,7 @@ class TimePlan:
     amplitude_error: float = 0.0
     error_source: str = ""
     steps_needed: int = 0
-    start: str = "rest"
+    start: Start = "rest"
     extension_periods: int = 0
 
     @property
@@ -160,7 +160,7 @@ class TimePlan:
 
 
 def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, modes: list[Mode], where: str = "run",
-             start: str = "rest") -> TimePlan:
+             start: Start = "rest") -> TimePlan:
     """Choose the step and the durations of a run.
 
     Parameters

@@ -40,7 +40,7 @@ from flexbodies.atomic import replacing
 from flexbodies.selection import MODE_MARGIN
 from workbook.answers.saving import save_figure, save_text
 from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
-from workbook.solve.method import FREQUENCY, TIME, MethodChoice
+from workbook.solve.method import FREQUENCY, TIME, Method, MethodChoice
 from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
 
 __all__ = ["Rung", "RungResult", "AccuracyStudy", "ladder", "run_study", "REFERENCE_RUNG"]
@@ -72,7 +72,7 @@ class Rung:
 
     label: str
     links: str
-    method: str
+    method: Method
     steps_per_period: int | None = None
 
     @property
@@ -144,7 +144,7 @@ class RungResult:
     transmissibility: dict
 
 
-def _solve(case: Case, excitation: SingleFrequencyExcitation, method: str):
+def _solve(case: Case, excitation: SingleFrequencyExcitation, method: Method):
     """T (3,) and DOF of one excitation of a prepared rung case."""
     if method == FREQUENCY:
         prepared = prepare(case, excitation)

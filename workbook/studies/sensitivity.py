@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import Literal, get_args
 
 from flexbodies.atomic import replacing
 from workbook.answers.saving import save_csv, save_figure
@@ -31,8 +32,9 @@ from workbook.studies.parametric import PARAMETERS
 __all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "StudyTable", "table_path",
            "read_finished", "WRITE_INTERVAL"]
 
+TableFormat = Literal["csv", "parquet"]
 #: File formats of the study table.
-TABLE_FORMATS = ("csv", "parquet")
+TABLE_FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
 #: Least time between two writes of a running study's table file, s. Writing
 #: a 10,000-row table takes about 0.3 s; written after every row, it would
 #: cost more than the rows themselves.
@@ -111,7 +113,7 @@ def plot_sensitivity(frame, parameters: list[str]):
     return fig
 
 
-def table_path(folder: str | Path, table_format: str = "csv") -> Path:
+def table_path(folder: str | Path, table_format: TableFormat = "csv") -> Path:
     """The study table's file in *folder*: ``parameter-study.<csv|parquet>``."""
     if table_format not in TABLE_FORMATS:
         raise ValueError(f"table format must be one of {', '.join(TABLE_FORMATS)}, got {table_format!r}")
@@ -234,7 +236,7 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
     return finished
 
 
-def write_study(frame, parameters: list[str], folder: str | Path, table_format: str = "csv") -> list[Path]:
+def write_study(frame, parameters: list[str], folder: str | Path, table_format: TableFormat = "csv") -> list[Path]:
     """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot, each all at once.
 
     Returns
