@@ -185,7 +185,7 @@ def _rows_for_casing(casing) -> list[dict]:
     base = flexbodies.material(casing.material.name.split(" ")[0])
     radial, axial = casing.bearing_stiffness
     row = {"radius": g.radius, "thickness": g.thickness, "x_start": g.x_start, "x_end": g.x_end,
-           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings, strict=True)
+           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings, strict=False)
               for name, value in (("x", ring.x), ("width", ring.width), ("radius", ring.outer_radius))},
            **dict(zip(L.CASING_BEARINGS, casing.bearing_planes, strict=False)), "material": base.name,
            **{key: getattr(casing.material, key) for key in ("youngs_modulus", "poisson_ratio", "density")
