@@ -127,12 +127,14 @@ def sweep(case, repeats: int) -> dict:
         prepared = prepare(case, excitation)
         with prepared.scene:
             model, force = prepared.model, excitation_phasor(excitation)
-            seconds, many = _timed(lambda: respond_many(model, frequencies, force, excitation.point), repeats)
+            seconds, many = _timed(lambda model=model, force=force, excitation=excitation:
+                                   respond_many(model, frequencies, force, excitation.point), repeats)
             at_once.append(seconds)
-            seconds, single = _timed(lambda: [model.respond(f, force, excitation.point) for f in frequencies], 1)
+            seconds, single = _timed(lambda model=model, force=force, excitation=excitation:
+                                     [model.respond(f, force, excitation.point) for f in frequencies], 1)
             point_by_point.append(seconds)
             worst = max(worst, max(float(np.abs(a - b.pylon_force).max() / np.abs(b.pylon_force).max())
-                                   for a, b in zip(many.pylon_force, single)))
+                                   for a, b in zip(many.pylon_force, single, strict=True)))
     return {"at once": max(at_once), "point by point": max(point_by_point), "worst": worst}
 
 

@@ -52,7 +52,7 @@ def main() -> None:
     start = time.perf_counter()
     reduced = reduce_casing(model, casing.modes, [LP_ROTOR.frequency, HP_ROTOR.frequency], use_cache=False)
     total = time.perf_counter() - start
-    for excitation, one in zip((LP_ROTOR, HP_ROTOR), reduced):
+    for excitation, one in zip((LP_ROTOR, HP_ROTOR), reduced, strict=True):
         info = one.info
         print(f"| {excitation.name} | {info['fe_dof']} | {one.dof} | {one.n_fixed_interface} | "
               f"{info['mesh_seconds']:.2f} | {info['assembly_seconds']:.2f} | {info['reduction_seconds']:.2f} | "

@@ -49,19 +49,19 @@ def bench(case, excitation, reduced, repeats: int) -> dict:
     for _ in range(repeats):
         seconds, scene = _time(lambda: build_scene(case, excitation, reduced=reduced))
         samples["build"].append(seconds)
-        seconds, _ = _time(lambda: solve_preload(scene))
+        seconds, _ = _time(lambda scene=scene: solve_preload(scene))
         samples["static solve"].append(seconds)
 
-        def frequency_run():
+        def frequency_run(scene=scene):
             model = harmonic_model(scene)
             return model, model.respond(excitation.frequency, force, excitation.point)
 
         seconds, (model, response) = _time(frequency_run)
         samples["frequency-domain run"].append(seconds)
-        seconds, _ = _time(lambda: [model.respond(f, force, excitation.point) for f in frequencies])
+        seconds, _ = _time(lambda model=model: [model.respond(f, force, excitation.point) for f in frequencies])
         samples[f"{SWEEP_POINTS}-point sweep"].append(seconds)
 
-        def time_run():
+        def time_run(scene=scene):
             linear = harmonic_model(scene)
             plan = plan_run(case.analysis, scene.excitation.signal, mounted_modes(modes_of(linear.linearization)),
                             start=STEADY)

@@ -32,16 +32,16 @@ def bench(case, excitation, repeats: int) -> dict[str, float]:
     for _ in range(repeats):
         seconds, reduced = _time(lambda: reduce_links(case, excitation))
         samples["reduce (cached)"].append(seconds)
-        seconds, scene = _time(lambda: build_scene(case, excitation, reduced=reduced))
+        seconds, scene = _time(lambda reduced=reduced: build_scene(case, excitation, reduced=reduced))
         samples["build scene"].append(seconds)
-        seconds, _ = _time(lambda: solve_preload(scene))
+        seconds, _ = _time(lambda scene=scene: solve_preload(scene))
         samples["static preload"].append(seconds)
-        seconds, mounted = _time(lambda: mounted_modes(modes_of(linearize(scene))))
+        seconds, mounted = _time(lambda scene=scene: mounted_modes(modes_of(linearize(scene))))
         samples["mounted modes"].append(seconds)
         plan = plan_run(case.analysis, scene.excitation.signal, mounted)
-        seconds, histories = _time(lambda: integrate(scene, plan))
+        seconds, histories = _time(lambda scene=scene, plan=plan: integrate(scene, plan))
         samples["time integration"].append(seconds)
-        seconds, _ = _time(lambda: extract(scene, plan, histories))
+        seconds, _ = _time(lambda scene=scene, plan=plan, histories=histories: extract(scene, plan, histories))
         samples["extraction"].append(seconds)
     medians = {stage: statistics.median(values) for stage, values in samples.items()}
     medians["steps"] = plan.steps

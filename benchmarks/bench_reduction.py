@@ -174,7 +174,7 @@ def _now(case, frequencies_hz, workers=None):
     os.environ["MOUNTWB_CACHE"] = folder
     try:
         reduce_in_workers(list(jobs), workers=workers)
-        return {(name, f): reduced for job, name in jobs.items() for f, reduced in zip(frequencies_hz, job.reduce())}
+        return {(name, f): reduced for job, name in jobs.items() for f, reduced in zip(frequencies_hz, job.reduce(), strict=True)}
     finally:
         if previous is None:
             os.environ.pop("MOUNTWB_CACHE")

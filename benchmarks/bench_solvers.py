@@ -108,13 +108,13 @@ def main(argv=None):
         for solver, make in SOLVERS.items():
             row = {"link": f"{name} ({A.shape[0]} DOF)", "solver": solver}
             try:
-                row["factorise [s]"], solve = _timed(lambda: make(A), args.repeats)
+                row["factorise [s]"], solve = _timed(lambda make=make, A=A: make(A), args.repeats)
             except Exception as error:  # an optional solver that is missing or broken here
                 row["note"] = f"{type(error).__name__}: {str(error).splitlines()[0][:60]}"
                 rows.append(row)
                 continue
-            row["1 solve [s]"], _ = _timed(lambda: solve(rhs[:, 0].copy()), args.repeats)
-            row["12 solves [s]"], X = _timed(lambda: solve(rhs), args.repeats)
+            row["1 solve [s]"], _ = _timed(lambda solve=solve, rhs=rhs: solve(rhs[:, 0].copy()), args.repeats)
+            row["12 solves [s]"], X = _timed(lambda solve=solve, rhs=rhs: solve(rhs), args.repeats)
             row["residual"] = float(np.abs(A @ X - rhs).max() / np.abs(rhs).max())
             rows.append(row)
     table = pd.DataFrame(rows).set_index(["link", "solver"])

@@ -53,7 +53,7 @@ def sections() -> dict[str, str]:
         t_rigid, dof_rigid, _, seconds_rigid = _answer(rigid, excitation)
         _answer(flexible, excitation)
         t_flex, dof_flex, reduced, seconds_flex = _answer(flexible, excitation)
-        for axis, a, b in zip("xyz", level_db(t_rigid), level_db(t_flex)):
+        for axis, a, b in zip("xyz", level_db(t_rigid), level_db(t_flex), strict=True):
             rows.append(f"| {excitation.name} ({excitation.frequency:g} Hz) | T_{axis} | {a:.2f} | {b:.2f} | "
                         f"{b - a:+.2f} |")
         facts.append(f"| {excitation.name} ({excitation.frequency:g} Hz) | {dof_rigid} | {dof_flex} | "

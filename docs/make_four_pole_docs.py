@@ -128,7 +128,7 @@ def sections(figure_path: Path | None = None) -> dict[str, str]:
     loss = pole.insertion_loss(EXAMPLE_PYLON)
     insertion = (f"On a pylon of {_sci(EXAMPLE_PYLON, 0)} N/m per pin (no mass; an example value, not a measured pylon) "
                  "the insertion loss is " + " and ".join(
-                     f"{_triple(row, '.1f')} dB in x, y, z at {f:g} Hz" for f, row in zip(pole.frequencies_hz, loss))
+                     f"{_triple(row, '.1f')} dB in x, y, z at {f:g} Hz" for f, row in zip(pole.frequencies_hz, loss, strict=True))
                  + ".")
     return {"impedance example": impedance, "stiff pylon": convergence, "beam modes": beam_modes,
             "beam table": beam_table, "low-frequency springs": springs, "rotor-frequency set": "\n".join(magnitudes),

@@ -62,9 +62,9 @@ def sections() -> dict[str, str]:
     mount = "\n".join(
         ["| quantity | off | auto | change |", "|---|---|---|---|"]
         + [f"| thrust-rod bending mode {i + 1} in the mount (Hz) | {a:.2f} | {b:.2f} | {100 * (b / a - 1):+.2f} % |"
-           for i, (a, b) in enumerate(zip(plain_rods[:4], rods[:4]))]
+           for i, (a, b) in enumerate(zip(plain_rods[:4], rods[:4], strict=True))]
         + [f"| LP T_{axis} | {a:.5f} | {b:.5f} | {100 * (b / a - 1):+.2f} % |"
-           for axis, a, b in zip("xyz", plain_t, t)]
+           for axis, a, b in zip("xyz", plain_t, t, strict=True)]
         + [f"| preload passes after stiffening | - | {record.passes} | last change of the tensions "
            f"{record.tension_change:.0e} |"])
     cost = (f"The stress-stiffening stage took {warm:.2f} s in this run; the geometric stiffness of the "

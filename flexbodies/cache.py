@@ -40,7 +40,7 @@ from .reduced import ReducedLink, ReducedLinkFileError, load_reduced_link, save_
 try:  # POSIX; elsewhere processes do not share work, each computes its own entries
     import fcntl
 except ImportError:  # pragma: no cover - not on the platforms tested
-    fcntl = None
+    fcntl = None  # type: ignore[assignment]
 
 __all__ = ["LinkCache", "default_cache_dir", "lock_timeout", "STALE_SECONDS", "SUMMARY_SCHEMA", "EntryReport"]
 

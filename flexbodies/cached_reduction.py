@@ -94,7 +94,7 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
 
     def answer(decisions, keys, links, made):
         return tuple(with_decision(link, d, cache_hit=True) if link is not None else with_decision(made[key], d, False)
-                     for link, d, key in zip(links, decisions, keys))
+                     for link, d, key in zip(links, decisions, keys, strict=True))
 
     frequencies, decisions, keys, links = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
     if complete(stored):
@@ -111,10 +111,10 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
             decisions = [decide(frequencies, f) for f in excitations_hz]
             keys = [record_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
             links = [None] * len(decisions)
-        missing = {key: decision for key, decision, link in zip(keys, decisions, links) if link is None}
+        missing = {key: decision for key, decision, link in zip(keys, decisions, links, strict=True) if link is None}
         infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
                  for key in missing]
-        made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos)))
+        made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos), strict=True))
         for key, link in made.items():
             cache.save_link(key, link)
         return answer(decisions, keys, links, made)

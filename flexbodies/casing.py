@@ -241,7 +241,7 @@ def casing_interfaces(casing_mesh: LinkMesh, interfaces, source: str) -> LinkMes
         for k, bore in enumerate(bores):
             reach[k, ~np.isin(shared, bore.nodes)] = np.inf
         owner[shared] = np.argmin(reach, axis=0)
-        for k, (interface, bore) in enumerate(zip(interfaces, bores)):
+        for k, (interface, bore) in enumerate(zip(interfaces, bores, strict=True)):
             keep = owner[bore.nodes] == k
             if not keep.any():
                 raise LinkModelError(f"{source}: interface {interface.name!r}: every surface node within its reach "
@@ -260,9 +260,9 @@ def _tributary(mesh, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     per_face = [corners]
     if mesh.doflocs.shape[1] > mesh.nvertices:
         per_face.append(mesh.nvertices + mesh.f2e[:, facets])
-    per_face = np.vstack(per_face)
-    nodes, index = np.unique(per_face, return_inverse=True)
-    weights = np.bincount(index.ravel(), weights=np.broadcast_to(area / len(per_face), per_face.shape).ravel(),
+    stacked = np.vstack(per_face)
+    nodes, index = np.unique(stacked, return_inverse=True)
+    weights = np.bincount(index.ravel(), weights=np.broadcast_to(area / len(stacked), stacked.shape).ravel(),
                           minlength=len(nodes))
     return nodes, weights
 

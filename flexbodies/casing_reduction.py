@@ -77,6 +77,7 @@ class CasingModel:
             size = self.element_size if self.element_size is not None else default_casing_element_size(self.geometry)
             shape = {"geometry": dataclasses.asdict(self.geometry), "element_size": size}
         else:
+            assert self.mesh_file is not None
             path = Path(self.mesh_file)
             try:
                 digest = hashlib.sha256(path.read_bytes()).hexdigest()
@@ -216,5 +217,5 @@ def add_casing_to_exudyn(mbs, casing: ReducedLink, position, *, modal_damping_ra
         mbs.SetObjectParameter(body, "dampingMatrixReduced", damping)
     markers = {interface: mbs.AddMarker(eii.MarkerSuperElementPosition(
         bodyNumber=body, meshNodeNumbers=[int(node)], weightingFactors=[1.0]))
-        for interface, node in zip(casing.interface_names, casing.master_nodes)}
+        for interface, node in zip(casing.interface_names, casing.master_nodes, strict=True)}
     return ExudynCasing(body, (items["nRigidBody"], items["nGenericODE2"]), markers, casing.dof, casing.mass)

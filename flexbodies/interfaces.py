@@ -173,7 +173,7 @@ def couple_interfaces(fe_model, kind="RBE2") -> InterfaceCoupling:
     all_bore_nodes = np.concatenate([b.nodes for b in bores])
     if len(np.unique(all_bore_nodes)) != len(all_bore_nodes):
         raise LinkModelError("two bores share FE nodes; interfaces must be disjoint")
-    per_bore = [(_rbe2_rows if one == "RBE2" else _rbe3_rows)(b, nodes) for one, b in zip(kinds, bores)]
+    per_bore = [(_rbe2_rows if one == "RBE2" else _rbe3_rows)(b, nodes) for one, b in zip(kinds, bores, strict=True)]
     kind = str(kind).upper() if isinstance(kind, str) else "/".join(kinds)
 
     dependent = np.concatenate([p[0] for p in per_bore])
@@ -184,7 +184,7 @@ def couple_interfaces(fe_model, kind="RBE2") -> InterfaceCoupling:
     master_dofs = n_ret + np.arange(6 * len(bores)).reshape(len(bores), 6)
 
     r, c, v = [retained], [np.arange(n_ret)], [np.ones(n_ret)]
-    for (dep, coeff_m, free, coeff_free), masters in zip(per_bore, master_dofs):
+    for (dep, coeff_m, free, coeff_free), masters in zip(per_bore, master_dofs, strict=True):
         rr = np.repeat(dep, 6)
         r.append(rr)
         c.append(np.tile(masters, len(dep)))

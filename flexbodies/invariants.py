@@ -84,7 +84,7 @@ def ffrf_invariants(nodes, mass, stiffness, mode_basis) -> dict:
     bases = np.hstack([phi_t, x_tilde, psi, psi_tilde])
     weighted = mass @ bases
     parts = np.cumsum([0, 3, 3, m, 3 * m])
-    t, xt, p, pt = (slice(a, b) for a, b in zip(parts[:-1], parts[1:]))
+    t, xt, p, pt = (slice(a, b) for a, b in zip(parts[:-1], parts[1:], strict=True))
     products = bases.T @ weighted
     mtt = products[t, t]
     total = mtt[0, 0]

@@ -97,6 +97,7 @@ class LinkModel:
             size = self.element_size if self.element_size is not None else default_element_size(self.geometry)
             shape = {"geometry": dataclasses.asdict(self.geometry), "element_size": size}
         else:
+            assert self.mesh is not None
             path = Path(self.mesh.path)
             try:
                 digest = hashlib.sha256(path.read_bytes()).hexdigest()
@@ -126,6 +127,7 @@ class LinkModel:
 
         if self.geometry is not None:
             return mesh_link(self.geometry, self.element_size)
+        assert self.mesh is not None
         return load_mesh(self.mesh.path, self.mesh.bores, scale=self.mesh.scale)
 
 

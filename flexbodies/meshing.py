@@ -142,6 +142,7 @@ class BoreSpec:
             return
         if not all(geometric):
             raise LinkModelError(f"bore {self.name!r}: a geometric bore needs centre, axis and radius (or give node_set)")
+        assert self.centre is not None and self.axis is not None and self.radius is not None
         if np.shape(self.centre) != (3,) or np.shape(self.axis) != (3,):
             raise LinkModelError(f"bore {self.name!r}: centre and axis must each have 3 components")
         if not np.linalg.norm(np.asarray(self.axis, dtype=float)) > 0:
@@ -539,12 +540,12 @@ class _NodeSets:
         if name in d.point_sets:
             return np.asarray(d.point_sets[name], dtype=np.int64)
         if name in d.cell_sets:
-            blocks = zip(d.cells, d.cell_sets[name])
+            blocks = zip(d.cells, d.cell_sets[name], strict=True)
             return np.unique(np.concatenate([b.data[idx].ravel() for b, idx in blocks if idx is not None]
                                             or [np.zeros(0, dtype=np.int64)]))
         tag = d.field_data[name][0]
         physical = d.cell_data.get("gmsh:physical", [None] * len(d.cells))
-        return np.unique(np.concatenate([b.data[tags == tag].ravel() for b, tags in zip(d.cells, physical)
+        return np.unique(np.concatenate([b.data[tags == tag].ravel() for b, tags in zip(d.cells, physical, strict=True)
                                          if tags is not None] or [np.zeros(0, dtype=np.int64)]))
 
 
@@ -562,6 +563,7 @@ def _resolve_bore(mesh, spec: BoreSpec, source: str, node_sets) -> Bore:
             raise LinkModelError(f"bore {spec.name!r}: node set {spec.node_set!r} of {source} contains "
                                  "no complete boundary face")
         return _bore_from_facets(mesh, spec.name, facets, None)
+    assert spec.axis is not None and spec.radius is not None
     centre = np.asarray(spec.centre, dtype=float)
     axis = np.asarray(spec.axis, dtype=float) / np.linalg.norm(spec.axis)
     tol = spec.tolerance if spec.tolerance is not None else _DEFAULT_RELATIVE_TOLERANCE * spec.radius

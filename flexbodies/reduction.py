@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from .assembly import FEModel
 from .craig_bampton import CraigBamptonBasis, elastic_modes, fixed_interface_set, kept_count
 from .frequencies import free_free_frequencies, mounted_frequencies
 from .interfaces import InterfaceCoupling, couple_interfaces
@@ -38,7 +39,7 @@ class CoupledModel:
         ``T^T K T`` and ``T^T M T`` in coupled coordinates.
     """
 
-    fe_model: object
+    fe_model: FEModel
     coupling: InterfaceCoupling
     stiffness: sp.csr_matrix
     mass: sp.csr_matrix
@@ -154,7 +155,7 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     static = solver.static_modes()
     shared = time.perf_counter() - start
     links = []
-    for decision, info in zip(decisions, infos):
+    for decision, info in zip(decisions, infos, strict=True):
         keep = kept_count(fixed_hz, decision.count, decision.cutoff_hz)
         cb = CraigBamptonBasis(np.hstack([static, fixed[:, :keep]]), solver.masters, fixed_hz[:keep])
         links.append(reduce_coupled(coupled, cb, decision, frequencies,

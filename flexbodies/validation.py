@@ -71,7 +71,7 @@ class HarmonicCheck:
                 "static modes, mass kept [%]": 100 * e_s,
                 "stiffness only, no mass [%]": 100 * e_q,
             }
-            for r, e_s, e_q in zip(self.ratios, self.static_modes_error, self.quasi_static_error)
+            for r, e_s, e_q in zip(self.ratios, self.static_modes_error, self.quasi_static_error, strict=True)
         ]
 
 

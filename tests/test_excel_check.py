@@ -124,8 +124,8 @@ def test_hinge_values_per_direction_and_loss_factors_are_read_and_written_back(t
     set_cells(path, {("Hinges", "stiffness axial", 3): 5e6, ("Hinges", "loss factor", 3): 0.05,
                      ("Hinges", "loss factor axial", 3): 0.1, ("Links", "loss factor", 3): 0.002,
                      ("Links", "modal damping", 3): 0.02,
-                     **{("Hinges", f"frame radial 1 {a}", 3): v for a, v in zip("xyz", (1.0, 0.0, 0.0))},
-                     **{("Hinges", f"frame axial {a}", 3): v for a, v in zip("xyz", axial)}})
+                     **{("Hinges", f"frame radial 1 {a}", 3): v for a, v in zip("xyz", (1.0, 0.0, 0.0), strict=True)},
+                     **{("Hinges", f"frame axial {a}", 3): v for a, v in zip("xyz", axial, strict=True)}})
     case = read_workbook(path).case
     hinge, plain = case.hinges[0], case.hinges[1]
     assert hinge.stiffness == (plain.stiffness, plain.stiffness, 5e6)

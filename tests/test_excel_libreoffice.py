@@ -188,7 +188,7 @@ def test_values_read_back_equal_the_answers(reference_run):
     values = load_workbook(case)["Result efficiency"]
     header = [c.value for c in values[2]]
     for row in values.iter_rows(min_row=3, values_only=True):
-        record = dict(zip(header, row))
+        record = dict(zip(header, row, strict=True))
         assert answers[(record["run"], record["point"], record["direction"])] == pytest.approx(
             [record["T"], record["eta %"], record["dB"]], rel=1e-12)
     summary = _csv(out / "raw" / "report-Summary.csv")

@@ -43,7 +43,7 @@ def _decorate(path):
     tests = wb["Test data"]
     for row, values in enumerate((("LP rotor", None, "y", TEST_LP_Y), ("LP rotor", "front-up-left", "z", TEST_HINGE_Z)),
                                  start=3):
-        for header, value in zip(("run", "location", "direction", "amplitude"), values):
+        for header, value in zip(("run", "location", "direction", "amplitude"), values, strict=True):
             tests.cell(row, column_of(tests, header)).value = value
     wb.save(path)
 
@@ -91,7 +91,7 @@ def _cheap_python_case():
 
 def _sheet_rows(ws, header_row=2):
     header = [c.value for c in ws[header_row]]
-    return [dict(zip(header, values)) for values in ws.iter_rows(min_row=header_row + 1, values_only=True)
+    return [dict(zip(header, values, strict=True)) for values in ws.iter_rows(min_row=header_row + 1, values_only=True)
             if any(v is not None for v in values)]
 
 

@@ -69,7 +69,7 @@ def test_soft_pylon_is_two_springs_in_series(tmp_path):
     frequencies = [ratio * NATURAL_HZ for ratio in RATIOS]
     table = _write(tmp_path / "pylon.csv", _rows([1.0, *frequencies, 100.0], _pins(case), _pylon))
     result = run_case(dataclasses.replace(case, pylon_impedance=read_impedance_csv(table)))
-    for ratio, frequency in zip(RATIOS, frequencies):
+    for ratio, frequency in zip(RATIOS, frequencies, strict=True):
         w = 2 * math.pi * frequency
         hinge = STIFFNESS + 1j * w * DAMPING
         pylon = _pylon(frequency)[0, 0]

@@ -256,7 +256,7 @@ def test_two_rotors_in_one_run_match_superposition_and_the_closed_forms():
     frequency, time = (answers[m] for m in ("frequency", "time"))
     assert [r.name for r in time.runs] == ["both / slow", "both / fast"] == [r.name for r in frequency.runs]
     np.testing.assert_allclose(time.runs[1].transmissibility[1:], closed_form(23.0 / NATURAL_HZ), rtol=5e-3)
-    for run, reference in zip(time.runs, frequency.runs):
+    for run, reference in zip(time.runs, frequency.runs, strict=True):
         assert run.steady and run.frequency_hz == reference.frequency_hz
         for name, amplitude in reference.hinge_amplitudes.items():
             np.testing.assert_allclose(run.hinge_amplitudes[name], amplitude, rtol=5e-3, atol=5e-3 * amplitude.max())
@@ -273,7 +273,7 @@ def test_lp_and_hp_together_in_one_time_run_match_the_superposed_frequency_domai
 
     item = Simultaneous("LP and HP", (LP_ROTOR, HP_ROTOR))
     answers = _together_answers(coarse_reference, item)
-    for run, reference in zip(answers["time"].runs, answers["frequency"].runs):
+    for run, reference in zip(answers["time"].runs, answers["frequency"].runs, strict=True):
         assert run.steady, run.name
         # the nearly cancelled lateral pylon force compares against the largest direction
         np.testing.assert_allclose(run.transmissibility, reference.transmissibility, rtol=0.01,

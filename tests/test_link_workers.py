@@ -35,7 +35,7 @@ def test_workers_fill_the_cache_with_the_links_a_serial_reduction_gives(fresh_ca
         assert is_reduced(job.model, job.modes, job.excitations_hz, stiffening=job.stiffening)
         loaded = job.reduce()
         serial = reduce_link_set(job.model, job.modes, job.excitations_hz, use_cache=False)
-        for a, b in zip(loaded, serial):
+        for a, b in zip(loaded, serial, strict=True):
             assert a.cache_hit and not b.cache_hit
             assert a.frequencies["mounted_hz"] == pytest.approx(b.frequencies["mounted_hz"], rel=1e-9)
             assert len(a.frequencies["reduced_hz"]) == len(b.frequencies["reduced_hz"])

@@ -76,7 +76,7 @@ def test_reference_mesh_and_bores(reference_mesh):
     assert [b.name for b in mesh.bores] == ["A", "B"]
     assert 15_000 <= 3 * mesh.nodes.shape[0] <= 25_000
     assert mesh.describe().startswith("quadratic tetrahedra, ")
-    for bore, centre in zip(mesh.bores, ([0, 0, 0], [REFERENCE.length, 0, 0])):
+    for bore, centre in zip(mesh.bores, ([0, 0, 0], [REFERENCE.length, 0, 0]), strict=True):
         np.testing.assert_allclose(bore.centre, centre, atol=1e-7)
         np.testing.assert_allclose(bore.axis, [0, 0, 1])
         relative = mesh.nodes[bore.nodes] - bore.centre
@@ -103,7 +103,7 @@ def test_mesh_link_is_deterministic_silent_and_leaves_nothing(tmp_path, monkeypa
     assert not gmsh.isInitialized()
     np.testing.assert_array_equal(again.nodes, coarse_mesh.nodes)
     np.testing.assert_array_equal(again.mesh.t, coarse_mesh.mesh.t)
-    for a, b in zip(again.bores, coarse_mesh.bores):
+    for a, b in zip(again.bores, coarse_mesh.bores, strict=True):
         np.testing.assert_array_equal(a.weights, b.weights)
 
 
@@ -135,7 +135,7 @@ def test_user_mesh_round_trip(tmp_path, coarse_mesh, coarse_frequencies, suffix,
     loaded = load_mesh(path, specs)
     assert loaded.source == str(path)
     np.testing.assert_array_equal(loaded.nodes, coarse_mesh.nodes)
-    for got, direct in zip(loaded.bores, coarse_mesh.bores):
+    for got, direct in zip(loaded.bores, coarse_mesh.bores, strict=True):
         assert got.name == direct.name
         np.testing.assert_array_equal(got.nodes, direct.nodes)
         np.testing.assert_allclose(got.weights, direct.weights, rtol=1e-12, atol=1e-20)

@@ -53,7 +53,7 @@ def test_pylon_sum_is_the_vector_sum_of_pylon_side_hinges(result):
 def test_halving_the_time_step_changes_transmissibility_by_less_than_half_a_percent(reference, result):
     finer = dataclasses.replace(reference, analysis=dataclasses.replace(reference.analysis, steps_per_period=80))
     fine = run_case(finer)
-    for coarse_run, fine_run in zip(result.runs, fine.runs):
+    for coarse_run, fine_run in zip(result.runs, fine.runs, strict=True):
         change = fine_run.transmissibility / coarse_run.transmissibility - 1
         assert np.all(np.abs(change) < 0.005), (coarse_run.name, change)
 
@@ -78,7 +78,7 @@ def test_static_modes_match_twenty_fixed_interface_modes_where_the_rule_holds(re
     static = run_case(static_case)
     modal = run_case(modal_case)
     assert modal.model_cards["HP rotor"].total_dof == static.model_cards["HP rotor"].total_dof + 6 * 20
-    for static_run, modal_run in zip(static.runs, modal.runs):
+    for static_run, modal_run in zip(static.runs, modal.runs, strict=True):
         change = static_run.transmissibility / modal_run.transmissibility - 1
         assert np.all(np.abs(change) < 0.01), (static_run.name, change)
 

@@ -77,10 +77,10 @@ def test_the_compliance_closure_is_the_stiffness_closure():
     by_stiffness = pole.respond(force, point, per_pin)
     by_compliance = pole.respond(force, point, compliance=compliance)
     rigid, zero = pole.respond(force, point), pole.respond(force, point, compliance=np.zeros_like(compliance))
-    for a, b in zip(by_stiffness, by_compliance):
+    for a, b in zip(by_stiffness, by_compliance, strict=True):
         np.testing.assert_allclose(b.pin_forces, a.pin_forces, rtol=1e-9, atol=1e-12)
         np.testing.assert_allclose(b.pin_motions, a.pin_motions, rtol=1e-9, atol=1e-18)
-    for a, b in zip(rigid, zero):
+    for a, b in zip(rigid, zero, strict=True):
         np.testing.assert_allclose(b.pin_forces, a.pin_forces, rtol=1e-12)
     with pytest.raises(CaseError, match="one of them"):
         pole.respond(force, point, per_pin, compliance=compliance)

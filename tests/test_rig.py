@@ -199,8 +199,8 @@ def test_workbook_compares_a_rig_record_in_the_result_sheets(lp_run, tmp_path):
     assert main(["run", str(path), "--run", "LP rotor", "--no-progress"]) == 0
     sheet = load_workbook(path)["Result efficiency"]
     header = [c.value for c in sheet[2]]
-    rows = [dict(zip(header, r)) for r in sheet.iter_rows(min_row=3, values_only=True)]
-    for row, t_test in zip(rows, measured):
+    rows = [dict(zip(header, r, strict=True)) for r in sheet.iter_rows(min_row=3, values_only=True)]
+    for row, t_test in zip(rows, measured, strict=True):
         assert row["test amplitude N"] == pytest.approx(t_test * 1000.0, rel=1e-9)
         assert row["error %"] == pytest.approx((row["T"] - t_test) / t_test * 100, rel=1e-6)
     # the same answers as the record's own simulation: x and z within 1 % of the test

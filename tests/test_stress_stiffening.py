@@ -127,7 +127,7 @@ def test_the_thrust_rods_tension_stiffens_them_as_the_beam_formula_says(coarse_r
     # eyes sit on hinge springs, whose stiffness the tension does not change
     factor = _shank_euler_factor(coarse_reference, "thrust-left", links["thrust-left"].tension)
     assert len(plain_modes) == len(stiffened_modes) >= 2
-    for plain, stiff in zip(plain_modes[:2], stiffened_modes[:2]):
+    for plain, stiff in zip(plain_modes[:2], stiffened_modes[:2], strict=True):
         assert 1.0 + 0.5 * (factor - 1.0) < stiff / plain < factor
     # and LP T_y, which the rods carry, moves by about a per cent
     assert abs(stiffened_t[1] / plain_t[1] - 1.0) > 0.005

@@ -246,7 +246,7 @@ class MechanismError(SimulationError):
         Description of each free motion.
     """
 
-    def __init__(self, case_name: str, motions: list[str], loose_eyes: list[str] = ()):
+    def __init__(self, case_name: str, motions: list[str], loose_eyes: list[str] | tuple[str, ...] = ()):
         self.motions = motions
         listing = "; ".join(f"({i + 1}) {m}" for i, m in enumerate(motions))
         hint = f" Eyes without a hinge: {', '.join(loose_eyes)}." if loose_eyes else ""
@@ -316,7 +316,7 @@ class UsageError(InputError):
 BAD_INPUT = (InputError,)
 
 
-def interruption(error: BaseException) -> KeyboardInterrupt | None:
+def interruption(error: BaseException | None) -> KeyboardInterrupt | None:
     """The interrupt behind *error*, if any.
 
     Exudyn turns a KeyboardInterrupt raised while it solves into an error of

@@ -153,8 +153,10 @@ def model_card(scene: Scene, preload, mounted: list, plan, timings: dict[str, fl
                    else "link asked to be rigid (flexible = False)")
             bodies.append(BodyEntry(link.name, "rigid link", item.dof, 0, item.mass, why))
     for name in scene.transducers:
+        assert case.test_rig is not None
         bodies.append(BodyEntry(name, "force transducer (point mass)", 3, 0, case.test_rig.mass,
                                 "test-rig transducer under a pylon pin: moving half on its spring to ground"))
+    assert scene.excitation is not None
     card = ModelCard(case.name, scene.excitation.name, bodies, _effects(scene, preload, method),
                      _solver(scene, plan) if solver is None else dict(solver),
                      [(m.frequency_hz, m.damping_ratio, m.description) for m in mounted], dict(timings),
@@ -319,13 +321,13 @@ def _imbalance_planes(scene) -> list[EffectEntry]:
     from workbook.model.case import Imbalance, Simultaneous
 
     excitation = scene.excitation.excitation if scene.excitation is not None else None
-    parts = excitation.parts if isinstance(excitation, Simultaneous) else (excitation,)
+    parts: tuple[Any, ...] = excitation.parts if isinstance(excitation, Simultaneous) else (excitation,)
     details = []
     for part in (p for p in parts if isinstance(p, Imbalance)):
-        planes = "; ".join(f"{f.force_amplitude:.4g} N at x = {f.point[0]:g} m, phase {f.phase_deg:g} deg"
+        forces = "; ".join(f"{f.force_amplitude:.4g} N at x = {f.point[0]:g} m, phase {f.phase_deg:g} deg"
                            for f in part.plane_forces())
         details.append(f"{len(part.planes)} planes of {part.name!r} at {part.frequency:g} Hz, each its own rotating "
-                       f"force U w^2 (or given force): {planes}; T refers to their summed amplitude "
+                       f"force U w^2 (or given force): {forces}; T refers to their summed amplitude "
                        f"{part.force_amplitude:.4g} N")
     planes = EffectEntry("imbalance planes", bool(details), "; ".join(details) or "the excitation is one force at "
                          "one point")

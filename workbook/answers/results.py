@@ -30,6 +30,9 @@ class PylonAnswers:
     and ``excitation_amplitude`` (N): a simulated run or a rig measurement.
     """
 
+    pylon_amplitude: np.ndarray
+    excitation_amplitude: float
+
     @property
     def transmissibility(self) -> np.ndarray:
         """Pylon-force transmissibility per direction x, y, z."""
@@ -164,7 +167,7 @@ class MountResult:
         rows = []
         for run in self.runs:
             for location, amplitude in run.amplitudes().items():
-                for axis, value in zip(DIRECTIONS, amplitude):
+                for axis, value in zip(DIRECTIONS, amplitude, strict=True):
                     t = transmissibility(value, run.excitation_amplitude)
                     rows.append((run.name, run.frequency_hz, location, location == PYLON_SUM
                                  or location in run.pylon_hinges, axis, value, t,
@@ -283,17 +286,17 @@ class MountResult:
         for i, axis in enumerate(DIRECTIONS):
             bars = ax.bar(positions + (i - 1) * width, table[f"eta % {axis}"], width, label=axis)
             ax.bar_label(bars, fmt="%.1f", fontsize="small")
-        ax.set_xticks(positions, [f"{name}\n{f:g} Hz" for name, f in zip(table.index, table["frequency Hz"])])
+        ax.set_xticks(positions, [f"{name}\n{f:g} Hz" for name, f in zip(table.index, table["frequency Hz"], strict=True)])
         ax.set_ylabel("isolation efficiency %")
         ax.legend(title="direction")
         ax.set_title(f"{self.case_name}: pylon isolation efficiency")
         return fig
 
 
-def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float]]:
+def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float | None]]:
     t = transmissibility(amplitude, reference)
     answers = {}
-    for axis, a, ti in zip(DIRECTIONS, amplitude, t):
+    for axis, a, ti in zip(DIRECTIONS, amplitude, t, strict=True):
         db = float(level_db(ti))
         answers[axis] = {"amplitude_n": float(a), "transmissibility": float(ti),
                          "efficiency_pct": float(efficiency(ti)), "db": db if np.isfinite(db) else None}

@@ -57,9 +57,10 @@ def run(args) -> int:
     orders = _numbers(args.orders, "--orders", ",")
     operating = None
     if args.operating:
-        operating = _numbers(args.operating, "--operating", ":")
-        if len(operating) != 2 or not 0 <= operating[0] < operating[1]:
+        bounds = _numbers(args.operating, "--operating", ":")
+        if len(bounds) != 2 or not 0 <= bounds[0] < bounds[1]:
             raise UsageError(f"--operating {args.operating!r}: expected LOW:HIGH rpm with 0 <= LOW < HIGH")
+        operating = (bounds[0], bounds[1])
     case = load_case(args.case, run=args.run, rigid=args.rigid) if args.case else reference_case(rotors=True)
     if args.rigid and not args.case:
         case = case.with_rigid_links()

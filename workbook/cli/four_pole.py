@@ -72,13 +72,13 @@ def run(args) -> int:
     for name, values in rigid.items():
         print(f"\nrigid pylon, force shape of {name!r}: T = |F_pylon| / |F| from K11, K21 and the engine")
         print("frequency Hz  " + "  ".join(f"T {axis:<7}" for axis in DIRECTIONS))
-        for frequency, row in zip(frequencies, values):
+        for frequency, row in zip(frequencies, values, strict=True):
             print(f"{frequency:12.4g}  " + "  ".join(f"{v:9.4g}" for v in np.asarray(row)))
     if loss is not None:
         print(f"\ninsertion loss on a pylon of {args.pylon_stiffness:g} N/m and {args.pylon_mass:g} kg per pin "
               f"(unit force at the centre of gravity; 20 log10 |F_bolted| / |F_mount|, dB)")
         print("frequency Hz  " + "  ".join(f"IL {axis} dB " for axis in DIRECTIONS))
-        for frequency, row in zip(frequencies, loss):
+        for frequency, row in zip(frequencies, loss, strict=True):
             print(f"{frequency:12.4g}  " + "  ".join(f"{v:9.2f}" for v in row))
     if args.csv:
         write_output(args.csv, "table", "four-pole", lambda target: save_csv(table, target))

@@ -24,8 +24,17 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     return links
 
 
-def links(args) -> int:
+def _exporter(link) -> Callable[[Path], Path]:
+    """The writer of *link*'s file in Exudyn's own reduced-body format."""
     from flexbodies import export_exudyn_file
+
+    def write(target: Path) -> Path:
+        return export_exudyn_file(link, target)
+
+    return write
+
+
+def links(args) -> int:
     from workbook.answers.link_table import link_table
     from workbook.scene.build import reduce_links
 
@@ -41,6 +50,5 @@ def links(args) -> int:
         print(f"{name}: {reason}")
     if args.export:
         for name, link in reduced.items():
-            write_output(str(Path(args.export) / f"{name}.npz"), f"link {name}", "export",
-                         lambda target, link=link: export_exudyn_file(link, target))
+            write_output(str(Path(args.export) / f"{name}.npz"), f"link {name}", "export", _exporter(link))
     return 0

@@ -12,7 +12,7 @@ import sys
 from pathlib import Path
 
 from workbook.errors import CaseError, UsageError
-from workbook.model.case import Case
+from workbook.model.case import AnalysisMethod, Case
 from workbook.model.codec import from_json
 from workbook.model.pylon_impedance import read_impedance_csv
 from workbook.model.reference import reference_case
@@ -45,7 +45,7 @@ def _json_case(path: str) -> Case:
 
 
 def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = False,
-              time_budget: float | None = None, method: str | None = None,
+              time_budget: float | None = None, method: AnalysisMethod | None = None,
               pylon_impedance: str | None = None) -> Case:
     """The case a command works on.
 
@@ -76,6 +76,7 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         from workbook.excel.execute import select_runs
         from workbook.excel.reader import read_workbook
 
+        assert path is not None
         book = read_workbook(path)
         case = book.case if run is None else book.run_case(select_runs(book, [run])[0])
     elif run is not None:

@@ -102,7 +102,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
               f"{measurement.nominal_hz:g} Hz), |F_exc| {measurement.excitation_amplitude:.1f} N, "
               f"{args.periods}-period windows differ by {100 * measurement.steady_change:.2f} %\n")
         if args.mode == "measure":
-            for axis, t, eta in zip("xyz", measurement.transmissibility, measurement.efficiency):
+            for axis, t, eta in zip("xyz", measurement.transmissibility, measurement.efficiency, strict=True):
                 print(f"{axis}: T {t:.5f}  eta {eta:7.3f} %")
             return 0
         table = comparison_frame(measurement, simulate_run(case, record.run))

@@ -14,13 +14,13 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-from typing import Callable
+from typing import Callable, cast
 
 from workbook.answers.saving import save_csv, save_figure
 from workbook.cli.loading import load_case
 from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
-from workbook.model.case import SPEED_UNITS, Case, RotatingForce, RunUp
+from workbook.model.case import SPEED_UNITS, Case, RotatingForce, RunUp, SingleFrequencyExcitation
 
 __all__ = ["arguments"]
 
@@ -67,7 +67,7 @@ def _run_ups(case: Case, args) -> list[RunUp]:
             raise UsageError(f"--unbalance: {args.excitation!r} is not a rotating force; give its planes' unbalance "
                              f"in the case")
         template = dataclasses.replace(template, amplitude=None, unbalance=args.unbalance)
-    return [RunUp.speeds(f"{args.excitation} run-up", template, args.start, args.stop, args.points, args.unit)]
+    return [RunUp.speeds(f"{args.excitation} run-up", cast(SingleFrequencyExcitation, template), args.start, args.stop, args.points, args.unit)]
 
 
 def run(args) -> int:

@@ -43,7 +43,7 @@ from workbook.answers.saving import record_written
 try:
     import fcntl
 except ImportError:  # Windows: no advisory locks
-    fcntl = None
+    fcntl = None  # type: ignore[assignment]
 
 __all__ = ["save_atomic", "lock_file", "lock_message", "unsupported_content", "restore_formula_values",
            "name_beside", "workbook_bytes", "new_file_target", "bounded_file_problem", "lost_parts", "write_atomic",
@@ -146,7 +146,7 @@ def _custom_note(style: bytes) -> bool:
     fields = dict(item.split(":", 1) for item in style.decode().replace(" ", "").split(";") if ":" in item)
     if fields.get("visibility", "hidden") != "hidden":
         return True
-    for key, default in zip(("width", "height"), _NOTE_BOX_PT):
+    for key, default in zip(("width", "height"), _NOTE_BOX_PT, strict=True):
         text = fields.get(key, "")
         match = re.fullmatch(r"([0-9.]+)(pt|px|in|cm|mm)?", text)
         if not match:
@@ -337,7 +337,7 @@ def new_file_target(path: str | Path, label: str, replaceable: Callable[[Path], 
         return name_beside(path, label, path.suffix), refused
     if path.exists() and replaceable is None:
         return name_beside(path, label, path.suffix), f"{path.name} exists; it is kept"
-    if path.exists() and not replaceable(path):
+    if path.exists() and replaceable is not None and not replaceable(path):
         return name_beside(path, label, path.suffix), (f"{path.name} exists and is not a {label} this program "
                                                        "wrote, or was changed since; it is kept")
     return path, None
@@ -385,8 +385,11 @@ def restore_formula_values(data: bytes, cached: dict[int, dict[str, object]]) ->
             if typed is None:
                 continue
             pattern = re.compile(rf'<c r="{cell}"([^>]*)>(<f\b[^>]*/>|<f\b[^>]*>.*?</f>)<v\s*/>(</c>)', re.S)
-            text = pattern.sub(lambda m: f'<c r="{cell}"{m.group(1)}{typed[0]}>{m.group(2)}<v>{typed[1]}</v></c>',
-                               text)
+
+            def filled(m: re.Match, cell: str = cell, typed: tuple = typed) -> str:
+                return f'<c r="{cell}"{m.group(1)}{typed[0]}>{m.group(2)}<v>{typed[1]}</v></c>'
+
+            text = pattern.sub(filled, text)
         return text.encode("utf-8")
 
     return _edit_members(data, edit)

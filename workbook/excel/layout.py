@@ -97,7 +97,7 @@ class Column:
         """Text of the template's unit cell."""
         if not self.has_unit:
             return ""
-        return self.unit or self.si_unit
+        return self.unit or self.si_unit or ""
 
     @property
     def drop_down(self) -> tuple:
@@ -158,7 +158,7 @@ class Table:
                 return column
         raise KeyError(key)
 
-    def vector_keys(self, key: str) -> tuple[str, str, str]:
+    def vector_keys(self, key: str) -> tuple[str, ...]:
         """Keys of the three columns of vector *key*."""
         return tuple(f"{key}_{axis}" for axis in "xyz")
 

@@ -13,7 +13,7 @@ import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, cast
 
 import numpy as np
 
@@ -65,7 +65,7 @@ class CaseBook:
 _GEOMETRY_KEYS = ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")
 _MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density")
 #: Case-model field -> columns, where the names differ.
-_FIELD_COLUMNS = {
+_FIELD_COLUMNS: dict[str, dict[str, tuple[str, ...]]] = {
     "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
                "inertia": ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")},
     "Engine casing": {"geometry": ("radius", "thickness", "x_start", "x_end"), "geometry.radius": ("radius",),
@@ -146,7 +146,7 @@ class _CaseReader(SheetReader):
         return ok
 
     def unique(self, records: list[Record], key: str = "name") -> None:
-        seen = {}
+        seen: dict[Any, int] = {}
         for record in records:
             name = record.values.get(key)
             if name is None:
@@ -216,7 +216,7 @@ class _CaseReader(SheetReader):
             keys = (*L.LINKS.vector_keys(f"mesh_bore_{eye}"), *L.LINKS.vector_keys("mesh_bore_axis"), "bore_radius")
             if not self.require(record, keys, f"bore {eye.upper()} of a mesh link without a node set"):
                 return None
-            bores.append(self.build(record, lambda: flexbodies.BoreSpec(
+            bores.append(self.build(record, lambda eye=eye: flexbodies.BoreSpec(
                 f"bore {eye.upper()}", centre=record.vector(f"mesh_bore_{eye}"),
                 axis=record.vector("mesh_bore_axis"), radius=record.get("bore_radius")), keys))
         if None in bores:
@@ -344,7 +344,7 @@ class _CaseReader(SheetReader):
     def rotor(self, record: Record) -> cm.Rotor | None:
         """A Rotors row: spin axis x, y or z (empty: the Rotor default, x)."""
         get = record.get
-        axis = {} if get("axis") is None else {"axis": L.AXES[get("axis")]}
+        axis: dict[str, Any] = {} if get("axis") is None else {"axis": L.AXES[get("axis")]}
         return self.build(record, lambda: cm.Rotor(get("name"), get("polar_inertia"),
                                                    frequency_hz=get("frequency_hz"), **axis))
 
@@ -409,7 +409,7 @@ class _CaseReader(SheetReader):
                  (("Links", self.link), ("Hinges", self.hinge), ("Static loads", self.static_load),
                   ("Rotors", self.rotor))}
         items["Excitations"] = self.excitations(tables["Excitations"])
-        first_links = {}
+        first_links: dict[Any, Any] = {}
         for record, link in items["Links"]:
             first_links.setdefault(record.get("name"), link)
         self.hinge_bodies(items["Hinges"], tables["Links"], first_links)
@@ -417,9 +417,9 @@ class _CaseReader(SheetReader):
         if self.problems or not engine or None in engine or not settings or None in settings[0]:
             return None
         (analysis, effects), record = settings[0], tables["Case"][0]
-        built = {key: tuple(item for _, item in pairs) for key, pairs in items.items()}
+        built: dict[str, tuple[Any, ...]] = {key: tuple(item for _, item in pairs) for key, pairs in items.items()}
         try:
-            return cm.Case(record.get("name"), engine[0], built["Links"], built["Hinges"], built["Static loads"],
+            return cm.Case(record.get("name"), cast(cm.Engine, engine[0]), built["Links"], built["Hinges"], built["Static loads"],
                            built["Excitations"], analysis=analysis, effects=effects,
                            description=record.get("description", ""), test_rig=test_rig[0] if test_rig else None,
                            rotors=built["Rotors"])
@@ -484,7 +484,7 @@ class _CaseReader(SheetReader):
 
     # -- runs and test data ------------------------------------------------------------------------------
 
-    def runs(self, case: cm.Case, records: list[Record]) -> list[RunSpec]:
+    def runs(self, case: cm.Case, records: list[Record]) -> list[tuple[Record, RunSpec]]:
         self.unique(records)
         if not records:
             self.problem(L.RUNS.sheet, f"row {L.FIRST_DATA_ROW}", None, None, "at least one run")
@@ -510,7 +510,7 @@ class _CaseReader(SheetReader):
                                     f"own unbalance or force)")
                 continue
             run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
-            if self.build(record, lambda: case_for_run(case, run)) is not None:
+            if self.build(record, lambda run=run: case_for_run(case, run)) is not None:
                 runs.append((record, run))
         return runs
 

@@ -82,7 +82,7 @@ def _table(ws, top: int, columns: list[tuple[str, str]], rows: list, left: int =
         cell.font, cell.fill = Font(bold=True), _HEADER_FILL
         cell.alignment = Alignment(horizontal="center", vertical="center", wrap_text=True)
     for r, values in enumerate(rows, start=top + 1):
-        for col, (value, (_, quantity)) in enumerate(zip(values, columns), start=left):
+        for col, (value, (_, quantity)) in enumerate(zip(values, columns, strict=True), start=left):
             cell = ws.cell(r, col, _value(value))
             if quantity in FORMATS:
                 cell.number_format = FORMATS[quantity]
@@ -133,7 +133,7 @@ def _summary(ws, book: CaseBook, runs: list[RunResult]) -> None:
         sweep_rows = []
         for run in sweeps:
             points = run.result.runs
-            peaks = [max(points, key=lambda p, i=i: p.transmissibility[i]) for i in range(len(DIRECTIONS))]
+            peaks = [max(points, key=lambda p, i=i: p.transmissibility[i]) for i in range(len(DIRECTIONS))]  # type: ignore[misc]
             sweep_rows.append([run.spec.name, points[0].frequency_hz, points[-1].frequency_hz,
                                *(p.transmissibility[i] for i, p in enumerate(peaks)), *(p.frequency_hz for p in peaks)])
         row = _table(ws, row, sweep_columns, sweep_rows) + 2
@@ -160,7 +160,7 @@ def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
     frame = frame[frame["test amplitude N"].notna()]
     t_test = frame["T"] * frame["test amplitude N"] / frame["amplitude N"]
     rows = [[row["run"], row["frequency Hz"], row["direction"], row["T"], t, row["error %"], row["eta %"],
-             efficiency(t), row["dB"], float(level_db(t))] for (_, row), t in zip(frame.iterrows(), t_test)]
+             efficiency(t), row["dB"], float(level_db(t))] for (_, row), t in zip(frame.iterrows(), t_test, strict=True)]
     _table(ws, 3, [("run", "text"), ("frequency (Hz)", "Hz"), ("direction", "text"), ("T sim (-)", "T"),
                    ("T test (-)", "T"), ("error (%)", "error"), ("eta sim (%)", "eta"), ("eta test (%)", "eta"),
                    ("level sim (dB)", "dB"), ("level test (dB)", "dB")], rows)
@@ -300,7 +300,7 @@ def four_pole_sheet(ws, pole) -> None:
                                               "N/m" if name.endswith(" N/m") else "deg") for name in table.columns]
     top = _TABLE_TOP + 1
     ws.cell(_TABLE_TOP, 1, "four-pole parameters").font = Font(bold=True)
-    _table(ws, top, columns, [[frequency, *row] for frequency, row in zip(table.index, table.to_numpy())])
+    _table(ws, top, columns, [[frequency, *row] for frequency, row in zip(table.index, table.to_numpy(), strict=True)])
     chart = _log_log_chart("Dynamic stiffness", "|K| (N/m)")
     x = Reference(ws, min_col=1, min_row=top + 1, max_row=top + len(table))
     magnitudes = {col: name[1:name.index("|", 1)].split() for col, name in enumerate(table.columns, start=2)

@@ -58,4 +58,4 @@ def record_test_points(path: Path, run_name: str, case: Case) -> list[TestPoint]
     measurement = measure(record, case.analysis.measured_periods, nominal_hz=excitation.frequency)
     amplitude = excitation.force_amplitude
     return [TestPoint(run_name, PYLON_SUM, axis, None, float(t) * amplitude)
-            for axis, t in zip(DIRECTIONS, measurement.transmissibility)]
+            for axis, t in zip(DIRECTIONS, measurement.transmissibility, strict=True)]

@@ -8,8 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
-from workbook.model.case import Case, Sweep
+from workbook.model.case import Case, ModeRequest, Sweep
 
 __all__ = ["RunSpec", "TestPoint", "case_for_run", "FIDELITY_RIGID"]
 
@@ -51,7 +52,7 @@ class RunSpec:
     excitation: str
     frequency: float | None = None
     amplitude: float | None = None
-    fidelity: str | int | float | None = None
+    fidelity: ModeRequest | None = None
     gap: float | None = None
     hinge_stiffness: float | None = None
     hinge_damping: float | None = None
@@ -87,7 +88,7 @@ class TestPoint:
 
 def _replace_excitation(excitation, run: RunSpec):
     """The excitation with the run's frequency and amplitude."""
-    changes = {}
+    changes: dict[str, Any] = {}
     if run.frequency is not None:
         changes.update(frequency_hz=run.frequency, rpm=None)
     if run.amplitude is not None:
@@ -120,7 +121,7 @@ def case_for_run(case: Case, run: RunSpec) -> Case:
         effects = dataclasses.replace(effects, flexible_links=True)
     if run.preload is not None:
         effects = dataclasses.replace(effects, preload=run.preload)
-    hinge_changes = {name: value for name, value in (("radial_clearance", run.gap),
+    hinge_changes: dict[str, Any] = {name: value for name, value in (("radial_clearance", run.gap),
                                                      ("stiffness", run.hinge_stiffness),
                                                      ("damping", run.hinge_damping)) if value is not None}
     hinges = tuple(dataclasses.replace(h, **hinge_changes) for h in case.hinges) if hinge_changes else case.hinges

@@ -128,7 +128,7 @@ class SheetReader:
         keys = tuple(k for k in keys if k in record.cells) or ()
         header = record.table.column(keys[0]).header if keys else None
         if len(keys) == 3 and keys == record.table.vector_keys(keys[0][:-2]):
-            header = header[:-2]
+            header = record.table.column(keys[0]).header[:-2]
         elif len(keys) > 1:
             header = f"{header} to {record.table.column(keys[-1]).header}"
         self.problem(record.table.sheet, record.where(*keys) if keys else f"row {record.row}", header, value,
@@ -180,7 +180,7 @@ class SheetReader:
 
     def _merged(self, table: L.Table, sheet: "_Cells", positions: dict) -> set:
         """Report merged cells over the columns read; the data rows they cover (not read further)."""
-        columns, rows = set(positions.values()), set()
+        columns, rows = set(positions.values()), set[int]()
         for merged in sheet.merged:
             if not any(merged.min_col <= col <= merged.max_col for col in columns):
                 continue
@@ -217,7 +217,7 @@ class SheetReader:
 
     def _units(self, table: L.Table, sheet: "_Cells", positions: dict) -> dict:
         """Factor to SI of each number column (None where the unit cell is bad)."""
-        factors = {}
+        factors: dict[str, float | None] = {}
         for key, col in positions.items():
             column = table.column(key)
             if not column.has_unit:
@@ -228,7 +228,7 @@ class SheetReader:
             except UnitProblem as exc:
                 factors[key] = None
                 self.problem(table.sheet, f"{get_column_letter(col)}{L.UNIT_ROW}", f"{column.header} (unit)",
-                             text, exc.expected + _unit_suggestion(text, column.si_unit))
+                             text, exc.expected + _unit_suggestion(text, column.si_unit or ""))
         return factors
 
     def _cell(self, sheet: "_Cells", row: int, col: int, table: L.Table) -> Any:
@@ -266,7 +266,7 @@ class SheetReader:
                     usable = False    # the unit cell is reported
                     continue
                 converted = converted * factors[key] if column.kind == "number" else converted
-                limit = L.MAGNITUDE_LIMITS.get(column.si_unit)
+                limit = L.MAGNITUDE_LIMITS.get(column.si_unit or "")
                 if column.kind == "number" and limit is not None and abs(converted) > limit:
                     self.problem(table.sheet, cells[key], column.header, value,
                                  f"a magnitude of at most {limit:g} {column.si_unit} (found {converted:g} "
@@ -362,7 +362,7 @@ def _text_number(text: str) -> float:
     """
     compact = text.strip().replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
     grouped = _GROUPED.match(compact)
-    separator = grouped.group("sep") if grouped else None
+    separator = grouped.group("sep") if grouped else ""
     if grouped and compact.count(separator) == 1:
         thousands, decimal = compact.replace(separator, ""), compact.replace(separator, ".")
         raise _Bad(f"a number whose separators can be read one way only: {text.strip()!r} reads as "
@@ -373,7 +373,8 @@ def _text_number(text: str) -> float:
     if "," in compact and "." in compact:
         decimal = "," if compact.rindex(",") > compact.rindex(".") else "."
         whole, _, fraction = compact.rpartition(decimal)
-        if _GROUPED.match(whole) and _GROUPED.match(whole).group("sep") != decimal and fraction.isdigit():
+        whole_grouped = _GROUPED.match(whole)
+        if whole_grouped and whole_grouped.group("sep") != decimal and fraction.isdigit():
             return float(whole.replace("," if decimal == "." else ".", "") + "." + fraction)
         raise _Bad("a number")
     if not _PLAIN.match(compact) and compact.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
@@ -417,7 +418,7 @@ def _as_yesno(value: Any, column: L.Column) -> bool:
 _CUTOFF = re.compile(r"^\s*([0-9.eE+-]+)\s*([A-Za-z/ ]+)\s*$")
 
 
-def _as_modes(value: Any, column: L.Column) -> str | int | float:
+def _as_modes(value: Any, column: L.Column) -> str | int | ModeCutoff:
     """auto, static, a whole number (mode count) or a frequency with its unit (cut-off, Hz)."""
     expected = "auto, static, a mode count or a cut-off frequency such as '2000 Hz'"
     if isinstance(value, (int, float)) and not isinstance(value, bool):
@@ -441,7 +442,7 @@ def _as_modes(value: Any, column: L.Column) -> str | int | float:
     raise _Bad(expected)
 
 
-def _as_fidelity(value: Any, column: L.Column) -> str | int | float:
+def _as_fidelity(value: Any, column: L.Column) -> str | int | ModeCutoff:
     if isinstance(value, str) and value.strip().lower() == FIDELITY_RIGID:
         return FIDELITY_RIGID
     try:

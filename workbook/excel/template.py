@@ -11,7 +11,7 @@ from __future__ import annotations
 import dataclasses
 import datetime
 from pathlib import Path
-from typing import Iterable
+from typing import Any, Iterable
 
 import numpy as np
 from openpyxl import Workbook
@@ -108,13 +108,13 @@ def _row_for_link(link: cm.Link) -> dict:
 
 
 def _vector(key: str, values) -> dict:
-    return {f"{key}_{axis}": value for axis, value in zip("xyz", values)}
+    return {f"{key}_{axis}": value for axis, value in zip("xyz", values, strict=True)}
 
 
 def _rows_for_excitation(excitation: cm.Excitation) -> list[dict]:
     """The Excitations rows of one excitation: one row, or one per imbalance plane
     (the first with the speed, the axis and any sweep or run-up)."""
-    row = {"name": excitation.name}
+    row: dict[str, Any] = {"name": excitation.name}
     if isinstance(excitation, cm.Simultaneous):
         raise UnwritableCase(f"excitation {excitation.name!r}: simultaneous excitations have no Excitations row; "
                              f"run them from Python or a JSON case")
@@ -186,9 +186,9 @@ def _rows_for_casing(casing) -> list[dict]:
     base = flexbodies.material(casing.material.name.split(" ")[0])
     radial, axial = casing.bearing_stiffness
     row = {"radius": g.radius, "thickness": g.thickness, "x_start": g.x_start, "x_end": g.x_end,
-           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings)
+           **{f"{key}_{name}": value for key, ring in zip(L.CASING_RINGS, g.rings, strict=False)
               for name, value in (("x", ring.x), ("width", ring.width), ("radius", ring.outer_radius))},
-           **dict(zip(L.CASING_BEARINGS, casing.bearing_planes)), "material": base.name,
+           **dict(zip(L.CASING_BEARINGS, casing.bearing_planes, strict=False)), "material": base.name,
            **{key: getattr(casing.material, key) for key in ("youngs_modulus", "poisson_ratio", "density")
               if getattr(casing.material, key) != getattr(base, key)},
            "element_size": casing.element_size, "spider_radius": casing.spider_radius,
@@ -240,7 +240,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
     }
 
 
-def _column_unit(column: L.Column, values: list) -> tuple[str, float]:
+def _column_unit(column: L.Column, values: list) -> tuple[str | None, float]:
     """Unit text and factor of a column: the display unit if every value reads back identically."""
     if not column.has_unit or column.kind != "number":
         return column.template_unit, 1.0
@@ -300,7 +300,7 @@ def _write_instructions(ws) -> None:
             for col, text in enumerate((table.sheet, column.header, column.template_unit, kind,
                                         "yes" if column.required else "", column.help), start=1):
                 ws.cell(row, col, text or None)
-    for letter, width in zip("ABCDEF", (14, 22, 10, 22, 9, 90)):
+    for letter, width in zip("ABCDEF", (14, 22, 10, 22, 9, 90), strict=True):
         ws.column_dimensions[letter].width = width
     ws.cell(1, 1).alignment = Alignment(vertical="top")
     print_setup(ws)

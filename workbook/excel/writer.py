@@ -123,7 +123,7 @@ def _long_frame(runs: list[RunResult], tests: tuple) -> pd.DataFrame:
         frames.append(frame)
     frame = pd.concat(frames, ignore_index=True)
     test_amplitude, test_error = [], []
-    by_key = {}
+    by_key: dict = {}
     for test in tests:
         by_key.setdefault((test.run, test.location, test.direction), []).append(test)
     for row in frame.to_dict("records"):
@@ -257,7 +257,7 @@ def _merged(earlier: list[tuple], fresh: list[tuple], computed: set[str]) -> lis
 def _earlier_rows(ws) -> tuple[list[str], list[tuple[str, dict]]]:
     """The header and the rows ``(run, {header: value})`` of a result table written before."""
     header = [value for value in next(ws.iter_rows(min_row=2, max_row=2, values_only=True), ()) if value]
-    rows = [(values[0], dict(zip(header, values))) for values in ws.iter_rows(min_row=3, values_only=True)
+    rows = [(values[0], dict(zip(header, values, strict=False))) for values in ws.iter_rows(min_row=3, values_only=True)
             if values and values[0] is not None]
     return header, rows
 
@@ -355,7 +355,7 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         values = load_workbook(path, data_only=True)
-    cached = {}
+    cached: dict[int, dict[str, object]] = {}
     for number, ws in enumerate(workbook.worksheets, start=1):
         if ws.title not in values.sheetnames:
             continue

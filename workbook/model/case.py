@@ -21,7 +21,7 @@ import dataclasses
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal, get_args
 
 import numpy as np
 
@@ -41,12 +41,15 @@ __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link"
 PYLON = "pylon"
 ENGINE = "engine"
 DIRECTIONS = ("x", "y", "z")
+AnalysisMethod = Literal["time", "frequency", "auto"]
 #: Analysis methods a case may ask for (AnalysisSettings.method).
-ANALYSIS_METHODS = ("time", "frequency", "auto")
+ANALYSIS_METHODS: tuple[AnalysisMethod, ...] = get_args(AnalysisMethod)
+TimeStart = Literal["auto", "steady", "rest"]
 #: Starts a time-domain run may take (AnalysisSettings.start).
-TIME_STARTS = ("auto", "steady", "rest")
+TIME_STARTS: tuple[TimeStart, ...] = get_args(TimeStart)
+StressStiffening = Literal["auto", "on", "off"]
 #: Settings of ``Effects.stress_stiffening``.
-STRESS_STIFFENING = ("auto", "on", "off")
+STRESS_STIFFENING: tuple[StressStiffening, ...] = get_args(StressStiffening)
 _RESERVED = (PYLON, ENGINE)
 # Two points closer than this (m) are the same point (a hinge on a link eye).
 POINT_TOLERANCE = 1e-6
@@ -294,7 +297,7 @@ class Link:
 HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
 
 
-def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | Vector3:
+def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | tuple[float, ...]:
     """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
 
     A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
@@ -306,7 +309,7 @@ def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float
         raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
                                            f"{len(values)} given")
     return tuple(_number(v, item, f"{name}[{direction}]", minimum=0.0, strictly=strictly)
-                 for v, direction in zip(values, HINGE_DIRECTIONS))
+                 for v, direction in zip(values, HINGE_DIRECTIONS, strict=True))
 
 
 def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
@@ -565,6 +568,9 @@ def _direction(value: Any, item: str, name: str) -> Vector3:
 class _OneFrequency:
     """The frequency of an excitation given as ``frequency_hz`` or ``rpm``."""
 
+    frequency_hz: float | None
+    rpm: float | None
+
     @property
     def frequency(self) -> float:
         """Excitation frequency, Hz."""
@@ -624,6 +630,7 @@ class RotatingForce(_OneFrequency):
         """Force amplitude, N."""
         if self.amplitude is not None:
             return self.amplitude
+        assert self.unbalance is not None
         return self.unbalance * (2 * math.pi * self.frequency) ** 2
 
     def force_coefficients(self) -> tuple[np.ndarray, np.ndarray]:
@@ -839,6 +846,10 @@ class Rotor(_OneFrequency):
         return self.polar_inertia * 2 * math.pi * self.frequency * np.asarray(self.axis)
 
 
+#: Spacings of the frequencies of :meth:`Sweep.band`.
+SweepSpacing = Literal["log", "linear"]
+
+
 @dataclass(frozen=True)
 class Sweep:
     """A stepped sweep: one excitation template run at each of several frequencies.
@@ -868,13 +879,13 @@ class Sweep:
                                 for f in self.frequencies_hz)
         except TypeError:
             raise CaseError(item, "frequencies_hz", self.frequencies_hz, "a list of frequencies") from None
-        if not frequencies or any(b <= a for a, b in zip(frequencies, frequencies[1:])):
+        if not frequencies or any(b <= a for a, b in zip(frequencies, frequencies[1:], strict=False)):
             raise CaseError(item, "frequencies_hz", self.frequencies_hz, "ascending frequencies")
         _set(self, "frequencies_hz", frequencies)
 
     @classmethod
     def band(cls, name: str, template: SingleFrequencyExcitation, start_hz: float, stop_hz: float,
-             points: int, spacing: str = "log") -> "Sweep":
+             points: int, spacing: SweepSpacing = "log") -> "Sweep":
         """A sweep of *points* frequencies from *start_hz* to *stop_hz* (``"log"`` or ``"linear"``)."""
         if spacing not in ("log", "linear"):
             raise CaseError(f"excitation {name!r}", "spacing", spacing, "'log' or 'linear'")
@@ -895,6 +906,8 @@ class Sweep:
 
 #: Speed units of a run-up and their factor to Hz.
 SPEED_UNITS = {"rpm": 1.0 / 60.0, "Hz": 1.0}
+#: The keys of :data:`SPEED_UNITS`.
+SpeedUnit = Literal["rpm", "Hz"]
 
 
 @dataclass(frozen=True)
@@ -918,7 +931,7 @@ class RunUp(Sweep):
         The unit the speeds are tabulated and plotted in.
     """
 
-    speed_unit: str = "rpm"
+    speed_unit: SpeedUnit = "rpm"
 
     def __post_init__(self):
         super().__post_init__()
@@ -933,7 +946,7 @@ class RunUp(Sweep):
 
     @classmethod
     def speeds(cls, name: str, template: SingleFrequencyExcitation, start: float, stop: float, points: int,
-               unit: str = "rpm") -> "RunUp":
+               unit: SpeedUnit = "rpm") -> "RunUp":
         """A run-up over *points* evenly spaced speeds from *start* to *stop*, in *unit* (rpm or Hz)."""
         item = f"excitation {name!r}"
         if unit not in SPEED_UNITS:
@@ -1078,11 +1091,11 @@ class AnalysisSettings:
     spectral_radius: float = 0.9
     newton_tolerance: float = 1e-6
     equilibrium_tolerance: float = 1e-6
-    method: str = "auto"
+    method: AnalysisMethod = "auto"
     step_halvings: int = 4
     time_budget: float | None = None
     divergence_displacement: float = 0.05
-    start: str = "auto"
+    start: TimeStart = "auto"
 
     def __post_init__(self):
         item = "analysis settings"
@@ -1156,7 +1169,7 @@ class Effects:
     clearance: bool = True
     rig_sensors: bool = True
     gyroscopics: bool = True
-    stress_stiffening: str = "auto"
+    stress_stiffening: StressStiffening = "auto"
 
     def __post_init__(self):
         for item in dataclasses.fields(self):
@@ -1354,7 +1367,7 @@ class Case:
     def single_frequency_excitations(self) -> tuple[SingleFrequencyExcitation, ...]:
         """Every run of the case: single excitations, expanded sweeps and the
         parts of simultaneous excitations."""
-        runs = []
+        runs: list[SingleFrequencyExcitation] = []
         for excitation in self.excitations:
             runs.extend(excitation.expand() if isinstance(excitation, (Sweep, Simultaneous)) else (excitation,))
         return tuple(runs)

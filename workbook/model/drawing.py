@@ -38,7 +38,7 @@ def plot_layout(case: Case):
 
     fig, axes = plt.subplots(1, 3, figsize=(16, 5.6), constrained_layout=True)
     cg = np.array(case.engine.center_of_mass)
-    for ax, (title, i, j) in zip(axes, _VIEWS):
+    for ax, (title, i, j) in zip(axes, _VIEWS, strict=True):
         for link in case.links:
             a, b = np.array(link.end_a), np.array(link.end_b)
             ax.plot([a[i], b[i]], [a[j], b[j]], color=_link_colour(link.name), lw=3, solid_capstyle="round")

@@ -287,8 +287,8 @@ def impedance_from_rows(rows: Iterable[Sequence], file: str, sheet: str | None =
     if problems:
         raise fail()
     source = file if sheet is None else f"{file}, sheet '{sheet}'"
-    values = np.array([[table[frequency][pin] for pin in pins] for frequency in order])
-    return PylonImpedance.from_array(source, order, pins, values)
+    matrix = np.array([[table[frequency][pin] for pin in pins] for frequency in order])
+    return PylonImpedance.from_array(source, order, pins, matrix)
 
 
 def read_impedance_csv(path: str | Path) -> PylonImpedance:

@@ -12,6 +12,8 @@ y lateral, z up (right-handed, so +y is the engine's left seen from behind).
 """
 from __future__ import annotations
 
+from typing import Any, Literal, cast, get_args
+
 import numpy as np
 
 from workbook.errors import CaseError
@@ -42,8 +44,9 @@ HINGE_LOSS_FACTOR = 0.05
 #: The former viscous hinge damping as a stiffness-proportional time constant,
 #: d = HINGE_DAMPING_TIME * k, s (``reference_case(hinge_damping="viscous")``).
 HINGE_DAMPING_TIME = 1.0e-3
+HingeDamping = Literal["loss factor", "viscous"]
 #: The hinge damping models of :func:`reference_case`.
-HINGE_DAMPING_MODELS = ("loss factor", "viscous")
+HINGE_DAMPING_MODELS: tuple[HingeDamping, ...] = get_args(HingeDamping)
 
 FRONT_X, REAR_X, LATERAL_X, THRUST_FORWARD_X = 0.0, -1.60, -1.72, -0.55
 
@@ -111,13 +114,13 @@ def _links(element_size: float | None) -> tuple[Link, ...]:
     return tuple(links)
 
 
-def _hinges(damping_model: str) -> tuple[Hinge, ...]:
+def _hinges(damping_model: HingeDamping) -> tuple[Hinge, ...]:
     """16 spring-damper hinges; up = pylon side, down = engine side."""
     if damping_model not in HINGE_DAMPING_MODELS:
         raise CaseError("reference case", "hinge_damping", damping_model, " or ".join(map(repr, HINGE_DAMPING_MODELS)))
     points = _link_points()
     viscous = damping_model == "viscous"
-    damping = {"damping": HINGE_DAMPING_TIME * HINGE_STIFFNESS} if viscous else {"loss_factor": HINGE_LOSS_FACTOR}
+    damping: dict[str, Any] = {"damping": HINGE_DAMPING_TIME * HINGE_STIFFNESS} if viscous else {"loss_factor": HINGE_LOSS_FACTOR}
 
     def hinge(name: str, body_a: str, body_b: str, point) -> Hinge:
         return Hinge(name, body_a, body_b, point, HINGE_STIFFNESS, **damping)
@@ -182,7 +185,7 @@ def reference_sweep(points: int = 25) -> Sweep:
 
 def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = None,
                    element_size: float | None = None, rotors: bool = False,
-                   hinge_damping: str = "loss factor") -> Case:
+                   hinge_damping: HingeDamping = "loss factor") -> Case:
     """The reference mount with the LP and HP rotor cases.
 
     Parameters
@@ -207,7 +210,7 @@ def reference_case(*, sweep: bool = False, analysis: AnalysisSettings | None = N
     Case
     """
     inertia = ENGINE_MASS * np.diag([ROLL_GYRATION ** 2, PITCH_GYRATION ** 2, PITCH_GYRATION ** 2])
-    engine = Engine(ENGINE_MASS, ENGINE_CG, tuple(map(tuple, inertia)))
+    engine = Engine(ENGINE_MASS, ENGINE_CG, cast(Any, tuple(map(tuple, inertia))))
     static_loads = (PointForce("thrust", force=(23_000.0, 0.0, 0.0), point=(ENGINE_CG[0], 0.0, 0.0)),
                     Gravity("gravity", (0.0, 0.0, -9.81)))
     excitations = (LP_ROTOR, HP_ROTOR) + ((reference_sweep(),) if sweep else ())

@@ -140,7 +140,7 @@ def read_record(path: str | Path) -> RigRecord:
                                   column=f"{name} {axis}")
         channels[name] = np.column_stack([data.pop(f"{name} {axis}") for axis in DIRECTIONS])
     if data:
-        stray = next(h for h in headers if _COLUMN.match(h)["name"] in data)
+        stray = next(h for h in headers if (match := _COLUMN.match(h)) and match["name"] in data)
         raise RecordError(path, f"channel without a '# transducer' header line: {', '.join(data)}",
                           line=table_start, column=stray)
     notes = {k: v for k, (v, _) in header.items() if k not in ("run", "nominal frequency [Hz]", "sample rate [Hz]")}
@@ -219,7 +219,7 @@ def _read_table(path, lines: list[str], start: int) -> tuple[list, dict]:
     if not np.isfinite(values).all():
         index, j = np.argwhere(~np.isfinite(values))[0]
         raise RecordError(path, "not a finite number", line=start + 1 + int(index), column=headers[j])
-    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors))}
+    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors, strict=True))}
 
 
 def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:

@@ -325,7 +325,7 @@ class Scene:
         try:
             yield
         finally:
-            for load, function in zip(self.excitation.loads, self.excitation.functions):
+            for load, function in zip(self.excitation.loads, self.excitation.functions, strict=True):
                 self.mbs.SetLoadParameter(load, "loadVectorUserFunction", function)
 
     @contextmanager
@@ -405,7 +405,7 @@ def loss_factors(case: Case) -> tuple[dict[str, Any], dict[str, float]]:
     return hinges, links
 
 
-def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | None) -> float:
+def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None) -> float:
     """Highest excitation frequency a reduction must serve, Hz."""
     if excitation is not None:
         return excitation.frequency
@@ -413,7 +413,7 @@ def _reduction_frequency(case: Case, excitation: SingleFrequencyExcitation | Non
     return max(frequencies) if frequencies else 0.0
 
 
-def link_jobs(case: Case, excitation: SingleFrequencyExcitation | None = None) -> dict:
+def link_jobs(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None = None) -> dict:
     """The distinct reductions the links of *case* need, each with the links it serves.
 
     Parameters
@@ -429,21 +429,21 @@ def link_jobs(case: Case, excitation: SingleFrequencyExcitation | None = None) -
         case's excitation frequencies and the run's own.
     """
     frequencies = tuple(sorted({e.frequency for e in case.excitations} | {_reduction_frequency(case, excitation)}))
-    jobs = {}
+    jobs: dict = {}
     for link in case.links:
         stiffening = case.effects.stress_stiffening != "off" and case.link_is_flexible(link.name)
         jobs.setdefault(LinkJob(link.model, case.link_modes(link.name), frequencies, stiffening), []).append(link.name)
     return jobs
 
 
-def _served_frequency(case: Case, excitation: SingleFrequencyExcitation | None, reduced: dict) -> float:
+def _served_frequency(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None, reduced: dict) -> float:
     """The frequency the scene's reductions serve, Hz: that the links were reduced for (a
     sweep's highest), else the excitation's (:func:`_reduction_frequency`)."""
     served = [link.decision.excitation_hz for link in reduced.values() if link.decision.excitation_hz]
     return max(served) if served else _reduction_frequency(case, excitation)
 
 
-def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None,
+def reduce_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None = None,
                  progress: Callable[[int], None] | None = None) -> dict:
     """Reduce every link of *case* (cached on disk and in memory by :mod:`flexbodies`).
 
@@ -487,7 +487,7 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None
     return {link.name: reduced[link.name] for link in case.links}
 
 
-def _load_scale(case: Case, excitation: SingleFrequencyExcitation | None, link_mass: float) -> float:
+def _load_scale(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None, link_mass: float) -> float:
     scale = 1.0
     if excitation is not None:
         scale = max(scale, excitation.force_amplitude)
@@ -500,7 +500,7 @@ def _load_scale(case: Case, excitation: SingleFrequencyExcitation | None, link_m
     return scale
 
 
-def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None, *,
+def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None = None, *,
                 reduced: dict | None = None, exact_loss_factors: bool = False) -> Scene:
     """Build the Exudyn system of *case*.
 
@@ -554,14 +554,14 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
 
     links = {}
     for link in case.links:
-        damping = case.effects.link_damping
+        link_damping = case.effects.link_damping
         optional = {} if link.spin_frequency_hz is None else {"spin_frequency_hz": link.spin_frequency_hz}
         links[link.name] = add_link_to_exudyn(
             mbs, reduced[link.name], link.end_a, link.end_b,
             flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
-            stiffness_damping=(link.stiffness_damping if damping else 0.0) + viscous(link_loss.get(link.name, 0.0), 1.0),
-            mass_damping=link.mass_damping if damping else 0.0,
-            modal_damping_ratio=link.modal_damping if damping else 0.0, name=exudyn_name("link", link.name), **optional)
+            stiffness_damping=(link.stiffness_damping if link_damping else 0.0) + viscous(link_loss.get(link.name, 0.0), 1.0),
+            mass_damping=link.mass_damping if link_damping else 0.0,
+            modal_damping_ratio=link.modal_damping if link_damping else 0.0, name=exudyn_name("link", link.name), **optional)
 
     transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
 
@@ -590,7 +590,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
             stiffness[:] = hinge.gap_contact_stiffness
         damping = (hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)) \
             + [viscous(eta, k) for eta, k in zip(hinge.values("loss_factor") if hinge.name in hinge_loss
-                                                 else np.zeros(3), stiffness)]
+                                                 else np.zeros(3), stiffness, strict=True)]
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
             name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
             damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
@@ -616,20 +616,20 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
 
     excitation_items = None
     if excitation is not None:
-        markers, loads, functions = [], [], []
+        force_markers, loads, functions = [], [], []
         parts = ExcitationSignal.at_points(excitation, case.analysis.ramp_periods)
         for k, (position, part) in enumerate(parts, start=1):
-            markers.append(mbs.AddMarker(eii.MarkerBodyPosition(
+            force_markers.append(mbs.AddMarker(eii.MarkerBodyPosition(
                 bodyNumber=engine.body, localPosition=list(np.subtract(position, case.engine.center_of_mass)))))
             label = excitation.name if len(parts) == 1 else f"{excitation.name} {k}"
             loads.append(mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", label),
-                                                         markerNumber=markers[-1], loadVector=[0.0] * 3)))
+                                                         markerNumber=force_markers[-1], loadVector=[0.0] * 3)))
             functions.append(CreateSymbolicUserFunction(mbs, part.exudyn_user_function(), "loadVectorUserFunction",
                                                         loads[-1]))
             mbs.SetLoadParameter(loads[-1], "loadVectorUserFunction", functions[-1])
         resultant = None if isinstance(excitation, Simultaneous) else ExcitationSignal.of(excitation,
                                                                                          case.analysis.ramp_periods)
-        excitation_items = ExcitationItems(excitation.name, tuple(markers), tuple(loads), resultant,
+        excitation_items = ExcitationItems(excitation.name, tuple(force_markers), tuple(loads), resultant,
                                            tuple(functions), excitation)
 
     mbs.Assemble()
@@ -655,6 +655,7 @@ def _add_transducers(mbs, case: Case, ground: int) -> dict[str, TransducerItems]
 
     eii = exu.itemInterface
     rig = case.test_rig
+    assert rig is not None
     transducers = {}
     for position, carried in case.pylon_pins():
         name = transducer_name(carried)
@@ -765,7 +766,7 @@ def exudyn_gyroscopic_function(momentum):
     """
     import exudyn as exu
 
-    esym = exu.symbolic
+    esym = exu.symbolic  # type: ignore[attr-defined]  # the stubs omit the submodule
     hx, hy, hz = (float(h) for h in momentum)
 
     def gyroscopic_force(mbs, t, itemNumber, q, q_t):

@@ -106,7 +106,7 @@ class ExcitationSignal:
         ``exudyn.advancedUtilities.CreateSymbolicUserFunction`` can record it."""
         import exudyn as exu
 
-        esym = exu.symbolic
+        esym = exu.symbolic  # type: ignore[attr-defined]  # the stubs omit the submodule
         omega, ramp_time = self.omega, self.ramp_time
         cos_part, sin_part = self.cos_part, self.sin_part
 

@@ -57,7 +57,7 @@ def exudyn_clearance_function(gap: float):
     """
     import exudyn as exu
 
-    esym = exu.symbolic
+    esym = exu.symbolic  # type: ignore[attr-defined]  # the stubs omit the submodule
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         u = [displacement[i] for i in range(3)]

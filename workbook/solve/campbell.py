@@ -238,7 +238,7 @@ def spinning_rotors(case: Case) -> tuple[SpinningRotor, ...]:
     if case.rotors:
         return tuple(SpinningRotor(r.name, float(r.frequency), np.asarray(r.axis, dtype=float), True)
                      for r in case.rotors)
-    rotors = []
+    rotors: list[SpinningRotor] = []
     for x in case.excitations:
         if isinstance(x, (RotatingForce, Imbalance)) and x.name not in {r.name for r in rotors}:
             axis = np.asarray(x.axis, dtype=float)
@@ -380,11 +380,12 @@ def campbell(case: Case, *, rotor: str | None = None, start_rpm: float = 0.0, st
     fractions = speeds / 60.0 / reference.frequency_hz
     if upper_hz is None:
         upper_hz = 1.1 * max(orders) * fractions[-1] * max(r.frequency_hz for r in rotors)
-    probe = HarmonicForce("Campbell probe", point=tuple(case.engine.center_of_mass), direction=(1.0, 0.0, 0.0),
+    probe = HarmonicForce("Campbell probe", point=case.engine.center_of_mass, direction=(1.0, 0.0, 0.0),
                           amplitude=1.0, frequency_hz=float(upper_hz))
     start = time.perf_counter()
     prepared = prepare(case, probe)
     with prepared.scene:
+        assert prepared.model is not None       # prepared for the frequency domain: it has its harmonic model
         lin = prepared.model.linearization
     built = time.perf_counter()
     basis_hz = BASIS_FACTOR * upper_hz if basis_hz is None else float(basis_hz)

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -71,6 +72,7 @@ class PylonAt:
         """The keyword arguments of :meth:`~workbook.solve.four_pole.FourPole.respond` at excitation *j*."""
         if self.stiffness is not None:
             return {"pylon": self.stiffness[j][None]}
+        assert self.compliance is not None
         return {"compliance": self.compliance[j][None]}
 
 
@@ -129,6 +131,7 @@ def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> Pylon
                              f"{facts['seconds']:.2f} s, compliance at the pins")
         return PylonAt(None, structure.compliance(frequencies), effect, time.perf_counter() - start)
     beam = case.pylon_beam
+    assert beam is not None
     model = beam_model(beam, [position for position, _ in pins])
     compliance = model.compliance(frequencies)
     effect = EffectEntry("flexible pylon (box beam)", True,
@@ -143,7 +146,7 @@ def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.nd
     return ExcitationResult(
         name=excitation.name, frequency_hz=excitation.frequency,
         excitation_amplitude=excitation.force_amplitude, pylon_amplitude=np.abs(pin_forces.sum(axis=0)),
-        hinge_amplitudes={pin: np.abs(force) for pin, force in zip(pins, pin_forces)},
+        hinge_amplitudes={pin: np.abs(force) for pin, force in zip(pins, pin_forces, strict=True)},
         pylon_hinges=list(pins), steady_change=0.0, steady_tolerance=steady_tolerance,
         warnings=[], time=np.zeros(0), hinge_histories={pin: empty for pin in pins},
         pylon_history=empty, excitation_history=empty, window=slice(0, 0))
@@ -183,7 +186,7 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
         start = time.perf_counter()
         forces = point_phasors(excitation)  # one force, or one per imbalance plane: their responses add
         pole = condense(prepared.model, case, [excitation.frequency], points=[point for point, _ in forces])
-        pin_forces = sum(pole.respond(phasor, point, **pylon.closure(j))[0].pin_forces for point, phasor in forces)
+        pin_forces = cast(np.ndarray, sum(pole.respond(phasor, point, **pylon.closure(j))[0].pin_forces for point, phasor in forces))
         seconds = time.perf_counter() - start
         result = _result(excitation, pole.pins, pin_forces, case.analysis.steady_tolerance)
         result.warnings.extend(link_warnings(case, prepared.scene.reduced))

@@ -385,9 +385,9 @@ class FourPole:
         import matplotlib.pyplot as plt
 
         fig, axes = plt.subplots(3, 1, sharex=True, figsize=(8, 8), constrained_layout=True)
-        for quantity, style in zip(QUANTITIES, ("-", "--", ":")):
+        for quantity, style in zip(QUANTITIES, ("-", "--", ":"), strict=True):
             values = np.abs(self.direction_values(quantity))
-            for d, axis in enumerate(DIRECTIONS):
+            for d, _axis in enumerate(DIRECTIONS):
                 axes[d].loglog(self.frequencies_hz, values[:, d], style, label=quantity)
         for d, axis in enumerate(DIRECTIONS):
             axes[d].set_ylabel(f"|K| {axis} N/m")
@@ -478,7 +478,7 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
         rows_d.append(sum(model.damping_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
         own_k = [hinge_matrix(mount, hinges[h], "stiffness") for h in carried]
         direct_k.append(sum(k + (1j * hinge_matrix(mount, hinges[h], "loss_factor") @ k if damped else 0.0)
-                            for h, k in zip(carried, own_k)))
+                            for h, k in zip(carried, own_k, strict=True)))
         direct_d.append(sum(hinge_matrix(mount, hinges[h], "damping") for h in carried) if damped
                         else np.zeros((3, 3)))
     output_k, output_h, output_d = np.vstack(rows_k), np.vstack(rows_h), np.vstack(rows_d)

@@ -32,7 +32,7 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
         (:class:`~workbook.errors.FourPoleError`).
     """
     frequencies = checked_frequencies(frequencies_hz)
-    probe = HarmonicForce("four-pole probe", point=tuple(case.engine.center_of_mass), direction=(1.0, 0.0, 0.0),
+    probe = HarmonicForce("four-pole probe", point=case.engine.center_of_mass, direction=(1.0, 0.0, 0.0),
                           amplitude=1.0, frequency_hz=float(frequencies.max()))
     prepared = prepare(mount_case(case), probe)
     with prepared.scene:

@@ -69,7 +69,7 @@ def point_phasors(excitation: SingleFrequencyExcitation) -> list[tuple[np.ndarra
 def excitation_phasor(excitation: SingleFrequencyExcitation) -> np.ndarray:
     """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)
     (of an imbalance of several planes: their resultant)."""
-    return sum(phasor for _, phasor in point_phasors(excitation))
+    return sum((phasor for _, phasor in point_phasors(excitation)), np.zeros(3, dtype=complex))
 
 
 @dataclass(frozen=True)
@@ -122,7 +122,7 @@ class HarmonicModel:
     stiffness_output: np.ndarray
     damping_output: np.ndarray
     engine_point_jacobian: Callable[[np.ndarray], np.ndarray] = field(repr=False)
-    structural_output: np.ndarray = field(default=None, repr=False)
+    structural_output: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # None: zeros
     _inputs: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -166,7 +166,7 @@ class HarmonicModel:
         motion = self.motion(frequency_hz, load)
         outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
         forces = (outputs @ motion).reshape(-1, 3)
-        hinges = dict(zip(self.hinge_names, forces))
+        hinges = dict(zip(self.hinge_names, forces, strict=True))
         pylon = pylon_sum(hinges, self.pylon_hinges)
         return FrequencyResponse(frequency_hz, hinges, pylon)
 

@@ -17,12 +17,16 @@ would run every point from rest.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Final, Literal
 
 from workbook.model.case import Case
 
 __all__ = ["MethodChoice", "choose_method", "clearance_hinges", "TIME", "FREQUENCY"]
 
-TIME, FREQUENCY = "time", "frequency"
+#: The methods a run is answered with.
+Method = Literal["time", "frequency"]
+TIME: Final = "time"
+FREQUENCY: Final = "frequency"
 
 
 @dataclass(frozen=True)
@@ -35,7 +39,7 @@ class MethodChoice:
     reason : str
     """
 
-    method: str
+    method: Method
     reason: str
 
     @property

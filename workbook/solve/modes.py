@@ -143,7 +143,7 @@ def _body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
     mbs = scene.mbs
     indices = {}
     for body, nodes in scene.body_nodes().items():
-        coordinates = []
+        coordinates: list[int] = []
         for node in nodes:
             start = mbs.GetNodeODE2Index(node)
             size = len(mbs.GetNodeOutput(node, exu.OutputVariableType.Coordinates))

@@ -77,7 +77,7 @@ class PreparedScene:
     timings: dict[str, float]
 
 
-def _reduce(case: Case, excitation: SingleFrequencyExcitation, reduce_for: SingleFrequencyExcitation,
+def _reduce(case: Case, excitation: SingleFrequencyExcitation | Simultaneous, reduce_for: SingleFrequencyExcitation | Simultaneous,
             progress: ProgressFactory | None) -> dict:
     if progress is None or not case.links:
         return reduce_links(case, reduce_for)
@@ -88,7 +88,7 @@ def _reduce(case: Case, excitation: SingleFrequencyExcitation, reduce_for: Singl
         close()
 
 
-def prepare(case: Case, excitation: SingleFrequencyExcitation, *,
+def prepare(case: Case, excitation: SingleFrequencyExcitation | Simultaneous, *,
             reduce_for: SingleFrequencyExcitation | None = None, reduced: dict | None = None,
             progress: ProgressFactory | None = None, harmonic: bool = True,
             linear_model: bool = False) -> PreparedScene:
@@ -198,19 +198,22 @@ def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
                        linear_model=steady)
     timings, scene = prepared.timings, prepared.scene
     mounted = mounted_modes(prepared.modes)
-    together = isinstance(excitation, Simultaneous)
     with scene:
         where = run_label(case.name, excitation.name)
-        plan = (plan_simultaneous(case.analysis, excitation, prepared.modes, where, start.start) if together
-                else plan_run(case.analysis, scene.excitation.signal, prepared.modes, where, start.start))
+        if isinstance(excitation, Simultaneous):
+            plan = plan_simultaneous(case.analysis, excitation, prepared.modes, where, start.start)
+        else:
+            assert scene.excitation is not None and scene.excitation.signal is not None
+            plan = plan_run(case.analysis, scene.excitation.signal, prepared.modes, where, start.start)
         if steady:
             with timed(timings, "steady start"):
+                assert prepared.model is not None
                 steady_start(prepared.model, excitation).apply(scene)
         log.info("%s / %s: %d steps of %.3g s from %s", case.name, excitation.name, plan.steps, plan.step,
                  start.start)
 
         def extract_all(histories: TimeHistories) -> list[ExcitationResult]:
-            return (extract_simultaneous(scene, plan, histories, excitation) if together
+            return (extract_simultaneous(scene, plan, histories, excitation) if isinstance(excitation, Simultaneous)
                     else [extract(scene, plan, histories)])
 
         def settled(histories: TimeHistories) -> bool:
@@ -271,6 +274,7 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
     preloads : dict of str to Preload
     """
     model = prepared.model
+    assert model is not None
     mounted = mounted_modes(prepared.modes)
     solver = _frequency_solver(case, model)
     gaps = [h for h in case.hinges if prepared.scene.hinges[h.name].clearance]

@@ -137,6 +137,7 @@ def spring_roundoff_force(scene: Scene) -> float:
     case = scene.case
     stiffness = [h.largest_stiffness for h in case.hinges]
     if scene.transducers:
+        assert case.test_rig is not None
         stiffness += list(case.test_rig.stiffness)
     reach = max((float(np.abs(h.position).max()) for h in case.hinges), default=0.0)
     return ROUNDOFF_MARGIN * max(stiffness, default=0.0) * np.finfo(float).eps * max(reach, 1.0)

@@ -107,7 +107,7 @@ def beam_model(beam: BoxBeamPylon, pins) -> BeamModel:
         stiffness[dofs, dofs] += rotate.T @ k @ rotate
         mass[dofs, dofs] += rotate.T @ m @ rotate
     pin_map = np.zeros((3 * len(feet), 6 * nodes))
-    for p, (position, foot) in enumerate(zip(pins, feet)):
+    for p, (position, foot) in enumerate(zip(pins, feet, strict=True)):
         node = int(np.argmin(np.abs(stations - foot)))
         offset = np.asarray(position) - (root + stations[node] * axis)
         cross = np.array([[0, -offset[2], offset[1]], [offset[2], 0, -offset[0]], [-offset[1], offset[0], 0]])

@@ -133,7 +133,7 @@ def _reduce(pylon: MeshPylon, pins, highest_hz: float) -> tuple[PylonStructure, 
     if len(cb.fixed_interface_hz) < MINIMUM_MODES:
         cb = craig_bampton(stiffness, mass, masters.ravel(), count=MINIMUM_MODES)
     pin_map = np.zeros((3 * len(pins), cb.vectors.shape[1]))
-    for p, (pin, centre) in enumerate(zip(pins, coupling.centres)):
+    for p, (pin, centre) in enumerate(zip(pins, coupling.centres, strict=True)):
         offset = np.asarray(pin, dtype=float) - centre
         # the master DOF are the first reduced coordinates, pin by pin (static modes)
         pin_map[3 * p:3 * p + 3, 6 * p:6 * p + 3] = np.eye(3)

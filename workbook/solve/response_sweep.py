@@ -127,7 +127,7 @@ class SweepResponse:
 
     def response(self, index: int) -> FrequencyResponse:
         """The answer at one frequency, as :meth:`HarmonicModel.respond` gives it."""
-        return FrequencyResponse(float(self.frequencies_hz[index]), dict(zip(self.hinge_names, self.hinge_forces[index])),
+        return FrequencyResponse(float(self.frequencies_hz[index]), dict(zip(self.hinge_names, self.hinge_forces[index], strict=True)),
                                  self.pylon_force[index])
 
 
@@ -161,5 +161,5 @@ def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> SweepRes
     third = len(outputs) // 3
     forces = (outputs[:third] + 1j * (outputs[third:2 * third] + omegas * outputs[2 * third:]))
     forces = forces.T.reshape(len(omegas), -1, 3)  # (f, h, 3)
-    hinges = dict(zip(model.hinge_names, np.moveaxis(forces, 1, 0)))
+    hinges = dict(zip(model.hinge_names, np.moveaxis(forces, 1, 0), strict=True))
     return SweepResponse(frequencies_hz, list(model.hinge_names), forces, pylon_sum(hinges, model.pylon_hinges))

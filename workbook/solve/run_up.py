@@ -12,6 +12,7 @@ speed unit).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
@@ -29,7 +30,7 @@ class RunUpAnswer(SweepAnswer):
 
     @property
     def speed_unit(self) -> str:
-        return self.sweep.speed_unit
+        return cast(RunUp, self.sweep).speed_unit
 
     @property
     def speeds(self) -> np.ndarray:

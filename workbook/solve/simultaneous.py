@@ -35,7 +35,7 @@ from workbook.scene.build import Scene
 from workbook.scene.excitation import ExcitationSignal
 from workbook.solve.guards import check_undamped_resonance
 from workbook.solve.modes import Mode
-from workbook.solve.steady_start import STEADY
+from workbook.solve.steady_start import STEADY, Start
 from workbook.solve.time_domain import TimeHistories, TimePlan, plan_run, run_warnings
 
 __all__ = ["plan_simultaneous", "extract_simultaneous"]
@@ -47,7 +47,7 @@ def _lowest_and_highest(item: Simultaneous):
 
 
 def plan_simultaneous(analysis: AnalysisSettings, item: Simultaneous, modes: list[Mode], where: str,
-                      start: str = "rest") -> TimePlan:
+                      start: Start = "rest") -> TimePlan:
     """The plan of one run of every part of *item* (see the module text).
 
     Raises

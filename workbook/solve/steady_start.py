@@ -39,6 +39,7 @@ settles from there, within the same limit).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Final, Literal
 
 import numpy as np
 
@@ -49,7 +50,10 @@ from workbook.solve.method import clearance_hinges
 
 __all__ = ["REST", "STEADY", "StartChoice", "choose_start", "SteadyStart", "steady_start"]
 
-REST, STEADY = "rest", "steady"
+#: The starts a time-domain run takes.
+Start = Literal["rest", "steady"]
+REST: Final = "rest"
+STEADY: Final = "steady"
 
 
 @dataclass(frozen=True)
@@ -62,7 +66,7 @@ class StartChoice:
     reason : str
     """
 
-    start: str
+    start: Start
     reason: str
 
 

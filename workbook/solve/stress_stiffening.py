@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 from flexbodies.geometric_stiffness import LinkStiffening, link_stiffening, stiffened
 from workbook.errors import BucklingError
-from workbook.model.case import Case, SingleFrequencyExcitation
+from workbook.model.case import Case, Simultaneous, SingleFrequencyExcitation
 from workbook.scene.build import Scene, build_scene
 from workbook.solve.preload import Preload, link_compression, solve_preload
 
@@ -182,7 +182,7 @@ def assess_links(scene: Scene, preload: Preload, stiffenings: dict[str, LinkStif
     return tuple(links)
 
 
-def stiffen_links(case: Case, excitation: SingleFrequencyExcitation | None, scene: Scene,
+def stiffen_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None, scene: Scene,
                   preload: Preload) -> tuple[Scene, Preload]:
     """Stiffen the flexible links by their axial preload (see the module).
 

@@ -64,7 +64,7 @@ from workbook.scene.build import Scene
 from workbook.scene.excitation import ExcitationSignal
 from workbook.solve.guards import MAX_STEPS, UNDAMPED_RATIO, check_undamped_resonance, newton_cause, run_label, solver_output
 from workbook.solve.modes import Mode, mounted_modes
-from workbook.solve.steady_start import STEADY
+from workbook.solve.steady_start import STEADY, Start
 from workbook.solve.step_accuracy import ACCURACY_LIMIT, ACCURACY_TARGET, amplitude_error, steps_for_accuracy
 
 __all__ = ["TimePlan", "plan_run", "integrate", "extract", "run_warnings", "TimeHistories", "TRANSIENT_SEGMENTS"]
@@ -122,7 +122,7 @@ class TimePlan:
     amplitude_error: float = 0.0
     error_source: str = ""
     steps_needed: int = 0
-    start: str = "rest"
+    start: Start = "rest"
     extension_periods: int = 0
 
     @property
@@ -155,12 +155,12 @@ class TimePlan:
         per_segment = max(1, math.ceil(transient / TRANSIENT_SEGMENTS))
         bounds = list(range(0, transient, per_segment)) + [transient]
         segments = [(a * self.steps_per_period, b * self.steps_per_period, False)
-                    for a, b in zip(bounds, bounds[1:])]
+                    for a, b in zip(bounds, bounds[1:], strict=False)]
         return segments + [(transient * self.steps_per_period, self.steps, True)]
 
 
 def plan_run(analysis: AnalysisSettings, signal: ExcitationSignal, modes: list[Mode], where: str = "run",
-             start: str = "rest") -> TimePlan:
+             start: Start = "rest") -> TimePlan:
     """Choose the step and the durations of a run.
 
     Parameters
@@ -299,7 +299,7 @@ def _solve_segment(scene: Scene, settings, plan: TimePlan, first: int, last: int
         integration.numberOfSteps = (last - first) * 2 ** halving
         solver = exu.MainSolverImplicitSecondOrder()
         with solver_output():
-            solved = solver.SolveSystem(scene.mbs, settings)
+            solved = solver.SolveSystem(scene.mbs, settings)  # type: ignore[call-arg,misc]
         if solved:
             _advance_initial_state(scene.mbs)
             if halving:
@@ -363,6 +363,7 @@ def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | 
     import exudyn as exu
 
     analysis = scene.case.analysis
+    assert scene.excitation is not None
     where = run_label(scene.case.name, scene.excitation.name)
     settings = _simulation_settings(scene, plan)
     preloaded = np.asarray(scene.mbs.GetNodeOutput(scene.engine.node, exu.OutputVariableType.Position,
@@ -371,7 +372,7 @@ def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | 
     # full from the first step, is still zero, so the equations of motion there would not give them
     settings.timeIntegration.generalizedAlpha.computeInitialAccelerations = plan.start != STEADY
     began = wall_clock.perf_counter()
-    retries = []
+    retries: list = []
     window = plan.measured_periods * plan.steps_per_period
     limit = plan.steps + plan.extension_periods * plan.steps_per_period
     segments = plan.segments()
@@ -394,6 +395,7 @@ def integrate(scene: Scene, plan: TimePlan, progress: Callable[[float], None] | 
             histories.extended_periods = (last - plan.steps) // plan.steps_per_period
             if steady is not None and last + window <= limit and not steady(histories):
                 segments.append((last, last + window, True))
+    assert histories is not None
     return histories
 
 
@@ -417,6 +419,7 @@ def _stored_histories(scene: Scene, before: TimeHistories | None, samples: int, 
 def extract(scene: Scene, plan: TimePlan, histories: TimeHistories) -> ExcitationResult:
     """Amplitudes at the excitation frequency, the steady-state check and warnings."""
     analysis = scene.case.analysis
+    assert scene.excitation is not None and scene.excitation.signal is not None
     signal = scene.excitation.signal
     time = histories.time
     pylon = pylon_sum(histories.hinge_forces, scene.pylon_channels)
@@ -438,6 +441,7 @@ def run_warnings(scene: Scene, plan: TimePlan, relative_change: float, extended_
     """The warnings of a time run: not steady (the pylon amplitudes of the two
     windows differ by *relative_change*, after *extended_periods* periods
     beyond the plan), a coarse step, undamped modes."""
+    assert scene.excitation is not None
     analysis = scene.case.analysis
     warnings = []
     if relative_change > analysis.steady_tolerance:

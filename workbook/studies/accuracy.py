@@ -41,7 +41,7 @@ from flexbodies.selection import MODE_MARGIN
 from workbook.answers.saving import free_stem, save_figure, save_text
 from workbook.errors import InputError
 from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
-from workbook.solve.method import FREQUENCY, TIME, MethodChoice
+from workbook.solve.method import FREQUENCY, TIME, Method, MethodChoice
 from workbook.solve.pipeline import prepare, run_excitation, solve_frequencies
 
 __all__ = ["Rung", "RungResult", "AccuracyStudy", "ladder", "run_study", "REFERENCE_RUNG"]
@@ -73,7 +73,7 @@ class Rung:
 
     label: str
     links: str
-    method: str
+    method: Method
     steps_per_period: int | None = None
 
     @property
@@ -145,7 +145,7 @@ class RungResult:
     transmissibility: dict
 
 
-def _solve(case: Case, excitation: SingleFrequencyExcitation, method: str):
+def _solve(case: Case, excitation: SingleFrequencyExcitation, method: Method):
     """T (3,) and DOF of one excitation of a prepared rung case."""
     if method == FREQUENCY:
         prepared = prepare(case, excitation)
@@ -222,7 +222,7 @@ class AccuracyStudy:
             row = {"rung": result.rung.label + (" (reference)" if result.rung.label == self.reference else ""),
                    "model": result.rung.description, "DOF": result.dof, "wall time s": result.wall_time}
             for name, error in self.errors(result).items():
-                row.update({f"{name} T_{axis} error %": e for axis, e in zip(DIRECTIONS, error)})
+                row.update({f"{name} T_{axis} error %": e for axis, e in zip(DIRECTIONS, error, strict=True)})
             row["worst |error| %"] = self.worst_error(result)
             rows.append(row)
         return pd.DataFrame(rows).set_index("rung")
@@ -268,7 +268,7 @@ class AccuracyStudy:
             cells = [label, f"{row['DOF']:d}", f"{row['wall time s']:.3g}"]
             cells += [f"{row[c]:+.3f}" for c in errors] + [f"{row['worst |error| %']:.3f}"]
             lines.append("| " + " | ".join(cells) + " |")
-        values = "; ".join(f"{name}: " + ", ".join(f"T_{d} = {t:.5g}" for d, t in zip(DIRECTIONS, row))
+        values = "; ".join(f"{name}: " + ", ".join(f"T_{d} = {t:.5g}" for d, t in zip(DIRECTIONS, row, strict=True))
                            for name, row in self.reference_frame().iterrows())
         lines += ["", f"Case: {self.case_name}. Errors: (T - T_ref) / T_ref x 100 % per excitation and direction, "
                   f"against the reference rung '{self.reference}' (the richest link model solved exactly by the "
@@ -294,7 +294,7 @@ class AccuracyStudy:
         errors = [self.worst_error(r) for r in self.results]
         positive = [e for e in errors if e > 0]
         floor = min(positive) / 3 if positive else 1e-6
-        for number, (result, error) in enumerate(zip(self.results, errors), start=1):
+        for number, (result, error) in enumerate(zip(self.results, errors, strict=True), start=1):
             is_reference = result.rung.label == self.reference
             marker = "*" if is_reference else ("s" if result.rung.method == TIME else "o")
             color = "C3" if is_reference else ("C1" if result.rung.method == TIME else "C0")

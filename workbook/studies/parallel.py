@@ -112,7 +112,7 @@ def prepare(cases: dict[int, Case | BaseException]) -> dict[int, Case | RowOutco
     """
     from flexbodies import reduce_link
 
-    reduced, prepared = set(), {}
+    reduced, prepared = set(), dict[int, Case | RowOutcome]()
     for index, case in cases.items():
         if isinstance(case, BaseException):
             prepared[index] = _failed(index, case)
@@ -169,8 +169,8 @@ def run_row(index: int, case: Case) -> RowOutcome:
     for run in result.runs:
         t = run.transmissibility
         runs.append({"run": run.name, "frequency Hz": run.frequency_hz,
-                     **{f"T {d}": float(v) for d, v in zip(DIRECTIONS, t)},
-                     **{f"eta % {d}": float(v) for d, v in zip(DIRECTIONS, efficiency(t))},
+                     **{f"T {d}": float(v) for d, v in zip(DIRECTIONS, t, strict=True)},
+                     **{f"eta % {d}": float(v) for d, v in zip(DIRECTIONS, efficiency(t), strict=True)},
                      "steady": run.steady})
     return RowOutcome(index, runs, wall_time=time.perf_counter() - start)
 
@@ -250,6 +250,7 @@ def _worker_init(started) -> None:
 
 
 def _reported_row(index: int, case: Case) -> RowOutcome:
+    assert _started is not None
     _started.put((index, os.getpid()))
     return run_row(index, case)
 
@@ -340,7 +341,7 @@ def _run_dask(pending: dict, address: str, done: Callable) -> None:
         if cache:  # the workers load the reductions made here (a shared folder on a real cluster)
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
         futures = client.map(run_row, list(pending), list(pending.values()), pure=False)
-        rows = {future.key: index for future, index in zip(futures, pending)}
+        rows = {future.key: index for future, index in zip(futures, pending, strict=True)}
         for future in dask_completed(futures):
             try:
                 done(future.result())

@@ -148,7 +148,7 @@ def grid(values: dict[str, list]) -> tuple[dict, ...]:
     """
     _check_names(values)
     names = list(values)
-    return tuple(dict(zip(names, combination)) for combination in itertools.product(*values.values()))
+    return tuple(dict(zip(names, combination, strict=True)) for combination in itertools.product(*values.values()))
 
 
 def linear_range(start: float, stop: float, points: int) -> list[float]:
@@ -184,7 +184,7 @@ def latin_hypercube(bounds: dict[str, tuple[float, float]], samples: int, seed: 
     unit = qmc.LatinHypercube(d=len(bounds), seed=seed).random(samples)
     low, high = np.array(list(bounds.values()), dtype=float).T
     points = qmc.scale(unit, low, high) if len(bounds) else unit
-    return tuple({name: float(value) for name, value in zip(bounds, row)} for row in points)
+    return tuple({name: float(value) for name, value in zip(bounds, row, strict=True)} for row in points)
 
 
 def row_case(case: Case, row: dict, index: int) -> Case:
@@ -208,7 +208,7 @@ def study_cases(case: Case, rows: tuple) -> list:
     -------
     list of Case or CaseError
     """
-    cases = []
+    cases: list[Case | CaseError] = []
     for index, row in enumerate(rows):
         try:
             cases.append(row_case(case, row, index))

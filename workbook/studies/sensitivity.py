@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
+from typing import Literal, get_args
 
 from flexbodies.atomic import replacing
 from workbook.answers.saving import free_stem, save_csv, save_figure
@@ -31,8 +32,9 @@ from workbook.studies.parametric import PARAMETERS
 __all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "StudyTable", "table_path",
            "new_study_table", "STUDY_STEM", "read_finished", "WRITE_INTERVAL"]
 
+TableFormat = Literal["csv", "parquet"]
 #: File formats of the study table.
-TABLE_FORMATS = ("csv", "parquet")
+TABLE_FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
 #: Least time between two writes of a running study's table file, s. Writing
 #: a 10,000-row table takes about 0.3 s; written after every row, it would
 #: cost more than the rows themselves.
@@ -115,14 +117,14 @@ def plot_sensitivity(frame, parameters: list[str]):
 STUDY_STEM = "parameter-study"
 
 
-def table_path(folder: str | Path, table_format: str = "csv", stem: str = STUDY_STEM) -> Path:
+def table_path(folder: str | Path, table_format: TableFormat = "csv", stem: str = STUDY_STEM) -> Path:
     """The study table's file in *folder*: ``<stem>.<csv|parquet>`` (``parameter-study.csv``)."""
     if table_format not in TABLE_FORMATS:
         raise ValueError(f"table format must be one of {', '.join(TABLE_FORMATS)}, got {table_format!r}")
     return Path(folder) / f"{stem}.{table_format}"
 
 
-def new_study_table(folder: str | Path, table_format: str = "csv") -> Path:
+def new_study_table(folder: str | Path, table_format: TableFormat = "csv") -> Path:
     """The table file of a new study in *folder*: ``parameter-study``, or ``parameter-study-2``... when a file of
     an earlier study (its table, sheet or plot) is there, which is kept."""
     return table_path(folder, table_format, free_stem(folder, STUDY_STEM, (f".{table_format}", ".xlsx", ".png")))
@@ -239,8 +241,8 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
              **{f"T {d}": float(r[f"T {d}"]) for d in DIRECTIONS},
              **{f"eta % {d}": float(r[f"eta % {d}"]) for d in DIRECTIONS},
              "steady": str(r["steady"]).lower() == "true"} for _, r in table.iterrows()]
-        error = "" if pd.isna(first["error"]) else str(first["error"])
-        finished[index] = RowOutcome(index, runs, status, error, float(first["wall time s"]))
+        message = "" if pd.isna(first["error"]) else str(first["error"])
+        finished[index] = RowOutcome(index, runs, status, message, float(first["wall time s"]))
     return finished
 
 
