@@ -11,7 +11,7 @@ The pieces, in the order a link passes through them::
 :func:`reduce_link_set` does it once for several excitations (one
 factorisation per link serves them all).
 """
-import importlib
+from workbook._lazy import lazy_names
 
 #: Where each name of the package's API lives. A name is imported on first use (PEP 562), so that
 #: ``import flexbodies.cache`` or a run whose links are all cached does not load gmsh and scikit-fem.
@@ -28,22 +28,11 @@ _HOMES = {
     "reduced": ("ReducedLink", "load_reduced_link", "save_reduced_link"),
     "selection": ("ModeDecision", "decide_modes"),
 }
-_MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}
+__getattr__, __dir__, _NAMES = lazy_names(__name__, _HOMES)
 
 # Imported at once: the function ``craig_bampton`` shares its name with its module, which would
 # otherwise stand in the package's namespace once any module imported it.
 from .craig_bampton import CraigBamptonBasis, craig_bampton, elastic_modes  # noqa: E402
 
-__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", *_MODULE_OF]
+__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", *_NAMES]
 
-
-def __getattr__(name: str):
-    if name not in _MODULE_OF:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{_MODULE_OF[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))

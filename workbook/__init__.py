@@ -14,7 +14,7 @@ Each name is imported on first use (PEP 562), so ``import workbook`` is
 fast and a name's heavy dependencies (Exudyn, scikit-fem, openpyxl) load
 only when it is used.
 """
-import importlib
+from workbook._lazy import lazy_names
 
 __version__ = "0.1.0"
 
@@ -50,18 +50,5 @@ _HOMES = {
                "EquilibriumError", "ResonanceError", "FourPoleError", "UnstablePreloadError", "BucklingError",
                "Terminated"),
 }
-_MODULE_OF = {name: module for module, names in _HOMES.items() for name in names}
-
-__all__ = ["__version__", *_MODULE_OF]
-
-
-def __getattr__(name: str):
-    if name not in _MODULE_OF:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{_MODULE_OF[name]}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(__all__))
+__getattr__, __dir__, _NAMES = lazy_names(__name__, _HOMES)
+__all__ = ["__version__", *_NAMES]

@@ -39,6 +39,7 @@ from openpyxl.utils.datetime import to_excel
 
 from flexbodies.atomic import replacing
 from workbook.answers.saving import record_written
+from workbook.errors import MountwbError
 
 try:
     import fcntl
@@ -208,8 +209,8 @@ def lock_message(lock: Path) -> str:
     return f"it is open in {application} (lock file {lock.name} present); close it and run again to write into it"
 
 
-class ChangedOnDisk(Exception):
-    """The file changed on disk after it was read (another save landed): it was not replaced."""
+class ChangedOnDisk(MountwbError):
+    """The file changed on disk after it was read (another save landed): it was not replaced (exit 1)."""
 
 
 def read_only_message(path: str | Path) -> str | None:
