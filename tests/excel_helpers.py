@@ -117,3 +117,28 @@ def compound_file(streams: dict) -> bytes:
                              starts[i - 1], streams[name]))
     directory = b"".join(entries) + bytes(128) * (4 - len(entries))
     return header + struct.pack("<128I", *fat) + directory + data
+
+
+def saved_by_libreoffice(*paths: Path) -> None:
+    """Open each workbook in LibreOffice Calc (headless) and save it as .xlsx in its place, as a user who
+    edits a case in LibreOffice does; one LibreOffice start for all of *paths* (in one folder).
+
+    Skips the calling test when ``soffice`` is not on PATH.
+    """
+    import subprocess
+
+    import pytest
+
+    soffice = shutil.which("soffice")
+    if soffice is None:
+        pytest.skip("LibreOffice (soffice) is not on PATH: apt-get install libreoffice-calc-nogui")
+    folder = Path(paths[0]).parent
+    out = folder / "saved-by-libreoffice"
+    result = subprocess.run([soffice, "--headless", f"-env:UserInstallation={(folder / 'lo-profile').as_uri()}",
+                             "--convert-to", "xlsx:Calc MS Excel 2007 XML", "--outdir", str(out),
+                             *map(str, paths)], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    for path in paths:
+        shutil.move(out / Path(path).name, path)
+    shutil.rmtree(out)
+    shutil.rmtree(folder / "lo-profile", ignore_errors=True)

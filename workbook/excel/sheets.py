@@ -23,7 +23,7 @@ import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
 from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
-from workbook.model.units import si_factor
+from workbook.model.units import DIMENSIONLESS, si_factor
 
 __all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "MAX_DATA_ROWS", "MAX_FILE_BYTES",
            "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
@@ -52,7 +52,12 @@ class _Cells:
     """The stored cells of one sheet (values as cached, and formulas), looked up without creating cells."""
 
     def __init__(self, ws_values, ws_formulas):
-        self._values = {(c.row, c.column): c.value for c in stored_cells(ws_values)}
+        cells = stored_cells(ws_values)
+        self._values = {(c.row, c.column): c.value for c in cells}
+        #: Cells holding a number shown as a percentage (5 % is stored as 0.05).
+        self.percent = {(c.row, c.column) for c in cells
+                        if isinstance(c.value, (int, float)) and not isinstance(c.value, bool)
+                        and _percent_format(c.number_format)}
         self._formulas = {(c.row, c.column): c.value for c in stored_cells(ws_formulas) if c.data_type == "f"}
         self.merged = list(ws_values.merged_cells.ranges)
 
@@ -73,6 +78,13 @@ class _Cells:
         """Data rows with a value or a formula in one of *columns*, in order."""
         found = {r for r, c in (*self._values, *self._formulas) if c in columns and self.has(r, c)}
         return sorted(r for r in found if r >= L.FIRST_DATA_ROW)
+
+
+def _percent_format(number_format: str | None) -> bool:
+    """True if *number_format* shows its number as a percentage (a ``%`` outside quotes and escapes)."""
+    if not number_format:
+        return False
+    return "%" in re.sub(r'"[^"]*"|\\.|\[[^]]*\]', "", number_format)
 
 
 @dataclass
@@ -169,7 +181,8 @@ class SheetReader:
             raw = {key: self._cell(sheet, row, col, table) for key, col in positions.items()}
             if all(v is None for v in raw.values()):
                 continue
-            records.append(self._record(table, row, raw, positions, factors))
+            percent = {key for key, col in positions.items() if (row, col) in sheet.percent}
+            records.append(self._record(table, row, raw, positions, factors, percent))
         if table.single_row:
             if not records and not table.optional:
                 self.problem(table.sheet, f"row {L.FIRST_DATA_ROW}", None, None, "one row of data")
@@ -225,6 +238,8 @@ class SheetReader:
             text = sheet.value(L.UNIT_ROW, col)
             try:
                 factors[key] = si_factor("" if text is None else str(text), column.si_unit)
+                if column.kind != "number" and factors[key] != 1.0:
+                    raise UnitProblem("'-' (the column counts: a count has no unit)")
             except UnitProblem as exc:
                 factors[key] = None
                 self.problem(table.sheet, f"{get_column_letter(col)}{L.UNIT_ROW}", f"{column.header} (unit)",
@@ -243,7 +258,15 @@ class SheetReader:
             return None
         return value
 
-    def _record(self, table: L.Table, row: int, raw: dict, positions: dict, factors: dict) -> Record:
+    def _record(self, table: L.Table, row: int, raw: dict, positions: dict, factors: dict,
+                percent: set) -> Record:
+        """One data row read: each cell parsed by its column's kind and converted to SI.
+
+        A number shown as a percentage (keys in *percent*) is read as shown:
+        a cell showing 5 % holds 0.05, which is 5 % whatever the column's unit
+        cell (``%``, ``-`` or empty); such a cell in a column with a dimension
+        or of counts is refused.
+        """
         values, cells, known, usable = {}, {}, len(self.problems), True
         for key, col in positions.items():
             cells[key] = f"{get_column_letter(col)}{row}"
@@ -260,6 +283,14 @@ class SheetReader:
                 converted = _PARSERS[column.kind](value, column)
             except _Bad as exc:
                 self.problem(table.sheet, cells[key], column.header, exc.shown or value, exc.expected)
+                continue
+            if key in percent:
+                if column.kind != "number" or column.si_unit != DIMENSIONLESS:
+                    self.problem(table.sheet, cells[key], column.header, _shown_percent(value),
+                                 f"a number not formatted as a percentage (the cell holds {value:g}; a percentage "
+                                 "is read only in a column without dimension: format the cell as a number)")
+                    continue
+                values[key] = converted    # the stored fraction is the value shown in %
                 continue
             if column.has_unit:
                 if factors.get(key) is None:
@@ -278,6 +309,11 @@ class SheetReader:
 
 
 _FORMULA_WITHOUT_VALUE = object()
+
+
+def _shown_percent(value: float) -> str:
+    """A number as a percent-formatted cell shows it: 0.05 -> '5 %'."""
+    return f"{value * 100:.10g} %"
 
 
 class _Bad(ValueError):
