@@ -2,11 +2,20 @@
 from __future__ import annotations
 
 import pytest
-from excel_helpers import column_of, copy_reference, saved_by_libreoffice, sha256
+from excel_helpers import column_of, copy_reference, saved_by_libreoffice, set_cells, sha256
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
 from workbook.excel.reader import read_workbook
+
+#: A Rotors row, a Test rig row and an Engine casing row, as ``set_cells`` edits.
+ROTOR_ROW = {("Rotors", "name", 3): "LP spool", ("Rotors", "polar inertia", 3): 100, ("Rotors", "speed", 3): 59}
+RIG_ROW = {("Test rig", f"stiffness {axis}", 3): 1e8 for axis in "xyz"}
+CASING_ROW = {("Engine casing", header, 3): value for header, value in (
+    ("radius", 500), ("wall thickness", 25), ("x start", -1.8), ("x end", 0.7), ("front ring x", 0.0),
+    ("front ring width", 80), ("front ring radius", 620), ("rear ring x", -1.72), ("rear ring width", 80),
+    ("rear ring radius", 580), ("bearing 1 x", 0.35), ("bearing 2 x", -1.2), ("element size", 120),
+    ("bearing band", 40))}
 
 
 def _edit(path, change) -> None:
@@ -72,3 +81,49 @@ def test_a_percentage_where_no_percentage_fits_is_refused(tmp_path, capsys):
     _refused(path, capsys, "sheet 'Links', cell M3, column 'eye outer radius': found '4000 %'",
              "not formatted as a percentage", "sheet 'Excitations', cell R5, column 'sweep points': found '2500 %'",
              "sheet 'Case', cell G2, column 'measured periods (unit)': found '%'", "a count has no unit")
+
+
+# -- sheet names --------------------------------------------------------------------------------------------
+
+
+def _rename(titles: dict):
+    """Rename sheets (through a name of its own: openpyxl, like Excel, takes 'Test Rig' for the 'Test rig' it
+    renames and would make it 'Test Rig1')."""
+    def change(wb):
+        for old, new in titles.items():
+            wb[old].title = "renamed"
+            wb["renamed"].title = new
+    return change
+
+
+def test_optional_sheets_are_found_whatever_the_letter_case_and_spaces(tmp_path):
+    path = copy_reference(tmp_path)
+    set_cells(path, {**ROTOR_ROW, **RIG_ROW, **CASING_ROW})
+    _edit(path, _rename({"Test rig": "Test Rig", "Engine casing": "Engine Casing", "Rotors": "Rotors "}))
+    saved_by_libreoffice(path)
+    assert {"Test Rig", "Engine Casing", "Rotors "} <= set(load_workbook(path).sheetnames)
+    case = read_workbook(path).case
+    assert [rotor.name for rotor in case.rotors] == ["LP spool"]
+    assert case.test_rig is not None and case.test_rig.stiffness == (1e8, 1e8, 1e8)
+    assert case.engine.casing is not None
+
+
+def test_two_sheets_of_one_name_are_refused(tmp_path, capsys):
+    path = copy_reference(tmp_path)
+    set_cells(path, ROTOR_ROW)
+
+    def change(wb):
+        wb.copy_worksheet(wb["Rotors"]).title = "Rotors "
+
+    _edit(path, change)
+    saved_by_libreoffice(path)
+    _refused(path, capsys, "found \"sheet 'Rotors', sheet 'Rotors '\"", "expected one sheet named 'Rotors'")
+
+
+def test_a_sheet_named_close_to_a_sheet_read_is_refused(tmp_path, capsys):
+    path = copy_reference(tmp_path)
+    set_cells(path, {**ROTOR_ROW, **RIG_ROW})
+    _edit(path, _rename({"Test rig": "Test-rig", "Rotors": "Rotor"}))
+    saved_by_libreoffice(path)
+    _refused(path, capsys, "sheet 'Test-rig': found 'Test-rig', expected a sheet name the package reads (did you "
+             "mean 'Test rig'?", "sheet 'Rotor': found 'Rotor'", "did you mean 'Rotors'?")

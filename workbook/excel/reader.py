@@ -21,6 +21,7 @@ import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import WorkbookError
 from workbook.excel.files import bounded_file_problem
+from workbook.excel.impedance_sheet import SHEET as IMPEDANCE_SHEET
 from workbook.excel.impedance_sheet import with_impedance_sheet
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import Record, SheetReader, open_workbook
@@ -594,6 +595,8 @@ def read_workbook(path: str | Path) -> CaseBook:
     formulas, values = open_workbook(path)
     reader = _CaseReader(path, formulas, values)
     tables = {table.sheet: reader.table(table) for table in L.TABLES}
+    reader.sheet_title(IMPEDANCE_SHEET)
+    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), IMPEDANCE_SHEET), (L.INSTRUCTIONS_SHEET,))
     if reader.merged_found:
         raise WorkbookError(reader.problems)
     case = reader.case(tables)

@@ -7,6 +7,7 @@ as the values Excel cached when it last saved the file.
 from __future__ import annotations
 
 import datetime
+import difflib
 import math
 import re
 import warnings
@@ -25,8 +26,8 @@ from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
 from workbook.model.units import DIMENSIONLESS, si_factor
 
-__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "MAX_DATA_ROWS", "MAX_FILE_BYTES",
-           "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
+__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
+           "MAX_FILE_BYTES", "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
 
 
 def peek(ws, coordinate: str) -> Any:
@@ -43,6 +44,20 @@ def stored_cells(ws) -> list:
     """The cells stored in *ws* (those in the file), by row then column; no empty cell is created."""
     return [ws._cells[key] for key in sorted(ws._cells)]
 
+
+def _sheet_key(name: str) -> str:
+    """A sheet name without letter case and spaces: 'Test Rig', 'test rig' and 'Rotors ' read as 'Test rig', 'Rotors'."""
+    return "".join(name.split()).casefold()
+
+
+def matching_sheets(titles, name: str) -> list[str]:
+    """The sheet *titles* that are *name* up to letter case and spaces, in workbook order."""
+    return [title for title in titles if _sheet_key(title) == _sheet_key(name)]
+
+
+#: How alike (difflib ratio, letters and digits only) a sheet name must be to a name read to be reported as a
+#: likely misspelling of it.
+_CLOSE_NAME = 0.8
 
 #: Data rows read per table at most.
 MAX_DATA_ROWS = 10_000
@@ -146,22 +161,65 @@ class SheetReader:
         self.problem(record.table.sheet, record.where(*keys) if keys else f"row {record.row}", header, value,
                      expected)
 
+    # -- sheets -------------------------------------------------------------------------------------------
+
+    def sheet_title(self, name: str) -> str | None:
+        """The title of the workbook's sheet *name*, matched up to letter case and spaces.
+
+        Returns None when no sheet matches, and when several do (reported,
+        naming them: which one holds the data cannot be told).
+        """
+        titles = matching_sheets(self.values.sheetnames, name)
+        if len(titles) > 1:
+            self.problem(None, None, None, ", ".join(f"sheet '{title}'" for title in titles),
+                         f"one sheet named '{name}' (these names read as the same one, letter case and spaces "
+                         "aside: rename or delete all but one)")
+            return None
+        return titles[0] if titles else None
+
+    def misspelt_sheets(self, read: tuple, known: tuple) -> None:
+        """Report each sheet whose name is close to a sheet read but is none of *read* or *known*.
+
+        Such a sheet ('Rotor', 'Test-rig', 'Engine_casing') would be ignored:
+        an optional sheet would silently be missing.
+
+        Parameters
+        ----------
+        read : tuple of str
+            Names of the sheets the package reads.
+        known : tuple of str
+            Names of other sheets the package knows (not reported).
+        """
+        squashed = {re.sub(r"[\W_]", "", _sheet_key(name)): name for name in read}
+        for title in self.values.sheetnames:
+            if any(matching_sheets((title,), name) for name in (*read, *known)):
+                continue
+            close = difflib.get_close_matches(re.sub(r"[\W_]", "", _sheet_key(title)), squashed, n=1,
+                                              cutoff=_CLOSE_NAME)
+            if close:
+                self.problem(title, None, None, title,
+                             f"a sheet name the package reads (did you mean '{squashed[close[0]]}'? a sheet under "
+                             f"another name is ignored; the names read: {', '.join(read)}; a sheet of notes: "
+                             "a name unlike these)")
+
     # -- tables -------------------------------------------------------------------------------------------
 
     def table(self, table: L.Table) -> list[Record]:
         """The data rows of *table* (empty if the sheet is unusable).
 
+        The sheet is found up to letter case and spaces (:meth:`sheet_title`).
         Only the cells stored in the file are looked at (a stray cell in the
         last row of the sheet costs nothing), and only the first
         :data:`MAX_DATA_ROWS` data rows are read: a value below them is a
         problem.
         """
-        if table.sheet not in self.values.sheetnames:
-            if not table.optional:
+        title = self.sheet_title(table.sheet)
+        if title is None:
+            if not table.optional and not matching_sheets(self.values.sheetnames, table.sheet):
                 self.problem(table.sheet, None, None, None,
                              f"a sheet named '{table.sheet}' (sheets: {', '.join(self.values.sheetnames)})")
             return []
-        sheet = _Cells(self.values[table.sheet], self.formulas[table.sheet])
+        sheet = _Cells(self.values[title], self.formulas[title])
         positions = self._headers(table, sheet)
         if positions is None:
             return []
