@@ -127,3 +127,23 @@ def test_a_sheet_named_close_to_a_sheet_read_is_refused(tmp_path, capsys):
     saved_by_libreoffice(path)
     _refused(path, capsys, "sheet 'Test-rig': found 'Test-rig', expected a sheet name the package reads (did you "
              "mean 'Test rig'?", "sheet 'Rotor': found 'Rotor'", "did you mean 'Rotors'?")
+
+
+# -- a mesh file and a geometry -----------------------------------------------------------------------------
+
+
+def test_a_row_with_a_mesh_file_and_a_geometry_is_refused(tmp_path, capsys):
+    """A Links row and the Engine casing row that give a mesh file and keep their parametric geometry."""
+    path = copy_reference(tmp_path)
+    (tmp_path / "meshes").mkdir()
+    for name in ("front-left.inp", "casing.inp"):
+        (tmp_path / "meshes" / name).write_text("*NODE\n")
+    set_cells(path, {**CASING_ROW, ("Engine casing", "mesh file", 3): "meshes/casing.inp",
+                     ("Links", "mesh file", 3): "meshes/front-left.inp", ("Links", "bore A node set", 3): "BORE_A",
+                     ("Links", "bore B node set", 3): "BORE_B"})
+    saved_by_libreoffice(path)
+    _refused(path, capsys, "sheet 'Links', cell AB3, column 'mesh file': found 'meshes/front-left.inp', expected a "
+             "mesh file or a parametric geometry, not both (row 3 also gives the geometry: 'eye outer radius' in M3, "
+             "'eye thickness' in O3, 'shank width' in P3, 'shank thickness' in Q3",
+             "sheet 'Engine casing', cell Y3, column 'mesh file': found 'meshes/casing.inp'",
+             "'radius' in A3, 'wall thickness' in B3, 'x start' in C3, 'x end' in D3, 'front ring x' in E3")

@@ -65,6 +65,11 @@ class CaseBook:
 
 _GEOMETRY_KEYS = ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")
 _MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density")
+#: Columns of a parametric link's or casing's geometry, which a mesh file replaces (a mesh link's bores take
+#: 'bore radius' too).
+_LINK_SHAPE_KEYS = tuple(key for key in _GEOMETRY_KEYS if key != "bore_radius")
+_CASING_SHAPE_KEYS = ("radius", "thickness", "x_start", "x_end",
+                      *(f"{ring}_{part}" for ring in L.CASING_RINGS for part in ("x", "width", "radius")))
 #: Case-model field -> columns, where the names differ.
 _FIELD_COLUMNS = {
     "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
@@ -146,6 +151,19 @@ class _CaseReader(SheetReader):
                 ok = False
         return ok
 
+    def one_shape(self, record: Record, geometry_keys: tuple) -> bool:
+        """False (reported at the mesh file's cell) if *record* gives a mesh file and cells of a parametric
+        geometry (*geometry_keys*): which of the two the user meant cannot be told."""
+        given = [key for key in geometry_keys if record.values.get(key) is not None]
+        if record.values.get("mesh_file") is None or not given:
+            return True
+        cells = ", ".join(f"'{record.table.column(key).header}' in {record.cells[key]}" for key in given)
+        self.record_problem(record, ("mesh_file",), record.get("mesh_file"),
+                            f"a mesh file or a parametric geometry, not both (row {record.row} also gives the "
+                            f"geometry: {cells}; clear the geometry cells to use the mesh, or the mesh file to use "
+                            "the geometry)")
+        return False
+
     def unique(self, records: list[Record], key: str = "name") -> None:
         seen = {}
         for record in records:
@@ -186,7 +204,9 @@ class _CaseReader(SheetReader):
                       interface=record.get("interface", "RBE2"))
         if record.get("mesh_file") is not None:
             mesh = self.mesh(record)
-            return None if mesh is None else flexbodies.LinkModel(mesh=mesh, **common)
+            if not self.one_shape(record, _LINK_SHAPE_KEYS) or mesh is None:
+                return None
+            return flexbodies.LinkModel(mesh=mesh, **common)
         if not self.require(record, _GEOMETRY_KEYS, "a parametric link without a mesh file"):
             return None
         distance = math.dist(record.vector("end_a"), record.vector("end_b"))
@@ -368,6 +388,7 @@ class _CaseReader(SheetReader):
             if problem is not None:
                 self.record_problem(record, ("mesh_file",), get("mesh_file"),
                                     f"a mesh file (relative to the workbook's folder; {problem})")
+            if not self.one_shape(record, _CASING_SHAPE_KEYS) or problem is not None:
                 return None
             shape = {"mesh": str(path), "scale": get("mesh_unit", 1.0)}
         else:
