@@ -147,3 +147,38 @@ def test_a_row_with_a_mesh_file_and_a_geometry_is_refused(tmp_path, capsys):
              "'eye thickness' in O3, 'shank width' in P3, 'shank thickness' in Q3",
              "sheet 'Engine casing', cell Y3, column 'mesh file': found 'meshes/casing.inp'",
              "'radius' in A3, 'wall thickness' in B3, 'x start' in C3, 'x end' in D3, 'front ring x' in E3")
+
+
+# -- every bad cell named, every problem at once ----------------------------------------------------------
+
+
+def test_bad_cells_found_by_trying_each_column_kind_are_named_together(tmp_path, capsys):
+    """Cells that gave Python's own words (or stopped the check): an empty casing 'x start', a superscript
+    two as a mode count or a fidelity, an Arabic-Indic three as a stiffness, a number so long as a mesh file
+    name that the system cannot look it up, unit cells 'mm/0' and '('."""
+    path = copy_reference(tmp_path)
+    set_cells(path, {**CASING_ROW, ("Engine casing", "x start", 3): None,
+                     ("Links", "modes", 3): "\u00b2", ("Runs", "fidelity", 4): "\u00b2",
+                     ("Hinges", "stiffness", 4): "\u0663", ("Links", "mesh file", 5): 1e300,
+                     ("Static loads", "force x", 2): "mm/0", ("Excitations", "phase", 2): "("})
+    saved_by_libreoffice(path)
+    message = _refused(path, capsys)
+    expected = ["sheet 'Engine casing', cell C3, column 'x start': found empty, expected a position, m",
+                "sheet 'Links', cell T3, column 'modes': found '\u00b2', expected auto, static, a mode count",
+                "sheet 'Runs', cell E4, column 'fidelity': found '\u00b2', expected rigid, static",
+                "sheet 'Hinges', cell G4, column 'stiffness': found '\u0663', expected a number",
+                "sheet 'Links', cell AB5, column 'mesh file': found '1000000000000000052504760255204420248704",
+                "cannot be looked at: File name too long",
+                "sheet 'Static loads', cell C2, column 'force x (unit)': found 'mm/0', expected a known unit",
+                "sheet 'Excitations', cell O2, column 'phase (unit)': found '(', expected a known unit"]
+    for text in expected:
+        assert text in message, f"{text!r} not in\n{message}"
+    assert "NoneType" not in message and "invalid literal" not in message
+
+
+def test_an_empty_ring_width_is_named(tmp_path, capsys):
+    path = copy_reference(tmp_path)
+    set_cells(path, {**CASING_ROW, ("Engine casing", "rear ring width", 3): None})
+    saved_by_libreoffice(path)
+    _refused(path, capsys, "sheet 'Engine casing', cell H3:J3, column 'rear ring x to rear ring radius': found "
+             "(-1.72, None, 580), expected a ring's mid-plane x, width and outer radius, m")

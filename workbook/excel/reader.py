@@ -75,7 +75,8 @@ _FIELD_COLUMNS = {
     "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
                "inertia": ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")},
     "Engine casing": {"geometry": ("radius", "thickness", "x_start", "x_end"), "geometry.radius": ("radius",),
-                      "geometry.thickness": ("thickness",), "geometry.x_end": ("x_start", "x_end"),
+                      "geometry.thickness": ("thickness",), "geometry.x_start": ("x_start",),
+                      "geometry.x_end": ("x_start", "x_end"),
                       **{f"geometry.rings[{k}]": (f"{ring}_x", f"{ring}_width", f"{ring}_radius")
                          for k, ring in enumerate(L.CASING_RINGS)},
                       "bearing_planes": L.CASING_BEARINGS, "mesh": ("mesh_file",), "scale": ("mesh_unit",),
@@ -96,6 +97,8 @@ _FIELD_COLUMNS = {
 _ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS,
                 "rotor": L.ROTORS}
 _ITEM = re.compile(rf"^({'|'.join(_ITEM_TABLES)}) '(.*)'$")
+#: Item of a CaseError about the engine's casing (the Engine casing sheet's one row).
+_CASING_ITEM = "engine casing"
 
 
 def _field_keys(table: L.Table, field: str) -> tuple:
@@ -128,13 +131,16 @@ class _CaseReader(SheetReader):
     """Builds the case, the runs and the test data from the tables."""
 
     def build(self, record: Record, make: Callable, fallback: tuple = ()) -> Any:
-        """Call *make*; report its CaseError (at the field's cells) or ValueError (at *fallback*)."""
+        """Call *make*; report its CaseError (at the field's cells) or ValueError (at *fallback*).
+
+        A TypeError is not caught: a value of the wrong type is a defect of the reader, not of the input.
+        """
         try:
             return make()
         except cm.CaseError as exc:
             keys = _field_keys(record.table, exc.field) or fallback
             self.record_problem(record, keys, record.typed(keys, exc.value), exc.expected)
-        except (ValueError, TypeError) as exc:
+        except ValueError as exc:    # flexbodies refuses a link geometry or material in words
             self.record_problem(record, fallback, record.typed(fallback, None), str(exc))
         return None
 
@@ -446,7 +452,7 @@ class _CaseReader(SheetReader):
                            description=record.get("description", ""), test_rig=test_rig[0] if test_rig else None,
                            rotors=built["Rotors"])
         except cm.CaseError as exc:
-            self.case_error(exc, items)
+            self.case_error(exc, items, tables[L.CASING.sheet])
         return None
 
     def hinge_bodies(self, hinges: list, link_records: list, links: dict) -> None:
@@ -492,8 +498,13 @@ class _CaseReader(SheetReader):
                 self.problem(L.HINGES.sheet, None, "body A", None,
                              f"at least one hinge to the {body} (body A or body B '{body}')")
 
-    def case_error(self, exc: cm.CaseError, items: dict) -> None:
-        """Report a CaseError of the Case constructor at the row of the item it names."""
+    def case_error(self, exc: cm.CaseError, items: dict, casing: list[Record]) -> None:
+        """Report a CaseError of the Case constructor at the row of the item it names (*items*: the
+        ``(record, item)`` pairs of each sheet; *casing*: the Engine casing rows)."""
+        if exc.item == _CASING_ITEM and casing:
+            keys = _field_keys(L.CASING, exc.field)
+            self.record_problem(casing[0], keys, casing[0].typed(keys, exc.value), exc.expected)
+            return
         match = _ITEM.match(exc.item)
         if match:
             table = _ITEM_TABLES[match.group(1)]

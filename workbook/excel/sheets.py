@@ -442,8 +442,8 @@ def _as_number(value: Any, column: L.Column) -> float:
 
 
 #: Digits grouped in threes by a separator: 1,234 or 12.345.678.
-_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$")
-_PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
+_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$", re.ASCII)
+_PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$", re.ASCII)
 
 
 def _text_number(text: str) -> float:
@@ -522,7 +522,7 @@ def _as_modes(value: Any, column: L.Column) -> str | int | float:
     text = raw.lower()
     if text in ("auto", "static"):
         return text
-    if text.isdigit():
+    if text.isascii() and text.isdigit():      # not '²' or other digits int() refuses
         return int(text)
     match = _CUTOFF.match(raw)             # units are case-sensitive: mHz is not MHz
     if match:
