@@ -1,12 +1,19 @@
 """Input cells read as the user sees them, in workbooks edited and saved by LibreOffice Calc."""
 from __future__ import annotations
 
+import dataclasses
+import json
+
 import pytest
 from excel_helpers import column_of, copy_reference, saved_by_libreoffice, set_cells, sha256
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
+from workbook.errors import CaseError
 from workbook.excel.reader import read_workbook
+from workbook.model.case import RunUp, Sweep
+from workbook.model.codec import from_json, to_json
+from workbook.model.reference import reference_case
 
 #: A Rotors row, a Test rig row and an Engine casing row, as ``set_cells`` edits.
 ROTOR_ROW = {("Rotors", "name", 3): "LP spool", ("Rotors", "polar inertia", 3): 100, ("Rotors", "speed", 3): 59}
@@ -182,3 +189,50 @@ def test_an_empty_ring_width_is_named(tmp_path, capsys):
     saved_by_libreoffice(path)
     _refused(path, capsys, "sheet 'Engine casing', cell H3:J3, column 'rear ring x to rear ring radius': found "
              "(-1.72, None, 580), expected a ring's mid-plane x, width and outer radius, m")
+
+
+# -- bounded counts -----------------------------------------------------------------------------------------
+
+
+def test_a_million_sweep_points_and_a_million_modes_are_refused_at_once(tmp_path, capsys):
+    """The sweep's 'sweep points' and a link's 'modes' name their cells, the value and the bound; the check
+    takes about as long as any other (it took 20 to 40 s for 1e6 points, and blamed the name cell)."""
+    import time
+
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Excitations", "sweep points", 5): 1_000_000, ("Links", "modes", 4): 1_000_000})
+    saved_by_libreoffice(path)
+    start = time.perf_counter()
+    _refused(path, capsys, "sheet 'Excitations', cell R5, column 'sweep points': found 1000000, expected a whole "
+             "number from 1 to 10,000 (the most points a sweep takes)",
+             "sheet 'Links', cell T4, column 'modes': found 1000000, expected a whole number from 0 to 1,000")
+    assert time.perf_counter() - start < 15
+
+
+def _long_sweep(data):
+    data["excitations"][-1]["frequencies_hz"] = [1.0 + k for k in range(20_000)]
+
+
+def _many_modes(data):
+    data["links"][0]["modes"] = 5000
+
+
+@pytest.mark.parametrize("change, named", [
+    (_long_sweep, ["excitation 'sweep'", "frequencies_hz", "20,000 frequencies", "at most 10,000"]),
+    (_many_modes, ["link 'front-left'", "modes", "5000", "from 0 to 1,000"]),
+])
+def test_json_cases_are_bounded_too(change, named):
+    data = json.loads(to_json(reference_case(sweep=True)))
+    change(data)
+    with pytest.raises(CaseError) as error:
+        from_json(json.dumps(data))
+    for words in named:
+        assert words in str(error.value)
+
+
+def test_a_run_up_and_a_sweep_built_in_python_are_bounded():
+    template = reference_case().excitations[0]
+    with pytest.raises(CaseError, match="points.*found 1000000.*from 2 to 10,000"):
+        RunUp.speeds("up", dataclasses.replace(template, amplitude=None, unbalance=1e-3), 600.0, 6000.0, 1_000_000)
+    with pytest.raises(CaseError, match="points.*found 1000000000000000.0.*from 1 to 10,000"):
+        Sweep.band("sweep", template, 5.0, 300.0, 1e15)
