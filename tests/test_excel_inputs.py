@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import time
 
 import pytest
 from excel_helpers import column_of, copy_reference, saved_by_libreoffice, set_cells, sha256
@@ -197,8 +198,6 @@ def test_an_empty_ring_width_is_named(tmp_path, capsys):
 def test_a_million_sweep_points_and_a_million_modes_are_refused_at_once(tmp_path, capsys):
     """The sweep's 'sweep points' and a link's 'modes' name their cells, the value and the bound; the check
     takes about as long as any other (it took 20 to 40 s for 1e6 points, and blamed the name cell)."""
-    import time
-
     path = copy_reference(tmp_path)
     set_cells(path, {("Excitations", "sweep points", 5): 1_000_000, ("Links", "modes", 4): 1_000_000})
     saved_by_libreoffice(path)
@@ -236,3 +235,16 @@ def test_a_run_up_and_a_sweep_built_in_python_are_bounded():
         RunUp.speeds("up", dataclasses.replace(template, amplitude=None, unbalance=1e-3), 600.0, 6000.0, 1_000_000)
     with pytest.raises(CaseError, match="points.*found 1000000000000000.0.*from 1 to 10,000"):
         Sweep.band("sweep", template, 5.0, 300.0, 1e15)
+
+
+@pytest.mark.parametrize("vary", [["--vary=hinge_stiffness=1e6:1e8:1000000"],
+                                  ["--vary=hinge_stiffness=1e6:1e8:1000", "--vary=clearance=0:1e-3:1000"],
+                                  ["--vary=hinge_stiffness=1e6:1e8", "--lhs=10000000"]])
+def test_a_study_of_millions_of_rows_is_refused(tmp_path, capsys, vary):
+    path = copy_reference(tmp_path)
+    start = time.perf_counter()
+    assert main(["study", "params", str(path), "--output", str(tmp_path / "out"), *vary]) == 2
+    assert time.perf_counter() - start < 15
+    message = capsys.readouterr().err
+    assert "rows; a study has at most 100,000" in message, message
+    assert not (tmp_path / "out").exists()
