@@ -6,14 +6,16 @@ import json
 import time
 
 import pytest
-from excel_helpers import column_of, copy_reference, saved_by_libreoffice, set_cells, sha256
+from excel_helpers import column_of, copy_reference, make_cheap, saved_by_libreoffice, set_cells, sha256
 from openpyxl import load_workbook
 
 from workbook.cli.main import main
 from workbook.errors import CaseError
+from workbook.excel.impedance_sheet import SHEET as IMPEDANCE_SHEET
 from workbook.excel.reader import read_workbook
 from workbook.model.case import RunUp, Sweep
 from workbook.model.codec import from_json, to_json
+from workbook.model.pylon_impedance import FORMAT_HEADER
 from workbook.model.reference import reference_case
 
 #: A Rotors row, a Test rig row and an Engine casing row, as ``set_cells`` edits.
@@ -248,3 +250,77 @@ def test_a_study_of_millions_of_rows_is_refused(tmp_path, capsys, vary):
     message = capsys.readouterr().err
     assert "rows; a study has at most 100,000" in message, message
     assert not (tmp_path / "out").exists()
+
+
+# -- the pylon impedance table and the runs -------------------------------------------------------------------
+
+
+def _pylon_sheet(wb, frequencies, pins) -> None:
+    """A Pylon impedance sheet: 100 MN/m along each axis at each pin, at each of *frequencies* (Hz)."""
+    ws = wb.create_sheet(IMPEDANCE_SHEET)
+    ws.append(list(FORMAT_HEADER))
+    ws.append(["Hz", ""] + ["MN/m"] * 18)
+    diagonal = {f"K{a}{a} re" for a in "xyz"}
+    for frequency in frequencies:
+        for pin in pins:
+            ws.append([frequency, pin] + [100.0 if column in diagonal else 0.0 for column in FORMAT_HEADER[2:]])
+
+
+def test_check_finds_a_pylon_table_that_does_not_cover_a_run(tmp_path, capsys):
+    """The reference sweep runs from 5 Hz; a table from 10 Hz covers the rotor runs but not the sweep."""
+    path = copy_reference(tmp_path)
+    pins = [hinges[0] for _, hinges in read_workbook(path).case.pylon_pins()]
+    _edit(path, lambda wb: _pylon_sheet(wb, (10.0, 100.0, 300.0), pins))
+    saved_by_libreoffice(path)
+    message = _refused(path, capsys, "sheet 'Runs', cell B5, column 'excitation': found 'sweep', expected an "
+                       "excitation within the pylon impedance table: run 'sweep' excites 5 to 300 Hz, the table "
+                       "(case.xlsx, sheet 'Pylon impedance') covers 10 to 300 Hz")
+    assert "cell B3" not in message and "cell B4" not in message
+
+
+@pytest.mark.slow
+def test_a_failing_run_is_named_and_the_answers_of_the_others_are_written(tmp_path, capsys):
+    """The HP rotor run, started from rest, plans more time steps than any meant run (numerical trouble,
+    exit 1): the LP rotor and sweep runs' answers are written all the same."""
+    path = copy_reference(tmp_path)
+    make_cheap(path)
+    set_cells(path, {("Case", "start", 3): "rest", ("Runs", "settle time", 4): 1e5})
+    assert main(["run", str(path), "--no-progress"]) == 1
+    message = capsys.readouterr().err
+    assert "run 'HP rotor' (excitation 'HP rotor') failed, numerical trouble:" in message, message
+    assert "the answers of 2 run(s) were written; 'HP rotor' failed" in message
+    rows = list(load_workbook(path)["Result efficiency"].iter_rows(min_row=3, values_only=True))
+    assert {row[0] for row in rows} == {"LP rotor", "sweep"}
+
+
+def test_check_finds_a_pylon_table_with_the_time_domain(tmp_path, capsys):
+    """The time domain has no frequency-dependent pylon: a run it would answer is refused by check, the rotor
+    runs; the sweep on the linear scene takes the frequency domain and is fine."""
+    path = copy_reference(tmp_path)
+    pins = [hinges[0] for _, hinges in read_workbook(path).case.pylon_pins()]
+    _edit(path, lambda wb: _pylon_sheet(wb, (1.0, 400.0), pins))
+    set_cells(path, {("Case", "method", 3): "time"})
+    message = _refused(path, capsys, "sheet 'Runs', cell B3, column 'excitation': found 'LP rotor', expected no "
+                       "frequency-dependent pylon impedance in the time domain", "(run 'LP rotor')",
+                       "sheet 'Runs', cell B4")
+    assert "cell B5" not in message
+
+
+@pytest.mark.slow
+def test_a_run_whose_input_fails_while_running_is_named_and_nothing_is_written(tmp_path, capsys):
+    """A mesh file that is no mesh (check sees that it exists; the run reads it): the run names itself, bad
+    input (exit 2), and no file is changed."""
+    path = copy_reference(tmp_path)
+    make_cheap(path)
+    (tmp_path / "front-left.inp").write_text("not a mesh\n")
+    set_cells(path, {("Links", "mesh file", 3): "front-left.inp", ("Links", "bore A node set", 3): "BORE_A",
+                     ("Links", "bore B node set", 3): "BORE_B",
+                     **{("Links", header, 3): None for header in ("eye outer radius", "eye thickness", "shank width",
+                                                                 "shank thickness")}})
+    assert main(["check", str(path)]) == 0
+    before, files = sha256(path), sorted(tmp_path.iterdir())
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor", "--run", "sweep"]) == 2
+    message = capsys.readouterr().err
+    assert "run 'LP rotor' (excitation 'LP rotor') failed, bad input:" in message, message
+    assert "front-left.inp" in message and "nothing was written" in message
+    assert sha256(path) == before and sorted(tmp_path.iterdir()) == files

@@ -543,9 +543,43 @@ class _CaseReader(SheetReader):
                                     f"own unbalance or force)")
                 continue
             run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
-            if self.build(record, lambda: case_for_run(case, run)) is not None:
+            run_case = self.build(record, lambda: case_for_run(case, run))
+            if run_case is not None and self.pylon_fits(record, run_case):
                 runs.append((record, run))
         return runs
+
+    def pylon_fits(self, record: Record, run_case: cm.Case) -> bool:
+        """False (reported at the run's excitation cell) if the run cannot be answered on the case's flexible
+        pylon: its excitation takes the time domain, which has none, or its frequencies leave the pylon
+        impedance table's range. The run would stop there, after the runs before it."""
+        if not run_case.flexible_pylon:
+            return True
+        from workbook.solve.flexible_pylon import refuse_time_domain
+        from workbook.solve.method import TIME, choose_method
+
+        for item in run_case.excitations:
+            chosen = choose_method(run_case, sweep=isinstance(item, cm.Sweep))
+            if chosen.method != TIME:
+                continue
+            try:
+                refuse_time_domain(run_case, chosen.reason)
+            except cm.CaseError as error:
+                self.record_problem(record, ("excitation",), record.get("excitation"),
+                                    f"{error.expected} (run '{record.get('name')}')")
+                return False
+        impedance = run_case.pylon_impedance
+        if impedance is None:
+            return True
+        try:
+            impedance.check_covers([x.frequency for x in run_case.single_frequency_excitations()])
+        except cm.CaseError as error:
+            self.record_problem(record, ("excitation",), record.get("excitation"),
+                                f"an excitation within the pylon impedance table: run '{record.get('name')}' "
+                                f"excites {error.value}, the table ({impedance.source}) covers "
+                                f"{impedance.frequencies_hz[0]:g} to {impedance.frequencies_hz[-1]:g} Hz (it is "
+                                "not extrapolated: extend the table or narrow the excitation's frequencies)")
+            return False
+        return True
 
     def tests(self, runs: list, records: list[Record], case: cm.Case) -> list[TestPoint]:
         by_name = {run.name: (record, run) for record, run in runs}
