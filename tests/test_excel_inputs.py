@@ -1,4 +1,5 @@
-"""Input cells read as the user sees them, in workbooks edited and saved by LibreOffice Calc."""
+"""Input cells read as the user sees them, in workbooks edited and saved by LibreOffice Calc (those tests are
+slow: each starts LibreOffice; skipped without ``soffice``), and the bounds of a case, a study and a run."""
 from __future__ import annotations
 
 import dataclasses
@@ -55,6 +56,7 @@ def _refused(path, capsys, *texts) -> str:
 # -- percentages --------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_a_cell_showing_5_percent_is_5_percent_in_a_percent_or_plain_column(tmp_path):
     """Link modal damping with the unit cell '%' and hinge loss factor with '-': a cell typed '5 %' is 0.05 in
     both; a plain 5 under '%' stays 0.05."""
@@ -77,6 +79,7 @@ def test_a_cell_showing_5_percent_is_5_percent_in_a_percent_or_plain_column(tmp_
     assert case.hinges[0].loss_factor == pytest.approx(0.05, rel=1e-12)
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_a_percentage_where_no_percentage_fits_is_refused(tmp_path, capsys):
     """A percent-formatted cell in a length column or a count column, and a '%' unit cell over counts."""
     path = copy_reference(tmp_path)
@@ -106,6 +109,7 @@ def _rename(titles: dict):
     return change
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_optional_sheets_are_found_whatever_the_letter_case_and_spaces(tmp_path):
     path = copy_reference(tmp_path)
     set_cells(path, {**ROTOR_ROW, **RIG_ROW, **CASING_ROW})
@@ -118,6 +122,7 @@ def test_optional_sheets_are_found_whatever_the_letter_case_and_spaces(tmp_path)
     assert case.engine.casing is not None
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_two_sheets_of_one_name_are_refused(tmp_path, capsys):
     path = copy_reference(tmp_path)
     set_cells(path, ROTOR_ROW)
@@ -130,6 +135,7 @@ def test_two_sheets_of_one_name_are_refused(tmp_path, capsys):
     _refused(path, capsys, "found \"sheet 'Rotors', sheet 'Rotors '\"", "expected one sheet named 'Rotors'")
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_a_sheet_named_close_to_a_sheet_read_is_refused(tmp_path, capsys):
     path = copy_reference(tmp_path)
     set_cells(path, {**ROTOR_ROW, **RIG_ROW})
@@ -142,6 +148,7 @@ def test_a_sheet_named_close_to_a_sheet_read_is_refused(tmp_path, capsys):
 # -- a mesh file and a geometry -----------------------------------------------------------------------------
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_a_row_with_a_mesh_file_and_a_geometry_is_refused(tmp_path, capsys):
     """A Links row and the Engine casing row that give a mesh file and keep their parametric geometry."""
     path = copy_reference(tmp_path)
@@ -162,6 +169,7 @@ def test_a_row_with_a_mesh_file_and_a_geometry_is_refused(tmp_path, capsys):
 # -- every bad cell named, every problem at once ----------------------------------------------------------
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_bad_cells_found_by_trying_each_column_kind_are_named_together(tmp_path, capsys):
     """Cells that gave Python's own words (or stopped the check): an empty casing 'x start', a superscript
     two as a mode count or a fidelity, an Arabic-Indic three as a stiffness, a number so long as a mesh file
@@ -186,6 +194,7 @@ def test_bad_cells_found_by_trying_each_column_kind_are_named_together(tmp_path,
     assert "NoneType" not in message and "invalid literal" not in message
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_an_empty_ring_width_is_named(tmp_path, capsys):
     path = copy_reference(tmp_path)
     set_cells(path, {**CASING_ROW, ("Engine casing", "rear ring width", 3): None})
@@ -197,6 +206,7 @@ def test_an_empty_ring_width_is_named(tmp_path, capsys):
 # -- bounded counts -----------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_a_million_sweep_points_and_a_million_modes_are_refused_at_once(tmp_path, capsys):
     """The sweep's 'sweep points' and a link's 'modes' name their cells, the value and the bound; the check
     takes about as long as any other (it took 20 to 40 s for 1e6 points, and blamed the name cell)."""
@@ -266,6 +276,7 @@ def _pylon_sheet(wb, frequencies, pins) -> None:
             ws.append([frequency, pin] + [100.0 if column in diagonal else 0.0 for column in FORMAT_HEADER[2:]])
 
 
+@pytest.mark.slow    # LibreOffice saves the workbook
 def test_check_finds_a_pylon_table_that_does_not_cover_a_run(tmp_path, capsys):
     """The reference sweep runs from 5 Hz; a table from 10 Hz covers the rotor runs but not the sweep."""
     path = copy_reference(tmp_path)
