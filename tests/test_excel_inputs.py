@@ -140,9 +140,11 @@ def test_a_sheet_named_close_to_a_sheet_read_is_refused(tmp_path, capsys):
     path = copy_reference(tmp_path)
     set_cells(path, {**ROTOR_ROW, **RIG_ROW})
     _edit(path, _rename({"Test rig": "Test-rig", "Rotors": "Rotor"}))
+    _edit(path, lambda wb: setattr(wb.copy_worksheet(wb["Runs"]), "title", "Runs (2)"))
     saved_by_libreoffice(path)
-    _refused(path, capsys, "sheet 'Test-rig': found 'Test-rig', expected a sheet name the package reads (did you "
-             "mean 'Test rig'?", "sheet 'Rotor': found 'Rotor'", "did you mean 'Rotors'?")
+    message = _refused(path, capsys, "sheet 'Test-rig': found 'Test-rig', expected a sheet name the package reads "
+                       "(did you mean 'Test rig'?", "sheet 'Rotor': found 'Rotor'", "did you mean 'Rotors'?")
+    assert "Runs (2)'" not in message      # a copy beside its sheet is the user's
 
 
 # -- a mesh file and a geometry -----------------------------------------------------------------------------

@@ -55,6 +55,8 @@ def matching_sheets(titles, name: str) -> list[str]:
     return [title for title in titles if _sheet_key(title) == _sheet_key(name)]
 
 
+#: The name Excel and LibreOffice give a copy of a sheet: 'Runs (2)'.
+_COPY = re.compile(r"^(.*?)\s*\(\d+\)$")
 #: How alike (difflib ratio, letters and digits only) a sheet name must be to a name read to be reported as a
 #: likely misspelling of it.
 _CLOSE_NAME = 0.8
@@ -181,7 +183,8 @@ class SheetReader:
         """Report each sheet whose name is close to a sheet read but is none of *read* or *known*.
 
         Such a sheet ('Rotor', 'Test-rig', 'Engine_casing') would be ignored:
-        an optional sheet would silently be missing.
+        an optional sheet would silently be missing. A copy of a sheet read
+        beside it ('Runs (2)' with 'Runs') is the user's and not reported.
 
         Parameters
         ----------
@@ -194,6 +197,10 @@ class SheetReader:
         for title in self.values.sheetnames:
             if any(matching_sheets((title,), name) for name in (*read, *known)):
                 continue
+            copy = _COPY.match(title)
+            if copy and any(matching_sheets(self.values.sheetnames, name) for name in read
+                            if matching_sheets((copy.group(1),), name)):
+                continue    # 'Runs (2)' beside 'Runs': a copy the user made, not a misspelling
             close = difflib.get_close_matches(re.sub(r"[\W_]", "", _sheet_key(title)), squashed, n=1,
                                               cutoff=_CLOSE_NAME)
             if close:
