@@ -59,7 +59,7 @@ def _refused(path, capsys, *texts) -> str:
 @pytest.mark.slow    # LibreOffice saves the workbook
 def test_a_cell_showing_5_percent_is_5_percent_in_a_percent_or_plain_column(tmp_path):
     """Link modal damping with the unit cell '%' and hinge loss factor with '-': a cell typed '5 %' is 0.05 in
-    both; a plain 5 under '%' stays 0.05."""
+    both; a plain 5 under '%' stays 0.05, and so is the text '5 %' in a text cell."""
     path = copy_reference(tmp_path)
 
     def change(wb):
@@ -68,6 +68,9 @@ def test_a_cell_showing_5_percent_is_5_percent_in_a_percent_or_plain_column(tmp_
         _type_percent(links, "modal damping", 3, 5)
         links.cell(4, column_of(links, "modal damping"), 5)
         _type_percent(wb["Hinges"], "loss factor", 3, 5)
+        hinges = wb["Hinges"]
+        cell = hinges.cell(4, column_of(hinges, "loss factor"), "5 %")
+        cell.number_format = "@"                                   # a text cell: '5 %' stays text
 
     _edit(path, change)
     saved_by_libreoffice(path)
@@ -77,6 +80,7 @@ def test_a_cell_showing_5_percent_is_5_percent_in_a_percent_or_plain_column(tmp_
     assert case.links[0].modal_damping == pytest.approx(0.05, rel=1e-12)
     assert case.links[1].modal_damping == pytest.approx(0.05, rel=1e-12)
     assert case.hinges[0].loss_factor == pytest.approx(0.05, rel=1e-12)
+    assert case.hinges[1].loss_factor == pytest.approx(0.05, rel=1e-12)
 
 
 @pytest.mark.slow    # LibreOffice saves the workbook

@@ -5,7 +5,7 @@ import logging
 from dataclasses import dataclass
 from typing import Iterable
 
-from workbook.errors import BAD_INPUT, Problem, SimulationError, WorkbookError, interruption
+from workbook.errors import Problem, SimulationError, WorkbookError, interruption
 from workbook.excel.reader import CaseBook
 from workbook.excel.runs import RunSpec
 from workbook.excel.writer import RunResult
@@ -85,7 +85,7 @@ def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> tuple[lis
         log.info("run %s (%s)", spec.name, spec.excitation)
         try:
             results.append(RunResult(spec, run_case(book.run_case(spec), progress=progress)))
-        except (SimulationError, *BAD_INPUT, ValueError, OSError) as error:
+        except (SimulationError, ValueError, OSError) as error:    # what the command line reports as such
             if interruption(error) is not None:
                 raise
             log.info("run %s failed: %s", spec.name, error)

@@ -330,7 +330,8 @@ class SheetReader:
         A number shown as a percentage (keys in *percent*) is read as shown:
         a cell showing 5 % holds 0.05, which is 5 % whatever the column's unit
         cell (``%``, ``-`` or empty); such a cell in a column with a dimension
-        or of counts is refused.
+        or of counts is refused. The text ``5 %`` in a column without
+        dimension is 5 % too.
         """
         values, cells, known, usable = {}, {}, len(self.problems), True
         for key, col in positions.items():
@@ -344,10 +345,17 @@ class SheetReader:
                 if column.required:
                     self.problem(table.sheet, cells[key], column.header, None, "a value (required)")
                 continue
+            typed_percent = (isinstance(value, str) and value.strip().endswith("%") and column.kind == "number"
+                             and column.si_unit == DIMENSIONLESS)
             try:
-                converted = _PARSERS[column.kind](value, column)
+                # '5 %' typed as text is 5 %, as a cell formatted as a percentage shows it
+                converted = (_as_number(value.strip()[:-1], column) / 100 if typed_percent
+                             else _PARSERS[column.kind](value, column))
             except _Bad as exc:
                 self.problem(table.sheet, cells[key], column.header, exc.shown or value, exc.expected)
+                continue
+            if typed_percent:
+                values[key] = converted
                 continue
             if key in percent:
                 if column.kind != "number" or column.si_unit != DIMENSIONLESS:
