@@ -38,6 +38,11 @@ __all__ = ["MountRing", "CasingGeometry", "CasingInterface", "mesh_casing", "cas
 _CURVATURE_POINTS = 12
 
 
+def _real(value) -> bool:
+    """True for a finite real number (not a bool, not None)."""
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+
+
 @dataclass(frozen=True)
 class MountRing:
     """A mount frame ring around the casing.
@@ -91,20 +96,21 @@ class CasingGeometry:
 
     def problems(self) -> list[tuple[str, object, str]]:
         """What is wrong with the numbers: (field, value, what was expected) per problem."""
-        found = []
-        for name in ("radius", "thickness"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                found.append((name, value, "a length > 0, m"))
+        found = [(name, getattr(self, name), "a length > 0, m") for name in ("radius", "thickness")
+                 if not (_real(getattr(self, name)) and getattr(self, name) > 0)]
+        found += [(name, getattr(self, name), "a position, m") for name in ("x_start", "x_end")
+                  if not _real(getattr(self, name))]
         if found:
             return found
         if self.thickness >= self.radius:
             found.append(("thickness", self.thickness, f"less than the radius {self.radius:g} m"))
-        if not (math.isfinite(self.x_start) and math.isfinite(self.x_end) and self.x_end > self.x_start):
+        if not self.x_end > self.x_start:
             found.append(("x_end", self.x_end, f"a position beyond x_start {self.x_start:g} m"))
             return found
         for k, ring in enumerate(self.rings):
-            if not (ring.width > 0 and ring.outer_radius > self.radius):
+            if not all(_real(value) for value in (ring.x, ring.width, ring.outer_radius)):
+                found.append((f"rings[{k}]", ring, "a ring's mid-plane x, width and outer radius, m"))
+            elif not (ring.width > 0 and ring.outer_radius > self.radius):
                 found.append((f"rings[{k}]", ring, f"a width > 0 and an outer radius > the casing radius "
                                                    f"{self.radius:g} m"))
             elif ring.x - ring.width / 2 < self.x_start or ring.x + ring.width / 2 > self.x_end:

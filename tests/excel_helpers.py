@@ -140,3 +140,22 @@ def save_in_libreoffice(path: Path, scratch: Path) -> Path:
     soffice_convert(scratch, "xlsx", path, outdir=outdir)
     shutil.move(outdir / path.name, path)
     return path
+
+
+def saved_by_libreoffice(*paths: Path) -> None:
+    """Open each workbook in LibreOffice Calc (headless) and save it as .xlsx in its place, as a user who
+    edits a case in LibreOffice does; one LibreOffice start for all of *paths* (in one folder).
+
+    Skips the calling test when ``soffice`` is not on PATH.
+    """
+    import pytest
+
+    if SOFFICE is None:
+        pytest.skip("LibreOffice (soffice) is not on PATH: apt-get install libreoffice-calc-nogui")
+    folder = Path(paths[0]).parent
+    out = folder / "saved-by-libreoffice"
+    soffice_convert(folder, "xlsx:Calc MS Excel 2007 XML", *paths, outdir=out)
+    for path in paths:
+        shutil.move(out / Path(path).name, path)
+    shutil.rmtree(out)
+    shutil.rmtree(folder / "lo-profile", ignore_errors=True)

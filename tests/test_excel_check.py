@@ -447,7 +447,9 @@ def test_mesh_link_and_missing_geometry_column(tmp_path):
     (tmp_path / "meshes" / "front-left.inp").write_text("*NODE\n")
     set_cells(path, {("Links", "mesh file", 3): "meshes/front-left.inp", ("Links", "mesh unit", 3): "mm",
                      ("Links", "bore A node set", 3): "BORE_A", ("Links", "bore B node set", 3): "BORE_B",
-                     ("Hinges", "body A", 3): "Pylon"})
+                     ("Hinges", "body A", 3): "Pylon",
+                     **{("Links", header, 3): None for header in ("eye outer radius", "eye thickness", "shank width",
+                                                                 "shank thickness")}})
     case = read_workbook(path).case
     mesh = case.links[0].model.mesh
     assert case.links[0].model.geometry is None and case.hinges[0].body_a == "pylon"

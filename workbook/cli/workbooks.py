@@ -92,7 +92,13 @@ def _print_summary(runs) -> None:
 
 
 def run_workbook(args) -> int:
-    """Run the runs of a case workbook, write the results back and optionally a report."""
+    """Run the runs of a case workbook, write the results back and optionally a report.
+
+    A run that fails is named and the others go on. When runs failed on
+    numerical trouble only, the answers of the runs that finished are
+    written and the exit code is 1; when a run found its input bad while
+    running, nothing is written and the exit code is 2.
+    """
     from workbook.errors import SimulationError, WorkbookError
     from workbook.excel.execute import run_book, select_runs
     from workbook.excel.reader import read_workbook
@@ -115,8 +121,14 @@ def run_workbook(args) -> int:
     except WorkbookError as error:
         return _report_problems(error)
     progress = None if getattr(args, "no_progress", False) else progress_factory()
+    runs, failures = run_book(book, selected, progress=progress)
+    for failure in failures:
+        print(f"mountwb run: {failure}", file=sys.stderr)
+    if any(failure.bad_input for failure in failures) or not runs:
+        print(f"mountwb run: {len(failures)} of {len(selected)} run(s) failed; nothing was written",
+              file=sys.stderr)
+        return EXIT_BAD_INPUT if any(failure.bad_input for failure in failures) else EXIT_TROUBLE
     try:
-        runs = run_book(book, selected, progress=progress)
         pole = report_four_pole(book.case) if args.four_pole else None
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
@@ -136,4 +148,8 @@ def run_workbook(args) -> int:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE
         print_written(args.report, "report", report.path, report.reason)
+    if failures:
+        print(f"mountwb run: the answers of {len(runs)} run(s) were written; "
+              f"{', '.join(repr(f.spec.name) for f in failures)} failed (numerical trouble, above)", file=sys.stderr)
+        return EXIT_TROUBLE
     return EXIT_OK

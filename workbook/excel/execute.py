@@ -2,14 +2,15 @@
 from __future__ import annotations
 
 import logging
+from dataclasses import dataclass
 from typing import Iterable
 
-from workbook.errors import Problem, WorkbookError
+from workbook.errors import Problem, SimulationError, WorkbookError, interruption
 from workbook.excel.reader import CaseBook
 from workbook.excel.runs import RunSpec
 from workbook.excel.writer import RunResult
 
-__all__ = ["select_runs", "run_book"]
+__all__ = ["select_runs", "run_book", "RunFailure"]
 
 log = logging.getLogger(__name__)
 
@@ -33,8 +34,33 @@ def select_runs(book: CaseBook, names: Iterable[str] | None = None) -> list[RunS
     return [run for run in book.runs if run.name in names]
 
 
-def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> list[RunResult]:
-    """Run each of *runs* of *book*.
+@dataclass(frozen=True)
+class RunFailure:
+    """A run of a workbook that stopped, and why.
+
+    Attributes
+    ----------
+    spec : RunSpec
+    error : Exception
+        Numerical trouble (:class:`~workbook.errors.SimulationError`) or
+        input found bad only while running (:attr:`bad_input`).
+    """
+
+    spec: RunSpec
+    error: Exception
+
+    @property
+    def bad_input(self) -> bool:
+        """True if the run stopped on the input, not on the solution."""
+        return not isinstance(self.error, SimulationError)
+
+    def __str__(self) -> str:
+        trouble = "bad input" if self.bad_input else "numerical trouble"
+        return f"run '{self.spec.name}' (excitation '{self.spec.excitation}') failed, {trouble}: {self.error}"
+
+
+def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> tuple[list[RunResult], list[RunFailure]]:
+    """Run each of *runs* of *book*; a run that fails does not stop the runs after it.
 
     Parameters
     ----------
@@ -45,12 +71,23 @@ def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> list[RunR
 
     Returns
     -------
-    list of RunResult
+    results : list of RunResult
+        The runs that finished, in order.
+    failures : list of RunFailure
+        The runs that stopped on numerical trouble or on input found bad
+        while running, in order. An interrupt, and an error that is neither
+        (a defect of the package), is raised.
     """
     from workbook.solve.pipeline import run_case
 
-    results = []
+    results, failures = [], []
     for spec in runs:
         log.info("run %s (%s)", spec.name, spec.excitation)
-        results.append(RunResult(spec, run_case(book.run_case(spec), progress=progress)))
-    return results
+        try:
+            results.append(RunResult(spec, run_case(book.run_case(spec), progress=progress)))
+        except (SimulationError, ValueError, OSError) as error:    # what the command line reports as such
+            if interruption(error) is not None:
+                raise
+            log.info("run %s failed: %s", spec.name, error)
+            failures.append(RunFailure(spec, error))
+    return results, failures

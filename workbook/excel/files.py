@@ -303,13 +303,17 @@ def bounded_file_problem(path: Path, limit: int) -> str | None:
     """Why the file a workbook names at *path* is not read (None: it may be read).
 
     Only a regular file of at most *limit* bytes is read: a device
-    (``/dev/zero``), a pipe or a folder never ends or is not a file.
+    (``/dev/zero``), a pipe or a folder never ends or is not a file; a
+    name the system cannot look up (too long) is not read either.
     """
-    if not path.exists():
-        return f"{path} does not exist"
-    if not path.is_file():
-        return f"{path} is not a regular file (a device, a pipe or a folder)"
-    size = path.stat().st_size
+    try:
+        if not path.exists():
+            return f"{path} does not exist"
+        if not path.is_file():
+            return f"{path} is not a regular file (a device, a pipe or a folder)"
+        size = path.stat().st_size
+    except OSError as error:    # a name too long for the file system, a folder that cannot be entered
+        return f"{path} cannot be looked at: {error.strerror}"
     if size > limit:
         return f"{path} has {size:,} bytes; at most {limit:,} are read"
     return None

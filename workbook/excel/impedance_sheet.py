@@ -10,6 +10,7 @@ import dataclasses
 from pathlib import Path
 
 from workbook.errors import CaseError, Problem, WorkbookError
+from workbook.excel.sheets import matching_sheets
 from workbook.model.case import Case
 from workbook.model.pylon_impedance import impedance_from_rows
 
@@ -20,7 +21,8 @@ SHEET = "Pylon impedance"
 
 
 def with_impedance_sheet(case: Case, path: Path, values) -> Case:
-    """*case* with the pylon impedance of the workbook's sheet, if it has one.
+    """*case* with the pylon impedance of the workbook's sheet, if it has one
+    (found up to letter case and spaces; the reader has refused two such sheets).
 
     Parameters
     ----------
@@ -36,9 +38,10 @@ def with_impedance_sheet(case: Case, path: Path, values) -> Case:
         A table that cannot be used (a :class:`~workbook.errors.TableError`
         naming row and column), or a pylon pin without rows.
     """
-    if SHEET not in values.sheetnames:
+    titles = matching_sheets(values.sheetnames, SHEET)
+    if not titles:
         return case
-    impedance = impedance_from_rows(values[SHEET].iter_rows(values_only=True), path.name, SHEET)
+    impedance = impedance_from_rows(values[titles[0]].iter_rows(values_only=True), path.name, SHEET)
     try:
         return dataclasses.replace(case, pylon_impedance=impedance)
     except CaseError as error:

@@ -21,6 +21,7 @@ import workbook.excel.layout as L
 from workbook.answers.results import PYLON_SUM
 from workbook.errors import WorkbookError
 from workbook.excel.files import bounded_file_problem
+from workbook.excel.impedance_sheet import SHEET as IMPEDANCE_SHEET
 from workbook.excel.impedance_sheet import with_impedance_sheet
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import Record, SheetReader, open_workbook
@@ -64,12 +65,18 @@ class CaseBook:
 
 _GEOMETRY_KEYS = ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")
 _MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density")
+#: Columns of a parametric link's or casing's geometry, which a mesh file replaces (a mesh link's bores take
+#: 'bore radius' too).
+_LINK_SHAPE_KEYS = tuple(key for key in _GEOMETRY_KEYS if key != "bore_radius")
+_CASING_SHAPE_KEYS = ("radius", "thickness", "x_start", "x_end",
+                      *(f"{ring}_{part}" for ring in L.CASING_RINGS for part in ("x", "width", "radius")))
 #: Case-model field -> columns, where the names differ.
 _FIELD_COLUMNS: dict[str, dict[str, tuple[str, ...]]] = {
     "Engine": {"center_of_mass": ("cg_x", "cg_y", "cg_z"),
                "inertia": ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")},
     "Engine casing": {"geometry": ("radius", "thickness", "x_start", "x_end"), "geometry.radius": ("radius",),
-                      "geometry.thickness": ("thickness",), "geometry.x_end": ("x_start", "x_end"),
+                      "geometry.thickness": ("thickness",), "geometry.x_start": ("x_start",),
+                      "geometry.x_end": ("x_start", "x_end"),
                       **{f"geometry.rings[{k}]": (f"{ring}_x", f"{ring}_width", f"{ring}_radius")
                          for k, ring in enumerate(L.CASING_RINGS)},
                       "bearing_planes": L.CASING_BEARINGS, "mesh": ("mesh_file",), "scale": ("mesh_unit",),
@@ -90,6 +97,8 @@ _FIELD_COLUMNS: dict[str, dict[str, tuple[str, ...]]] = {
 _ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS,
                 "rotor": L.ROTORS}
 _ITEM = re.compile(rf"^({'|'.join(_ITEM_TABLES)}) '(.*)'$")
+#: Item of a CaseError about the engine's casing (the Engine casing sheet's one row).
+_CASING_ITEM = "engine casing"
 
 
 def _field_keys(table: L.Table, field: str) -> tuple:
@@ -122,13 +131,16 @@ class _CaseReader(SheetReader):
     """Builds the case, the runs and the test data from the tables."""
 
     def build(self, record: Record, make: Callable, fallback: tuple = ()) -> Any:
-        """Call *make*; report its CaseError (at the field's cells) or ValueError (at *fallback*)."""
+        """Call *make*; report its CaseError (at the field's cells) or ValueError (at *fallback*).
+
+        A TypeError is not caught: a value of the wrong type is a defect of the reader, not of the input.
+        """
         try:
             return make()
         except cm.CaseError as exc:
             keys = _field_keys(record.table, exc.field) or fallback
             self.record_problem(record, keys, record.typed(keys, exc.value), exc.expected)
-        except (ValueError, TypeError) as exc:
+        except ValueError as exc:    # flexbodies refuses a link geometry or material in words
             self.record_problem(record, fallback, record.typed(fallback, None), str(exc))
         return None
 
@@ -144,6 +156,19 @@ class _CaseReader(SheetReader):
                              f"a column headed '{record.table.column(key).header}' ({why})")
                 ok = False
         return ok
+
+    def one_shape(self, record: Record, geometry_keys: tuple) -> bool:
+        """False (reported at the mesh file's cell) if *record* gives a mesh file and cells of a parametric
+        geometry (*geometry_keys*): which of the two the user meant cannot be told."""
+        given = [key for key in geometry_keys if record.values.get(key) is not None]
+        if record.values.get("mesh_file") is None or not given:
+            return True
+        cells = ", ".join(f"'{record.table.column(key).header}' in {record.cells[key]}" for key in given)
+        self.record_problem(record, ("mesh_file",), record.get("mesh_file"),
+                            f"a mesh file or a parametric geometry, not both (row {record.row} also gives the "
+                            f"geometry: {cells}; clear the geometry cells to use the mesh, or the mesh file to use "
+                            "the geometry)")
+        return False
 
     def unique(self, records: list[Record], key: str = "name") -> None:
         seen: dict[Any, int] = {}
@@ -185,7 +210,9 @@ class _CaseReader(SheetReader):
                       interface=record.get("interface", "RBE2"))
         if record.get("mesh_file") is not None:
             mesh = self.mesh(record)
-            return None if mesh is None else flexbodies.LinkModel(mesh=mesh, **common)
+            if not self.one_shape(record, _LINK_SHAPE_KEYS) or mesh is None:
+                return None
+            return flexbodies.LinkModel(mesh=mesh, **common)
         if not self.require(record, _GEOMETRY_KEYS, "a parametric link without a mesh file"):
             return None
         distance = math.dist(record.vector("end_a"), record.vector("end_b"))
@@ -367,6 +394,7 @@ class _CaseReader(SheetReader):
             if problem is not None:
                 self.record_problem(record, ("mesh_file",), get("mesh_file"),
                                     f"a mesh file (relative to the workbook's folder; {problem})")
+            if not self.one_shape(record, _CASING_SHAPE_KEYS) or problem is not None:
                 return None
             shape = {"mesh": str(path), "scale": get("mesh_unit", 1.0)}
         else:
@@ -424,7 +452,7 @@ class _CaseReader(SheetReader):
                            description=record.get("description", ""), test_rig=test_rig[0] if test_rig else None,
                            rotors=built["Rotors"])
         except cm.CaseError as exc:
-            self.case_error(exc, items)
+            self.case_error(exc, items, tables[L.CASING.sheet])
         return None
 
     def hinge_bodies(self, hinges: list, link_records: list, links: dict) -> None:
@@ -470,8 +498,13 @@ class _CaseReader(SheetReader):
                 self.problem(L.HINGES.sheet, None, "body A", None,
                              f"at least one hinge to the {body} (body A or body B '{body}')")
 
-    def case_error(self, exc: cm.CaseError, items: dict) -> None:
-        """Report a CaseError of the Case constructor at the row of the item it names."""
+    def case_error(self, exc: cm.CaseError, items: dict, casing: list[Record]) -> None:
+        """Report a CaseError of the Case constructor at the row of the item it names (*items*: the
+        ``(record, item)`` pairs of each sheet; *casing*: the Engine casing rows)."""
+        if exc.item == _CASING_ITEM and casing:
+            keys = _field_keys(L.CASING, exc.field)
+            self.record_problem(casing[0], keys, casing[0].typed(keys, exc.value), exc.expected)
+            return
         match = _ITEM.match(exc.item)
         if match:
             table = _ITEM_TABLES[match.group(1)]
@@ -510,9 +543,43 @@ class _CaseReader(SheetReader):
                                     f"own unbalance or force)")
                 continue
             run = RunSpec(**{k: v for k, v in record.values.items() if k in fields})
-            if self.build(record, lambda run=run: case_for_run(case, run)) is not None:
+            run_case = self.build(record, lambda run=run: case_for_run(case, run))
+            if run_case is not None and self.pylon_fits(record, run_case):
                 runs.append((record, run))
         return runs
+
+    def pylon_fits(self, record: Record, run_case: cm.Case) -> bool:
+        """False (reported at the run's excitation cell) if the run cannot be answered on the case's flexible
+        pylon: its excitation takes the time domain, which has none, or its frequencies leave the pylon
+        impedance table's range. The run would stop there, after the runs before it."""
+        if not run_case.flexible_pylon:
+            return True
+        from workbook.solve.flexible_pylon import refuse_time_domain
+        from workbook.solve.method import TIME, choose_method
+
+        for item in run_case.excitations:
+            chosen = choose_method(run_case, sweep=isinstance(item, cm.Sweep))
+            if chosen.method != TIME:
+                continue
+            try:
+                refuse_time_domain(run_case, chosen.reason)
+            except cm.CaseError as error:
+                self.record_problem(record, ("excitation",), record.get("excitation"),
+                                    f"{error.expected} (run '{record.get('name')}')")
+                return False
+        impedance = run_case.pylon_impedance
+        if impedance is None:
+            return True
+        try:
+            impedance.check_covers([x.frequency for x in run_case.single_frequency_excitations()])
+        except cm.CaseError as error:
+            self.record_problem(record, ("excitation",), record.get("excitation"),
+                                f"an excitation within the pylon impedance table: run '{record.get('name')}' "
+                                f"excites {error.value}, the table ({impedance.source}) covers "
+                                f"{impedance.frequencies_hz[0]:g} to {impedance.frequencies_hz[-1]:g} Hz (it is "
+                                "not extrapolated: extend the table or narrow the excitation's frequencies)")
+            return False
+        return True
 
     def tests(self, runs: list, records: list[Record], case: cm.Case) -> list[TestPoint]:
         by_name = {run.name: (record, run) for record, run in runs}
@@ -594,6 +661,8 @@ def read_workbook(path: str | Path) -> CaseBook:
     formulas, values = open_workbook(path)
     reader = _CaseReader(path, formulas, values)
     tables = {table.sheet: reader.table(table) for table in L.TABLES}
+    reader.sheet_title(IMPEDANCE_SHEET)
+    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), IMPEDANCE_SHEET), (L.INSTRUCTIONS_SHEET,))
     if reader.merged_found:
         raise WorkbookError(reader.problems)
     case = reader.case(tables)

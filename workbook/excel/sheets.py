@@ -7,6 +7,7 @@ as the values Excel cached when it last saved the file.
 from __future__ import annotations
 
 import datetime
+import difflib
 import math
 import re
 import warnings
@@ -23,10 +24,10 @@ import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
 from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
-from workbook.model.units import si_factor
+from workbook.model.units import DIMENSIONLESS, si_factor
 
-__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "MAX_DATA_ROWS", "MAX_FILE_BYTES",
-           "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
+__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
+           "MAX_FILE_BYTES", "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
 
 
 def peek(ws, coordinate: str) -> Any:
@@ -44,6 +45,22 @@ def stored_cells(ws) -> list:
     return [ws._cells[key] for key in sorted(ws._cells)]
 
 
+def _sheet_key(name: str) -> str:
+    """A sheet name without letter case and spaces: 'Test Rig', 'test rig' and 'Rotors ' read as 'Test rig', 'Rotors'."""
+    return "".join(name.split()).casefold()
+
+
+def matching_sheets(titles, name: str) -> list[str]:
+    """The sheet *titles* that are *name* up to letter case and spaces, in workbook order."""
+    return [title for title in titles if _sheet_key(title) == _sheet_key(name)]
+
+
+#: The name Excel and LibreOffice give a copy of a sheet: 'Runs (2)'.
+_COPY = re.compile(r"^(.*?)\s*\(\d+\)$")
+#: How alike (difflib ratio, letters and digits only) a sheet name must be to a name read to be reported as a
+#: likely misspelling of it.
+_CLOSE_NAME = 0.8
+
 #: Data rows read per table at most.
 MAX_DATA_ROWS = 10_000
 
@@ -52,7 +69,12 @@ class _Cells:
     """The stored cells of one sheet (values as cached, and formulas), looked up without creating cells."""
 
     def __init__(self, ws_values, ws_formulas):
-        self._values = {(c.row, c.column): c.value for c in stored_cells(ws_values)}
+        cells = stored_cells(ws_values)
+        self._values = {(c.row, c.column): c.value for c in cells}
+        #: Cells holding a number shown as a percentage (5 % is stored as 0.05).
+        self.percent = {(c.row, c.column) for c in cells
+                        if isinstance(c.value, (int, float)) and not isinstance(c.value, bool)
+                        and _percent_format(c.number_format)}
         self._formulas = {(c.row, c.column): c.value for c in stored_cells(ws_formulas) if c.data_type == "f"}
         self.merged = list(ws_values.merged_cells.ranges)
 
@@ -73,6 +95,13 @@ class _Cells:
         """Data rows with a value or a formula in one of *columns*, in order."""
         found = {r for r, c in (*self._values, *self._formulas) if c in columns and self.has(r, c)}
         return sorted(r for r in found if r >= L.FIRST_DATA_ROW)
+
+
+def _percent_format(number_format: str | None) -> bool:
+    """True if *number_format* shows its number as a percentage (a ``%`` outside quotes and escapes)."""
+    if not number_format:
+        return False
+    return "%" in re.sub(r'"[^"]*"|\\.|\[[^]]*\]', "", number_format)
 
 
 @dataclass
@@ -134,22 +163,70 @@ class SheetReader:
         self.problem(record.table.sheet, record.where(*keys) if keys else f"row {record.row}", header, value,
                      expected)
 
+    # -- sheets -------------------------------------------------------------------------------------------
+
+    def sheet_title(self, name: str) -> str | None:
+        """The title of the workbook's sheet *name*, matched up to letter case and spaces.
+
+        Returns None when no sheet matches, and when several do (reported,
+        naming them: which one holds the data cannot be told).
+        """
+        titles = matching_sheets(self.values.sheetnames, name)
+        if len(titles) > 1:
+            self.problem(None, None, None, ", ".join(f"sheet '{title}'" for title in titles),
+                         f"one sheet named '{name}' (these names read as the same one, letter case and spaces "
+                         "aside: rename or delete all but one)")
+            return None
+        return titles[0] if titles else None
+
+    def misspelt_sheets(self, read: tuple, known: tuple) -> None:
+        """Report each sheet whose name is close to a sheet read but is none of *read* or *known*.
+
+        Such a sheet ('Rotor', 'Test-rig', 'Engine_casing') would be ignored:
+        an optional sheet would silently be missing. A copy of a sheet read
+        beside it ('Runs (2)' with 'Runs') is the user's and not reported.
+
+        Parameters
+        ----------
+        read : tuple of str
+            Names of the sheets the package reads.
+        known : tuple of str
+            Names of other sheets the package knows (not reported).
+        """
+        squashed = {re.sub(r"[\W_]", "", _sheet_key(name)): name for name in read}
+        for title in self.values.sheetnames:
+            if any(matching_sheets((title,), name) for name in (*read, *known)):
+                continue
+            copy = _COPY.match(title)
+            if copy and any(matching_sheets(self.values.sheetnames, name) for name in read
+                            if matching_sheets((copy.group(1),), name)):
+                continue    # 'Runs (2)' beside 'Runs': a copy the user made, not a misspelling
+            close = difflib.get_close_matches(re.sub(r"[\W_]", "", _sheet_key(title)), squashed, n=1,
+                                              cutoff=_CLOSE_NAME)
+            if close:
+                self.problem(title, None, None, title,
+                             f"a sheet name the package reads (did you mean '{squashed[close[0]]}'? a sheet under "
+                             f"another name is ignored; the names read: {', '.join(read)}; a sheet of notes: "
+                             "a name unlike these)")
+
     # -- tables -------------------------------------------------------------------------------------------
 
     def table(self, table: L.Table) -> list[Record]:
         """The data rows of *table* (empty if the sheet is unusable).
 
+        The sheet is found up to letter case and spaces (:meth:`sheet_title`).
         Only the cells stored in the file are looked at (a stray cell in the
         last row of the sheet costs nothing), and only the first
         :data:`MAX_DATA_ROWS` data rows are read: a value below them is a
         problem.
         """
-        if table.sheet not in self.values.sheetnames:
-            if not table.optional:
+        title = self.sheet_title(table.sheet)
+        if title is None:
+            if not table.optional and not matching_sheets(self.values.sheetnames, table.sheet):
                 self.problem(table.sheet, None, None, None,
                              f"a sheet named '{table.sheet}' (sheets: {', '.join(self.values.sheetnames)})")
             return []
-        sheet = _Cells(self.values[table.sheet], self.formulas[table.sheet])
+        sheet = _Cells(self.values[title], self.formulas[title])
         positions = self._headers(table, sheet)
         if positions is None:
             return []
@@ -169,7 +246,8 @@ class SheetReader:
             raw = {key: self._cell(sheet, row, col, table) for key, col in positions.items()}
             if all(v is None for v in raw.values()):
                 continue
-            records.append(self._record(table, row, raw, positions, factors))
+            percent = {key for key, col in positions.items() if (row, col) in sheet.percent}
+            records.append(self._record(table, row, raw, positions, factors, percent))
         if table.single_row:
             if not records and not table.optional:
                 self.problem(table.sheet, f"row {L.FIRST_DATA_ROW}", None, None, "one row of data")
@@ -225,6 +303,8 @@ class SheetReader:
             text = sheet.value(L.UNIT_ROW, col)
             try:
                 factors[key] = si_factor("" if text is None else str(text), column.si_unit)
+                if column.kind != "number" and factors[key] != 1.0:
+                    raise UnitProblem("'-' (the column counts: a count has no unit)")
             except UnitProblem as exc:
                 factors[key] = None
                 self.problem(table.sheet, f"{get_column_letter(col)}{L.UNIT_ROW}", f"{column.header} (unit)",
@@ -243,7 +323,16 @@ class SheetReader:
             return None
         return value
 
-    def _record(self, table: L.Table, row: int, raw: dict, positions: dict, factors: dict) -> Record:
+    def _record(self, table: L.Table, row: int, raw: dict, positions: dict, factors: dict,
+                percent: set) -> Record:
+        """One data row read: each cell parsed by its column's kind and converted to SI.
+
+        A number shown as a percentage (keys in *percent*) is read as shown:
+        a cell showing 5 % holds 0.05, which is 5 % whatever the column's unit
+        cell (``%``, ``-`` or empty); such a cell in a column with a dimension
+        or of counts is refused. The text ``5 %`` in a column without
+        dimension is 5 % too.
+        """
         values, cells, known, usable = {}, {}, len(self.problems), True
         for key, col in positions.items():
             cells[key] = f"{get_column_letter(col)}{row}"
@@ -256,10 +345,25 @@ class SheetReader:
                 if column.required:
                     self.problem(table.sheet, cells[key], column.header, None, "a value (required)")
                 continue
+            typed_percent = (isinstance(value, str) and value.strip().endswith("%") and column.kind == "number"
+                             and column.si_unit == DIMENSIONLESS)
             try:
-                converted = _PARSERS[column.kind](value, column)
+                # '5 %' typed as text is 5 %, as a cell formatted as a percentage shows it
+                converted = (_as_number(value.strip()[:-1], column) / 100 if typed_percent
+                             else _PARSERS[column.kind](value, column))
             except _Bad as exc:
                 self.problem(table.sheet, cells[key], column.header, exc.shown or value, exc.expected)
+                continue
+            if typed_percent:
+                values[key] = converted
+                continue
+            if key in percent:
+                if column.kind != "number" or column.si_unit != DIMENSIONLESS:
+                    self.problem(table.sheet, cells[key], column.header, _shown_percent(value),
+                                 f"a number not formatted as a percentage (the cell holds {value:g}; a percentage "
+                                 "is read only in a column without dimension: format the cell as a number)")
+                    continue
+                values[key] = converted    # the stored fraction is the value shown in %
                 continue
             if column.has_unit:
                 if factors.get(key) is None:
@@ -278,6 +382,11 @@ class SheetReader:
 
 
 _FORMULA_WITHOUT_VALUE = object()
+
+
+def _shown_percent(value: float) -> str:
+    """A number as a percent-formatted cell shows it: 0.05 -> '5 %'."""
+    return f"{value * 100:.10g} %"
 
 
 class _Bad(ValueError):
@@ -348,8 +457,8 @@ def _as_number(value: Any, column: L.Column) -> float:
 
 
 #: Digits grouped in threes by a separator: 1,234 or 12.345.678.
-_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$")
-_PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$")
+_GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$", re.ASCII)
+_PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$", re.ASCII)
 
 
 def _text_number(text: str) -> float:
@@ -429,7 +538,7 @@ def _as_modes(value: Any, column: L.Column) -> str | int | ModeCutoff:
     text = raw.lower()
     if text in ("auto", "static"):
         return text
-    if text.isdigit():
+    if text.isascii() and text.isdigit():      # not '²' or other digits int() refuses
         return int(text)
     match = _CUTOFF.match(raw)             # units are case-sensitive: mHz is not MHz
     if match:

@@ -27,6 +27,7 @@ import numpy as np
 
 from workbook.errors import CaseError
 from workbook.model.casing import CASING, EngineCasing
+from workbook.model.fields import MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_mesh import MeshPylon
@@ -130,7 +131,7 @@ def mode_request(value: Any, item: str = "link") -> ModeRequest:
             return mode_request(ModeCutoff(float(match.group(1))), item)
         raise CaseError(item, "modes", value, expected)
     if isinstance(value, int) and not isinstance(value, bool) and value >= 0:
-        return value
+        return bounded_count(item, "modes", value, 0, MAX_MODE_COUNT, "the most modes a reduction keeps by count")
     if isinstance(value, float):
         raise CaseError(item, "modes", value, f"{expected} (a plain float is ambiguous: "
                         f"write {int(value) if value.is_integer() and value >= 0 else 'a whole number'} for a count "
@@ -875,6 +876,9 @@ class Sweep:
         if not isinstance(self.template, SINGLE_FREQUENCY_KINDS):
             raise CaseError(item, "template", self.template, "a RotatingForce, HarmonicForce or Imbalance")
         try:
+            if len(self.frequencies_hz) > MAX_SWEEP_POINTS:
+                raise CaseError(item, "frequencies_hz", f"{len(self.frequencies_hz):,} frequencies",
+                                f"at most {MAX_SWEEP_POINTS:,} frequencies (the most points a sweep takes)")
             frequencies = tuple(_number(f, item, "frequencies_hz", minimum=0.0, strictly=True)
                                 for f in self.frequencies_hz)
         except TypeError:
@@ -889,8 +893,12 @@ class Sweep:
         """A sweep of *points* frequencies from *start_hz* to *stop_hz* (``"log"`` or ``"linear"``)."""
         if spacing not in ("log", "linear"):
             raise CaseError(f"excitation {name!r}", "spacing", spacing, "'log' or 'linear'")
+        item = f"excitation {name!r}"
+        start_hz = _number(start_hz, item, "start", minimum=0.0, strictly=True)
+        stop_hz = _number(stop_hz, item, "stop", minimum=0.0, strictly=True)
+        points = bounded_count(item, "points", points, 1, MAX_SWEEP_POINTS, "the most points a sweep takes")
         space = np.geomspace if spacing == "log" else np.linspace
-        return cls(name, template, tuple(float(f) for f in space(start_hz, stop_hz, int(points))))
+        return cls(name, template, tuple(float(f) for f in space(start_hz, stop_hz, points)))
 
     @property
     def frequency(self) -> float:
@@ -955,10 +963,9 @@ class RunUp(Sweep):
         stop = _number(stop, item, "stop", minimum=0.0, strictly=True)
         if stop <= start:
             raise CaseError(item, "stop", stop, f"a speed above the start ({start:g} {unit})")
-        if isinstance(points, bool) or not isinstance(points, (int, np.integer)) or points < 2:
-            raise CaseError(item, "points", points, "a whole number >= 2")
+        points = bounded_count(item, "points", points, 2, MAX_SWEEP_POINTS, "the most speeds a run-up takes")
         factor = SPEED_UNITS[unit]
-        return cls(name, template, tuple(float(s) * factor for s in np.linspace(start, stop, int(points))), unit)
+        return cls(name, template, tuple(float(s) * factor for s in np.linspace(start, stop, points)), unit)
 
     @property
     def speed_values(self) -> np.ndarray:

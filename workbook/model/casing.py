@@ -28,7 +28,7 @@ from flexbodies.casing import CasingGeometry, CasingInterface, MountRing, defaul
 from flexbodies.casing_reduction import CasingModel
 from flexbodies.materials import TITANIUM, Material
 from workbook.errors import CaseError
-from workbook.model.fields import positive_number
+from workbook.model.fields import MAX_MODE_COUNT, bounded_count, positive_number
 
 __all__ = ["EngineCasing", "CoreBody", "split_engine", "CASING", "MountRing", "CasingGeometry",
            "DEFAULT_BEARING_STIFFNESS", "parallel_axis", "casing_origin", "bearing_name",
@@ -141,6 +141,8 @@ class EngineCasing:
         if not (self.modes in ("auto", "static") or (isinstance(self.modes, int) and not isinstance(self.modes, bool)
                                                        and self.modes >= 0)):
             raise CaseError(_ITEM, "modes", self.modes, "'auto', 'static' or a count >= 0")
+        if isinstance(self.modes, int):
+            bounded_count(_ITEM, "modes", self.modes, 0, MAX_MODE_COUNT, "the most modes a reduction keeps by count")
         try:
             planes = tuple(float(x) for x in self.bearing_planes)
         except (TypeError, ValueError):

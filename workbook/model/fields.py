@@ -5,7 +5,15 @@ import math
 
 from workbook.errors import CaseError
 
-__all__ = ["positive_number", "finite_point"]
+__all__ = ["positive_number", "finite_point", "bounded_count", "MAX_SWEEP_POINTS", "MAX_MODE_COUNT"]
+
+#: Most frequencies of one sweep, or speeds of one run-up: each is a solve of its own (a time-domain point
+#: takes seconds), and a longer list is a slip (1e6 typed for 100) whose building alone costs minutes and
+#: gigabytes.
+MAX_SWEEP_POINTS = 10_000
+#: Most fixed-interface modes a link or the casing keeps by count (the low-frequency rule keeps tens; a
+#: reduction with thousands of modes is no longer a reduction).
+MAX_MODE_COUNT = 1_000
 
 
 def positive_number(item: str, name: str, value) -> float:
@@ -28,3 +36,15 @@ def finite_point(item: str, name: str, value) -> tuple:
     if len(point) != 3 or not all(math.isfinite(v) for v in point):
         raise CaseError(item, name, value, "three finite numbers (x, y, z), m")
     return point
+
+
+def bounded_count(item: str, name: str, value, minimum: int, maximum: int, what: str) -> int:
+    """*value* as a whole number from *minimum* to *maximum*, or a CaseError naming *item*, *name*, the
+    value and the bounds (*what*: what the bound is, in words, e.g. 'the most points a sweep takes')."""
+    try:
+        whole = not isinstance(value, bool) and float(value).is_integer()
+    except (TypeError, ValueError, OverflowError):
+        whole = False
+    if not (whole and minimum <= value <= maximum):
+        raise CaseError(item, name, value, f"a whole number from {minimum} to {maximum:,} ({what})")
+    return int(value)

@@ -138,18 +138,33 @@ class PylonImpedance:
             A frequency outside the table's range.
         """
         wanted = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+        self.check_covers(wanted)
         table = np.asarray(self.frequencies_hz)
-        outside = wanted[(wanted < table[0] * (1 - 1e-12)) | (wanted > table[-1] * (1 + 1e-12))]
-        if outside.size:
-            raise CaseError(f"pylon impedance {self.source}", "frequency", float(outside[0]),
-                            f"a frequency the table covers, {table[0]:g} to {table[-1]:g} Hz "
-                            f"(the table is not extrapolated)")
         values = self.values[:, list(order)]
         flat = values.reshape(len(table), -1)
         clipped = np.clip(wanted, table[0], table[-1])
         columns = [np.interp(clipped, table, flat[:, c].real) + 1j * np.interp(clipped, table, flat[:, c].imag)
                    for c in range(flat.shape[1])]
         return np.array(columns).T.reshape(len(wanted), *values.shape[1:])
+
+    def check_covers(self, frequencies_hz) -> None:
+        """Refuse *frequencies_hz* (Hz) unless the table's range holds every one of them.
+
+        Raises
+        ------
+        workbook.errors.CaseError
+            Naming the frequencies asked for (one, or the lowest to the
+            highest) and the table's range; the table is not extrapolated.
+        """
+        wanted = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
+        table = np.asarray(self.frequencies_hz)
+        outside = wanted[(wanted < table[0] * (1 - 1e-12)) | (wanted > table[-1] * (1 + 1e-12))]
+        if outside.size:
+            asked = f"{wanted[0]:g} Hz" if wanted.size == 1 else f"{wanted.min():g} to {wanted.max():g} Hz"
+            raise CaseError(f"pylon impedance {self.source}", "frequency", asked,
+                            f"frequencies the table covers, {table[0]:g} to {table[-1]:g} Hz ({outside.size} of "
+                            f"{wanted.size} outside; the table is not extrapolated: extend it or narrow the "
+                            "excitation's frequencies)")
 
     def describe(self) -> str:
         """One line for the model card."""

@@ -40,11 +40,14 @@ def registry():
 
 
 def _parse(text: str):
+    import tokenize
+
     import pint
 
     try:
         return registry().Quantity(1.0, text)
-    except (pint.PintError, AssertionError, AttributeError, SyntaxError, TypeError, ValueError):
+    except (pint.PintError, AssertionError, AttributeError, SyntaxError, TypeError, ValueError,
+            tokenize.TokenError, ArithmeticError):    # '(' and 'mm/0' are the text's, not ours
         raise UnitProblem("a known unit") from None
 
 

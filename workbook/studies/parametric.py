@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
@@ -34,7 +35,8 @@ import numpy as np
 from workbook.errors import CaseError, InputError
 from workbook.model.case import Case, HarmonicForce, RotatingForce
 
-__all__ = ["Parameter", "PARAMETERS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases"]
+__all__ = ["Parameter", "PARAMETERS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases",
+           "MAX_STUDY_ROWS"]
 
 
 @dataclass(frozen=True)
@@ -127,6 +129,17 @@ PARAMETERS = {p.name: p for p in (
 )}
 
 
+#: Most rows of one study: a row is a run of its own (seconds each at best), and more is a slip (a range of
+#: 1e6 points typed for 100, or too many lists combined) whose rows alone would fill the memory.
+MAX_STUDY_ROWS = 100_000
+
+
+def _check_rows(count: int, what: str) -> None:
+    """Refuse a study of more than :data:`MAX_STUDY_ROWS` rows (*what*: where the count comes from)."""
+    if count > MAX_STUDY_ROWS:
+        raise InputError(f"{what} gives {count:,} rows; a study has at most {MAX_STUDY_ROWS:,}")
+
+
 def _check_names(names) -> None:
     unknown = [n for n in names if n not in PARAMETERS]
     if unknown:
@@ -147,6 +160,8 @@ def grid(values: dict[str, list]) -> tuple[dict, ...]:
     tuple of dict
     """
     _check_names(values)
+    _check_rows(math.prod(len(v) for v in values.values()),
+                " x ".join(f"{len(v):,} {name}" for name, v in values.items()) or "no parameter")
     names = list(values)
     return tuple(dict(zip(names, combination, strict=True)) for combination in itertools.product(*values.values()))
 
@@ -155,6 +170,7 @@ def linear_range(start: float, stop: float, points: int) -> list[float]:
     """*points* evenly spaced values from *start* to *stop*."""
     if points < 1:
         raise InputError(f"a range needs at least one point, got {points}")
+    _check_rows(points, f"a range of {points:,} points")
     return [float(v) for v in np.linspace(start, stop, points)]
 
 
@@ -181,6 +197,7 @@ def latin_hypercube(bounds: dict[str, tuple[float, float]], samples: int, seed: 
         raise InputError(f"a Latin hypercube needs numeric ranges; {', '.join(text)} takes a list")
     if samples < 1:
         raise InputError(f"a Latin hypercube needs at least one sample, got {samples}")
+    _check_rows(samples, f"a Latin hypercube of {samples:,} samples")
     unit = qmc.LatinHypercube(d=len(bounds), seed=seed).random(samples)
     low, high = np.array(list(bounds.values()), dtype=float).T
     points = qmc.scale(unit, low, high) if len(bounds) else unit
