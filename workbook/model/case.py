@@ -26,6 +26,7 @@ from typing import Any, Literal, get_args
 import numpy as np
 
 from workbook.errors import CaseError
+from workbook.model import fields
 from workbook.model.casing import CASING, EngineCasing
 from workbook.model.fields import MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
 from workbook.model.pylon_beam import BoxBeamPylon
@@ -56,33 +57,6 @@ _RESERVED = (PYLON, ENGINE)
 POINT_TOLERANCE = 1e-6
 
 Vector3 = tuple[float, float, float]
-
-
-def _vector3(value: Any, item: str, name: str) -> Vector3:
-    """Return *value* as a tuple of three finite floats or raise CaseError."""
-    try:
-        vector = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        raise CaseError(item, name, value, "three numbers") from None
-    if len(vector) != 3 or not all(math.isfinite(v) for v in vector):
-        raise CaseError(item, name, value, "three finite numbers")
-    return vector
-
-
-def _number(value: Any, item: str, name: str, *, minimum: float = -math.inf,
-            strictly: bool = False) -> float:
-    """Return *value* as a finite float above *minimum* or raise CaseError."""
-    if isinstance(value, bool):
-        raise CaseError(item, name, value, "a number")
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise CaseError(item, name, value, "a number") from None
-    too_small = number <= minimum if strictly else number < minimum
-    if not math.isfinite(number) or too_small:
-        bound = f"{'>' if strictly else '>='} {minimum:g}" if minimum > -math.inf else "finite"
-        raise CaseError(item, name, value, f"a number {bound}")
-    return number
 
 
 class ModeCutoff(float):
@@ -139,12 +113,6 @@ def mode_request(value: Any, item: str = "link") -> ModeRequest:
     raise CaseError(item, "modes", value, expected)
 
 
-def _name(value: Any, item: str) -> str:
-    if not isinstance(value, str) or not value.strip():
-        raise CaseError(item, "name", value, "a non-empty text")
-    return value
-
-
 def _set(obj: Any, name: str, value: Any) -> None:
     """Normalise a field of a frozen dataclass in ``__post_init__``."""
     object.__setattr__(obj, name, value)
@@ -174,10 +142,10 @@ class Engine:
 
     def __post_init__(self):
         item = "engine"
-        _set(self, "mass", _number(self.mass, item, "mass", minimum=0.0, strictly=True))
-        _set(self, "center_of_mass", _vector3(self.center_of_mass, item, "center_of_mass"))
+        _set(self, "mass", fields.positive_number(item, "mass", self.mass))
+        _set(self, "center_of_mass", fields.vector3(item, "center_of_mass", self.center_of_mass))
         try:
-            rows = tuple(_vector3(row, item, "inertia") for row in self.inertia)
+            rows = tuple(fields.vector3(item, "inertia", row) for row in self.inertia)
         except TypeError:
             raise CaseError(item, "inertia", self.inertia, "a 3x3 tensor") from None
         if len(rows) != 3:
@@ -253,11 +221,11 @@ class Link:
 
     def __post_init__(self):
         item = f"link {self.name!r}"
-        _name(self.name, "link")
+        fields.nonempty_name("link", self.name)
         if self.name in _RESERVED:
             raise CaseError(item, "name", self.name, f"a name other than {_RESERVED}")
-        _set(self, "end_a", _vector3(self.end_a, item, "end_a"))
-        _set(self, "end_b", _vector3(self.end_b, item, "end_b"))
+        _set(self, "end_a", fields.vector3(item, "end_a", self.end_a))
+        _set(self, "end_b", fields.vector3(item, "end_b", self.end_b))
         if self.length <= POINT_TOLERANCE:
             raise CaseError(item, "end_b", self.end_b, "a point apart from end_a")
         geometry = getattr(self.model, "geometry", None)
@@ -269,17 +237,16 @@ class Link:
         if not isinstance(self.flexible, bool):
             raise CaseError(item, "flexible", self.flexible, "True or False")
         _set(self, "stiffness_damping",
-             _number(self.stiffness_damping, item, "stiffness_damping", minimum=0.0))
-        _set(self, "mass_damping", _number(self.mass_damping, item, "mass_damping", minimum=0.0))
-        _set(self, "loss_factor", _number(self.loss_factor, item, "loss_factor", minimum=0.0))
-        _set(self, "modal_damping", _number(self.modal_damping, item, "modal_damping", minimum=0.0))
+             fields.number(item, "stiffness_damping", self.stiffness_damping, minimum=0.0))
+        _set(self, "mass_damping", fields.number(item, "mass_damping", self.mass_damping, minimum=0.0))
+        _set(self, "loss_factor", fields.number(item, "loss_factor", self.loss_factor, minimum=0.0))
+        _set(self, "modal_damping", fields.number(item, "modal_damping", self.modal_damping, minimum=0.0))
         if self.modal_damping >= 1.0:
             raise CaseError(item, "modal_damping", self.modal_damping, "a damping ratio >= 0 and < 1")
         if self.spin_frequency_hz is not None:
-            _set(self, "spin_frequency_hz", _number(self.spin_frequency_hz, item,
-                                                    "spin_frequency_hz", minimum=0.0, strictly=True))
+            _set(self, "spin_frequency_hz", fields.positive_number(item, "spin_frequency_hz", self.spin_frequency_hz))
         if self.bore_axis is not None:
-            _set(self, "bore_axis", _vector3(self.bore_axis, item, "bore_axis"))
+            _set(self, "bore_axis", fields.vector3(item, "bore_axis", self.bore_axis))
 
     @property
     def length(self) -> float:
@@ -298,25 +265,25 @@ class Link:
 HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
 
 
-def _per_direction(value: Any, item: str, name: str, *, strictly: bool) -> float | tuple[float, ...]:
+def _per_direction(item: str, name: str, value: Any, *, strictly: bool) -> float | tuple[float, ...]:
     """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
 
     A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
     """
     if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
-        return _number(value, item, name, minimum=0.0, strictly=strictly)
+        return fields.number(item, name, value, minimum=0.0, strictly=strictly)
     values = tuple(value)
     if len(values) != 3:
         raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
                                            f"{len(values)} given")
-    return tuple(_number(v, item, f"{name}[{direction}]", minimum=0.0, strictly=strictly)
+    return tuple(fields.number(item, f"{name}[{direction}]", v, minimum=0.0, strictly=strictly)
                  for v, direction in zip(values, HINGE_DIRECTIONS, strict=True))
 
 
 def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
     """*value* as three orthonormal rows (a hinge frame) or raise CaseError."""
     try:
-        rows = tuple(_vector3(row, item, "frame") for row in value)
+        rows = tuple(fields.vector3(item, "frame", row) for row in value)
     except TypeError:
         raise CaseError(item, "frame", value, "three directions of three numbers each") from None
     if len(rows) != 3:
@@ -382,21 +349,20 @@ class Hinge:
 
     def __post_init__(self):
         item = f"hinge {self.name!r}"
-        _name(self.name, "hinge")
+        fields.nonempty_name("hinge", self.name)
         for name in ("body_a", "body_b"):
             if not isinstance(getattr(self, name), str) or not getattr(self, name):
                 raise CaseError(item, name, getattr(self, name), "a body name")
         if self.body_a == self.body_b:
             raise CaseError(item, "body_b", self.body_b, "a body other than body_a")
-        _set(self, "position", _vector3(self.position, item, "position"))
-        _set(self, "stiffness", _per_direction(self.stiffness, item, "stiffness", strictly=True))
-        _set(self, "damping", _per_direction(self.damping, item, "damping", strictly=False))
+        _set(self, "position", fields.vector3(item, "position", self.position))
+        _set(self, "stiffness", _per_direction(item, "stiffness", self.stiffness, strictly=True))
+        _set(self, "damping", _per_direction(item, "damping", self.damping, strictly=False))
         _set(self, "radial_clearance",
-             _number(self.radial_clearance, item, "radial_clearance", minimum=0.0))
+             fields.number(item, "radial_clearance", self.radial_clearance, minimum=0.0))
         if self.contact_stiffness is not None:
-            _set(self, "contact_stiffness", _number(self.contact_stiffness, item,
-                                                    "contact_stiffness", minimum=0.0, strictly=True))
-        _set(self, "loss_factor", _per_direction(self.loss_factor, item, "loss_factor", strictly=False))
+            _set(self, "contact_stiffness", fields.positive_number(item, "contact_stiffness", self.contact_stiffness))
+        _set(self, "loss_factor", _per_direction(item, "loss_factor", self.loss_factor, strictly=False))
         if self.frame is not None:
             _set(self, "frame", _frame(self.frame, item))
         if self.radial_clearance > 0 and not self.isotropic:
@@ -444,9 +410,9 @@ class PointForce:
 
     def __post_init__(self):
         item = f"static load {self.name!r}"
-        _name(self.name, "static load")
-        _set(self, "force", _vector3(self.force, item, "force"))
-        _set(self, "point", _vector3(self.point, item, "point"))
+        fields.nonempty_name("static load", self.name)
+        _set(self, "force", fields.vector3(item, "force", self.force))
+        _set(self, "point", fields.vector3(item, "point", self.point))
 
 
 @dataclass(frozen=True)
@@ -458,8 +424,8 @@ class PointMoment:
 
     def __post_init__(self):
         item = f"static load {self.name!r}"
-        _name(self.name, "static load")
-        _set(self, "moment", _vector3(self.moment, item, "moment"))
+        fields.nonempty_name("static load", self.name)
+        _set(self, "moment", fields.vector3(item, "moment", self.moment))
 
 
 @dataclass(frozen=True)
@@ -470,9 +436,8 @@ class Gravity:
     acceleration: Vector3 = (0.0, 0.0, -9.81)
 
     def __post_init__(self):
-        _name(self.name, "static load")
-        _set(self, "acceleration", _vector3(self.acceleration, f"static load {self.name!r}",
-                                            "acceleration"))
+        fields.nonempty_name("static load", self.name)
+        _set(self, "acceleration", fields.vector3(f"static load {self.name!r}", "acceleration", self.acceleration))
 
 
 StaticLoad = PointForce | PointMoment | Gravity
@@ -515,15 +480,15 @@ class ForceTransducers:
 
     def __post_init__(self):
         item = "test-rig force transducers"
-        stiffness = _vector3(self.stiffness, item, "stiffness")
+        stiffness = fields.vector3(item, "stiffness", self.stiffness)
         if min(stiffness) <= 0:
             raise CaseError(item, "stiffness", self.stiffness, "three numbers > 0 (N/m in x, y, z)")
-        damping = _vector3(self.damping, item, "damping")
+        damping = fields.vector3(item, "damping", self.damping)
         if min(damping) < 0:
             raise CaseError(item, "damping", self.damping, "three numbers >= 0 (N s/m in x, y, z)")
         _set(self, "stiffness", stiffness)
         _set(self, "damping", damping)
-        _set(self, "mass", _number(self.mass, item, "mass", minimum=0.0, strictly=True))
+        _set(self, "mass", fields.positive_number(item, "mass", self.mass))
 
 
 #: A test-rig transducer is named by this prefix and the pylon-side hinges it carries.
@@ -554,16 +519,8 @@ def _frequency(item: str, frequency_hz: Any, rpm: Any) -> float:
     if (frequency_hz is None) == (rpm is None):
         raise CaseError(item, "frequency_hz", frequency_hz, "either frequency_hz or rpm, not both")
     if frequency_hz is not None:
-        return _number(frequency_hz, item, "frequency_hz", minimum=0.0, strictly=True)
-    return _number(rpm, item, "rpm", minimum=0.0, strictly=True) / 60.0
-
-
-def _direction(value: Any, item: str, name: str) -> Vector3:
-    """Return *value* as three finite floats, not all zero, or raise CaseError."""
-    vector = _vector3(value, item, name)
-    if np.linalg.norm(vector) == 0:
-        raise CaseError(item, name, value, "a non-zero direction")
-    return vector
+        return fields.positive_number(item, "frequency_hz", frequency_hz)
+    return fields.positive_number(item, "rpm", rpm) / 60.0
 
 
 class _OneFrequency:
@@ -615,16 +572,16 @@ class RotatingForce(_OneFrequency):
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
-        _name(self.name, "excitation")
-        _set(self, "point", _vector3(self.point, item, "point"))
+        fields.nonempty_name("excitation", self.name)
+        _set(self, "point", fields.vector3(item, "point", self.point))
         _frequency(item, self.frequency_hz, self.rpm)
         if (self.amplitude is None) == (self.unbalance is None):
             raise CaseError(item, "amplitude", self.amplitude, "either amplitude or unbalance, not both")
         for name in ("amplitude", "unbalance"):
             if getattr(self, name) is not None:
-                _set(self, name, _number(getattr(self, name), item, name, minimum=0.0, strictly=True))
-        _set(self, "axis", _direction(self.axis, item, "axis"))
-        _set(self, "phase_deg", _number(self.phase_deg, item, "phase_deg"))
+                _set(self, name, fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True))
+        _set(self, "axis", fields.direction(item, "axis", self.axis))
+        _set(self, "phase_deg", fields.number(item, "phase_deg", self.phase_deg))
 
     @property
     def force_amplitude(self) -> float:
@@ -684,12 +641,12 @@ class HarmonicForce(_OneFrequency):
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
-        _name(self.name, "excitation")
-        _set(self, "point", _vector3(self.point, item, "point"))
-        _set(self, "direction", _direction(self.direction, item, "direction"))
-        _set(self, "amplitude", _number(self.amplitude, item, "amplitude", minimum=0.0, strictly=True))
+        fields.nonempty_name("excitation", self.name)
+        _set(self, "point", fields.vector3(item, "point", self.point))
+        _set(self, "direction", fields.direction(item, "direction", self.direction))
+        _set(self, "amplitude", fields.positive_number(item, "amplitude", self.amplitude))
         _frequency(item, self.frequency_hz, self.rpm)
-        _set(self, "phase_deg", _number(self.phase_deg, item, "phase_deg"))
+        _set(self, "phase_deg", fields.number(item, "phase_deg", self.phase_deg))
 
     @property
     def force_amplitude(self) -> float:
@@ -731,10 +688,9 @@ class ImbalancePlane:
         """The plane with validated fields; *item* names it in a CaseError."""
         if (self.amplitude is None) == (self.unbalance is None):
             raise CaseError(item, "unbalance", self.unbalance, "either unbalance or amplitude, not both")
-        given = {name: _number(getattr(self, name), item, name, minimum=0.0, strictly=True)
+        given = {name: fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True)
                  for name in ("unbalance", "amplitude") if getattr(self, name) is not None}
-        return ImbalancePlane(_vector3(self.point, item, "point"), phase_deg=_number(self.phase_deg, item,
-                                                                                    "phase_deg"), **given)
+        return ImbalancePlane(fields.vector3(item, "point", self.point), phase_deg=fields.number(item, "phase_deg", self.phase_deg), **given)
 
 
 @dataclass(frozen=True)
@@ -769,9 +725,9 @@ class Imbalance(_OneFrequency):
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
-        _name(self.name, "excitation")
+        fields.nonempty_name("excitation", self.name)
         _frequency(item, self.frequency_hz, self.rpm)
-        _set(self, "axis", _direction(self.axis, item, "axis"))
+        _set(self, "axis", fields.direction(item, "axis", self.axis))
         try:
             planes = tuple(self.planes)
         except TypeError:
@@ -834,11 +790,11 @@ class Rotor(_OneFrequency):
 
     def __post_init__(self):
         item = f"rotor {self.name!r}"
-        _name(self.name, "rotor")
-        _set(self, "polar_inertia", _number(self.polar_inertia, item, "polar_inertia", minimum=0.0,
+        fields.nonempty_name("rotor", self.name)
+        _set(self, "polar_inertia", fields.number(item, "polar_inertia", self.polar_inertia, minimum=0.0,
                                             strictly=True))
         _frequency(item, self.frequency_hz, self.rpm)
-        axis = np.array(_direction(self.axis, item, "axis"))
+        axis = np.array(fields.direction(item, "axis", self.axis))
         _set(self, "axis", tuple(float(v) for v in axis / np.linalg.norm(axis)))
 
     @property
@@ -872,14 +828,14 @@ class Sweep:
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
-        _name(self.name, "excitation")
+        fields.nonempty_name("excitation", self.name)
         if not isinstance(self.template, SINGLE_FREQUENCY_KINDS):
             raise CaseError(item, "template", self.template, "a RotatingForce, HarmonicForce or Imbalance")
         try:
             if len(self.frequencies_hz) > MAX_SWEEP_POINTS:
                 raise CaseError(item, "frequencies_hz", f"{len(self.frequencies_hz):,} frequencies",
                                 f"at most {MAX_SWEEP_POINTS:,} frequencies (the most points a sweep takes)")
-            frequencies = tuple(_number(f, item, "frequencies_hz", minimum=0.0, strictly=True)
+            frequencies = tuple(fields.positive_number(item, "frequencies_hz", f)
                                 for f in self.frequencies_hz)
         except TypeError:
             raise CaseError(item, "frequencies_hz", self.frequencies_hz, "a list of frequencies") from None
@@ -894,8 +850,8 @@ class Sweep:
         if spacing not in ("log", "linear"):
             raise CaseError(f"excitation {name!r}", "spacing", spacing, "'log' or 'linear'")
         item = f"excitation {name!r}"
-        start_hz = _number(start_hz, item, "start", minimum=0.0, strictly=True)
-        stop_hz = _number(stop_hz, item, "stop", minimum=0.0, strictly=True)
+        start_hz = fields.positive_number(item, "start", start_hz)
+        stop_hz = fields.positive_number(item, "stop", stop_hz)
         points = bounded_count(item, "points", points, 1, MAX_SWEEP_POINTS, "the most points a sweep takes")
         space = np.geomspace if spacing == "log" else np.linspace
         return cls(name, template, tuple(float(f) for f in space(start_hz, stop_hz, points)))
@@ -959,8 +915,8 @@ class RunUp(Sweep):
         item = f"excitation {name!r}"
         if unit not in SPEED_UNITS:
             raise CaseError(item, "speed_unit", unit, " or ".join(repr(u) for u in SPEED_UNITS))
-        start = _number(start, item, "start", minimum=0.0, strictly=True)
-        stop = _number(stop, item, "stop", minimum=0.0, strictly=True)
+        start = fields.positive_number(item, "start", start)
+        stop = fields.positive_number(item, "stop", stop)
         if stop <= start:
             raise CaseError(item, "stop", stop, f"a speed above the start ({start:g} {unit})")
         points = bounded_count(item, "points", points, 2, MAX_SWEEP_POINTS, "the most speeds a run-up takes")
@@ -999,7 +955,7 @@ class Simultaneous:
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
-        _name(self.name, "excitation")
+        fields.nonempty_name("excitation", self.name)
         try:
             parts = tuple(self.parts)
         except TypeError:
@@ -1112,9 +1068,9 @@ class AnalysisSettings:
                 or not 0 <= self.step_halvings <= 20:
             raise CaseError(item, "step_halvings", self.step_halvings, "a whole number from 0 to 20")
         if self.time_budget is not None:
-            _set(self, "time_budget", _number(self.time_budget, item, "time_budget", minimum=0.0, strictly=True))
-        _set(self, "divergence_displacement", _number(self.divergence_displacement, item,
-                                                      "divergence_displacement", minimum=0.0, strictly=True))
+            _set(self, "time_budget", fields.positive_number(item, "time_budget", self.time_budget))
+        _set(self, "divergence_displacement", fields.positive_number(item, "divergence_displacement",
+                                                                     self.divergence_displacement))
         if self.method not in ANALYSIS_METHODS:
             raise CaseError(item, "method", self.method, " or ".join(repr(m) for m in ANALYSIS_METHODS))
         for name in ("steps_per_period", "measured_periods"):
@@ -1123,14 +1079,13 @@ class AnalysisSettings:
                 raise CaseError(item, name, value, "a positive whole number")
         if self.steps_per_period < 8:
             raise CaseError(item, "steps_per_period", self.steps_per_period, "at least 8")
-        _set(self, "ramp_periods", _number(self.ramp_periods, item, "ramp_periods", minimum=0.0))
-        _set(self, "settle_time_constants", _number(self.settle_time_constants, item,
-                                                    "settle_time_constants", minimum=0.0))
+        _set(self, "ramp_periods", fields.number(item, "ramp_periods", self.ramp_periods, minimum=0.0))
+        _set(self, "settle_time_constants", fields.number(item, "settle_time_constants", self.settle_time_constants, minimum=0.0))
         if self.settle_time is not None:
-            _set(self, "settle_time", _number(self.settle_time, item, "settle_time", minimum=0.0))
+            _set(self, "settle_time", fields.number(item, "settle_time", self.settle_time, minimum=0.0))
         for name in ("steady_tolerance", "newton_tolerance", "equilibrium_tolerance"):
-            _set(self, name, _number(getattr(self, name), item, name, minimum=0.0, strictly=True))
-        rho = _number(self.spectral_radius, item, "spectral_radius", minimum=0.0)
+            _set(self, name, fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True))
+        rho = fields.number(item, "spectral_radius", self.spectral_radius, minimum=0.0)
         if rho > 1:
             raise CaseError(item, "spectral_radius", rho, "a number from 0 to 1")
         _set(self, "spectral_radius", rho)
@@ -1247,7 +1202,7 @@ class Case:
     pylon_mesh: MeshPylon | None = None
 
     def __post_init__(self):
-        _name(self.name, "case")
+        fields.nonempty_name("case", self.name)
         checks = (("engine", Engine), ("analysis", AnalysisSettings), ("effects", Effects))
         for name, kind in checks:
             if not isinstance(getattr(self, name), kind):

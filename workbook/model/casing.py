@@ -28,7 +28,7 @@ from flexbodies.casing import CasingGeometry, CasingInterface, MountRing, defaul
 from flexbodies.casing_reduction import CasingModel
 from flexbodies.materials import TITANIUM, Material
 from workbook.errors import CaseError
-from workbook.model.fields import MAX_MODE_COUNT, bounded_count, positive_number
+from workbook.model.fields import MAX_MODE_COUNT, bounded_count, pair, positive_number
 
 __all__ = ["EngineCasing", "CoreBody", "split_engine", "CASING", "MountRing", "CasingGeometry",
            "DEFAULT_BEARING_STIFFNESS", "parallel_axis", "casing_origin", "bearing_name",
@@ -49,17 +49,6 @@ DEFAULT_CORE_SPIN_HZ = 2000.0
 #: casing dissipates about 1-2 % of critical; 0.02 is its upper end.
 DEFAULT_CASING_DAMPING = 0.02
 _ITEM = "engine casing"
-
-
-def _pair(name: str, value, *, strictly: bool) -> tuple[float, float]:
-    try:
-        pair = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        pair = ()
-    low = (lambda v: v > 0) if strictly else (lambda v: v >= 0)
-    if len(pair) != 2 or not all(math.isfinite(v) and low(v) for v in pair):
-        raise CaseError(_ITEM, name, value, f"two numbers (radial, axial) {'> 0' if strictly else '>= 0'}")
-    return pair
 
 
 @dataclass(frozen=True)
@@ -133,8 +122,8 @@ class EngineCasing:
         for name in ("spider_radius", "core_spin_hz") + (("element_size",) if self.element_size is not None else ()) \
                 + (("bearing_band",) if self.bearing_band is not None else ()):
             object.__setattr__(self, name, positive_number(_ITEM, name, getattr(self, name)))
-        object.__setattr__(self, "bearing_stiffness", _pair("bearing_stiffness", self.bearing_stiffness, strictly=True))
-        object.__setattr__(self, "bearing_damping", _pair("bearing_damping", self.bearing_damping, strictly=False))
+        object.__setattr__(self, "bearing_stiffness", pair(_ITEM, "bearing_stiffness", self.bearing_stiffness, strictly=True))
+        object.__setattr__(self, "bearing_damping", pair(_ITEM, "bearing_damping", self.bearing_damping, strictly=False))
         zeta = self.modal_damping
         if isinstance(zeta, bool) or not (isinstance(zeta, (int, float)) and 0 <= zeta < 1):
             raise CaseError(_ITEM, "modal_damping", zeta, "a damping ratio, 0 <= zeta < 1")

@@ -1,11 +1,17 @@
-"""Checks of single fields that several parts of a case share: a value found, or a CaseError naming it."""
+"""Checks of single fields, the one vocabulary of every part of a case: a value found, or a CaseError naming it.
+
+Every check takes ``(item, name, value, ...)``: the item at fault (``"hinge 'front-up-left'"``), the
+field's name and the value found, and returns the value in its normal form.
+"""
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from workbook.errors import CaseError
 
-__all__ = ["positive_number", "finite_point", "bounded_count", "MAX_SWEEP_POINTS", "MAX_MODE_COUNT"]
+__all__ = ["number", "positive_number", "vector3", "finite_point", "pair", "direction", "nonempty_name", "bounded_count",
+           "MAX_SWEEP_POINTS", "MAX_MODE_COUNT"]
 
 #: Most frequencies of one sweep, or speeds of one run-up: each is a solve of its own (a time-domain point
 #: takes seconds), and a longer list is a slip (1e6 typed for 100) whose building alone costs minutes and
@@ -16,26 +22,66 @@ MAX_SWEEP_POINTS = 10_000
 MAX_MODE_COUNT = 1_000
 
 
-def positive_number(item: str, name: str, value) -> float:
-    """*value* as a finite float > 0, or a CaseError naming *item* and *name*."""
+def number(item: str, name: str, value: Any, *, minimum: float = -math.inf, strictly: bool = False) -> float:
+    """*value* as a finite float at or above *minimum* (above it if *strictly*), or a CaseError."""
+    if isinstance(value, bool):
+        raise CaseError(item, name, value, "a number")
     try:
-        number = float(value)
+        found = float(value)
     except (TypeError, ValueError):
-        number = math.nan
-    if isinstance(value, bool) or not (math.isfinite(number) and number > 0):
-        raise CaseError(item, name, value, "a finite number > 0")
-    return number
+        raise CaseError(item, name, value, "a number") from None
+    too_small = found <= minimum if strictly else found < minimum
+    if not math.isfinite(found) or too_small:
+        bound = f"{'>' if strictly else '>='} {minimum:g}" if minimum > -math.inf else "finite"
+        raise CaseError(item, name, value, f"a number {bound}")
+    return found
 
 
-def finite_point(item: str, name: str, value) -> tuple:
-    """*value* as three finite floats (x, y, z), or a CaseError naming *item* and *name*."""
+def positive_number(item: str, name: str, value: Any) -> float:
+    """*value* as a finite float > 0, or a CaseError."""
+    return number(item, name, value, minimum=0.0, strictly=True)
+
+
+def vector3(item: str, name: str, value: Any) -> tuple[float, float, float]:
+    """*value* as three finite floats, or a CaseError."""
     try:
-        point = tuple(float(v) for v in value)
+        vector = tuple(float(v) for v in value)
     except (TypeError, ValueError):
-        point = ()
-    if len(point) != 3 or not all(math.isfinite(v) for v in point):
-        raise CaseError(item, name, value, "three finite numbers (x, y, z), m")
-    return point
+        raise CaseError(item, name, value, "three numbers") from None
+    if len(vector) != 3 or not all(math.isfinite(v) for v in vector):
+        raise CaseError(item, name, value, "three finite numbers")
+    return vector[0], vector[1], vector[2]
+
+
+def finite_point(item: str, name: str, value: Any) -> tuple[float, float, float]:
+    """*value* as a point (x, y, z), m: three finite floats, or a CaseError."""
+    return vector3(item, name, value)
+
+
+def pair(item: str, name: str, value: Any, *, strictly: bool) -> tuple[float, float]:
+    """*value* as two finite floats (radial, axial), each >= 0 (> 0 if *strictly*), or a CaseError."""
+    try:
+        found = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        found = ()
+    if len(found) != 2 or not all(math.isfinite(v) and (v > 0 if strictly else v >= 0) for v in found):
+        raise CaseError(item, name, value, f"two numbers (radial, axial) {'> 0' if strictly else '>= 0'}")
+    return found[0], found[1]
+
+
+def direction(item: str, name: str, value: Any) -> tuple[float, float, float]:
+    """*value* as three finite floats, not all zero, or a CaseError."""
+    vector = vector3(item, name, value)
+    if not any(vector):
+        raise CaseError(item, name, value, "a non-zero direction")
+    return vector
+
+
+def nonempty_name(item: str, value: Any) -> str:
+    """*value* as the name of *item*: a text that is not blank, or a CaseError."""
+    if not isinstance(value, str) or not value.strip():
+        raise CaseError(item, "name", value, "a non-empty text")
+    return value
 
 
 def bounded_count(item: str, name: str, value, minimum: int, maximum: int, what: str) -> int:
