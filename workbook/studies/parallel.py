@@ -55,12 +55,8 @@ log = logging.getLogger(__name__)
 #: ``workers`` value that runs every row in this process.
 SERIAL = 1
 #: Rows per worker process in one chunk of rows; each chunk runs in a fresh
-#: pool, which bounds the memory a run might still leave behind. Measured with
-#: ``benchmarks/bench_memory.py`` (worker mode, reference mount): a worker's
-#: resident memory did not grow over 30 rows (125.3 MB after 5 rows, 120.8 MB
-#: after 30) now that scenes free Exudyn's system; before, a run of the
-#: reference mount left about 33 MB behind. Even at the 1 MB per run the
-#: memory tests allow, a chunk keeps a worker within about 200 MB of its start.
+#: pool, which bounds the memory a run might still leave behind (measured in
+#: docs/reliability.md, "Memory over many runs").
 ROWS_PER_WORKER = 200
 
 

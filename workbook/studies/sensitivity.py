@@ -35,9 +35,9 @@ __all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "S
 TableFormat = Literal["csv", "parquet"]
 #: File formats of the study table.
 TABLE_FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
-#: Least time between two writes of a running study's table file, s. Writing
-#: a 10,000-row table takes about 0.3 s; written after every row, it would
-#: cost more than the rows themselves.
+#: Least time between two writes of a running study's table file, s: written
+#: after every row, a long study's growing table would cost more than its rows
+#: (docs/reliability.md, ``benchmarks/bench_study_table.py``).
 WRITE_INTERVAL = 2.0
 #: Columns of a run's answers.
 ANSWERS = ("run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS), *(f"eta % {d}" for d in DIRECTIONS), "steady")
