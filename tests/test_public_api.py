@@ -41,7 +41,7 @@ INTERNAL_MODULES = (
     "workbook.rig", "workbook.rig.correlation", "workbook.rig.records", "workbook.rig.synthetic",
     "workbook.scene", "workbook.scene.bearing", "workbook.scene.build", "workbook.scene.engine_casing",
     "workbook.scene.excitation", "workbook.scene.hinge_law", "workbook.scene.link_workers",
-    "workbook.scene.structural_damping",
+    "workbook.scene.mode_budget", "workbook.scene.structural_damping",
     "workbook.solve", "workbook.solve.flexible_pylon", "workbook.solve.four_pole", "workbook.solve.four_pole_set",
     "workbook.solve.guards", "workbook.solve.harmonic", "workbook.solve.method", "workbook.solve.modes",
     "workbook.solve.pipeline", "workbook.solve.preload", "workbook.solve.pylon_beam", "workbook.solve.pylon_mesh",

@@ -39,6 +39,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from flexbodies.craig_bampton import ModeBudgetExceeded
 from workbook.model.case import (
     ENGINE,
     POINT_TOLERANCE,
@@ -58,6 +59,7 @@ from workbook.scene.engine_casing import CasingItems, add_flexible_engine
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 from workbook.scene.link_workers import LinkJob, reduce_in_workers
+from workbook.scene.mode_budget import mode_budget_error
 from workbook.scene.structural_damping import equivalent_viscous_damping
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
@@ -466,6 +468,12 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None
     Returns
     -------
     dict of str to flexbodies.ReducedLink
+
+    Raises
+    ------
+    CaseError
+        An excitation (or a link's cut-off) asks for more fixed-interface
+        modes than a reduction keeps (:mod:`workbook.scene.mode_budget`).
     """
     frequency = _reduction_frequency(case, excitation)
     jobs = link_jobs(case, excitation)
@@ -480,7 +488,10 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | None = None
     reduce_in_workers(list(jobs), done=lambda job: show(shown + len(jobs[job])))
     reduced = {}
     for job, names in jobs.items():
-        per_frequency = job.reduce()
+        try:
+            per_frequency = job.reduce()
+        except ModeBudgetExceeded as error:
+            raise mode_budget_error(case, f"link {names[0]!r}", job.modes, error) from None
         for name in names:
             reduced[name] = per_frequency[job.excitations_hz.index(frequency)]
         show(len(reduced))
