@@ -45,6 +45,10 @@ STIFFNESS_COLUMNS = tuple(f"K{a}{b} {part}" for a, b in itertools.product(_AXES,
 FORMAT_HEADER = ("frequency", "pin", *STIFFNESS_COLUMNS)
 #: Largest table read, rows.
 MAX_ROWS = 200_000
+#: A row is passive when the least eigenvalue of the Hermitian part of its
+#: imaginary part, ``(Z - Z^H) / 2i``, is above minus this share of its
+#: largest entry: the round-off of a table printed to six digits.
+PASSIVITY_TOLERANCE = 1e-6
 
 
 def _nested(array: np.ndarray) -> tuple:
@@ -66,6 +70,12 @@ class PylonImpedance:
     real, imag : nested tuples, shape (f, p, 3, 3)
         Real and imaginary parts of ``Z_p``, N/m: force on the pylon at a
         pin (row x, y, z) per motion of the pin (column x, y, z).
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        Values of the wrong shape, or a row that is not passive
+        (:data:`PASSIVITY_TOLERANCE`).
     """
 
     source: str
@@ -96,6 +106,34 @@ class PylonImpedance:
             object.__setattr__(self, name, _nested(values))
         object.__setattr__(self, "frequencies_hz", tuple(float(f) for f in frequencies))
         object.__setattr__(self, "pins", pins)
+        self._check_passive(item)
+
+    def _check_passive(self, item: str) -> None:
+        """Refuse rows that give energy to the mount.
+
+        The mean power a pin puts into the pylon moving as ``x e^{iwt}`` is
+        ``w/2 x^H (Z - Z^H)/2i x``: a passive structure absorbs it for every
+        ``x``, so the Hermitian part of the imaginary part is positive
+        semi-definite (for a symmetric Z: ``Im Z``). A row where it is not
+        (an active damper) makes the coupled mount unstable, and a steady
+        answer on it is no answer.
+        """
+        values = self.values
+        dissipation = (values - np.conj(np.swapaxes(values, -1, -2))) / 2j
+        least = np.linalg.eigvalsh(dissipation)[..., 0]
+        scale = np.abs(values).max(axis=(-2, -1))
+        active = np.argwhere(least < -PASSIVITY_TOLERANCE * scale)
+        if not active.size:
+            return
+        listed = "; ".join(f"pin {self.pins[p]!r} at {self.frequencies_hz[f]:g} Hz (least eigenvalue "
+                           f"{least[f, p]:.3g} N/m)" for f, p in active[:3])
+        more = f" and {len(active) - 3} more" if len(active) > 3 else ""
+        raise CaseError(item, "imag", f"{len(active)} of {least.size} rows giving energy to the mount: {listed}{more}",
+                        "a passive pylon: at every row the Hermitian part of the imaginary part, (Z - Z^H)/2i, "
+                        "positive semi-definite (for a symmetric Z: every 'K.. im' on the diagonal >= 0, the "
+                        "damping of each direction). A negative imaginary part is an active damper: the mount "
+                        "on it is unstable and has no steady answer. Check the sign convention of the table "
+                        "(the force on the pylon per motion of its pin)")
 
     @classmethod
     def from_array(cls, source: str, frequencies_hz, pins, values) -> "PylonImpedance":
