@@ -189,6 +189,64 @@ class PylonImpedance:
                    for c in range(flat.shape[1])]
         return np.array(columns).T.reshape(len(wanted), *values.shape[1:])
 
+    def interpolation_warnings(self, frequencies_hz, order: Sequence[int]) -> list[list[str]]:
+        """Warnings for the frequencies the table's rows cannot resolve.
+
+        A real part that changes sign between two rows is a resonance of
+        the pylon between them. Linear interpolation follows it only when
+        the rows lie closer than its half-power bandwidth, estimated as
+        ``2 |Im Z| / |d Re Z / df|`` at the zero of the interpolated real
+        part (a mass-spring-damper's bandwidth); otherwise a frequency
+        between the two rows is warned.
+
+        Parameters
+        ----------
+        frequencies_hz : sequence of float
+            Frequencies within the table, Hz.
+        order : sequence of int
+            The table's pin of each pin of the case (:meth:`pin_order`).
+
+        Returns
+        -------
+        list of list of str
+            The warnings of each frequency.
+        """
+        table = np.asarray(self.frequencies_hz)
+        values = self.values[:, list(order)]
+        pins = [self.pins[n] for n in order]
+        scale = np.abs(values).max(axis=(1, 2, 3))
+        warned = []
+        for frequency in np.atleast_1d(np.asarray(frequencies_hz, dtype=float)):
+            row = int(np.searchsorted(table, frequency))
+            if row == 0 or row == len(table) or frequency == table[row]:
+                warned.append([])
+                continue
+            low, high = values[row - 1], values[row]
+            width = table[row] - table[row - 1]
+            # an element that matters (above 1e-3 of the rows' largest) whose real part changes sign
+            floor = 1e-3 * max(scale[row - 1], scale[row])
+            crossing = (low.real * high.real < 0) & (np.minimum(abs(low.real), abs(high.real)) > floor)
+            found = []
+            for pin, a, b in np.argwhere(crossing):
+                share = low[pin, a, b].real / (low[pin, a, b].real - high[pin, a, b].real)
+                damping = abs(low[pin, a, b].imag + share * (high[pin, a, b].imag - low[pin, a, b].imag))
+                band_hz = 2 * damping * width / abs(high[pin, a, b].real - low[pin, a, b].real)
+                if width > band_hz:
+                    found.append((band_hz, pins[pin], f"K{_AXES[a]}{_AXES[b]}", low[pin, a, b].real,
+                                  high[pin, a, b].real))
+            if found:
+                band_hz, pin, entry, before, after = min(found)
+                warned.append([
+                    f"pylon impedance {self.source}: {frequency:g} Hz lies between the rows at {table[row - 1]:g} "
+                    f"and {table[row]:g} Hz, where Re {entry} of pin {pin!r} changes sign ({before:.4g} to "
+                    f"{after:.4g} N/m; {len(found)} entries change sign there): a resonance of the pylon between "
+                    f"the rows, about {band_hz:.2g} Hz wide, which linear interpolation between rows {width:g} Hz "
+                    f"apart does not follow (T there may be many times off). Give rows no more than "
+                    f"{band_hz / 4:.2g} Hz apart from {table[row - 1]:g} to {table[row]:g} Hz"])
+            else:
+                warned.append([])
+        return warned
+
     def describe(self) -> str:
         """One line for the model card."""
         return (f"{len(self.pins)} pin(s), {len(self.frequencies_hz)} frequencies from "
