@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from flexbodies.casing import ElementSizeTooLarge
 from flexbodies.casing_reduction import add_casing_to_exudyn, reduce_casing
 from flexbodies.craig_bampton import ModeBudgetExceeded
 from workbook.errors import CaseError
@@ -85,7 +86,8 @@ def reduce_engine_casing(case, excitation_hz: float):
     CaseError
         The mesh file cannot be read or has no surface at an interface, or two
         interfaces overlap (the message is the reduction's, naming the file);
-        or an excitation asks for more modes than a reduction keeps.
+        a parametric casing's element size too large to mesh untangled; or
+        an excitation asks for more modes than a reduction keeps.
     """
     casing, engine = case.engine.casing, case.engine
     model = casing.model(engine.center_of_mass, [(eye_name(names), point) for point, names in case.engine_eyes()])
@@ -94,6 +96,9 @@ def reduce_engine_casing(case, excitation_hz: float):
         return reduce_casing(model, casing.modes, frequencies)[frequencies.index(excitation_hz)]
     except ModeBudgetExceeded as error:
         raise mode_budget_error(case, f"the {CASING}", casing.modes, error) from None
+    except ElementSizeTooLarge as error:
+        raise CaseError(CASING, "element_size", error.element_size,
+                        f"an element size of at most {error.largest:g} m: {error}") from None
     except (ValueError, OSError) as error:
         field_name = "mesh" if casing.mesh is not None else "geometry"
         raise CaseError("engine casing", field_name, casing.mesh or "the parametric casing",
