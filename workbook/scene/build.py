@@ -599,18 +599,19 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | None = None,
         stiffness = hinge.values("stiffness")
         if clearance:
             stiffness[:] = hinge.gap_contact_stiffness
-        damping = (hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)) \
-            + [viscous(eta, k) for eta, k in zip(hinge.values("loss_factor") if hinge.name in hinge_loss
-                                                 else np.zeros(3), stiffness)]
+        etas = hinge.values("loss_factor") if hinge.name in hinge_loss else np.zeros(3)
+        damping = hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)
+        if not clearance:      # the clearance law damps its loss factor on its own tangent stiffness
+            damping = damping + [viscous(eta, k) for eta, k in zip(etas, stiffness)]
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
             name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
             damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         law = None
         if clearance:
-            gap = hinge.radial_clearance
-            if gap not in clearance_functions:
-                clearance_functions[gap] = exudyn_clearance_function(gap)
-            law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
+            key = (hinge.radial_clearance, tuple(viscous(eta, 1.0) for eta in etas))
+            if key not in clearance_functions:
+                clearance_functions[key] = exudyn_clearance_function(*key)
+            law = CreateSymbolicUserFunction(mbs, clearance_functions[key], "springForceUserFunction", connector)
             mbs.SetObjectParameter(connector, "springForceUserFunction", law)
         elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
             bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),
