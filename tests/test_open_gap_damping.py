@@ -55,7 +55,8 @@ def test_the_time_domain_gives_the_closed_form_on_open_gaps(open_gaps):
 
 def test_the_loss_damps_the_tangent_stiffness_of_the_law():
     """The law's tangent stiffness against central differences of its
-    force, open and in contact; and its loss force is c K_t v."""
+    force, open and in contact; and its loss force is c K_t v. At impact
+    the loss force starts from the open gap's and grows continuously."""
     k, c = 2e8, 1e-4
     for u in ([3e-6, -2e-6, 1e-6], [4e-5, 1e-5, -2e-5]):       # open (|u| < 20 um) and in contact
         step = 1e-12
@@ -64,7 +65,12 @@ def test_the_loss_damps_the_tangent_stiffness_of_the_law():
                    for e in step * np.eye(3)]
         np.testing.assert_allclose(tangent_stiffness(u, 2e-5, k), np.array(columns).T, rtol=1e-6, atol=1e-6 * k)
         v = np.array([0.1, 0.2, -0.3])
+        # beyond a gap width of penetration (the second point) the loss damps the full tangent
         loss = clearance_force(u, v, 2e-5, k, 0.0, c) - clearance_force(u, np.zeros(3), 2e-5, k, 0.0)
         np.testing.assert_allclose(loss, c * tangent_stiffness(u, 2e-5, k) @ v, rtol=1e-12)
     open_loss = c * tangent_stiffness([3e-6, 0.0, 0.0], 2e-5, k)
     np.testing.assert_allclose(open_loss, c * RESIDUAL_STIFFNESS_RATIO * k * np.eye(3))
+    v = np.array([0.1, 0.0, 0.0])
+    just_open, just_closed = ([(1 + s) * 2e-5, 0.0, 0.0] for s in (-1e-9, 1e-9))
+    jump = clearance_force(just_closed, v, 2e-5, k, 0.0, c) - clearance_force(just_open, v, 2e-5, k, 0.0, c)
+    assert np.abs(jump).max() < 1e-6 * c * k * 0.1

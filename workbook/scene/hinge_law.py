@@ -12,7 +12,10 @@ is the viscous equivalent of the hinge's loss factor in a time integration
 (``c = eta / omega``, :mod:`workbook.scene.structural_damping`): the loss
 factor acts on the law's tangent stiffness ``K_t``, as in the frequency
 domain, so across an open gap it damps only with the residual stiffness,
-and in contact with the contact's. The law is recorded as an Exudyn symbolic
+and in contact with the contact's. Its part along the contact normal grows
+with the penetration over the first gap width (the full tangent beyond):
+a damper that switches on at full strength at impact made the contact force
+jump and Newton fail on rattling gaps. The law is recorded as an Exudyn symbolic
 user function and runs at C++ speed (plain Python user functions were
 measured about 2x slower per run).
 """
@@ -27,7 +30,7 @@ __all__ = ["RESIDUAL_STIFFNESS_RATIO", "clearance_force", "tangent_stiffness", "
 RESIDUAL_STIFFNESS_RATIO = 1e-4
 
 
-def tangent_stiffness(displacement, gap: float, contact_stiffness: float) -> np.ndarray:
+def tangent_stiffness(displacement, gap: float, contact_stiffness: float, *, onset: bool = False) -> np.ndarray:
     """The law's tangent stiffness ``K_t = dF/du`` (the spring part), N/m.
 
     Inside the gap ``k_r I``; in contact ``(k_r + k_c (1 - g/|u|)) I + k_c
@@ -43,6 +46,9 @@ def tangent_stiffness(displacement, gap: float, contact_stiffness: float) -> np.
         m.
     contact_stiffness : float
         N/m.
+    onset : bool
+        True: the normal part ``k_c (g/|u|) n n^T`` times ``min(penetration
+        / g, 1)``, what the loss factor damps (module text).
 
     Returns
     -------
@@ -53,6 +59,8 @@ def tangent_stiffness(displacement, gap: float, contact_stiffness: float) -> np.
     factor = RESIDUAL_STIFFNESS_RATIO * contact_stiffness \
         + contact_stiffness * max(distance - gap, 0.0) / max(distance, gap)
     radial = contact_stiffness * gap / distance if distance > gap else 0.0
+    if onset:
+        radial *= min(max(distance - gap, 0.0) / gap, 1.0)
     normal = u / distance if distance > 0 else np.zeros(3)
     return factor * np.eye(3) + radial * np.outer(normal, normal)
 
@@ -73,7 +81,7 @@ def clearance_force(displacement, velocity, gap: float, contact_stiffness: float
         Viscous damping d, N s/m.
     loss_time : float or array_like, shape (3,)
         ``c = eta / omega`` of the loss factor's viscous equivalent per
-        direction, s (0: none).
+        direction, s (0: none); it damps ``tangent_stiffness(..., onset=True)``.
 
     Returns
     -------
@@ -85,7 +93,7 @@ def clearance_force(displacement, velocity, gap: float, contact_stiffness: float
     distance = np.linalg.norm(u)
     factor = RESIDUAL_STIFFNESS_RATIO * contact_stiffness \
         + contact_stiffness * max(distance - gap, 0.0) / max(distance, gap)
-    loss = np.asarray(loss_time, dtype=float) * (tangent_stiffness(u, gap, contact_stiffness) @ v)
+    loss = np.asarray(loss_time, dtype=float) * (tangent_stiffness(u, gap, contact_stiffness, onset=True) @ v)
     return factor * u + damping * v + loss
 
 
@@ -117,9 +125,9 @@ def exudyn_clearance_function(gap: float, loss_time=(0.0, 0.0, 0.0)):
         force = [factor * u[i] + damping[i] * v[i] for i in range(3)]
         if not any(loss_time):
             return force
-        # K_t v (tangent_stiffness): the radial term acts only in contact (sign: 1 in contact, 0 open)
-        closed = esym.sign(esym.max(distance - gap, esym.Real(0.0)))
-        radial = closed * stiffness[0] * gap / esym.max(distance, esym.Real(gap)) \
+        # K_t v (tangent_stiffness with onset): the normal part grows over the first gap width of penetration
+        onset = esym.min(esym.max(distance - gap, esym.Real(0.0)) / gap, esym.Real(1.0))
+        radial = onset * stiffness[0] * gap / esym.max(distance, esym.Real(gap)) \
             * (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / esym.max(distance * distance, esym.Real(gap * gap))
         return [force[i] + loss_time[i] * (factor * v[i] + radial * u[i]) for i in range(3)]
 
