@@ -18,7 +18,7 @@ from workbook._lazy import lazy_names
 _HOMES = {
     "assembly": ("FEModel", "assemble"),
     "eigen": ("natural_frequencies",),
-    "errors": ("LinkModelError", "ReducedLinkFileError"),
+    "errors": ("LinkModelError", "TangledElements", "ReducedLinkFileError"),
     "exudyn_body": ("ExudynLink", "add_link_to_exudyn", "export_exudyn_file", "link_rotation"),
     "geometry": ("LinkGeometry",),
     "interfaces": ("InterfaceCoupling", "couple_interfaces"),

@@ -14,11 +14,11 @@ import numpy as np
 import scipy.sparse as sp
 import skfem
 
-from .errors import LinkModelError
+from .errors import TangledElements
 from .materials import Material
 from .meshing import Bore, LinkMesh
 
-__all__ = ["FEModel", "Bore", "assemble", "INTEGRATION_ORDERS"]
+__all__ = ["FEModel", "Bore", "assemble", "INTEGRATION_ORDERS", "tangled_elements"]
 
 logger = logging.getLogger(__name__)
 
@@ -105,8 +105,8 @@ def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = Non
 
     Raises
     ------
-    ValueError
-        If an element is tangled or degenerate (Jacobian determinant zero or
+    TangledElements
+        A ValueError, if an element is tangled or degenerate (Jacobian determinant zero or
         changing sign inside it), e.g. a hexahedron whose node order is not
         meshio's. Mirrored elements (negative determinant throughout) are
         valid and accepted.
@@ -205,8 +205,21 @@ class _BlockPattern:
         return matrix
 
 
+def _orientation(basis: skfem.CellBasis) -> tuple[np.ndarray, np.ndarray]:
+    """The tangled elements' indices, and which elements are mirrored (det J < 0 throughout)."""
+    points = np.hstack([basis.X, basis.mesh.elem().doflocs.T])
+    det = basis.mapping.detDF(points)
+    positive, negative = (det > 0).all(axis=1), (det < 0).all(axis=1)
+    return np.flatnonzero(~(positive | negative)), negative
+
+
+def tangled_elements(mesh: skfem.Mesh) -> np.ndarray:
+    """Indices of the elements of *mesh* that :func:`assemble` refuses as tangled or degenerate."""
+    return _orientation(skfem.Basis(mesh, mesh.elem(), intorder=INTEGRATION_ORDERS[type(mesh)][0]))[0]
+
+
 def _check_orientation(basis: skfem.CellBasis, source: str) -> None:
-    """Raise if an element's Jacobian determinant vanishes or changes sign.
+    """Raise :class:`TangledElements` if an element's Jacobian determinant vanishes or changes sign.
 
     scikit-fem integrates with |det J|. That is harmless for a mirrored
     element (det J < 0 everywhere: the map is still one-to-one), but a
@@ -214,15 +227,11 @@ def _check_orientation(basis: skfem.CellBasis, source: str) -> None:
     order, would assemble silently into a wrong matrix. The determinant is
     checked at the integration points and at the element's nodes.
     """
-    points = np.hstack([basis.X, basis.mesh.elem().doflocs.T])
-    det = basis.mapping.detDF(points)
-    positive, negative = (det > 0).all(axis=1), (det < 0).all(axis=1)
-    bad = np.flatnonzero(~(positive | negative))
+    bad, negative = _orientation(basis)
     if bad.size:
-        raise LinkModelError(
-            f"{source}: {bad.size} of {det.shape[0]} elements are tangled or degenerate (the Jacobian "
+        raise TangledElements(
+            f"{source}: {bad.size} of {negative.size} elements are tangled or degenerate (the Jacobian "
             f"determinant vanishes or changes sign inside; first: element {bad[0]}); check the element "
-            "node order (meshio's order is expected) and the mesh quality"
-        )
+            "node order (meshio's order is expected) and the mesh quality", bad.size, negative.size)
     if negative.any():
         logger.debug("%s: %d mirrored (negatively oriented) elements; valid", source, negative.sum())

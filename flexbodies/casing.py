@@ -30,7 +30,7 @@ if TYPE_CHECKING:  # meshing loads gmsh, meshio and scikit-fem: imported where a
     from .meshing import LinkMesh
 
 __all__ = ["MountRing", "CasingGeometry", "CasingInterface", "mesh_casing", "casing_interfaces",
-           "default_casing_element_size"]
+           "default_casing_element_size", "ElementSizeTooLarge", "element_size_error"]
 
 
 #: Elements at least round a full circle: 12 (a 30 degree arc per quadratic
@@ -182,6 +182,60 @@ def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> 
         points, cells = generate_tet10(size, curvature_points=_CURVATURE_POINTS)
     mesh, _ = skfem_mesh("tetra10", points, cells)
     return LinkMesh(mesh=mesh, bores=(), source=f"gmsh casing mesh, element size {size * 1e3:.4g} mm")
+
+
+#: Each smaller element size tried for one that meshes is this share of the last.
+_SIZE_STEP = 0.9
+
+
+class ElementSizeTooLarge(LinkModelError):
+    """A parametric casing whose gmsh mesh at its element size has tangled elements.
+
+    Attributes
+    ----------
+    element_size : float
+        The size asked for, m.
+    largest : float
+        The largest size tried that meshes untangled, m (the default size
+        when none larger does).
+    """
+
+    def __init__(self, message: str, element_size: float, largest: float):
+        super().__init__(message)
+        self.element_size, self.largest = element_size, largest
+
+
+def element_size_error(geometry: CasingGeometry, element_size: float, tangled: int,
+                       total: int) -> ElementSizeTooLarge:
+    """Why *element_size* does not mesh *geometry*, with the largest size that does.
+
+    Quadratic tetrahedra much larger than the wall's thickness, their edge
+    nodes placed on the curved surfaces, fold over (on the reference casing,
+    0.5 m radius and 25 mm wall: 0.13 m meshes, 0.14 m gives 2 tangled
+    elements; a 50 mm wall tangles already at 0.22 m). The sizes from
+    *element_size* down in steps of :data:`_SIZE_STEP` are meshed until one
+    has no tangled element, at most down to the default size.
+
+    Parameters
+    ----------
+    geometry : CasingGeometry
+    element_size : float
+        m.
+    tangled, total : int
+        Tangled elements at *element_size*, and all elements.
+    """
+    from .assembly import tangled_elements
+
+    default = default_casing_element_size(geometry)
+    size = float(f"{element_size * _SIZE_STEP:.3g}")      # the size tried is the size offered
+    while size > default and tangled_elements(mesh_casing(geometry, size).mesh).size:
+        size = float(f"{size * _SIZE_STEP:.3g}")
+    largest = max(size, default)
+    return ElementSizeTooLarge(
+        f"the parametric casing meshed with element_size {element_size:.4g} m has {tangled} of "
+        f"{total} quadratic elements tangled: larger than its {geometry.thickness:g} m wall several times "
+        f"over, an element folds where its edge nodes follow the curved surfaces. element_size {largest:g} m "
+        f"meshes (the default for this casing is {default:.3g} m)", element_size, largest)
 
 
 @dataclass(frozen=True)

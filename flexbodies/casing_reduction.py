@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from .cached_reduction import cached_reductions
-from .casing import CasingGeometry, casing_interfaces, default_casing_element_size, mesh_casing
+from .casing import CasingGeometry, casing_interfaces, default_casing_element_size, element_size_error, mesh_casing
 from .exudyn_body import exudyn_cms_interface, modal_damping_matrix
 from .materials import TITANIUM, Material
 from .reduced import SCHEMA_VERSION, ReducedLink
@@ -97,11 +97,24 @@ class CasingModel:
         return "the parametric casing" if self.geometry is not None else f"casing mesh {self.mesh_file}"
 
     def meshed(self):
-        """The casing mesh with its interfaces resolved."""
+        """The casing mesh with its interfaces resolved.
+
+        Raises
+        ------
+        flexbodies.casing.ElementSizeTooLarge
+            A parametric casing whose mesh has tangled elements (checked
+            before its interfaces, which a tangled mesh may miss too).
+        """
         from .meshing import load_mesh
 
         if self.geometry is not None:
-            casing_mesh = mesh_casing(self.geometry, self.element_size)
+            from .assembly import tangled_elements
+
+            size = self.element_size if self.element_size is not None else default_casing_element_size(self.geometry)
+            casing_mesh = mesh_casing(self.geometry, size)
+            tangled = tangled_elements(casing_mesh.mesh).size
+            if tangled:
+                raise element_size_error(self.geometry, size, tangled, casing_mesh.mesh.nelements)
         else:
             casing_mesh = load_mesh(self.mesh_file, (), scale=self.scale)
         return casing_interfaces(casing_mesh, self.interfaces, self.source())

@@ -20,7 +20,8 @@ import scipy.sparse as sp
 from .eigen import factorize, lowest_modes
 from .errors import LinkModelError
 
-__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "fixed_interface_set", "kept_count"]
+__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "fixed_interface_set", "kept_count",
+           "ModeBudgetExceeded", "MODE_BUDGET", "estimated_mode_count"]
 
 #: Frequencies below this fraction of the first elastic one count as rigid-body modes.
 _RIGID_FRACTION = 1e-3
@@ -58,6 +59,66 @@ class CraigBamptonBasis:
 
 #: Margin on the mode count a cut-off is estimated to need (:func:`fixed_interface_set`).
 _BATCH_MARGIN = 1.25
+#: Most fixed-interface modes a cut-off may ask of one body. The reference
+#: mount's links hold 5 to 31 modes below 10 kHz, its casing 41 below 1 kHz;
+#: a cut-off far beyond (an rpm typed as Hz) would ask for thousands, whose
+#: Lanczos vectors alone fill gigabytes.
+MODE_BUDGET = 200
+#: Bounds of the exponent p of the mode count N(f) ~ f^p fitted to a batch:
+#: 1 for a slender body's bending and axial modes, 3 for a solid's (Weyl).
+_EXPONENT_BOUNDS = (1.0, 3.0)
+
+
+class ModeBudgetExceeded(LinkModelError):
+    """A cut-off that asks for more than :data:`MODE_BUDGET` fixed-interface modes.
+
+    Attributes
+    ----------
+    cutoff_hz : float
+        The cut-off asked for, Hz.
+    estimate : int
+        The number of modes below it, extrapolated (:func:`estimated_mode_count`).
+    served_hz : float
+        The cut-off up to which :data:`MODE_BUDGET` modes are estimated to reach, Hz.
+    """
+
+    def __init__(self, cutoff_hz: float, estimate: int, served_hz: float, frequencies_hz):
+        self.cutoff_hz, self.estimate, self.served_hz = cutoff_hz, estimate, served_hz
+        super().__init__(
+            f"fixed-interface modes up to {cutoff_hz:.6g} Hz: about {estimate} of them (extrapolated from the "
+            f"{len(frequencies_hz)} lowest, {frequencies_hz[0]:.4g} to {frequencies_hz[-1]:.4g} Hz), more than the "
+            f"{MODE_BUDGET} a reduction keeps (they reach about {served_hz:.5g} Hz)")
+
+
+def estimated_mode_count(frequencies_hz, cutoff_hz: float) -> tuple[int, float]:
+    """The number of modes below a cut-off, extrapolated from the lowest ones.
+
+    The count is taken to grow as ``N(f) = k (f / f_k)^p`` with ``p`` fitted
+    to the upper half of the ``k`` frequencies known (bounded to 1 to 3).
+    From the 8 lowest, on the coarse reference thrust rod: 41 modes below
+    10 kHz (31 counted) and 81 below 20 kHz (56); on the reference casing
+    47 below 1 kHz (41).
+
+    Parameters
+    ----------
+    frequencies_hz : array_like
+        The lowest frequencies, ascending, Hz (at least two, positive).
+    cutoff_hz : float
+        Hz.
+
+    Returns
+    -------
+    estimate : int
+        Modes below ``cutoff_hz``.
+    served_hz : float
+        Frequency below which :data:`MODE_BUDGET` modes are estimated to lie, Hz.
+    """
+    f = np.asarray(frequencies_hz, dtype=float)
+    k, half = len(f), max(len(f) // 2, 1)
+    ratio = f[-1] / f[half - 1]
+    p = _EXPONENT_BOUNDS[1] if ratio <= 1 else float(np.clip(math.log(k / half) / math.log(ratio),
+                                                                *_EXPONENT_BOUNDS))
+    return math.ceil(k * (cutoff_hz / f[-1]) ** p), float(f[-1] * (MODE_BUDGET / k) ** (1 / p))
 
 
 def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: float | None = None):
@@ -65,7 +126,8 @@ def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: f
 
     With a cut-off the modes are computed in growing batches until the
     highest one reaches ``cutoff_hz``, so the kept set spans at least up to it;
-    each batch after the first is sized from the modal density of the last.
+    each batch after the first is sized from the modal density of the last
+    (:func:`estimated_mode_count`), at least twice the last.
 
     Parameters
     ----------
@@ -75,6 +137,12 @@ def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: f
         Size of the fixed-interface problem.
     count, cutoff_hz
         As in :func:`craig_bampton`.
+
+    Raises
+    ------
+    ModeBudgetExceeded
+        A cut-off estimated to lie above more than :data:`MODE_BUDGET`
+        modes, refused before the batch that would compute them.
     """
     if count == 0:
         return np.zeros(0), None
@@ -86,9 +154,12 @@ def fixed_interface_set(modes_of, n: int, count: int | None = None, cutoff_hz: f
             return freqs, vec
         if np.any(freqs >= cutoff_hz) or k_eff == n - 2:
             return freqs, vec
-        # the next batch from the modal density so far (mode count taken as growing with the square of
-        # the frequency, with a margin), at least twice this one: each batch is a Lanczos run of its own
-        k = max(2 * k, math.ceil(_BATCH_MARGIN * k * (cutoff_hz / max(freqs[-1], 1e-300)) ** 2))
+        assert cutoff_hz is not None          # a cut-off, as there is no count
+        estimate, served_hz = estimated_mode_count(freqs, cutoff_hz)
+        if estimate > MODE_BUDGET or k_eff > MODE_BUDGET:
+            raise ModeBudgetExceeded(cutoff_hz, max(estimate, k_eff + 1), served_hz, freqs)
+        # each batch is a Lanczos run of its own: at least twice the last, one past the budget at most
+        k = min(max(2 * k, math.ceil(_BATCH_MARGIN * estimate)), MODE_BUDGET + 1)
 
 
 def kept_count(frequencies_hz, count: int | None = None, cutoff_hz: float | None = None) -> int:

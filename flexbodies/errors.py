@@ -1,6 +1,6 @@
 """The errors :mod:`flexbodies` raises on purpose.
 
-Both are bad input (exit 2 of the ``mountwb`` command line): they derive
+Each is bad input (exit 2 of the ``mountwb`` command line): they derive
 from :class:`workbook.errors.InputError`, the bad-input branch of the one
 root of the package's errors, and from :class:`ValueError`. Any other
 exception out of :mod:`flexbodies` is a defect, not the user's input.
@@ -9,13 +9,27 @@ from __future__ import annotations
 
 from workbook.errors import InputError
 
-__all__ = ["LinkModelError", "ReducedLinkFileError"]
+__all__ = ["LinkModelError", "TangledElements", "ReducedLinkFileError"]
 
 
 class LinkModelError(InputError):
     """A link or engine-casing model that cannot be used: its geometry,
     material, mesh (file, cells, bores, node sets), interfaces or mode
     selection. The message names the item and what was expected."""
+
+
+class TangledElements(LinkModelError):
+    """Elements whose Jacobian determinant vanishes or changes sign inside.
+
+    Attributes
+    ----------
+    count, total : int
+        Tangled elements, and all elements of the mesh.
+    """
+
+    def __init__(self, message: str, count: int, total: int):
+        super().__init__(message)
+        self.count, self.total = count, total
 
 
 class ReducedLinkFileError(InputError):

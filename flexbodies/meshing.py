@@ -34,7 +34,7 @@ from skfem.io.meshio import HEX_MAPPING
 from .errors import LinkModelError
 from .geometry import LinkGeometry, default_element_size
 
-__all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "default_element_size", "gmsh_model",
+__all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "mesh_pieces", "default_element_size", "gmsh_model",
            "generate_tet10", "skfem_mesh"]
 
 logger = logging.getLogger(__name__)
@@ -313,8 +313,9 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
     FileNotFoundError
         If the file does not exist.
     ValueError
-        If the file cannot be read, holds no supported volume cells, or a
-        bore cannot be found; the message names the file.
+        If the file cannot be read, holds no supported volume cells, is
+        more than one connected piece (:func:`mesh_pieces`), or a bore
+        cannot be found; the message names the file.
 
     Notes
     -----
@@ -340,6 +341,7 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
     if points.shape[1] != 3:
         raise LinkModelError(f"{path}: expected 3-D points, got {points.shape[1]} coordinates per point")
     mesh, fe_index = skfem_mesh(cell_type, points * scale, cells)
+    _check_one_piece(mesh, path)
     node_sets = _NodeSets(data, fe_index, path)
     resolved = tuple(_resolve_bore(mesh, spec, str(path), node_sets) for spec in bores)
     link = LinkMesh(mesh=mesh, bores=resolved, source=str(path))
@@ -489,6 +491,52 @@ def skfem_mesh(cell_type: str, points: np.ndarray, cells: np.ndarray):
     fe_index[cells.T] = mesh.dofs.element_dofs
     _check_node_order(mesh, points, fe_index, cell_type)
     return mesh, fe_index
+
+
+def mesh_pieces(mesh: skfem.Mesh) -> np.ndarray:
+    """The connected piece of every element: elements sharing a node are joined.
+
+    Parameters
+    ----------
+    mesh : skfem.Mesh
+
+    Returns
+    -------
+    ndarray of int, shape (nelements,)
+        Piece number of each element, 0 for the piece with the most elements,
+        then by decreasing size.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    dofs = mesh.dofs.element_dofs
+    nodes = mesh.doflocs.shape[1]
+    # each element joins its first node to its others
+    graph = coo_matrix((np.ones(dofs[1:].size), (np.repeat(dofs[0], dofs.shape[0] - 1), dofs[1:].T.ravel())),
+                       shape=(nodes, nodes))
+    _, node_piece = connected_components(graph, directed=False)
+    _, piece, sizes = np.unique(node_piece[dofs[0]], return_inverse=True, return_counts=True)
+    rank = np.empty_like(sizes)
+    rank[np.argsort(-sizes, kind="stable")] = np.arange(sizes.size)
+    return rank[piece]
+
+
+def _check_one_piece(mesh: skfem.Mesh, path: Path) -> None:
+    """Refuse a mesh of more than one connected piece: each loose piece would move
+    freely, with elastic frequencies of zero."""
+    piece = mesh_pieces(mesh)
+    count = int(piece.max()) + 1
+    if count == 1:
+        return
+    sizes = np.bincount(piece)
+    nodes = np.unique(mesh.dofs.element_dofs[:, piece == 1])
+    low, high = mesh.doflocs[:, nodes].min(axis=1), mesh.doflocs[:, nodes].max(axis=1)
+    raise LinkModelError(
+        f"{path}: the mesh is {count} unconnected pieces ({', '.join(str(s) for s in sizes[:5])}"
+        f"{', ...' if count > 5 else ''} elements), not one body: a loose piece moves freely (an elastic "
+        f"frequency of zero). The second largest lies within x {low[0]:.4g} to {high[0]:.4g}, "
+        f"y {low[1]:.4g} to {high[1]:.4g}, z {low[2]:.4g} to {high[2]:.4g} m. Remove the loose pieces, or "
+        f"join pieces that touch by merging their duplicate nodes")
 
 
 def _check_node_order(mesh, points, fe_index, cell_type) -> None:

@@ -123,9 +123,17 @@ def decide_modes(modes, fundamental_hz: float, excitation_hz: float | None = Non
     Returns
     -------
     ModeDecision
+
+    Raises
+    ------
+    ValueError
+        A bad request, or a fundamental frequency that is not positive.
     """
     kind, value = _parse_request(modes)
     f1 = float(fundamental_hz)
+    if not f1 > 0:
+        raise LinkModelError(f"the body's first elastic frequency is {f1:g} Hz: part of it moves freely (a mesh of "
+                         f"unconnected pieces, or a piece held by nothing), so it cannot be reduced")
     if kind == "static":
         return ModeDecision("static", 0, None, f1, excitation_hz, "static modes only, as requested")
     if kind == "count":

@@ -111,9 +111,15 @@ SHAKE = HarmonicForce("vertical shake", point=(-0.55, 0.0, -0.03), direction=(0,
 @pytest.mark.slow
 def test_rattling_in_every_hinge_without_preload_is_periodic_and_bounded(rigid):
     """20 um gaps on all 16 hinges, no preload, 60 kN at 59 Hz: the engine
-    (free inside the gaps) moves about 0.12 mm and impacts on every cycle."""
-    rattling = dataclasses.replace(_hinges(rigid, radial_clearance=20e-6, contact_stiffness=2e8),
-                                   effects=dataclasses.replace(rigid.effects, preload=False))
+    (free inside the gaps) moves about 0.12 mm and impacts on every cycle.
+
+    Inside the open gaps the mounted modes rest on the residual stiffness
+    alone (0.05 Hz, damped only by its loss factor: a planned settle of
+    340 s); the impacts settle the motion, within 2 s (measured: the two
+    windows agree to 1e-3)."""
+    rattling = _with(dataclasses.replace(_hinges(rigid, radial_clearance=20e-6, contact_stiffness=2e8),
+                                         effects=dataclasses.replace(rigid.effects, preload=False)),
+                     settle_time=2.0)
     coarse, fine = _time(rattling, SHAKE), _time(_with(rattling, steps_per_period=80), SHAKE)
     assert coarse.steady and fine.steady
     # the impacts make the pylon force large (free mass: T would be ~0.001)

@@ -45,6 +45,10 @@ STIFFNESS_COLUMNS = tuple(f"K{a}{b} {part}" for a, b in itertools.product(_AXES,
 FORMAT_HEADER = ("frequency", "pin", *STIFFNESS_COLUMNS)
 #: Largest table read, rows.
 MAX_ROWS = 200_000
+#: A row is passive when the least eigenvalue of the Hermitian part of its
+#: imaginary part, ``(Z - Z^H) / 2i``, is above minus this share of its
+#: largest entry: the round-off of a table printed to six digits.
+PASSIVITY_TOLERANCE = 1e-6
 
 
 def _nested(array: np.ndarray) -> tuple:
@@ -66,6 +70,12 @@ class PylonImpedance:
     real, imag : nested tuples, shape (f, p, 3, 3)
         Real and imaginary parts of ``Z_p``, N/m: force on the pylon at a
         pin (row x, y, z) per motion of the pin (column x, y, z).
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        Values of the wrong shape, or a row that is not passive
+        (:data:`PASSIVITY_TOLERANCE`).
     """
 
     source: str
@@ -96,6 +106,34 @@ class PylonImpedance:
             object.__setattr__(self, name, _nested(values))
         object.__setattr__(self, "frequencies_hz", tuple(float(f) for f in frequencies))
         object.__setattr__(self, "pins", pins)
+        self._check_passive(item)
+
+    def _check_passive(self, item: str) -> None:
+        """Refuse rows that give energy to the mount.
+
+        The mean power a pin puts into the pylon moving as ``x e^{iwt}`` is
+        ``w/2 x^H (Z - Z^H)/2i x``: a passive structure absorbs it for every
+        ``x``, so the Hermitian part of the imaginary part is positive
+        semi-definite (for a symmetric Z: ``Im Z``). A row where it is not
+        (an active damper) makes the coupled mount unstable, and a steady
+        answer on it is no answer.
+        """
+        values = self.values
+        dissipation = (values - np.conj(np.swapaxes(values, -1, -2))) / 2j
+        least = np.linalg.eigvalsh(dissipation)[..., 0]
+        scale = np.abs(values).max(axis=(-2, -1))
+        active = np.argwhere(least < -PASSIVITY_TOLERANCE * scale)
+        if not active.size:
+            return
+        listed = "; ".join(f"pin {self.pins[p]!r} at {self.frequencies_hz[f]:g} Hz (least eigenvalue "
+                           f"{least[f, p]:.3g} N/m)" for f, p in active[:3])
+        more = f" and {len(active) - 3} more" if len(active) > 3 else ""
+        raise CaseError(item, "imag", f"{len(active)} of {least.size} rows giving energy to the mount: {listed}{more}",
+                        "a passive pylon: at every row the Hermitian part of the imaginary part, (Z - Z^H)/2i, "
+                        "positive semi-definite (for a symmetric Z: every 'K.. im' on the diagonal >= 0, the "
+                        "damping of each direction). A negative imaginary part is an active damper: the mount "
+                        "on it is unstable and has no steady answer. Check the sign convention of the table "
+                        "(the force on the pylon per motion of its pin)")
 
     @classmethod
     def from_array(cls, source: str, frequencies_hz, pins, values) -> "PylonImpedance":
@@ -165,6 +203,64 @@ class PylonImpedance:
                             f"frequencies the table covers, {table[0]:g} to {table[-1]:g} Hz ({outside.size} of "
                             f"{wanted.size} outside; the table is not extrapolated: extend it or narrow the "
                             "excitation's frequencies)")
+
+    def interpolation_warnings(self, frequencies_hz, order: Sequence[int]) -> list[list[str]]:
+        """Warnings for the frequencies the table's rows cannot resolve.
+
+        A real part that changes sign between two rows is a resonance of
+        the pylon between them. Linear interpolation follows it only when
+        the rows lie closer than its half-power bandwidth, estimated as
+        ``2 |Im Z| / |d Re Z / df|`` at the zero of the interpolated real
+        part (a mass-spring-damper's bandwidth); otherwise a frequency
+        between the two rows is warned.
+
+        Parameters
+        ----------
+        frequencies_hz : sequence of float
+            Frequencies within the table, Hz.
+        order : sequence of int
+            The table's pin of each pin of the case (:meth:`pin_order`).
+
+        Returns
+        -------
+        list of list of str
+            The warnings of each frequency.
+        """
+        table = np.asarray(self.frequencies_hz)
+        values = self.values[:, list(order)]
+        pins = [self.pins[n] for n in order]
+        scale = np.abs(values).max(axis=(1, 2, 3))
+        warned: list[list[str]] = []
+        for frequency in np.atleast_1d(np.asarray(frequencies_hz, dtype=float)):
+            row = int(np.searchsorted(table, frequency))
+            if row == 0 or row == len(table) or frequency == table[row]:
+                warned.append([])
+                continue
+            low, high = values[row - 1], values[row]
+            width = table[row] - table[row - 1]
+            # an element that matters (above 1e-3 of the rows' largest) whose real part changes sign
+            floor = 1e-3 * max(scale[row - 1], scale[row])
+            crossing = (low.real * high.real < 0) & (np.minimum(abs(low.real), abs(high.real)) > floor)
+            found = []
+            for pin, a, b in np.argwhere(crossing):
+                share = low[pin, a, b].real / (low[pin, a, b].real - high[pin, a, b].real)
+                damping = abs(low[pin, a, b].imag + share * (high[pin, a, b].imag - low[pin, a, b].imag))
+                band_hz = 2 * damping * width / abs(high[pin, a, b].real - low[pin, a, b].real)
+                if width > band_hz:
+                    found.append((band_hz, pins[pin], f"K{_AXES[a]}{_AXES[b]}", low[pin, a, b].real,
+                                  high[pin, a, b].real))
+            if found:
+                band_hz, pin, entry, before, after = min(found)
+                warned.append([
+                    f"pylon impedance {self.source}: {frequency:g} Hz lies between the rows at {table[row - 1]:g} "
+                    f"and {table[row]:g} Hz, where Re {entry} of pin {pin!r} changes sign ({before:.4g} to "
+                    f"{after:.4g} N/m; {len(found)} entries change sign there): a resonance of the pylon between "
+                    f"the rows, about {band_hz:.2g} Hz wide, which linear interpolation between rows {width:g} Hz "
+                    f"apart does not follow (T there may be many times off). Give rows no more than "
+                    f"{band_hz / 4:.2g} Hz apart from {table[row - 1]:g} to {table[row]:g} Hz"])
+            else:
+                warned.append([])
+        return warned
 
     def describe(self) -> str:
         """One line for the model card."""

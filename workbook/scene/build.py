@@ -39,6 +39,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from flexbodies.craig_bampton import ModeBudgetExceeded
 from workbook.model.case import (
     ENGINE,
     POINT_TOLERANCE,
@@ -58,6 +59,7 @@ from workbook.scene.engine_casing import CasingItems, add_flexible_engine
 from workbook.scene.excitation import ExcitationSignal
 from workbook.scene.hinge_law import exudyn_clearance_function
 from workbook.scene.link_workers import LinkJob, reduce_in_workers
+from workbook.scene.mode_budget import mode_budget_error
 from workbook.scene.structural_damping import equivalent_viscous_damping
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
@@ -466,6 +468,12 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneou
     Returns
     -------
     dict of str to flexbodies.ReducedLink
+
+    Raises
+    ------
+    CaseError
+        An excitation (or a link's cut-off) asks for more fixed-interface
+        modes than a reduction keeps (:mod:`workbook.scene.mode_budget`).
     """
     frequency = _reduction_frequency(case, excitation)
     jobs = link_jobs(case, excitation)
@@ -480,7 +488,10 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneou
     reduce_in_workers(list(jobs), done=lambda job: show(shown + len(jobs[job])))
     reduced = {}
     for job, names in jobs.items():
-        per_frequency = job.reduce()
+        try:
+            per_frequency = job.reduce()
+        except ModeBudgetExceeded as error:
+            raise mode_budget_error(case, f"link {names[0]!r}", job.modes, error) from None
         for name in names:
             reduced[name] = per_frequency[job.excitations_hz.index(frequency)]
         show(len(reduced))
@@ -588,18 +599,19 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
         stiffness = hinge.values("stiffness")
         if clearance:
             stiffness[:] = hinge.gap_contact_stiffness
-        damping = (hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)) \
-            + [viscous(eta, k) for eta, k in zip(hinge.values("loss_factor") if hinge.name in hinge_loss
-                                                 else np.zeros(3), stiffness, strict=True)]
+        etas = hinge.values("loss_factor") if hinge.name in hinge_loss else np.zeros(3)
+        damping = hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)
+        if not clearance:      # the clearance law damps its loss factor on its own tangent stiffness
+            damping = damping + [viscous(eta, k) for eta, k in zip(etas, stiffness, strict=True)]
         connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
             name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
             damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
         law = None
         if clearance:
-            gap = hinge.radial_clearance
-            if gap not in clearance_functions:
-                clearance_functions[gap] = exudyn_clearance_function(gap)
-            law = CreateSymbolicUserFunction(mbs, clearance_functions[gap], "springForceUserFunction", connector)
+            key = (hinge.radial_clearance, tuple(viscous(eta, 1.0) for eta in etas))
+            if key not in clearance_functions:
+                clearance_functions[key] = exudyn_clearance_function(*key)
+            law = CreateSymbolicUserFunction(mbs, clearance_functions[key], "springForceUserFunction", connector)
             mbs.SetObjectParameter(connector, "springForceUserFunction", law)
         elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
             bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),

@@ -23,9 +23,12 @@ from typing import Any
 
 import numpy as np
 
+from flexbodies.casing import ElementSizeTooLarge
 from flexbodies.casing_reduction import add_casing_to_exudyn, reduce_casing
+from flexbodies.craig_bampton import ModeBudgetExceeded
 from workbook.errors import CaseError
-from workbook.model.casing import CoreBody, bearing_name, casing_origin, parallel_axis, split_engine
+from workbook.model.casing import CASING, CoreBody, bearing_name, casing_origin, parallel_axis, split_engine
+from workbook.scene.mode_budget import mode_budget_error
 
 __all__ = ["CasingItems", "reduce_engine_casing", "add_flexible_engine", "eye_name"]
 
@@ -82,13 +85,20 @@ def reduce_engine_casing(case, excitation_hz: float):
     ------
     CaseError
         The mesh file cannot be read or has no surface at an interface, or two
-        interfaces overlap (the message is the reduction's, naming the file).
+        interfaces overlap (the message is the reduction's, naming the file);
+        a parametric casing's element size too large to mesh untangled; or
+        an excitation asks for more modes than a reduction keeps.
     """
     casing, engine = case.engine.casing, case.engine
     model = casing.model(engine.center_of_mass, [(eye_name(names), point) for point, names in case.engine_eyes()])
     try:
         frequencies = sorted({e.frequency for e in case.excitations} | {excitation_hz})
         return reduce_casing(model, casing.modes, frequencies)[frequencies.index(excitation_hz)]
+    except ModeBudgetExceeded as error:
+        raise mode_budget_error(case, f"the {CASING}", casing.modes, error) from None
+    except ElementSizeTooLarge as error:
+        raise CaseError(CASING, "element_size", error.element_size,
+                        f"an element size of at most {error.largest:g} m: {error}") from None
     except (ValueError, OSError) as error:
         field_name = "mesh" if casing.mesh is not None else "geometry"
         raise CaseError("engine casing", field_name, casing.mesh or "the parametric casing",

@@ -2,27 +2,71 @@
 
 With relative displacement ``u = p1 - p0`` (m) and gap g, the hinge force is
 
-    F = (k_r + k_c * max(|u| - g, 0) / max(|u|, g)) * u + d * v
+    F = (k_r + k_c * max(|u| - g, 0) / max(|u|, g)) * u + d * v + c K_t v
 
 i.e. zero contact force inside the gap and a spring of stiffness k_c on the
 penetration beyond it, along u. A small residual stiffness ``k_r`` inside the
 gap keeps the static solve regular (a zero-stiffness dead zone was measured to
-break it; 1e-4 k_c fixed it). The law is recorded as an Exudyn symbolic user
-function and runs at C++ speed (plain Python user functions were measured
-about 2x slower per run).
+break it; 1e-4 k_c fixed it). ``d`` is the hinge's viscous damping. ``c K_t v``
+is the viscous equivalent of the hinge's loss factor in a time integration
+(``c = eta / omega``, :mod:`workbook.scene.structural_damping`): the loss
+factor acts on the law's tangent stiffness ``K_t``, as in the frequency
+domain, so across an open gap it damps only with the residual stiffness,
+and in contact with the contact's. Its part along the contact normal grows
+with the penetration over the first gap width (the full tangent beyond):
+a damper that switches on at full strength at impact made the contact force
+jump and Newton fail on rattling gaps. The law is recorded as an Exudyn symbolic
+user function and runs at C++ speed (plain Python user functions were
+measured about 2x slower per run).
 """
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["RESIDUAL_STIFFNESS_RATIO", "clearance_force", "exudyn_clearance_function", "linearised_gap_warnings"]
+__all__ = ["RESIDUAL_STIFFNESS_RATIO", "clearance_force", "tangent_stiffness", "exudyn_clearance_function",
+           "linearised_gap_warnings"]
 
 #: Stiffness inside the gap relative to the contact stiffness.
 RESIDUAL_STIFFNESS_RATIO = 1e-4
 
 
+def tangent_stiffness(displacement, gap: float, contact_stiffness: float, *, onset: bool = False) -> np.ndarray:
+    """The law's tangent stiffness ``K_t = dF/du`` (the spring part), N/m.
+
+    Inside the gap ``k_r I``; in contact ``(k_r + k_c (1 - g/|u|)) I + k_c
+    (g/|u|) n n^T`` with ``n = u/|u|``: the full contact stiffness along u
+    and, across it, only what the penetration turns (a ball rolls round its
+    socket).
+
+    Parameters
+    ----------
+    displacement : array_like, shape (3,)
+        ``p1 - p0``, m.
+    gap : float
+        m.
+    contact_stiffness : float
+        N/m.
+    onset : bool
+        True: the normal part ``k_c (g/|u|) n n^T`` times ``min(penetration
+        / g, 1)``, what the loss factor damps (module text).
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+    """
+    u = np.asarray(displacement, dtype=float)
+    distance = np.linalg.norm(u)
+    factor = RESIDUAL_STIFFNESS_RATIO * contact_stiffness \
+        + contact_stiffness * max(distance - gap, 0.0) / max(distance, gap)
+    radial = contact_stiffness * gap / distance if distance > gap else 0.0
+    if onset:
+        radial *= min(max(distance - gap, 0.0) / gap, 1.0)
+    normal = u / distance if distance > 0 else np.zeros(3)
+    return factor * np.eye(3) + radial * np.outer(normal, normal)
+
+
 def clearance_force(displacement, velocity, gap: float, contact_stiffness: float,
-                    damping: float) -> np.ndarray:
+                    damping: float, loss_time=0.0) -> np.ndarray:
     """The clearance law evaluated with numpy (reference for tests and plots).
 
     Parameters
@@ -34,7 +78,10 @@ def clearance_force(displacement, velocity, gap: float, contact_stiffness: float
     contact_stiffness : float
         N/m.
     damping : float
-        N s/m.
+        Viscous damping d, N s/m.
+    loss_time : float or array_like, shape (3,)
+        ``c = eta / omega`` of the loss factor's viscous equivalent per
+        direction, s (0: none); it damps ``tangent_stiffness(..., onset=True)``.
 
     Returns
     -------
@@ -42,29 +89,47 @@ def clearance_force(displacement, velocity, gap: float, contact_stiffness: float
         Spring-damper force F, N (on marker 0; marker 1 gets -F).
     """
     u = np.asarray(displacement, dtype=float)
+    v = np.asarray(velocity, dtype=float)
     distance = np.linalg.norm(u)
     factor = RESIDUAL_STIFFNESS_RATIO * contact_stiffness \
         + contact_stiffness * max(distance - gap, 0.0) / max(distance, gap)
-    return factor * u + damping * np.asarray(velocity, dtype=float)
+    loss = np.asarray(loss_time, dtype=float) * (tangent_stiffness(u, gap, contact_stiffness, onset=True) @ v)
+    return factor * u + damping * v + loss
 
 
-def exudyn_clearance_function(gap: float):
+def exudyn_clearance_function(gap: float, loss_time=(0.0, 0.0, 0.0)):
     """A ``springForceUserFunction`` for ``ObjectConnectorCartesianSpringDamper``.
 
-    The contact stiffness and damping come from the connector's ``stiffness``
-    and ``damping`` parameters (first component), so one recorded function
-    serves every hinge with the same gap.
+    The contact stiffness and the viscous damping come from the connector's
+    ``stiffness`` (first component) and ``damping`` parameters, so one
+    recorded function serves every hinge with the same gap and loss.
+
+    Parameters
+    ----------
+    gap : float
+        m.
+    loss_time : 3 floats
+        ``c = eta / omega`` per direction, s (:func:`clearance_force`).
     """
     import exudyn as exu
 
     esym = exu.symbolic  # type: ignore[attr-defined]  # the stubs omit the submodule
+    loss_time = tuple(float(c) for c in loss_time)
 
     def spring_force(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):
         u = [displacement[i] for i in range(3)]
+        v = [velocity[i] for i in range(3)]
         distance = esym.sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2])
         contact = stiffness[0] * esym.max(distance - gap, esym.Real(0.0)) / esym.max(distance, esym.Real(gap))
         factor = RESIDUAL_STIFFNESS_RATIO * stiffness[0] + contact
-        return [factor * u[i] + damping[i] * velocity[i] for i in range(3)]
+        force = [factor * u[i] + damping[i] * v[i] for i in range(3)]
+        if not any(loss_time):
+            return force
+        # K_t v (tangent_stiffness with onset): the normal part grows over the first gap width of penetration
+        onset = esym.min(esym.max(distance - gap, esym.Real(0.0)) / gap, esym.Real(1.0))
+        radial = onset * stiffness[0] * gap / esym.max(distance, esym.Real(gap)) \
+            * (u[0] * v[0] + u[1] * v[1] + u[2] * v[2]) / esym.max(distance * distance, esym.Real(gap * gap))
+        return [force[i] + loss_time[i] * (factor * v[i] + radial * u[i]) for i in range(3)]
 
     return spring_force
 

@@ -61,12 +61,16 @@ class PylonAt:
         The model-card entry.
     seconds : float
         Wall time of forming it, s.
+    warnings : list of list of str
+        Per excitation, what the pylon model cannot resolve there (an
+        impedance table too coarse across a resonance).
     """
 
     stiffness: np.ndarray | None
     compliance: np.ndarray | None
     effect: EffectEntry
     seconds: float
+    warnings: list | None = None
 
     def closure(self, j: int) -> dict:
         """The keyword arguments of :meth:`~workbook.solve.four_pole.FourPole.respond` at excitation *j*."""
@@ -116,10 +120,12 @@ def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> Pylon
     pins = case.pylon_pins()
     if case.pylon_impedance is not None:
         impedance = case.pylon_impedance
-        stiffness = impedance.at(frequencies, impedance.pin_order(pins))
+        order = impedance.pin_order(pins)
+        stiffness = impedance.at(frequencies, order)
         effect = EffectEntry("flexible pylon (point dynamic stiffness)", True,
                              f"{impedance.describe()}; real and imaginary parts interpolated linearly in frequency")
-        return PylonAt(stiffness, None, effect, time.perf_counter() - start)
+        return PylonAt(stiffness, None, effect, time.perf_counter() - start,
+                       impedance.interpolation_warnings(frequencies, order))
     if case.pylon_mesh is not None:
         highest = max(x.frequency for x in case.single_frequency_excitations())  # one reduction serves every run
         structure, facts = mesh_pylon_model(case.pylon_mesh, [position for position, _ in pins], highest)
@@ -190,6 +196,7 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
         seconds = time.perf_counter() - start
         result = _result(excitation, pole.pins, pin_forces, case.analysis.steady_tolerance)
         result.warnings.extend(link_warnings(case, prepared.scene.reduced))
+        result.warnings.extend(pylon.warnings[j] if pylon.warnings else [])
         timings = dict(prepared.timings, **{"pylon": pylon.seconds, "harmonic solve on the pylon": seconds})
         solver = {"analysis": "frequency domain on a flexible pylon: the mount's four-pole set (6 engine + "
                               f"{3 * len(pole.pins)} pin coordinates) closed by the pylon",

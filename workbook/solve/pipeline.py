@@ -41,6 +41,7 @@ from workbook.solve.simultaneous import extract_simultaneous, plan_simultaneous
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
 from workbook.solve.steady_start import STEADY, choose_start, steady_start
 from workbook.solve.stress_stiffening import stiffen_links
+from workbook.solve.sweep_grid import add_grid_warnings
 from workbook.solve.time_domain import TimeHistories, extract, integrate, plan_run
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
@@ -345,6 +346,8 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
             with prepared.scene:
                 item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
                                                                          progress=progress)
+            if isinstance(item, Sweep):
+                add_grid_warnings(item, item_runs, prepared.modes)
         elif isinstance(item, Simultaneous):
             item_runs, card, preload = run_in_time(case, item, reduce_for=highest, progress=progress, method=chosen)
             item_cards = {result.name: card for result in item_runs}

@@ -19,30 +19,10 @@ from workbook.answers.isolation import transmissibility
 from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.solve.method import FREQUENCY, MethodChoice
-from workbook.solve.modes import ENGINE_SHARE, FREE_FREQUENCY_HZ, Mode
 from workbook.solve.pipeline import prepare, solve_frequencies
+from workbook.solve.sweep_grid import add_grid_warnings, modes_in_band
 
 __all__ = ["SweepAnswer", "run_sweep", "modes_in_band"]
-
-
-def modes_in_band(modes: list[Mode], stop_hz: float) -> list[tuple[str, Mode]]:
-    """The mounted modes and the link modes up to *stop_hz*, labelled.
-
-    Returns
-    -------
-    list of (str, Mode)
-        ``("mounted", mode)`` for every mounted mode (whatever its frequency)
-        and ``("link", mode)`` for link modes from 0 to *stop_hz*, ascending.
-    """
-    chosen = []
-    for mode in modes:
-        if mode.frequency_hz < FREE_FREQUENCY_HZ:
-            continue
-        if mode.engine_share >= ENGINE_SHARE:
-            chosen.append(("mounted", mode))
-        elif mode.frequency_hz <= stop_hz:
-            chosen.append(("link", mode))
-    return chosen
 
 
 @dataclass
@@ -137,6 +117,9 @@ class SweepAnswer:
 def run_sweep(case: Case, sweep: Sweep, *, reduced=None) -> SweepAnswer:
     """Run *sweep* on *case* in the frequency domain.
 
+    A mode whose peak the grid steps over is warned on the point nearest
+    to it (:func:`~workbook.solve.sweep_grid.grid_warnings`).
+
     Parameters
     ----------
     case : Case
@@ -154,5 +137,6 @@ def run_sweep(case: Case, sweep: Sweep, *, reduced=None) -> SweepAnswer:
                                        "every frequency")
     with prepared.scene:
         runs, cards, preloads = solve_frequencies(case, prepared, points, method)
+    add_grid_warnings(sweep, runs, prepared.modes)
     return SweepAnswer(sweep, MountResult(case.name, runs, cards, preloads),
                        modes_in_band(prepared.modes, sweep.frequencies_hz[-1]))
