@@ -1,5 +1,8 @@
 """``mountwb rig``: measured rig records against simulation.
 
+A record is a CSV (:mod:`workbook.rig.records`) or UFF dataset 58 time
+histories (``.uff``, ``.unv``; :mod:`workbook.rig.uff`).
+
 - ``mountwb rig measure RECORD.csv [--periods N] [--at-nominal]``: measured T
   and eta per direction of a rig record (DFT at the spectral peak next to
   the nominal rotor frequency, or at the nominal one);
@@ -67,7 +70,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     measure = modes.add_parser("measure", help="measured T and eta per direction of a rig record")
     compare = modes.add_parser("compare", help="simulate the record's run and print the validation table")
     for sub in (measure, compare):
-        sub.add_argument("record", help="rig record (CSV)")
+        sub.add_argument("record", help="rig record: CSV, or UFF dataset 58 time histories (.uff, .unv)")
         sub.add_argument("--periods", type=int, default=_DEFAULT_PERIODS,
                          help=f"whole rotor periods per window (default {_DEFAULT_PERIODS})")
         sub.add_argument("--at-nominal", action="store_true",
@@ -76,7 +79,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     compare.add_argument("--rigid", action="store_true", help="make every link rigid")
     compare.add_argument("--csv", metavar="OUT.csv", help="also write the validation table")
     synthesize = modes.add_parser("synthesize", help="write a synthetic rig record made from a simulation")
-    synthesize.add_argument("output", help="record to write (CSV)")
+    synthesize.add_argument("output", help="record to write: CSV, or UFF dataset 58 (.uff, .unv)")
     synthesize.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     synthesize.add_argument("--run", default="LP rotor", help="excitation to simulate (default 'LP rotor')")
     synthesize.add_argument("--rigid", action="store_true", help="make every link rigid")
@@ -117,8 +120,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 def _synthesize(args) -> int:
     from workbook.rig.records import write_record
     from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, synthetic_record
+    from workbook.rig.uff import UFF_SUFFIXES
 
-    check_output("output", args.output, (".csv",), [args.case])
+    check_output("output", args.output, (".csv", *UFF_SUFFIXES), [args.case])
     case = load_case(args.case, rigid=args.rigid)
     result = simulate_run(case, args.run, histories=True)
     pylon = sorted(h.name for h in case.pylon_hinges)

@@ -33,7 +33,7 @@ from workbook.answers.saving import save_text
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 
-__all__ = ["RigRecord", "read_record", "write_record", "EXCITATION_CHANNEL",
+__all__ = ["RigRecord", "read_record", "write_record", "parse_header_line", "EXCITATION_CHANNEL",
            "SAMPLE_RATE_TOLERANCE"]
 
 #: Channel name of the excitation force.
@@ -41,7 +41,7 @@ EXCITATION_CHANNEL = "excitation"
 #: Largest relative difference between the stated and the sampled rate.
 SAMPLE_RATE_TOLERANCE = 1e-3
 _MAGIC = "mountwb rig record"
-_HEADER = re.compile(r"^#\s*(?P<key>[^:]+?)\s*:\s*(?P<value>.*?)\s*$")
+_HEADER = re.compile(r"^\s*(?P<key>[^:]+?)\s*:\s*(?P<value>.*?)\s*$")
 _COLUMN = re.compile(r"^\s*(?P<name>.+?)\s*\[\s*(?P<unit>[^\]]+?)\s*\]\s*$")
 
 
@@ -107,8 +107,14 @@ class RigRecord:
                               f"pylon-side hinges ({', '.join(pylon_hinges)}): {'; '.join(problems)}")
 
 
+def parse_header_line(text: str) -> tuple[str, str] | None:
+    """``(key, value)`` of a header line ``key: value`` (without its ``#``), or None for another text."""
+    match = _HEADER.match(text)
+    return None if match is None else (match["key"], match["value"])
+
+
 def read_record(path: str | Path) -> RigRecord:
-    """Read and check a rig record CSV.
+    """Read and check a rig record: a CSV, or a UFF file (``.uff``, ``.unv``: :mod:`workbook.rig.uff`).
 
     Raises
     ------
@@ -118,6 +124,10 @@ def read_record(path: str | Path) -> RigRecord:
         that differs from the stated one.
     """
     path = Path(path)
+    from workbook.rig.uff import UFF_SUFFIXES, read_uff_record
+
+    if path.suffix.lower() in UFF_SUFFIXES:
+        return read_uff_record(path)
     try:
         lines = path.read_text().splitlines()
     except OSError as error:
@@ -155,10 +165,10 @@ def _read_header(path, lines: list[str]) -> tuple[dict, dict, int]:
         if not text.startswith("#"):
             table_start = number
             break
-        match = _HEADER.match(text)
-        if match is None:
+        parsed = parse_header_line(text[1:])
+        if parsed is None:
             continue
-        key, value = match["key"], match["value"]
+        key, value = parsed
         if key.startswith(TRANSDUCER_PREFIX):
             names = tuple(n.strip() for n in value.split("+") if n.strip())
             if not names:
@@ -239,13 +249,18 @@ def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:
 
 
 def write_record(path: str | Path, record: RigRecord, *, digits: int = 4) -> Path:
-    """Write *record* as a rig record CSV (forces in N with *digits* decimals, time in s).
+    """Write *record* as a rig record CSV (forces in N with *digits* decimals, time in s), or as a UFF
+    file for a path ending in ``.uff`` or ``.unv`` (:func:`workbook.rig.uff.write_uff_record`).
 
     Returns
     -------
     Path
     """
     path = Path(path)
+    from workbook.rig.uff import UFF_SUFFIXES, write_uff_record
+
+    if path.suffix.lower() in UFF_SUFFIXES:
+        return write_uff_record(path, record)
     lines = [f"# {_MAGIC}", f"# run: {record.run}", f"# nominal frequency [Hz]: {record.nominal_hz:.10g}",
              f"# sample rate [Hz]: {record.sample_rate_hz:.10g}"]
     lines += [f"# transducer {name}: {' + '.join(hinges)}" for name, hinges in record.hinges.items()]
