@@ -38,7 +38,7 @@ INTERNAL_MODULES = (
     "workbook.model.drawing", "workbook.model.fields", "workbook.model.pylon_beam", "workbook.model.pylon_impedance",
     "workbook.model.pylon_mesh", "workbook.model.reference", "workbook.model.units",
     "workbook.processes",
-    "workbook.rig", "workbook.rig.correlation", "workbook.rig.records", "workbook.rig.synthetic", "workbook.rig.uff",
+    "workbook.rig", "workbook.rig.channel_map", "workbook.rig.correlation", "workbook.rig.records", "workbook.rig.synthetic", "workbook.rig.uff",
     "workbook.scene", "workbook.scene.bearing", "workbook.scene.build", "workbook.scene.engine_casing",
     "workbook.scene.excitation", "workbook.scene.hinge_law", "workbook.scene.link_workers",
     "workbook.scene.structural_damping",

@@ -131,3 +131,90 @@ def test_a_file_that_is_not_uff_is_refused(tmp_path):
     path.write_text("a lab's notes, not a universal file\n")
     with pytest.raises(RecordError, match="notes.uff: no dataset 58 of function type 1"):
         read_record(path)
+
+
+#: The hand-written lab CSV: time in ms, one transducer in kN mounted with y reversed, the shaker in lbf.
+LAB_CSV = """# bench 3, run 12
+t_ms,PIN XX,PIN YY,PIN ZZ,SHK XX,SHK YY,SHK ZZ
+0.0,0.010,0.020,0.030,100,0,0
+0.5,0.011,0.021,0.031,101,0,0
+1.0,0.012,0.022,0.032,102,0,0
+"""
+LBF = 4.4482216152605  # N
+
+
+def _lab_map(**changes) -> dict:
+    channels = {f"PIN {d * 2}": {"sensor": "pin", "direction": d.lower(), "unit": "kN"} for d in "XYZ"}
+    channels["PIN YY"]["sign"] = -1
+    channels |= {f"SHK {d * 2}": {"sensor": "excitation", "direction": d.lower(), "unit": "lbf"} for d in "XYZ"}
+    data = {"run": "LP rotor", "nominal frequency [Hz]": 59, "time": {"column": "t_ms", "unit": "ms"},
+            "transducers": {"pin": ["front-up-left", "front-up-right"]}, "channels": channels}
+    for key, value in changes.items():  # "channels.PIN XX.unit": a change inside; None removes the entry
+        *parents, last = key.split(".")
+        target = data
+        for parent in parents:
+            target = target[parent]
+        if value is None:
+            del target[last]
+        else:
+            target[last] = value
+    return data
+
+
+def _lab_files(tmp_path, csv_text=LAB_CSV, **changes):
+    import json
+
+    (tmp_path / "lab.csv").write_text(csv_text)
+    (tmp_path / "map.json").write_text(json.dumps(_lab_map(**changes)))
+    return tmp_path / "lab.csv", tmp_path / "map.json"
+
+
+def test_a_lab_csv_is_read_through_its_channel_map(tmp_path):
+    from workbook.rig.channel_map import read_mapped_record
+
+    record = read_mapped_record(*_lab_files(tmp_path))
+    assert (record.run, record.nominal_hz, record.hinges) == ("LP rotor", 59.0, {"pin": ("front-up-left", "front-up-right")})
+    assert record.sample_rate_hz == pytest.approx(2000.0) and record.time[-1] == pytest.approx(1e-3)
+    # kN to N, the reversed y negated; lbf to N
+    np.testing.assert_allclose(record.transducers["pin"], [[10, -20, 30], [11, -21, 31], [12, -22, 32]], rtol=1e-12)
+    np.testing.assert_allclose(record.excitation[:, 0], np.array([100, 101, 102]) * LBF, rtol=1e-12)
+
+
+@pytest.mark.parametrize(("changes", "csv_text", "message"), [
+    ({"channels.PIN ZZ": None}, LAB_CSV, r"map.json: sensor 'pin' has no channel in z"),
+    ({"transducers.rear": ["rear-up-left"]}, LAB_CSV, r"map.json: sensor 'rear' has no channel in x, y, z"),
+    ({"channels.PIN XX.unit": "m/s^2"}, LAB_CSV, r"map.json: channel 'PIN XX': unit 'm/s\^2'"),
+    ({"channels.PIN XX.sensor": "rear"}, LAB_CSV, r"map.json: channel 'PIN XX': sensor 'rear' is neither a transducer"),
+    ({}, LAB_CSV.replace(",SHK ZZ", "").replace(",0\n", "\n"), r"lab.csv, line 2: channel 'SHK ZZ' of the channel map"),
+    ({}, LAB_CSV.replace("SHK ZZ", "SHK RZ"), r"lab.csv, line 2, column 'SHK RZ': a column the channel map .* does not cover"),
+], ids=["missing direction", "missing sensor", "wrong unit", "unknown sensor", "missing channel", "unmapped column"])
+def test_a_wrong_channel_map_is_refused_naming_the_channel(tmp_path, changes, csv_text, message):
+    from workbook.rig.channel_map import read_mapped_record
+
+    with pytest.raises(RecordError, match=message):
+        read_mapped_record(*_lab_files(tmp_path, csv_text, **changes))
+
+
+def test_rig_measure_reads_the_committed_record_as_a_lab_writes_it(tmp_path, capsys):
+    """The committed record renamed as the seed study's lab names its channels, in kN with the rear y reversed."""
+    import json
+
+    committed = read_record(CASES / "reference-lp-rig.csv")
+    short = {"front-left": "FL", "front-right": "FR", "rear-left": "RL", "rear-right": "RR", "excitation": "EXC"}
+    columns = {"Time": committed.time}
+    channels = {}
+    for name, forces in {**committed.transducers, "excitation": committed.excitation}.items():
+        for axis, label in enumerate(("XX", "YY", "ZZ")):
+            sign = -1 if name.startswith("rear") and label == "YY" else 1
+            columns[f"{short[name]} {label}"] = sign * forces[:, axis] / 1000
+            channels[f"{short[name]} {label}"] = {"sensor": name, "direction": "xyz"[axis], "unit": "kN", "sign": sign}
+    lines = [",".join(columns)] + [",".join(f"{v:.10g}" for v in row) for row in np.column_stack(list(columns.values()))]
+    (tmp_path / "lab.csv").write_text("\n".join(lines) + "\n")
+    (tmp_path / "map.json").write_text(json.dumps({
+        "run": committed.run, "nominal frequency [Hz]": committed.nominal_hz, "time": {"column": "Time", "unit": "s"},
+        "transducers": {name: list(h) for name, h in committed.hinges.items()}, "channels": channels}))
+    assert main(["rig", "measure", str(tmp_path / "lab.csv"), "--map", str(tmp_path / "map.json"), "--periods", "100"]) == 0
+    lab = capsys.readouterr().out
+    assert main(["rig", "measure", str(CASES / "reference-lp-rig.csv"), "--periods", "100"]) == 0
+    own = capsys.readouterr().out
+    assert lab.splitlines()[1:] == own.splitlines()[1:]  # all but the file's name: the same T and eta

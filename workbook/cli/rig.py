@@ -3,7 +3,10 @@
 A record is a CSV (:mod:`workbook.rig.records`) or UFF dataset 58 time
 histories (``.uff``, ``.unv``; :mod:`workbook.rig.uff`).
 
-- ``mountwb rig measure RECORD.csv [--periods N] [--at-nominal]``: measured T
+A lab's CSV with its own channel names is read with ``--map MAP.json``
+(:mod:`workbook.rig.channel_map`).
+
+- ``mountwb rig measure RECORD.csv [--map MAP.json] [--periods N] [--at-nominal]``: measured T
   and eta per direction of a rig record (DFT at the spectral peak next to
   the nominal rotor frequency, or at the nominal one);
 - ``mountwb rig compare RECORD.csv [CASE] [--rigid] [--periods N] [--csv OUT.csv]``:
@@ -19,7 +22,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from workbook.answers.results import ExcitationResult
 from workbook.answers.saving import save_csv
@@ -28,7 +31,10 @@ from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
 from workbook.model.case import AnalysisSettings, Case
 
-__all__ = ["arguments", "simulate_run"]
+if TYPE_CHECKING:
+    from workbook.rig.records import RigRecord
+
+__all__ = ["arguments", "simulate_run", "read_any_record"]
 
 _DEFAULT_PERIODS = AnalysisSettings().measured_periods
 
@@ -65,6 +71,20 @@ def simulate_run(case: Case, run: str, *, histories: bool = False) -> Excitation
     return run_case(dataclasses.replace(case, excitations=(excitations[run],))).runs[0]
 
 
+def read_any_record(path: str, channel_map: str | None = None) -> RigRecord:
+    """The rig record at *path*: the package's CSV, a UFF file, or with *channel_map* a lab's CSV.
+
+    Raises
+    ------
+    RecordError
+        A record (or map) that cannot be used.
+    """
+    from workbook.rig.channel_map import read_mapped_record
+    from workbook.rig.records import read_record
+
+    return read_record(path) if channel_map is None else read_mapped_record(path, channel_map)
+
+
 def arguments(parser: argparse.ArgumentParser) -> Callable:
     modes = parser.add_subparsers(dest="mode", required=True)
     measure = modes.add_parser("measure", help="measured T and eta per direction of a rig record")
@@ -73,6 +93,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         sub.add_argument("record", help="rig record: CSV, or UFF dataset 58 time histories (.uff, .unv)")
         sub.add_argument("--periods", type=int, default=_DEFAULT_PERIODS,
                          help=f"whole rotor periods per window (default {_DEFAULT_PERIODS})")
+        sub.add_argument("--map", metavar="MAP.json",
+                         help="channel map of a lab's CSV: channel -> sensor, direction, unit, sign (docs/rig-correlation.md)")
         sub.add_argument("--at-nominal", action="store_true",
                          help="DFT at the nominal rotor frequency, not at the spectral peak next to it")
     compare.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
@@ -93,10 +115,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         if args.mode == "synthesize":
             return _synthesize(args)
         from workbook.rig.correlation import PEAK_SEARCH, comparison_frame, measure
-        from workbook.rig.records import read_record
-
-        check_output("--csv", getattr(args, "csv", None), (".csv",), [args.record, getattr(args, "case", None)])
-        record = read_record(args.record)
+        check_output("--csv", getattr(args, "csv", None), (".csv",), [args.record, args.map, getattr(args, "case", None)])
+        record = read_any_record(args.record, args.map)
         if args.mode == "compare":
             case = load_case(args.case, rigid=args.rigid)
             record.check_hinges([h.name for h in case.pylon_hinges])

@@ -33,7 +33,8 @@ from workbook.answers.saving import save_text
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 
-__all__ = ["RigRecord", "read_record", "write_record", "parse_header_line", "EXCITATION_CHANNEL",
+__all__ = ["RigRecord", "read_record", "write_record", "parse_header_line", "table_values",
+           "check_sampling", "EXCITATION_CHANNEL",
            "SAMPLE_RATE_TOLERANCE"]
 
 #: Channel name of the excitation force.
@@ -139,9 +140,7 @@ def read_record(path: str | Path) -> RigRecord:
     if "time" not in data:
         raise RecordError(path, "no 'time [s]' column", line=table_start)
     time = data.pop("time")
-    _check_sampling(path, time, rate, table_start)
-    # the checked times, without the rounding of the file's digits
-    time = time[0] + np.arange(len(time)) * (time[-1] - time[0]) / (len(time) - 1)
+    time = check_sampling(path, time, rate, table_start)
     channels = {}
     for name in (*hinges, EXCITATION_CHANNEL):
         for axis in DIRECTIONS:
@@ -215,6 +214,18 @@ def _read_table(path, lines: list[str], start: int) -> tuple[list, dict]:
         except UnitProblem as problem:
             raise RecordError(path, f"unit {match['unit']!r}: {problem}", line=start, column=header) from None
         names.append(match["name"])
+    values = table_values(path, lines, start, headers)
+    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors, strict=True))}
+
+
+def table_values(path, lines: list[str], start: int, headers: list[str]) -> np.ndarray:
+    """The numbers of the CSV rows after the column header line *start* (1-based), shape (rows, columns).
+
+    Raises
+    ------
+    RecordError
+        A row of another length, or a cell that is not a finite number, naming its line and column.
+    """
     rows = [row for row in csv.reader(lines[start:]) if row]
     values = np.empty((len(rows), len(headers)))
     for index, row in enumerate(rows):
@@ -229,10 +240,28 @@ def _read_table(path, lines: list[str], start: int) -> tuple[list, dict]:
     if not np.isfinite(values).all():
         index, j = np.argwhere(~np.isfinite(values))[0]
         raise RecordError(path, "not a finite number", line=start + 1 + int(index), column=headers[j])
-    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors, strict=True))}
+    return values
 
 
-def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:
+def check_sampling(path, time: np.ndarray, rate: float, start: int, column: str = "time [s]") -> np.ndarray:
+    """Check that *time* (s) is sampled uniformly at *rate* (Hz); return the uniform times, s.
+
+    The times returned lie on the checked grid, without the rounding of the file's digits.
+
+    Parameters
+    ----------
+    start : int
+        Line of the column header (the first sample is on the next line).
+    column : str
+        The time column's header, for the message.
+
+    Raises
+    ------
+    RecordError
+        Fewer than 2 samples, a step that differs from the others by more
+        than 0.1 % (naming its line), or a sampled rate that differs from
+        *rate* by more than :data:`SAMPLE_RATE_TOLERANCE`.
+    """
     if len(time) < 2:
         raise RecordError(path, f"{len(time)} samples; a record needs many periods of the rotor")
     steps = np.diff(time)
@@ -241,11 +270,12 @@ def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:
     if steps.min() <= 0 or len(bad):
         index = int(np.flatnonzero(steps <= 0)[0] if steps.min() <= 0 else bad[0])
         raise RecordError(path, f"time is not uniformly sampled: step {steps[index]:.6g} s here, "
-                          f"{np.median(steps):.6g} s elsewhere", line=start + 2 + index, column="time [s]")
+                          f"{np.median(steps):.6g} s elsewhere", line=start + 2 + index, column=column)
     sampled = 1.0 / float(np.median(steps))
     if abs(sampled - rate) > SAMPLE_RATE_TOLERANCE * rate:
         raise RecordError(path, f"wrong sample rate: the header states {rate:g} Hz, the time column is "
-                          f"sampled at {sampled:.6g} Hz (step {step:.6g} s expected)", column="time [s]")
+                          f"sampled at {sampled:.6g} Hz (step {step:.6g} s expected)", column=column)
+    return time[0] + np.arange(len(time)) * (time[-1] - time[0]) / (len(time) - 1)
 
 
 def write_record(path: str | Path, record: RigRecord, *, digits: int = 4) -> Path:
