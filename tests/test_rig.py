@@ -82,7 +82,7 @@ def test_force_amplitude_is_the_largest_magnitude_over_a_period():
 
 @pytest.mark.slow
 def test_committed_record_is_what_the_code_generates(tmp_path, cache_dir):
-    assert main(["rig", "synthesize", str(tmp_path / "rig.csv"), "--rigid"]) == 0
+    assert main(["rig", "synthesize", str(tmp_path / "rig.csv"), "--rigid", "--rate", "2048"]) == 0
     committed, made = read_record(CASES / "reference-lp-rig.csv"), read_record(tmp_path / "rig.csv")
     assert committed.hinges == made.hinges and committed.notes == made.notes
     np.testing.assert_allclose(committed.excitation, made.excitation, atol=2e-4)
@@ -212,3 +212,28 @@ def test_workbook_names_the_cell_of_a_record_of_another_run(tmp_path, capsys):
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert "Test data" in err and "rig record" in err and "nominal frequency 59 Hz is not run 'HP rotor'" in err
+
+
+@pytest.mark.parametrize(("run", "suffix"), [("LP rotor", ".csv"), ("HP rotor", ".uff")])
+def test_a_record_synthesized_at_the_default_rate_can_be_compared_for_either_rotor(tmp_path, cache_dir, run, suffix):
+    """The default rate samples the HP rotor (248.5 Hz) at least 10 times a period: 4096 Hz, 16.5 samples.
+
+    (2048 Hz, the former default, gave 8.2 and compare refused the HP rotor's record.)"""
+    import pandas as pd
+
+    from workbook.cli.loading import load_case
+    from workbook.cli.rig import simulate_run
+    from workbook.model.codec import to_json
+
+    case = tmp_path / "case.json"
+    case.write_text(to_json(reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE)))
+    record, table = tmp_path / f"rig{suffix}", tmp_path / "validation.csv"
+    assert main(["rig", "synthesize", str(record), str(case), "--rigid", "--run", run, "--duration", "1", "--noise", "0", "--drift", "0"]) == 0
+    # (a UFF file's abscissa increment has 6 digits: 2.44141e-04 s)
+    assert read_record(record).sample_rate_hz == pytest.approx(4096.0, rel=1e-5)
+    assert main(["rig", "compare", str(record), str(case), "--rigid", "--periods", "20", "--csv", str(table)]) == 0
+    # the record's T is the time-domain run's that made it (the table's "T sim" is the frequency domain's)
+    made = simulate_run(load_case(str(case), rigid=True), run, histories=True).transmissibility
+    measured = pd.read_csv(table, index_col="direction")["T test"].to_numpy()
+    # a window of 20 periods spans them to within one sample: 1 / (20 x 16.5) = 3e-3 at the HP rotor
+    np.testing.assert_allclose(measured, made, rtol=3e-3)

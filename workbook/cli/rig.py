@@ -108,7 +108,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     synthesize.add_argument("--noise", type=float, default=0.005, help="noise / transducer amplitude (0.005)")
     synthesize.add_argument("--drift", type=float, default=0.002, help="relative speed drift (0.002)")
     synthesize.add_argument("--seed", type=int, default=0, help="noise seed (0)")
-    synthesize.add_argument("--rate", type=float, default=2048.0, help="sample rate, Hz (2048)")
+    synthesize.add_argument("--rate", type=float, default=None,
+                            help="sample rate, Hz (default: the power of two that samples the case's highest rotor "
+                                 "frequency at least 12.5 times a period; 4096 for the reference mount)")
     synthesize.add_argument("--duration", type=float, default=4.0, help="record length, s (4)")
 
     def rig(args) -> int:
@@ -139,7 +141,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 
 def _synthesize(args) -> int:
     from workbook.rig.records import write_record
-    from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, synthetic_record
+    from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, default_sample_rate, synthetic_record
     from workbook.rig.uff import UFF_SUFFIXES
 
     check_output("output", args.output, (".csv", *UFF_SUFFIXES), [args.case])
@@ -149,7 +151,9 @@ def _synthesize(args) -> int:
     reference = sorted(h for hinges in REFERENCE_TRANSDUCERS.values() for h in hinges)
     # the seed study's rig on the reference mount, else one transducer per pylon-side hinge
     transducers = REFERENCE_TRANSDUCERS if pylon == reference else {name: (name,) for name in pylon}
-    record = synthetic_record(result, transducers, sample_rate_hz=args.rate, duration=args.duration,
+    # a record of any run of the case can be compared (MIN_SAMPLES_PER_PERIOD at its highest frequency)
+    rate = args.rate if args.rate is not None else default_sample_rate(e.frequency_hz for e in case.single_frequency_excitations())
+    record = synthetic_record(result, transducers, sample_rate_hz=rate, duration=args.duration,
                               noise=args.noise, drift=args.drift, seed=args.seed)
     write_output(args.output, "rig record", "rig", lambda target: write_record(target, record))
     return 0
