@@ -237,3 +237,60 @@ def test_a_record_synthesized_at_the_default_rate_can_be_compared_for_either_rot
     measured = pd.read_csv(table, index_col="direction")["T test"].to_numpy()
     # a window of 20 periods spans them to within one sample: 1 / (20 x 16.5) = 3e-3 at the HP rotor
     np.testing.assert_allclose(measured, made, rtol=3e-3)
+
+
+def test_a_sine_on_a_bin_reads_its_amplitude_in_the_spectrum():
+    from workbook.rig.plots import amplitude_spectrum, coherent_samples
+
+    rate, frequency, amplitude = 1000.0, 50.0, 3.0
+    time = np.arange(1000) / rate  # 50 whole periods: the sine is on bin 50
+    frequencies, amplitudes = amplitude_spectrum(2.0 + amplitude * np.sin(2 * np.pi * frequency * time + 0.7), rate)
+    assert frequencies[np.argmax(amplitudes[1:]) + 1] == frequency
+    assert amplitudes[50] == pytest.approx(amplitude, rel=1e-12) and amplitudes[0] == pytest.approx(2.0, rel=1e-12)
+    # 8000 samples at 2048 Hz hold 230.5 periods of 59 Hz: 230 periods are 7983.7 samples -> 7984
+    assert coherent_samples(2048.0, 59.0, 8000) == 7984
+    assert coherent_samples(2048.0, 59.0, 8192) == 8192  # 4 s: 236 whole periods
+
+
+def test_rig_plot_shows_the_excitation_at_the_rotor_frequency_with_its_amplitude(lp_run, tmp_path):
+    """The spectra of a synthetic record (no noise, no drift): the rotating 1000 N force on its rotor line."""
+    from workbook.rig.plots import plot_record
+
+    record = read_record(write_record(tmp_path / "rig.csv", synthetic_record(lp_run, REFERENCE_TRANSDUCERS, noise=0.0,
+                                                                             drift=0.0)))
+    figure = plot_record(record)
+    # a column per sensor (4 transducers and the excitation): time on top, spectra below
+    assert len(figure.axes) == 2 * 5
+    spectrum = figure.axes[2 * 4 + 1]
+    assert spectrum.get_xlabel() == "frequency [Hz]" and figure.axes[2 * 4].get_title() == "excitation"
+    lines = {line.get_label(): line.get_data() for line in spectrum.get_lines()}
+    assert lines["rotor 59.00 Hz"][0][0] == pytest.approx(59.0, rel=1e-6)
+    for axis in "yz":  # the LP rotor's force rotates about the engine axis x: 1000 N in y and z
+        frequencies, amplitudes = lines[axis]
+        peak = np.argmax(amplitudes)
+        # 4 s at 2048 Hz hold 236 whole periods: the rotor line is on a bin
+        assert frequencies[peak] == pytest.approx(59.0, abs=0.5 * (frequencies[1] - frequencies[0]))
+        assert amplitudes[peak] == pytest.approx(1000.0, rel=1e-3)
+    # each transducer's line at the rotor frequency is its amplitude by the single-bin DFT of the measurement
+    measured = measure(record, periods=100)
+    front = {line.get_label(): line.get_data()[1] for line in figure.axes[1].get_lines()}
+    for axis, amplitude in zip("xyz", measured.transducer_amplitudes["front-left"], strict=True):
+        assert front[axis][np.argmax(lines["y"][1])] == pytest.approx(amplitude, rel=2e-3, abs=1e-3)
+    # with the comparison: one more row
+    assert len(plot_record(record, comparison_frame(measured, lp_run)).axes) == 2 * 5 + 1
+
+
+def test_rig_plot_command_writes_the_png_beside_an_existing_one(tmp_path, cache_dir, capsys):
+    from PIL import Image
+
+    from workbook.model.codec import to_json
+
+    case = tmp_path / "case.json"
+    case.write_text(to_json(reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE)))
+    out = tmp_path / "rig.png"
+    record = str(CASES / "reference-lp-rig.csv")
+    assert main(["rig", "plot", record, "--output", str(out)]) == 0
+    assert Image.open(out).size[0] > Image.open(out).size[1]
+    assert main(["rig", "plot", record, "--case", str(case), "--rigid", "--periods", "50", "--output", str(out)]) == 0
+    assert "rig.png was not overwritten" in capsys.readouterr().out
+    assert main(["rig", "plot", record, "--output", str(tmp_path / "rig.jpg")]) == 2

@@ -12,6 +12,9 @@ A lab's CSV with its own channel names is read with ``--map MAP.json``
 - ``mountwb rig compare RECORD.csv [CASE] [--rigid] [--periods N] [--csv OUT.csv]``:
   simulate the record's run of the case (default: the reference mount) and
   print the validation table, error = (sim - test) / test x 100 %;
+- ``mountwb rig plot RECORD.csv [--map MAP.json] [--case [CASE]] [--rigid] --output OUT.png``:
+  time histories and amplitude spectra of every channel
+  (:mod:`workbook.rig.plots`); with ``--case``, measured against simulated T;
 - ``mountwb rig synthesize OUT.csv [CASE] [--run NAME] [--rigid] [--noise F]
   [--drift F] [--seed N] [--rate HZ] [--duration S]``: a synthetic record
   made from a simulation (:mod:`workbook.rig.synthetic`).
@@ -89,7 +92,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     modes = parser.add_subparsers(dest="mode", required=True)
     measure = modes.add_parser("measure", help="measured T and eta per direction of a rig record")
     compare = modes.add_parser("compare", help="simulate the record's run and print the validation table")
-    for sub in (measure, compare):
+    plot = modes.add_parser("plot", help="time histories and amplitude spectra of a rig record (PNG); with --case, "
+                                         "measured against simulated T")
+    for sub in (measure, compare, plot):
         sub.add_argument("record", help="rig record: CSV, or UFF dataset 58 time histories (.uff, .unv)")
         sub.add_argument("--periods", type=int, default=_DEFAULT_PERIODS,
                          help=f"whole rotor periods per window (default {_DEFAULT_PERIODS})")
@@ -98,7 +103,12 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         sub.add_argument("--at-nominal", action="store_true",
                          help="DFT at the nominal rotor frequency, not at the spectral peak next to it")
     compare.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
-    compare.add_argument("--rigid", action="store_true", help="make every link rigid")
+    plot.add_argument("--case", nargs="?", const="", metavar="CASE",
+                      help="also plot measured against simulated T of the record's run of this case (JSON or .xlsx "
+                           "workbook; --case alone: the reference mount)")
+    plot.add_argument("--output", required=True, metavar="OUT.png", help="PNG file to write")
+    for sub in (compare, plot):
+        sub.add_argument("--rigid", action="store_true", help="make every link rigid")
     compare.add_argument("--csv", metavar="OUT.csv", help="also write the validation table")
     synthesize = modes.add_parser("synthesize", help="write a synthetic rig record made from a simulation")
     synthesize.add_argument("output", help="record to write: CSV, or UFF dataset 58 (.uff, .unv)")
@@ -117,11 +127,17 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
         if args.mode == "synthesize":
             return _synthesize(args)
         from workbook.rig.correlation import PEAK_SEARCH, comparison_frame, measure
-        check_output("--csv", getattr(args, "csv", None), (".csv",), [args.record, args.map, getattr(args, "case", None)])
+
+        inputs = [args.record, args.map, getattr(args, "case", None) or None]
+        check_output("--csv", getattr(args, "csv", None), (".csv",), inputs)
+        check_output("--output", getattr(args, "output", None), (".png",), inputs)
         record = read_any_record(args.record, args.map)
-        if args.mode == "compare":
-            case = load_case(args.case, rigid=args.rigid)
+        compared = args.mode == "compare" or (args.mode == "plot" and args.case is not None)
+        if compared:
+            case = load_case(args.case or None, rigid=args.rigid)
             record.check_hinges([h.name for h in case.pylon_hinges])
+        elif args.mode == "plot":
+            return _plot(args, record, None)
         measurement = measure(record, args.periods, search=0.0 if args.at_nominal else PEAK_SEARCH)
         print(f"{record.path}: run {record.run!r}, rotor at {measurement.frequency_hz:.4f} Hz (nominal "
               f"{measurement.nominal_hz:g} Hz), |F_exc| {measurement.excitation_amplitude:.1f} N, "
@@ -132,11 +148,25 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
             return 0
         table = comparison_frame(measurement, simulate_run(case, record.run))
         print(table.to_string(float_format=lambda v: f"{v:10.5g}"))
+        if args.mode == "plot":
+            return _plot(args, record, table)
         if args.csv:
             write_output(args.csv, "validation table", "rig", lambda target: save_csv(table, target))
         return 0
 
     return rig
+
+
+def _plot(args, record: RigRecord, table) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from workbook.answers.saving import save_figure
+    from workbook.rig.plots import plot_record
+
+    figure = plot_record(record, table)
+    write_output(args.output, "rig record plot", "rig", lambda target: save_figure(figure, target))
+    return 0
 
 
 def _synthesize(args) -> int:
