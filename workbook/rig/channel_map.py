@@ -195,11 +195,11 @@ def read_mapped_record(path: str | Path, channel_map: str | Path | ChannelMap) -
         raise RecordError(path, "a second column of this channel", line=start, column=twice)
     values = table_values(path, lines, start, headers)
     time = values[:, headers.index(mapping.time_column)] * mapping.time_factor
-    rate = 1.0 / float(np.median(np.diff(time))) if len(time) > 1 else 1.0
-    time = check_sampling(path, time, rate, start, column=mapping.time_column)
+    time = check_sampling(path, time, None, start, column=mapping.time_column)
     forces = {name: np.zeros((len(time), 3)) for name in (*mapping.hinges, EXCITATION_CHANNEL)}
     for column, (sensor, axis, factor) in mapping.channels.items():
         forces[sensor][:, axis] = factor * values[:, headers.index(column)]
     excitation = forces.pop(EXCITATION_CHANNEL)
+    rate = (len(time) - 1) / (time[-1] - time[0])
     return RigRecord(time, forces, excitation, dict(mapping.hinges), rate, mapping.nominal_hz, mapping.run, str(path),
                      {"channel map": mapping.path})

@@ -243,17 +243,21 @@ def table_values(path, lines: list[str], start: int, headers: list[str]) -> np.n
     return values
 
 
-def check_sampling(path, time: np.ndarray, rate: float, start: int, column: str = "time [s]") -> np.ndarray:
+def check_sampling(path, time: np.ndarray, rate: float | None, start: int | None,
+                   column: str = "time [s]") -> np.ndarray:
     """Check that *time* (s) is sampled uniformly at *rate* (Hz); return the uniform times, s.
 
     The times returned lie on the checked grid, without the rounding of the file's digits.
 
     Parameters
     ----------
-    start : int
-        Line of the column header (the first sample is on the next line).
+    rate : float or None
+        The stated sample rate, Hz (None: none is stated; the record's rate is its time's).
+    start : int or None
+        Line of the column header (the first sample is on the next line;
+        None: the times are not lines of a file).
     column : str
-        The time column's header, for the message.
+        The time column (or channel), for the message.
 
     Raises
     ------
@@ -265,16 +269,16 @@ def check_sampling(path, time: np.ndarray, rate: float, start: int, column: str 
     if len(time) < 2:
         raise RecordError(path, f"{len(time)} samples; a record needs many periods of the rotor")
     steps = np.diff(time)
-    step = 1.0 / rate
     bad = np.flatnonzero(np.abs(steps - np.median(steps)) > 1e-3 * np.median(steps))
     if steps.min() <= 0 or len(bad):
         index = int(np.flatnonzero(steps <= 0)[0] if steps.min() <= 0 else bad[0])
         raise RecordError(path, f"time is not uniformly sampled: step {steps[index]:.6g} s here, "
-                          f"{np.median(steps):.6g} s elsewhere", line=start + 2 + index, column=column)
+                          f"{np.median(steps):.6g} s elsewhere", line=None if start is None else start + 2 + index,
+                          column=column)
     sampled = 1.0 / float(np.median(steps))
-    if abs(sampled - rate) > SAMPLE_RATE_TOLERANCE * rate:
+    if rate is not None and abs(sampled - rate) > SAMPLE_RATE_TOLERANCE * rate:
         raise RecordError(path, f"wrong sample rate: the header states {rate:g} Hz, the time column is "
-                          f"sampled at {sampled:.6g} Hz (step {step:.6g} s expected)", column=column)
+                          f"sampled at {sampled:.6g} Hz (step {1.0 / rate:.6g} s expected)", column=column)
     return time[0] + np.arange(len(time)) * (time[-1] - time[0]) / (len(time) - 1)
 
 

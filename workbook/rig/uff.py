@@ -35,7 +35,7 @@ import numpy as np
 from workbook.errors import RecordError, UnitProblem
 from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 from workbook.model.units import si_factor
-from workbook.rig.records import EXCITATION_CHANNEL, SAMPLE_RATE_TOLERANCE, RigRecord, parse_header_line
+from workbook.rig.records import EXCITATION_CHANNEL, RigRecord, check_sampling, parse_header_line
 
 __all__ = ["read_uff_record", "write_uff_record", "UFF_SUFFIXES"]
 
@@ -82,20 +82,13 @@ def _force_factor(path, label: str, dataset: dict) -> float:
 
 
 def _time(path, label: str, dataset: dict) -> np.ndarray:
-    """The dataset's abscissa in s, checked uniform."""
+    """The dataset's abscissa in s, checked uniform (:func:`~workbook.rig.records.check_sampling`)."""
     units = str(dataset.get("abscissa_axis_units_lab", "")).strip()
     try:
         factor = 1.0 if units in _NONE else si_factor(units, "s")
     except UnitProblem as problem:
         raise RecordError(path, f"{label}: abscissa unit {units!r}: {problem}") from None
-    time = np.asarray(dataset["x"], dtype=float) * factor
-    if len(time) < 2:
-        raise RecordError(path, f"{label}: {len(time)} samples; a record needs many periods of the rotor")
-    steps = np.diff(time)
-    if steps.min() <= 0 or np.ptp(steps) > SAMPLE_RATE_TOLERANCE * np.median(steps):
-        raise RecordError(path, f"{label}: time is not uniformly sampled (steps from {steps.min():.6g} s to "
-                          f"{steps.max():.6g} s)")
-    return time
+    return check_sampling(path, np.asarray(dataset["x"], dtype=float) * factor, None, None, column=label)
 
 
 def read_uff_record(path: str | Path) -> RigRecord:
@@ -192,10 +185,9 @@ def read_uff_record(path: str | Path) -> RigRecord:
         if missing:
             raise RecordError(path, f"channel {name!r} has no {', '.join(missing)} dataset")
         forces[name] = np.column_stack([channels[node, axis] for axis in DIRECTIONS])
-    step = (time[-1] - time[0]) / (len(time) - 1)
-    time = time[0] + np.arange(len(time)) * step
     excitation = forces.pop(EXCITATION_CHANNEL)
-    return RigRecord(time, forces, excitation, {name: hinges[name] for name in forces}, 1.0 / step, nominal,
+    return RigRecord(time, forces, excitation, {name: hinges[name] for name in forces},
+                     (len(time) - 1) / (time[-1] - time[0]), nominal,
                      header["run"][0], str(path), {k: v for k, (v, _) in header.items()
                                                    if k not in ("run", "nominal frequency [Hz]")})
 
