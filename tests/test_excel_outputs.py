@@ -208,7 +208,8 @@ def _json_case(folder):
     (["run", "{case}", "--report", "report.ods"], "--report", ".xlsx"),
     (["layout", "{case}", "-o", "{case}"], "--output", ".png"),
     (["template", "case.ods"], "output", ".xlsx or .xlsm"),
-    (["rig", "synthesize", "{case}", "{case}"], "output", ".csv"),
+    (["rig", "synthesize", "{case}", "{case}"], "output", ".csv or .uff or .unv"),
+    (["rig", "plot", "{case}", "--output", "plot.pdf"], "--output", ".png"),
 ])
 def test_an_output_with_the_wrong_ending_is_refused_before_anything_runs(user_case, folder, capsys, argv, option,
                                                                          expected):

@@ -82,7 +82,7 @@ def test_force_amplitude_is_the_largest_magnitude_over_a_period():
 
 @pytest.mark.slow
 def test_committed_record_is_what_the_code_generates(tmp_path, cache_dir):
-    assert main(["rig", "synthesize", str(tmp_path / "rig.csv"), "--rigid"]) == 0
+    assert main(["rig", "synthesize", str(tmp_path / "rig.csv"), "--rigid", "--rate", "2048"]) == 0
     committed, made = read_record(CASES / "reference-lp-rig.csv"), read_record(tmp_path / "rig.csv")
     assert committed.hinges == made.hinges and committed.notes == made.notes
     np.testing.assert_allclose(committed.excitation, made.excitation, atol=2e-4)
@@ -212,3 +212,85 @@ def test_workbook_names_the_cell_of_a_record_of_another_run(tmp_path, capsys):
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert "Test data" in err and "rig record" in err and "nominal frequency 59 Hz is not run 'HP rotor'" in err
+
+
+@pytest.mark.parametrize(("run", "suffix"), [("LP rotor", ".csv"), ("HP rotor", ".uff")])
+def test_a_record_synthesized_at_the_default_rate_can_be_compared_for_either_rotor(tmp_path, cache_dir, run, suffix):
+    """The default rate samples the HP rotor (248.5 Hz) at least 10 times a period: 4096 Hz, 16.5 samples.
+
+    (2048 Hz, the former default, gave 8.2 and compare refused the HP rotor's record.)"""
+    import pandas as pd
+
+    from workbook.cli.loading import load_case
+    from workbook.cli.rig import simulate_run
+    from workbook.model.codec import to_json
+
+    case = tmp_path / "case.json"
+    case.write_text(to_json(reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE)))
+    record, table = tmp_path / f"rig{suffix}", tmp_path / "validation.csv"
+    assert main(["rig", "synthesize", str(record), str(case), "--rigid", "--run", run, "--duration", "1", "--noise", "0", "--drift", "0"]) == 0
+    # (a UFF file's abscissa increment has 6 digits: 2.44141e-04 s)
+    assert read_record(record).sample_rate_hz == pytest.approx(4096.0, rel=1e-5)
+    assert main(["rig", "compare", str(record), str(case), "--rigid", "--periods", "20", "--csv", str(table)]) == 0
+    # the record's T is the time-domain run's that made it (the table's "T sim" is the frequency domain's)
+    made = simulate_run(load_case(str(case), rigid=True), run, histories=True).transmissibility
+    measured = pd.read_csv(table, index_col="direction")["T test"].to_numpy()
+    # a window of 20 periods spans them to within one sample: 1 / (20 x 16.5) = 3e-3 at the HP rotor
+    np.testing.assert_allclose(measured, made, rtol=3e-3)
+
+
+def test_a_sine_on_a_bin_reads_its_amplitude_in_the_spectrum():
+    from workbook.rig.plots import amplitude_spectrum, coherent_samples
+
+    rate, frequency, amplitude = 1000.0, 50.0, 3.0
+    time = np.arange(1000) / rate  # 50 whole periods: the sine is on bin 50
+    frequencies, amplitudes = amplitude_spectrum(2.0 + amplitude * np.sin(2 * np.pi * frequency * time + 0.7), rate)
+    assert frequencies[np.argmax(amplitudes[1:]) + 1] == frequency
+    assert amplitudes[50] == pytest.approx(amplitude, rel=1e-12) and amplitudes[0] == pytest.approx(2.0, rel=1e-12)
+    # 8000 samples at 2048 Hz hold 230.5 periods of 59 Hz: 230 periods are 7983.7 samples -> 7984
+    assert coherent_samples(2048.0, 59.0, 8000) == 7984
+    assert coherent_samples(2048.0, 59.0, 8192) == 8192  # 4 s: 236 whole periods
+
+
+def test_rig_plot_shows_the_excitation_at_the_rotor_frequency_with_its_amplitude(lp_run, tmp_path):
+    """The spectra of a synthetic record (no noise, no drift): the rotating 1000 N force on its rotor line."""
+    from workbook.rig.plots import plot_record
+
+    record = read_record(write_record(tmp_path / "rig.csv", synthetic_record(lp_run, REFERENCE_TRANSDUCERS, noise=0.0,
+                                                                             drift=0.0)))
+    figure = plot_record(record)
+    # a column per sensor (4 transducers and the excitation): time on top, spectra below
+    assert len(figure.axes) == 2 * 5
+    spectrum = figure.axes[2 * 4 + 1]
+    assert spectrum.get_xlabel() == "frequency [Hz]" and figure.axes[2 * 4].get_title() == "excitation"
+    lines = {line.get_label(): line.get_data() for line in spectrum.get_lines()}
+    assert lines["rotor 59.00 Hz"][0][0] == pytest.approx(59.0, rel=1e-6)
+    for axis in "yz":  # the LP rotor's force rotates about the engine axis x: 1000 N in y and z
+        frequencies, amplitudes = lines[axis]
+        peak = np.argmax(amplitudes)
+        # 4 s at 2048 Hz hold 236 whole periods: the rotor line is on a bin
+        assert frequencies[peak] == pytest.approx(59.0, abs=0.5 * (frequencies[1] - frequencies[0]))
+        assert amplitudes[peak] == pytest.approx(1000.0, rel=1e-3)
+    # each transducer's line at the rotor frequency is its amplitude by the single-bin DFT of the measurement
+    measured = measure(record, periods=100)
+    front = {line.get_label(): line.get_data()[1] for line in figure.axes[1].get_lines()}
+    for axis, amplitude in zip("xyz", measured.transducer_amplitudes["front-left"], strict=True):
+        assert front[axis][np.argmax(lines["y"][1])] == pytest.approx(amplitude, rel=2e-3, abs=1e-3)
+    # with the comparison: one more row
+    assert len(plot_record(record, comparison_frame(measured, lp_run)).axes) == 2 * 5 + 1
+
+
+def test_rig_plot_command_writes_the_png_beside_an_existing_one(tmp_path, cache_dir, capsys):
+    from PIL import Image
+
+    from workbook.model.codec import to_json
+
+    case = tmp_path / "case.json"
+    case.write_text(to_json(reference_case(analysis=SHORT, element_size=COARSE_ELEMENT_SIZE)))
+    out = tmp_path / "rig.png"
+    record = str(CASES / "reference-lp-rig.csv")
+    assert main(["rig", "plot", record, "--output", str(out)]) == 0
+    assert Image.open(out).size[0] > Image.open(out).size[1]
+    assert main(["rig", "plot", record, "--case", str(case), "--rigid", "--periods", "50", "--output", str(out)]) == 0
+    assert "rig.png was not overwritten" in capsys.readouterr().out
+    assert main(["rig", "plot", record, "--output", str(tmp_path / "rig.jpg")]) == 2

@@ -33,7 +33,8 @@ from workbook.answers.saving import save_text
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 
-__all__ = ["RigRecord", "read_record", "write_record", "EXCITATION_CHANNEL",
+__all__ = ["RigRecord", "read_record", "write_record", "parse_header_line", "table_values",
+           "check_sampling", "EXCITATION_CHANNEL",
            "SAMPLE_RATE_TOLERANCE"]
 
 #: Channel name of the excitation force.
@@ -41,7 +42,7 @@ EXCITATION_CHANNEL = "excitation"
 #: Largest relative difference between the stated and the sampled rate.
 SAMPLE_RATE_TOLERANCE = 1e-3
 _MAGIC = "mountwb rig record"
-_HEADER = re.compile(r"^#\s*(?P<key>[^:]+?)\s*:\s*(?P<value>.*?)\s*$")
+_HEADER = re.compile(r"^\s*(?P<key>[^:]+?)\s*:\s*(?P<value>.*?)\s*$")
 _COLUMN = re.compile(r"^\s*(?P<name>.+?)\s*\[\s*(?P<unit>[^\]]+?)\s*\]\s*$")
 
 
@@ -107,8 +108,14 @@ class RigRecord:
                               f"pylon-side hinges ({', '.join(pylon_hinges)}): {'; '.join(problems)}")
 
 
+def parse_header_line(text: str) -> tuple[str, str] | None:
+    """``(key, value)`` of a header line ``key: value`` (without its ``#``), or None for another text."""
+    match = _HEADER.match(text)
+    return None if match is None else (match["key"], match["value"])
+
+
 def read_record(path: str | Path) -> RigRecord:
-    """Read and check a rig record CSV.
+    """Read and check a rig record: a CSV, or a UFF file (``.uff``, ``.unv``: :mod:`workbook.rig.uff`).
 
     Raises
     ------
@@ -118,6 +125,10 @@ def read_record(path: str | Path) -> RigRecord:
         that differs from the stated one.
     """
     path = Path(path)
+    from workbook.rig.uff import UFF_SUFFIXES, read_uff_record
+
+    if path.suffix.lower() in UFF_SUFFIXES:
+        return read_uff_record(path)
     try:
         lines = path.read_text().splitlines()
     except OSError as error:
@@ -129,9 +140,7 @@ def read_record(path: str | Path) -> RigRecord:
     if "time" not in data:
         raise RecordError(path, "no 'time [s]' column", line=table_start)
     time = data.pop("time")
-    _check_sampling(path, time, rate, table_start)
-    # the checked times, without the rounding of the file's digits
-    time = time[0] + np.arange(len(time)) * (time[-1] - time[0]) / (len(time) - 1)
+    time = check_sampling(path, time, rate, table_start)
     channels = {}
     for name in (*hinges, EXCITATION_CHANNEL):
         for axis in DIRECTIONS:
@@ -155,10 +164,10 @@ def _read_header(path, lines: list[str]) -> tuple[dict, dict, int]:
         if not text.startswith("#"):
             table_start = number
             break
-        match = _HEADER.match(text)
-        if match is None:
+        parsed = parse_header_line(text[1:])
+        if parsed is None:
             continue
-        key, value = match["key"], match["value"]
+        key, value = parsed
         if key.startswith(TRANSDUCER_PREFIX):
             names = tuple(n.strip() for n in value.split("+") if n.strip())
             if not names:
@@ -205,6 +214,18 @@ def _read_table(path, lines: list[str], start: int) -> tuple[list, dict]:
         except UnitProblem as problem:
             raise RecordError(path, f"unit {match['unit']!r}: {problem}", line=start, column=header) from None
         names.append(match["name"])
+    values = table_values(path, lines, start, headers)
+    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors, strict=True))}
+
+
+def table_values(path, lines: list[str], start: int, headers: list[str]) -> np.ndarray:
+    """The numbers of the CSV rows after the column header line *start* (1-based), shape (rows, columns).
+
+    Raises
+    ------
+    RecordError
+        A row of another length, or a cell that is not a finite number, naming its line and column.
+    """
     rows = [row for row in csv.reader(lines[start:]) if row]
     values = np.empty((len(rows), len(headers)))
     for index, row in enumerate(rows):
@@ -219,33 +240,61 @@ def _read_table(path, lines: list[str], start: int) -> tuple[list, dict]:
     if not np.isfinite(values).all():
         index, j = np.argwhere(~np.isfinite(values))[0]
         raise RecordError(path, "not a finite number", line=start + 1 + int(index), column=headers[j])
-    return headers, {name: values[:, j] * factor for j, (name, factor) in enumerate(zip(names, factors, strict=True))}
+    return values
 
 
-def _check_sampling(path, time: np.ndarray, rate: float, start: int) -> None:
+def check_sampling(path, time: np.ndarray, rate: float | None, start: int | None,
+                   column: str = "time [s]") -> np.ndarray:
+    """Check that *time* (s) is sampled uniformly at *rate* (Hz); return the uniform times, s.
+
+    The times returned lie on the checked grid, without the rounding of the file's digits.
+
+    Parameters
+    ----------
+    rate : float or None
+        The stated sample rate, Hz (None: none is stated; the record's rate is its time's).
+    start : int or None
+        Line of the column header (the first sample is on the next line;
+        None: the times are not lines of a file).
+    column : str
+        The time column (or channel), for the message.
+
+    Raises
+    ------
+    RecordError
+        Fewer than 2 samples, a step that differs from the others by more
+        than 0.1 % (naming its line), or a sampled rate that differs from
+        *rate* by more than :data:`SAMPLE_RATE_TOLERANCE`.
+    """
     if len(time) < 2:
         raise RecordError(path, f"{len(time)} samples; a record needs many periods of the rotor")
     steps = np.diff(time)
-    step = 1.0 / rate
     bad = np.flatnonzero(np.abs(steps - np.median(steps)) > 1e-3 * np.median(steps))
     if steps.min() <= 0 or len(bad):
         index = int(np.flatnonzero(steps <= 0)[0] if steps.min() <= 0 else bad[0])
         raise RecordError(path, f"time is not uniformly sampled: step {steps[index]:.6g} s here, "
-                          f"{np.median(steps):.6g} s elsewhere", line=start + 2 + index, column="time [s]")
+                          f"{np.median(steps):.6g} s elsewhere", line=None if start is None else start + 2 + index,
+                          column=column)
     sampled = 1.0 / float(np.median(steps))
-    if abs(sampled - rate) > SAMPLE_RATE_TOLERANCE * rate:
+    if rate is not None and abs(sampled - rate) > SAMPLE_RATE_TOLERANCE * rate:
         raise RecordError(path, f"wrong sample rate: the header states {rate:g} Hz, the time column is "
-                          f"sampled at {sampled:.6g} Hz (step {step:.6g} s expected)", column="time [s]")
+                          f"sampled at {sampled:.6g} Hz (step {1.0 / rate:.6g} s expected)", column=column)
+    return time[0] + np.arange(len(time)) * (time[-1] - time[0]) / (len(time) - 1)
 
 
 def write_record(path: str | Path, record: RigRecord, *, digits: int = 4) -> Path:
-    """Write *record* as a rig record CSV (forces in N with *digits* decimals, time in s).
+    """Write *record* as a rig record CSV (forces in N with *digits* decimals, time in s), or as a UFF
+    file for a path ending in ``.uff`` or ``.unv`` (:func:`workbook.rig.uff.write_uff_record`).
 
     Returns
     -------
     Path
     """
     path = Path(path)
+    from workbook.rig.uff import UFF_SUFFIXES, write_uff_record
+
+    if path.suffix.lower() in UFF_SUFFIXES:
+        return write_uff_record(path, record)
     lines = [f"# {_MAGIC}", f"# run: {record.run}", f"# nominal frequency [Hz]: {record.nominal_hz:.10g}",
              f"# sample rate [Hz]: {record.sample_rate_hz:.10g}"]
     lines += [f"# transducer {name}: {' + '.join(hinges)}" for name, hinges in record.hinges.items()]

@@ -14,14 +14,21 @@ signal is the steady response at the instantaneous speed.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from workbook.answers.amplitude import harmonic_amplitude
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
+from workbook.rig.correlation import MIN_SAMPLES_PER_PERIOD
 from workbook.rig.records import RigRecord
 
-__all__ = ["synthetic_record", "REFERENCE_TRANSDUCERS"]
+__all__ = ["synthetic_record", "default_sample_rate", "REFERENCE_TRANSDUCERS", "RATE_MARGIN"]
+
+#: A default record samples the highest frequency this many times more
+#: often than :data:`~workbook.rig.correlation.MIN_SAMPLES_PER_PERIOD` (at least).
+RATE_MARGIN = 1.25
 
 #: The seed study's rig: two front and two rear three-way transducers, named
 #: by the pylon-side hinges of the reference mount they carry.
@@ -31,6 +38,26 @@ REFERENCE_TRANSDUCERS = {
     "rear-left": ("rear-up-left", "rear-up-middle"),
     "rear-right": ("rear-up-right", "rear-up-lateral"),
 }
+
+
+def default_sample_rate(frequencies_hz) -> float:
+    """The sample rate at which a record of any of *frequencies_hz* can be measured, Hz.
+
+    The next power of two at or above ``MIN_SAMPLES_PER_PERIOD x RATE_MARGIN
+    x max(frequencies_hz)``: 4096 Hz for the reference mount (HP rotor
+    248.5 Hz: 16.5 samples per period; LP rotor 59 Hz: 69).
+
+    Parameters
+    ----------
+    frequencies_hz : iterable of float
+        Rotor frequencies of the case's runs, Hz.
+
+    Returns
+    -------
+    float
+        Hz.
+    """
+    return float(2 ** math.ceil(math.log2(MIN_SAMPLES_PER_PERIOD * RATE_MARGIN * max(frequencies_hz))))
 
 
 def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate_hz: float = 2048.0,
