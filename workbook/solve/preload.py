@@ -40,7 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from workbook.answers.isolation import pylon_sum
-from workbook.errors import EquilibriumError, MechanismError, UnstablePreloadError
+from workbook.errors import EquilibriumError, MechanismError, UnstablePreloadError, interruption
 from workbook.model.case import ENGINE, Gravity, PointForce, PointMoment
 from workbook.scene.build import Scene, marker_bodies
 from workbook.solve.guards import solver_output
@@ -349,7 +349,10 @@ def _attempt(scene: Scene, settings) -> tuple[bool, str]:
     with solver_output() as output, scene.excitation_paused():
         try:
             converged = bool(scene.mbs.SolveStatic(settings, updateInitialValues=True))
-        except exu.SolverError:
+        except exu.SolverError as error:
+            interrupt = interruption(error)      # Ctrl-C or SIGTERM while Exudyn solved: not a failed solve
+            if interrupt is not None:
+                raise interrupt from None
             converged = False
     return converged, output.getvalue()
 

@@ -31,11 +31,13 @@ written as rows finish), so an interrupt loses only the rows in flight.
 """
 from __future__ import annotations
 
+import contextlib
 import itertools
 import logging
 import multiprocessing
 import os
 import signal
+import threading
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -44,7 +46,7 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 from workbook.answers.isolation import efficiency
-from workbook.errors import interruption
+from workbook.errors import Terminated, interruption
 from workbook.model.case import DIRECTIONS, Case
 from workbook.processes import end_with_parent, stop_workers
 
@@ -225,11 +227,47 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
     if dask is not None:
         _run_dask(pending, dask, done)
     elif workers <= SERIAL or len(pending) <= 1:
-        for index, case in pending.items():
-            done(run_row(index, case))
+        with _signals_seen() as seen:
+            for index, case in pending.items():
+                outcome = run_row(index, case)
+                if seen:        # a signal that a library swallowed during the row: the row is not run
+                    raise Terminated() if signal.SIGTERM in seen else KeyboardInterrupt()
+                done(outcome)
     else:
         _run_processes(pending, workers, done, rows_per_worker)
     return [outcomes[i] for i in range(total)]
+
+
+@contextlib.contextmanager
+def _signals_seen():
+    """Note every Ctrl-C and SIGTERM while rows run in this process, then handle it as before.
+
+    Yields
+    ------
+    list of int
+        The signals received. A signal that a library (Exudyn) turned into an
+        error of its own without its cause is still seen here, so that a row
+        it ended is never recorded as failed and the study stops.
+    """
+    seen: list[int] = []
+    previous = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+
+    def note(signum, frame):
+        seen.append(signum)
+        handler = previous[signum]
+        if callable(handler):
+            handler(signum, frame)
+
+    watched = [signum for signum, handler in previous.items() if callable(handler)]
+    if threading.current_thread() is not threading.main_thread():
+        watched = []                         # only the main thread may set signal handlers
+    for signum in watched:
+        signal.signal(signum, note)
+    try:
+        yield seen
+    finally:
+        for signum in watched:
+            signal.signal(signum, previous[signum])
 
 
 #: In a worker process: where the worker reports the row it starts.
