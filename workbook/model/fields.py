@@ -10,7 +10,7 @@ from typing import Any
 
 from workbook.errors import CaseError
 
-__all__ = ["number", "positive_number", "vector3", "finite_point", "pair", "direction", "nonempty_name", "bounded_count",
+__all__ = ["number", "positive_number", "vector3", "pair", "direction", "nonempty_name", "bounded_count",
            "MAX_SWEEP_POINTS", "MAX_MODE_COUNT"]
 
 #: Most frequencies of one sweep, or speeds of one run-up: each is a solve of its own (a time-domain point
@@ -51,11 +51,6 @@ def vector3(item: str, name: str, value: Any) -> tuple[float, float, float]:
     if len(vector) != 3 or not all(math.isfinite(v) for v in vector):
         raise CaseError(item, name, value, "three finite numbers")
     return vector[0], vector[1], vector[2]
-
-
-def finite_point(item: str, name: str, value: Any) -> tuple[float, float, float]:
-    """*value* as a point (x, y, z), m: three finite floats, or a CaseError."""
-    return vector3(item, name, value)
 
 
 def pair(item: str, name: str, value: Any, *, strictly: bool) -> tuple[float, float]:

@@ -16,7 +16,7 @@ import numpy as np
 
 from flexbodies.materials import Material
 from workbook.errors import CaseError
-from workbook.model.fields import finite_point, positive_number
+from workbook.model.fields import positive_number, vector3
 
 __all__ = ["BoxBeamPylon", "SectionProperties"]
 
@@ -81,7 +81,7 @@ class BoxBeamPylon:
         item = f"pylon beam {self.name!r}"
         set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         for name in ("root", "tip", "up"):
-            set_(name, finite_point(item, name, getattr(self, name)))
+            set_(name, vector3(item, name, getattr(self, name)))
         for name in ("width", "height", "wall"):
             set_(name, positive_number(item, name, getattr(self, name)))
         if self.wall >= min(self.width, self.height) / 2:

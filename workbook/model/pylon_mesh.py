@@ -18,7 +18,7 @@ import numpy as np
 
 from flexbodies.materials import Material
 from workbook.errors import CaseError
-from workbook.model.fields import finite_point, positive_number
+from workbook.model.fields import positive_number, vector3
 
 __all__ = ["MeshPylon"]
 
@@ -67,7 +67,7 @@ class MeshPylon:
             raise CaseError(item, "path", self.path, "the path of a mesh file")
         set_("path", str(self.path))
         for name in ("root_point", "root_normal", "bore_axis"):
-            set_(name, finite_point(item, name, getattr(self, name)))
+            set_(name, vector3(item, name, getattr(self, name)))
         for name in ("root_normal", "bore_axis"):
             if not np.linalg.norm(getattr(self, name)) > 0:
                 raise CaseError(item, name, getattr(self, name), "a non-zero direction")

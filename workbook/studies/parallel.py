@@ -230,7 +230,7 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         with _signals_seen() as seen:
             for index, case in pending.items():
                 outcome = run_row(index, case)
-                if seen:        # a signal that a library swallowed during the row: the row is not run
+                if seen:        # a signal a library swallowed during the row: its outcome is dropped, --resume reruns it
                     raise Terminated() if signal.SIGTERM in seen else KeyboardInterrupt()
                 done(outcome)
     else:
