@@ -81,9 +81,14 @@ def test_the_command_writes_its_files_and_refuses_bad_options(tmp_path, capsys):
     assert {c["whirl"] for c in answer["critical speeds"]} >= {"forward", "backward"}
     assert plot.stat().st_size > 0 and table.read_text().startswith("branch,speed rpm,frequency Hz")
     for bad, words in ((["--rotor", "HP"], "one of rotor"), (["--operating", "900:300"], "--operating"),
-                       (["--orders", "1,x"], "--orders"), (["--plot", str(tmp_path / "c.pdf")], "expected a .png")):
+                       (["--orders", "1,x"], "--orders"), (["--plot", str(tmp_path / "c.pdf")], "expected a file ending in .png")):
         assert main(["campbell", str(path), "--points", "3", *bad]) == EXIT_BAD_INPUT
         assert words in capsys.readouterr().err
     assert not (tmp_path / "c.pdf").exists()
+    table.write_text("a table of the user's")              # an existing file of the output's name is kept
+    assert main(["campbell", str(path), "--to", "1000", "--points", "3", "--csv", str(table)]) == 0
+    assert table.read_text() == "a table of the user's"
+    beside = [p for p in tmp_path.glob("campbell-campbell-*.csv")]
+    assert len(beside) == 1 and beside[0].read_text().startswith("branch,speed rpm,frequency Hz")
     with pytest.raises(CaseError, match="a rotor or a rotating excitation"):
         campbell(whirl_case(rotors=()))

@@ -5,16 +5,19 @@ mounted engine against rotor speed, with the gyroscopic split of the
 case's rotors, the engine-order lines and the critical speeds where they
 meet. Prints the critical speeds and the branches; ``--plot``, ``--csv``
 and ``--json`` write the picture, the branches table and everything.
-Everything is computed before a file is written.
+Everything is computed before a file is written; an existing file of an
+output's name is kept and the new one goes beside it.
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from typing import Callable
 
 from workbook.cli.loading import load_case
+from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
 
 __all__ = ["arguments"]
@@ -48,12 +51,12 @@ def _numbers(text: str, option: str, separator: str) -> tuple[float, ...]:
 
 
 def run(args) -> int:
+    from workbook.answers.saving import save_csv, save_figure
     from workbook.model.reference import reference_case
     from workbook.solve.campbell import WHIRL, campbell
 
     for option, path, suffix in (("--plot", args.plot, ".png"), ("--csv", args.csv, ".csv")):
-        if path and not path.lower().endswith(suffix):
-            raise UsageError(f"{option} {path}: expected a {suffix} file")
+        check_output(option, path, (suffix,), [args.case])
     orders = _numbers(args.orders, "--orders", ",")
     operating = None
     if args.operating:
@@ -91,11 +94,11 @@ def run(args) -> int:
         if any(WHIRL[int(w)] == "backward" for w in diagram.whirl.ravel()):
             print("\nAn imbalance (1x, forward) excites mainly the forward-whirl modes; backward-whirl crossings "
                   "matter for asymmetric mounts.")
-    if args.csv:
-        diagram.to_frame().to_csv(args.csv, index=False)
-    if figure is not None:
-        figure.savefig(args.plot, dpi=120)
-    for path in (args.csv, args.plot):
-        if path:
-            print(path, file=sys.stderr)
+    # where each file went goes to stderr with --json, so that stdout stays one JSON document
+    with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
+        if args.csv:
+            write_output(args.csv, "branches table", "campbell", lambda target: save_csv(diagram.to_frame(), target,
+                                                                                        index=False))
+        if figure is not None:
+            write_output(args.plot, "plot", "campbell", lambda target: save_figure(figure, target, dpi=120))
     return 0
