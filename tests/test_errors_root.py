@@ -33,6 +33,7 @@ PLAIN = {"ValueError", "TypeError", "RuntimeError", "KeyError", "IndexError", "L
 #: The raises that stay plain, by module and function, and why: each is a defect of the package or of a
 #: program calling it, never the user's case, workbook, record, mesh or command line.
 PLAIN_RAISES = {
+    ("workbook/design/kinematics.py", "identify"): "a marker of the scene the package built (caught: OutsideDesignModel)",
     # internal invariants: the package made the value that fails
     ("workbook/answers/amplitude.py", "period_window"): "histories the package computed (rig records are checked first)",
     ("workbook/answers/amplitude.py", "_uniform_step"): "histories the package computed (rig records are checked first)",

@@ -37,6 +37,7 @@ _HOMES = {
     "solve.four_pole": ("FourPole", "frequency_grid"),
     "solve.modes": ("mounted_modes", "Mode"),
     "solve.campbell": ("campbell", "CampbellDiagram"),
+    "design.linear_mount": ("LinearMount", "DesignAnswer"),
     "answers.results": ("MountResult", "ExcitationResult"),
     "answers.isolation": ("transmissibility", "efficiency", "level_db"),
     "excel.reader": ("read_workbook", "CaseBook"),
@@ -48,7 +49,7 @@ _HOMES = {
     "studies.parallel": ("run_rows", "RowOutcome"),
     "errors": ("MountwbError", "InputError", "CaseError", "WorkbookError", "RecordError", "UsageError", "SimulationError", "MechanismError",
                "EquilibriumError", "ResonanceError", "FourPoleError", "UnstablePreloadError", "BucklingError",
-               "Terminated"),
+               "OutsideDesignModel", "Terminated"),
 }
 __getattr__, __dir__, _NAMES = lazy_names(__name__, _HOMES)
 __all__ = ["__version__", *_NAMES]

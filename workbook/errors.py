@@ -30,7 +30,7 @@ from typing import Any
 __all__ = ["MountwbError", "InputError", "CaseFileError", "UnwritableCase",
            "CaseError", "UnitProblem", "Problem", "WorkbookError", "TableError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
-           "MechanismError", "EquilibriumError", "FourPoleError", "UnstablePreloadError", "BucklingError", "UsageError",
+           "MechanismError", "EquilibriumError", "FourPoleError", "OutsideDesignModel", "UnstablePreloadError", "BucklingError", "UsageError",
            "BAD_INPUT",
            "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
            "EXIT_INTERRUPTED", "EXIT_TERMINATED", "EXIT_FAILED_ROWS", "Terminated", "interruption", "exit_code"]
@@ -354,6 +354,17 @@ def exit_code(error: BaseException) -> int:
     if isinstance(error, OSError):
         return EXIT_BAD_INPUT
     return EXIT_TROUBLE
+
+
+class OutsideDesignModel(SimulationError):
+    """A design the prepared linear mount cannot answer without a new
+    preparation (:mod:`workbook.design.linear_mount`): a limit of the fast
+    method, not the user's bad input; the full pipeline answers it."""
+
+    def __init__(self, case_name: str, change: str):
+        self.change = change
+        super().__init__(f"{case_name}: the design evaluation cannot follow {change}; it needs a new preparation "
+                         "(the full pipeline)")
 
 
 class FourPoleError(SimulationError):

@@ -39,7 +39,8 @@ from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
 
-__all__ = ["Linearization", "Mode", "linearize", "eigenpairs", "modes_from", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
+__all__ = ["Linearization", "Mode", "linearize",
+           "body_coordinates", "eigenpairs", "modes_from", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
            "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
 
 #: Modes below this frequency count as free motions (mechanisms), Hz. The
@@ -137,7 +138,7 @@ class Mode:
         return "motion of " + ", ".join(repr(name) for name in names) + " with the engine still"
 
 
-def _body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
+def body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
     import exudyn as exu
 
     mbs = scene.mbs
@@ -179,7 +180,7 @@ def linearize(scene: Scene) -> Linearization:
     else:
         basis = np.eye(size)
     project = lambda matrix: basis.T @ matrix @ basis  # noqa: E731
-    coordinates = _body_coordinates(scene)
+    coordinates = body_coordinates(scene)
     gyroscopic = None
     if scene.gyroscopics is not None:
         rotations = np.ix_(coordinates[ENGINE][3:], coordinates[ENGINE][3:])

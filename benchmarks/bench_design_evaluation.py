@@ -1,0 +1,50 @@
+"""Design evaluation in NumPy (workbook.design) against the Exudyn pipeline, on the reference mount.
+
+Prints, for hinge designs with every hinge's stiffness scaled per direction
+(random factors 1 to 4), the median wall time of one design (both rotors)
+by each path and the largest normwise difference of T and of the hinge
+forces. Run with ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
+"""
+import dataclasses
+import statistics
+import sys
+import time
+
+import numpy as np
+
+import workbook as wb
+
+
+def main(count: int = 5) -> None:
+    case = wb.reference_case()
+    case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, equilibrium_tolerance=1e-10))
+    start = time.perf_counter()
+    mount = wb.LinearMount.prepare(case)
+    prepare_seconds = time.perf_counter() - start
+    rng = np.random.default_rng(1)
+    fast_times, exact_times, t_errors, hinge_errors = [], [], [], []
+    for _ in range(count):
+        design = dataclasses.replace(case, hinges=tuple(
+            dataclasses.replace(h, stiffness=tuple(h.values("stiffness") * rng.uniform(1.0, 4.0, 3)))
+            for h in case.hinges))
+        start = time.perf_counter()
+        fast = mount.evaluate(design).result
+        fast_times.append(time.perf_counter() - start)
+        start = time.perf_counter()
+        exact = wb.run_case(design)
+        exact_times.append(time.perf_counter() - start)
+        for f, e in zip(fast.runs, exact.runs, strict=True):
+            t_errors.append(np.abs(f.transmissibility - e.transmissibility).max() / e.transmissibility.max())
+            hinge_errors.append(max(np.abs(f.hinge_amplitudes[n] - e.hinge_amplitudes[n]).max()
+                                    / e.hinge_amplitudes[n].max() for n in e.hinge_amplitudes))
+    fast_median, exact_median = statistics.median(fast_times), statistics.median(exact_times)
+    print(f"reference mount, {count} hinge designs, both rotors (preparation {prepare_seconds:.2f} s)")
+    print(f"{'path':<24}{'median s/design':>16}{'designs/s':>11}")
+    print(f"{'NumPy (LinearMount)':<24}{fast_median:>16.4f}{1 / fast_median:>11.1f}")
+    print(f"{'Exudyn (run_case)':<24}{exact_median:>16.4f}{1 / exact_median:>11.1f}")
+    print(f"speed-up {exact_median / fast_median:.1f}x; largest difference: T {max(t_errors):.1e}, "
+          f"hinge forces {max(hinge_errors):.1e} (normwise)")
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 5)

@@ -1,0 +1,70 @@
+"""The design evaluation in NumPy (workbook.design) against the Exudyn pipeline it replaces."""
+import dataclasses
+
+import numpy as np
+import pytest
+
+from workbook import run_case
+from workbook.design.linear_mount import LinearMount
+from workbook.errors import OutsideDesignModel
+from workbook.model.reference import reference_case
+
+pytestmark = pytest.mark.slow
+
+
+def _tight(case):
+    # the Exudyn reference solves its preload to 1e-13 of the loads, so that its own tolerance does not count
+    return dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, equilibrium_tolerance=1e-10))
+
+
+@pytest.fixture(scope="module")
+def mount():
+    return LinearMount.prepare(_tight(reference_case()))
+
+
+def _design(case, rng):
+    hinges = tuple(dataclasses.replace(h, stiffness=tuple(h.values("stiffness") * rng.uniform(1.0, 4.0, 3)),
+                                       loss_factor=float(rng.uniform(0.02, 0.1)))
+                   for h in case.hinges)
+    return dataclasses.replace(case, hinges=hinges)
+
+
+def _normwise(fast, exact):
+    return np.abs(fast - exact).max() / np.abs(exact).max()
+
+
+def _compare(mount, case):
+    fast = mount.evaluate(case).result
+    exact = run_case(case)
+    for f, e in zip(fast.runs, exact.runs, strict=True):
+        assert f.name == e.name
+        yield _normwise(f.transmissibility, e.transmissibility), max(
+            _normwise(f.hinge_amplitudes[name], e.hinge_amplitudes[name]) for name in e.hinge_amplitudes)
+
+
+def test_prepared_design_is_the_pipeline_answer(mount):
+    for t_error, hinge_error in _compare(mount, mount.case):
+        assert t_error < 1e-6 and hinge_error < 2e-6
+
+
+def test_random_hinge_designs_agree_with_the_pipeline(mount):
+    rng = np.random.default_rng(25)
+    for _ in range(2):
+        for t_error, hinge_error in _compare(mount, _design(mount.case, rng)):
+            assert t_error < 5e-6 and hinge_error < 1e-5
+
+
+def test_engine_mass_and_excitation_amplitude(mount):
+    case = mount.case
+    engine = dataclasses.replace(case.engine, mass=1.1 * case.engine.mass,
+                                 inertia=tuple(tuple(1.2 * v for v in row) for row in case.engine.inertia))
+    excitations = tuple(dataclasses.replace(e, amplitude=2.0 * e.amplitude) for e in case.excitations)
+    for t_error, hinge_error in _compare(mount, dataclasses.replace(case, engine=engine, excitations=excitations)):
+        assert t_error < 5e-6 and hinge_error < 1e-5
+
+
+def test_a_change_it_cannot_follow_is_named(mount):
+    case = mount.case
+    moved = dataclasses.replace(case.engine, center_of_mass=(-0.5, 0.0, -0.03))
+    with pytest.raises(OutsideDesignModel, match="a new preparation"):
+        mount.evaluate(dataclasses.replace(case, engine=moved))

@@ -1,0 +1,460 @@
+"""The linear mount as a fast function of its design.
+
+:meth:`LinearMount.prepare` runs the case once through the Exudyn pipeline
+(reductions, preload, stress stiffening, linearisation) for each excitation
+item and keeps the scene as a :class:`~workbook.design.expansion.SceneExpansion`.
+:meth:`LinearMount.evaluate` then answers a design - the case with other
+hinge stiffness, damping or loss factors (per hinge and per direction),
+test-rig transducer springs, engine mass and inertia, or excitation
+frequencies and amplitudes - in NumPy alone: the preload equilibrium by
+Newton (with the stress-stiffening passes of
+:mod:`workbook.solve.stress_stiffening`), the linearisation at it, and one
+complex solve per frequency. Its answers equal :func:`workbook.run_case`'s
+(``tests/test_linear_mount.py``). A change the expansion cannot follow (a
+link's section or material, the geometry, the effects, a mode selection the
+new frequency changes) raises :class:`~workbook.errors.OutsideDesignModel`,
+naming the change: such a design needs a new preparation.
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from workbook.answers.results import ExcitationResult, MountResult
+from workbook.design.assembly import (
+    ChannelSprings,
+    Projection,
+    StateLoads,
+    channel_force,
+    channel_state,
+    normal_components,
+    projection,
+    rest_matrices,
+    static_state,
+    tangent_stiffness,
+)
+from workbook.design.expansion import SceneExpansion, expand_scene
+from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, UnstablePreloadError
+from workbook.model.case import Case, Engine, Gravity, Simultaneous, SingleFrequencyExcitation, Sweep
+from workbook.scene.bearing import hinge_matrix
+from workbook.scene.build import Scene, loss_factors
+from workbook.solve.harmonic import point_phasors
+from workbook.solve.stages import link_warnings
+
+__all__ = ["LinearMount", "DesignAnswer", "channel_springs"]
+
+
+def channel_springs(case: Case, channels: list[str]) -> ChannelSprings:
+    """The springs of the force channels *channels* (hinges, then transducers) of *case*."""
+    hinge_loss, _ = loss_factors(case)
+    by_name = {hinge.name: hinge for hinge in case.hinges}
+    stiffness, damping, structural = (np.zeros((len(channels), 3, 3)) for _ in range(3))
+    for k, name in enumerate(channels):
+        hinge = by_name.get(name)
+        if hinge is None:
+            rig = case.test_rig
+            assert rig is not None
+            stiffness[k] = np.diag(rig.stiffness)
+            damping[k] = np.diag(rig.damping)
+            continue
+        stiffness[k] = hinge_matrix(case, hinge, "stiffness")
+        if case.effects.hinge_damping:
+            damping[k] = hinge_matrix(case, hinge, "damping")
+        if name in hinge_loss:
+            structural[k] = hinge_matrix(case, hinge, "loss_factor") @ stiffness[k]
+    return ChannelSprings(stiffness, damping, structural)
+
+
+@dataclass(frozen=True)
+class _FlexibleLink:
+    """What the design evaluation needs of one flexible link's stress stiffening and loss."""
+
+    name: str
+    modal: np.ndarray                  # full coordinates of its modal coordinates
+    geometric: np.ndarray              # K_G,r per N of tension
+    base_tension: float                # the tension the prepared scene's K_r + P K_G,r holds
+    stiffness_damping: float           # Rayleigh beta, s
+    loss_factor: float
+    reduced_stiffness: np.ndarray      # K_r of the prepared scene (stiffened there or not)
+    stiffening: object = field(repr=False)   # flexbodies LinkStiffening
+
+
+@dataclass
+class _Item:
+    """One excitation item, prepared."""
+
+    name: str
+    expansion: SceneExpansion
+    size: int
+    sign: float                        # Exudyn's Force output = sign * S d
+    base_force: np.ndarray             # the rest's internal force at the prepared state
+    compression: np.ndarray            # (links, channels, 3): link compression per channel force
+    links: list                        # _FlexibleLink, in the case's order of the assessed links
+    engine: np.ndarray                 # the engine's full coordinates
+    points: list                       # excitation points of the item's excitations
+    warnings: list
+    modes: list
+    base_engine: Engine
+    prepared_seconds: float
+
+
+@dataclass(frozen=True)
+class DesignAnswer:
+    """The answers of one design.
+
+    Attributes
+    ----------
+    result : MountResult
+        As :func:`workbook.run_case` gives it (no time histories; the model
+        cards and preloads are those of the prepared case, the preloads
+        replaced by the design's hinge forces).
+    static_hinge_forces : dict of str to dict of str to ndarray
+        Per excitation item, the preload force of every channel, N.
+    seconds : float
+        Wall time of the evaluation, s.
+    """
+
+    result: MountResult
+    static_hinge_forces: dict
+    seconds: float
+
+
+def _normalised(case: Case, base: Case) -> Case:
+    """*case* with every field a design may change set to *base*'s."""
+    hinges = tuple(dataclasses.replace(h, stiffness=b.stiffness, damping=b.damping, loss_factor=b.loss_factor)
+                   for h, b in zip(case.hinges, base.hinges, strict=True)) \
+        if [h.name for h in case.hinges] == [b.name for b in base.hinges] else case.hinges
+    engine = dataclasses.replace(case.engine, mass=base.engine.mass, inertia=base.engine.inertia)
+    rig = case.test_rig
+    if rig is not None and base.test_rig is not None:
+        rig = dataclasses.replace(rig, stiffness=base.test_rig.stiffness, damping=base.test_rig.damping)
+    return dataclasses.replace(case, hinges=hinges, engine=engine, test_rig=rig, excitations=base.excitations)
+
+
+class LinearMount:
+    """A case's linear mount, prepared once and answered per design in NumPy.
+
+    Use :meth:`prepare`; then :meth:`evaluate` answers any design the
+    expansion follows (see the module text).
+    """
+
+    def __init__(self, case: Case, items: dict, channels: list, pylon: list, cards: dict, preloads: dict):
+        self.case = case
+        self.items = items
+        self.channels = channels
+        self.pylon = pylon
+        self._cards = cards
+        self._preloads = preloads
+
+    @classmethod
+    def prepare(cls, case: Case) -> "LinearMount":
+        """Prepare every excitation item of *case* (the expensive part: reductions, Exudyn preload, expansion).
+
+        Raises
+        ------
+        OutsideDesignModel
+            A case the design evaluation cannot answer: a flexible pylon,
+            clearance laws, a flexible engine, or a time-domain method.
+        workbook.errors.SimulationError
+            As :func:`workbook.run_case`.
+        """
+        from workbook.solve.method import FREQUENCY, choose_method
+        from workbook.solve.pipeline import prepare, solve_frequencies
+
+        if case.flexible_pylon:
+            raise OutsideDesignModel(case.name, "a flexible pylon (answered by the four-pole set)")
+        if case.engine.casing is not None:
+            raise OutsideDesignModel(case.name, "a flexible engine casing")
+        items, cards, preloads = {}, {}, {}
+        channels: list[str] = []
+        pylon: list[str] = []
+        for item in case.excitations:
+            points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
+            chosen = choose_method(case, sweep=isinstance(item, Sweep))
+            if chosen.method != FREQUENCY:
+                raise OutsideDesignModel(case.name, f"{item.name!r} is answered in the time domain ({chosen.reason})")
+            start = time.perf_counter()
+            highest = max(points, key=lambda point: point.frequency)
+            prepared = prepare(case, points[0], reduce_for=highest)
+            with prepared.scene as scene:
+                if any(items_.clearance for items_ in scene.hinges.values()):
+                    raise OutsideDesignModel(case.name, "hinge clearance laws (a nonlinear scene)")
+                _, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen)
+                channels, pylon = list(scene.force_channels), list(scene.pylon_channels)
+                items[item.name] = _prepare_item(case, item, scene, prepared, channels,
+                                                 [np.asarray(p) for e in points for p, _ in point_phasors(e)],
+                                                 time.perf_counter() - start)
+            cards.update(item_cards)
+            preloads.update(item_preloads)
+        return cls(case, items, channels, pylon, cards, preloads)
+
+    def check(self, case: Case) -> None:
+        """Raise :class:`OutsideDesignModel` unless *case* differs from the prepared case only in what
+        a design may change (see the module text)."""
+        base = self.case
+        if _normalised(case, base) != base:
+            raise OutsideDesignModel(case.name, "a change beyond hinge springs, transducer springs, engine mass "
+                                     "properties and excitation frequencies and amplitudes")
+        if [type(e) for e in case.excitations] != [type(e) for e in base.excitations] or \
+                [e.name for e in case.excitations] != [e.name for e in base.excitations]:
+            raise OutsideDesignModel(case.name, "other excitations")
+        for item in case.excitations:
+            prepared = self.items[item.name]
+            for excitation in _points_of(item):
+                for point, _ in point_phasors(excitation):
+                    if tuple(np.round(np.asarray(point, dtype=float), 12)) not in prepared.expansion.points:
+                        raise OutsideDesignModel(case.name, f"{excitation.name!r} acts at a point the prepared "
+                                                 f"case has no excitation at ({point})")
+        _check_mode_decisions(case, base)
+
+    def evaluate(self, case: Case) -> DesignAnswer:
+        """Answer the design *case* (the prepared case with other springs, masses or excitations).
+
+        Raises
+        ------
+        OutsideDesignModel
+            *case* changes what needs a new preparation.
+        workbook.errors.SimulationError
+            The design buckles a link, loses its stability under the preload,
+            or is excited on an undamped resonance.
+        """
+        start = time.perf_counter()
+        self.check(case)
+        springs = channel_springs(case, self.channels)
+        runs, static = [], {}
+        for item in case.excitations:
+            prepared = self.items[item.name]
+            state = _solve_state(case, prepared, springs)
+            model = _harmonic(case, prepared, springs, state)
+            static[item.name] = dict(zip(self.channels, state.forces, strict=True))
+            for excitation in _points_of(item):
+                runs.append(_answer(case, prepared, model, excitation, self.channels, self.pylon))
+        result = MountResult(case.name, runs, dict(self._cards), dict(self._preloads))
+        return DesignAnswer(result, static, time.perf_counter() - start)
+
+
+def _points_of(item) -> tuple:
+    return item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
+
+
+def _check_mode_decisions(case: Case, base: Case) -> None:
+    """The links' mode selections at *case*'s frequencies must be the prepared ones."""
+    from workbook.scene.build import link_jobs
+
+    for item, base_item in zip(case.excitations, base.excitations, strict=True):
+        if max(p.frequency for p in _points_of(item)) == max(p.frequency for p in _points_of(base_item)):
+            continue
+        highest = max(_points_of(item), key=lambda point: point.frequency)
+        new = {name: job.modes for job, names in link_jobs(case, highest).items() for name in names}
+        if any(case.link_modes(name) == "auto" for name in new):
+            raise OutsideDesignModel(case.name, f"{item.name!r} at another frequency: the links' automatic mode "
+                                     "selection may keep other modes")
+
+
+def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str], points: list,
+                  seconds: float) -> _Item:
+    from flexbodies.geometric_stiffness import link_stiffening
+    from workbook.solve.preload import link_compression
+
+    start = time.perf_counter()
+    expansion = expand_scene(scene, points)
+    size = len(expansion.state)
+    forces = scene.hinge_forces()
+    base_springs = channel_springs(case, channels)
+    states = channel_state(expansion, np.zeros(size))
+    own = np.array([base_springs.stiffness[k] @ states[k][0] for k in range(len(channels))])
+    exudyn = np.array([forces[name] for name in channels])
+    scale = max(np.abs(exudyn).max(), 1e-300)
+    sign = 1.0 if np.abs(own - exudyn).max() <= np.abs(own + exudyn).max() else -1.0
+    if np.abs(sign * own - exudyn).max() > 1e-6 * scale:
+        raise OutsideDesignModel(case.name, "a force channel whose force is not its spring's (a user law)")
+    base_force = -channel_force(expansion, base_springs, states)
+    for indices, unit, normal in normal_components(expansion, np.zeros(size), -base_force):
+        base_force[indices] += normal * unit
+    names = [link.name for link in case.links]
+    compression = np.zeros((len(names), len(channels), 3))
+    hinge_names = [hinge.name for hinge in case.hinges]
+    for name in hinge_names:
+        for axis in range(3):
+            unit = {other: np.zeros(3) for other in hinge_names}
+            unit[name] = np.eye(3)[axis]
+            values = link_compression(scene, unit)
+            compression[:, channels.index(name), axis] = [values[link] for link in names]
+    flexible = []
+    if case.effects.stress_stiffening != "off" and prepared.preload.solved:
+        for link in case.links:
+            if not case.link_is_flexible(link.name):
+                continue
+            reduced = scene.reduced[link.name]
+            stiffening = link_stiffening(link.model)
+            start_index = scene.mbs.GetNodeODE2Index(scene.links[link.name].nodes[1])
+            reduced_stiffness = np.asarray(reduced.ffrf["stiffnessMatrixReduced"], dtype=float)
+            flexible.append(_FlexibleLink(
+                link.name, np.arange(start_index, start_index + reduced_stiffness.shape[0]),
+                stiffening.project(reduced.mode_basis), float(reduced.info.get("axial_tension_N", 0.0)),
+                link.stiffness_damping if case.effects.link_damping else 0.0,
+                loss_factors(case)[1].get(link.name, 0.0), reduced_stiffness, stiffening))
+            if link.modal_damping > 0 and case.effects.link_damping:
+                raise OutsideDesignModel(case.name, f"link {link.name!r}: modal damping on a stiffened link")
+    engine = np.arange(scene.mbs.GetNodeODE2Index(scene.engine.node), scene.mbs.GetNodeODE2Index(scene.engine.node) + 6)
+    warnings = link_warnings(case, scene.reduced)
+    return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine, points, warnings,
+                 prepared.modes, case.engine, seconds + time.perf_counter() - start)
+
+
+@dataclass(frozen=True)
+class _State:
+    """A design's preloaded state."""
+
+    dq: np.ndarray
+    tensions: dict             # used in K_r + P K_G,r per flexible link (0: not stiffened)
+    forces: np.ndarray         # (channels, 3) static channel forces, N
+    loads: StateLoads
+
+
+def _engine_rotation_map(angles: np.ndarray) -> np.ndarray:
+    """``G`` of Exudyn's Tait-Bryan (Rxyz) angles: body angular velocity = G @ angle rates."""
+    _, b, c = angles
+    return np.array([[np.cos(b) * np.cos(c), np.sin(c), 0.0],
+                     [-np.cos(b) * np.sin(c), np.cos(c), 0.0],
+                     [np.sin(b), 0.0, 1.0]])
+
+
+def _state_loads(case: Case, prepared: _Item, tensions: dict) -> StateLoads:
+    base = prepared.base_engine
+    added_mass = case.engine.mass - base.mass
+    added_inertia = case.engine.inertia_matrix - base.inertia_matrix
+    force = np.zeros(prepared.size)
+    mass = []
+    if added_mass or np.any(added_inertia):
+        def engine_mass(q: np.ndarray) -> np.ndarray:
+            rotation = _engine_rotation_map(q[3:6])
+            block = np.zeros((6, 6))
+            block[:3, :3] = added_mass * np.eye(3)
+            block[3:, 3:] = rotation.T @ added_inertia @ rotation
+            return block
+        mass.append((prepared.engine, engine_mass))
+        if case.effects.preload:
+            for load in case.static_loads:
+                if isinstance(load, Gravity):
+                    force[prepared.engine[:3]] += added_mass * np.asarray(load.acceleration)
+    modal = [(link.modal, (tensions.get(link.name, 0.0) - link.base_tension) * link.geometric)
+             for link in prepared.links if tensions.get(link.name, 0.0) != link.base_tension]
+    return StateLoads(modal, mass, force)
+
+
+
+def _channel_forces(prepared: _Item, springs: ChannelSprings, dq: np.ndarray) -> np.ndarray:
+    states = channel_state(prepared.expansion, dq)
+    return prepared.sign * np.array([s @ sep for s, (sep, _, _) in zip(springs.stiffness, states, strict=True)])
+
+
+def _solve_state(case: Case, prepared: _Item, springs: ChannelSprings) -> _State:
+    """The design's preload with the stress-stiffening passes of the Exudyn pipeline."""
+    from workbook.solve.stress_stiffening import AUTO_SHIFT, MAX_PASSES, TENSION_TOLERANCE
+
+    def solve(tensions: dict, start: np.ndarray) -> tuple[np.ndarray, np.ndarray, StateLoads]:
+        loads = _state_loads(case, prepared, tensions)
+        try:
+            dq, _ = static_state(prepared.expansion, springs, prepared.base_force, loads, start)
+        except np.linalg.LinAlgError as error:
+            raise UnstablePreloadError(f"{case.name}: the design's preload has no stable equilibrium ({error})",
+                                       []) from None
+        return dq, _channel_forces(prepared, springs, dq), loads
+
+    dq, forces, loads = solve({}, np.zeros(prepared.size))
+    tensions: dict = {}
+    if prepared.links:
+        names = [link.name for link in case.links]
+        compression = dict(zip(names, np.einsum("lcx,cx->l", prepared.compression, forces), strict=True))
+        chosen = []
+        for link in prepared.links:
+            tension = -compression[link.name]
+            unloaded = float(link.stiffening.pinned_hz(0.0, 1)[0])
+            if -tension >= link.stiffening.buckling_load:
+                raise BucklingError(case.name, link.name, -tension, link.stiffening.buckling_load, unloaded)
+            shift = abs(float(link.stiffening.pinned_hz(tension, 1)[0]) / unloaded - 1.0)
+            if case.effects.stress_stiffening == "on" or shift > AUTO_SHIFT:
+                chosen.append(link.name)
+            tensions[link.name] = tension
+        used = {name: tensions[name] for name in chosen}
+        passes = 0
+        while chosen and passes < MAX_PASSES:
+            dq, forces, loads = solve(used, dq)
+            passes += 1
+            new = dict(zip(names, -np.einsum("lcx,cx->l", prepared.compression, forces), strict=True))
+            change = max(abs(new[name] - used[name]) for name in chosen) / max(abs(used[name]) for name in chosen)
+            if change <= TENSION_TOLERANCE or passes == MAX_PASSES:
+                break
+            used = {name: new[name] for name in chosen}
+        tensions = used
+    return _State(dq, tensions, forces, loads)
+
+
+@dataclass(frozen=True)
+class _Harmonic:
+    mass: np.ndarray
+    stiffness: np.ndarray
+    damping: np.ndarray
+    structural: np.ndarray
+    outputs: tuple              # C_k, C_d, C_h, shape (3 c, n) each
+    basis: Projection
+    inputs: dict                # point -> (n, 3)
+
+
+def _harmonic(case: Case, prepared: _Item, springs: ChannelSprings, state: _State) -> _Harmonic:
+    expansion, size, dq = prepared.expansion, prepared.size, state.dq
+    states = channel_state(expansion, dq)
+    mass, rest_stiffness, damping = rest_matrices(expansion, dq, size, state.loads)
+    stiffness = tangent_stiffness(expansion, dq, rest_stiffness, springs, states)
+    structural = np.zeros((size, size))
+    outputs = [np.zeros((3 * len(states), size)) for _ in range(3)]
+    for k, ((_, jacobian, _), geometry) in enumerate(zip(states, expansion.channels.values(), strict=True)):
+        rows = np.ix_(geometry.coordinates, geometry.coordinates)
+        damping[rows] += jacobian.T @ springs.damping[k] @ jacobian
+        structural[rows] += prepared.sign * jacobian.T @ springs.structural[k] @ jacobian
+        for output, spring in zip(outputs, (springs.stiffness, springs.damping, springs.structural), strict=True):
+            output[3 * k:3 * k + 3, geometry.coordinates] = prepared.sign * spring[k] @ jacobian
+    for link in prepared.links:
+        added = (state.tensions.get(link.name, 0.0) - link.base_tension) * link.geometric
+        block = np.ix_(link.modal, link.modal)
+        damping[block] += link.stiffness_damping * added
+        structural[block] += link.loss_factor * (link.reduced_stiffness + added)
+    basis = projection(expansion, dq)
+    inputs = {}
+    q = expansion.reference + expansion.state + dq
+    for key, point in expansion.points.items():
+        _, jacobian, _ = point.expand(q[point.coordinates])
+        full = np.zeros((size, 3))
+        full[point.coordinates] = jacobian.T
+        inputs[key] = basis.rows(full)
+    return _Harmonic(basis.both(mass), basis.both(stiffness), basis.both(damping), basis.both(structural),
+                     tuple(basis.columns(o) for o in outputs), basis, inputs)
+
+
+def _answer(case: Case, prepared: _Item, model: _Harmonic, excitation: SingleFrequencyExcitation,
+            channels: list[str], pylon: list[str]) -> ExcitationResult:
+    omega = 2 * np.pi * excitation.frequency
+    load = sum(model.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))] @ phasor
+               for p, phasor in point_phasors(excitation))
+    dynamic = model.stiffness - omega ** 2 * model.mass + 1j * (omega * model.damping + model.structural)
+    try:
+        motion = sla.solve(dynamic, load, check_finite=False)
+    except (np.linalg.LinAlgError, sla.LinAlgWarning) as error:
+        raise ResonanceError(f"{case.name} / {excitation.name}: the design is excited on an undamped resonance at "
+                             f"{excitation.frequency:g} Hz ({error})") from None
+    stiffness_output, damping_output, structural_output = model.outputs
+    forces = ((stiffness_output + 1j * (structural_output + omega * damping_output)) @ motion).reshape(-1, 3)
+    amplitudes = dict(zip(channels, np.abs(forces), strict=True))
+    pylon_force = forces[[channels.index(name) for name in pylon]].sum(axis=0)
+    empty = np.zeros((0, 3))
+    return ExcitationResult(
+        name=excitation.name, frequency_hz=excitation.frequency, excitation_amplitude=excitation.force_amplitude,
+        pylon_amplitude=np.abs(pylon_force), hinge_amplitudes=amplitudes, pylon_hinges=list(pylon),
+        steady_change=0.0, steady_tolerance=case.analysis.steady_tolerance, warnings=list(prepared.warnings),
+        time=np.zeros(0), hinge_histories={name: empty for name in channels}, pylon_history=empty,
+        excitation_history=empty, window=slice(0, 0))
