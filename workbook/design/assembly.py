@@ -174,16 +174,6 @@ class Projection:
     euler: list
     size: int
 
-    def matrix(self, full: int) -> np.ndarray:
-        """The basis as a dense (full, size) array."""
-        basis = np.zeros((full, self.size))
-        basis[self.free, np.arange(len(self.free))] = 1.0
-        column = len(self.free)
-        for indices, tangent in self.euler:
-            basis[indices, column:column + 3] = tangent
-            column += 3
-        return basis
-
     def columns(self, matrix: np.ndarray) -> np.ndarray:
         """``matrix @ basis`` for a matrix with the full coordinates as columns."""
         parts = [matrix[:, self.free]] + [matrix[:, indices] @ tangent for indices, tangent in self.euler]
