@@ -24,9 +24,10 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 
 #: Modules of the implementation: importable, but their names may change between versions.
 INTERNAL_MODULES = (
-    "workbook.answers", "workbook.answers.amplitude", "workbook.answers.isolation", "workbook.answers.link_stiffness",
+    "workbook.answers", "workbook.answers.amplitude", "workbook.answers.hinge_curves", "workbook.answers.isolation",
+    "workbook.answers.link_stiffness",
     "workbook.answers.link_table", "workbook.answers.model_card", "workbook.answers.results",
-    "workbook.answers.saving",
+    "workbook.answers.saving", "workbook.answers.warning_groups",
     "workbook.cli", "workbook.cli.cache", "workbook.cli.campbell", "workbook.cli.four_pole", "workbook.cli.layout",
     "workbook.cli.links", "workbook.cli.loading", "workbook.cli.main", "workbook.cli.outputs", "workbook.cli.params",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
