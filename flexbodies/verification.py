@@ -68,6 +68,7 @@ class _Row:
     harmonic: np.ndarray
     frequencies_hz: np.ndarray
     seconds: float
+    highest_hz: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -126,16 +127,16 @@ class LinkVerification:
         -------
         pandas.DataFrame
             Indexed by (link, model); tip displacements in m, errors in %,
-            frequencies in Hz (the highest fixed-interface mode kept with
-            both eyes held, and the first of the clamped link), wall time in s.
+            frequencies in Hz (the highest mode kept: a fixed-interface mode,
+            both eyes held, or a free-free orthonormal mode; and the first
+            of the clamped link), wall time in s.
         """
         import pandas as pd
 
         records = []
         for row in (self.full, *self.reduced):
-            m = 0 if math.isnan(row.modes) else int(row.modes)
             record = {"link": self.name, "model": row.model, "modes": row.modes, "DOF": row.dof,
-                      "highest mode kept [Hz]": self.fixed_interface_hz[m - 1] if m else math.nan,
+                      "highest mode kept [Hz]": row.highest_hz,
                       "static tip [m]": row.static,
                       "static error [%]": 100 * (row.static / self.full.static - 1.0)}
             for f, value, reference in zip(self.frequencies_hz, row.harmonic, self.full.harmonic, strict=True):
@@ -263,12 +264,12 @@ def _lowest(K: np.ndarray, M: np.ndarray, count: int) -> np.ndarray:
 
 
 def _reduced_row(model: str, m: int, K: np.ndarray, M: np.ndarray, load: np.ndarray, tip: np.ndarray,
-                 frequencies_hz: np.ndarray, start: float) -> _Row:
+                 frequencies_hz: np.ndarray, start: float, highest_hz: float) -> _Row:
     """Answers of a reduced model ``K, M`` with generalised load ``load`` and tip row ``tip``."""
     static = float(tip @ np.linalg.solve(K, load))
     harmonic = np.array([tip @ np.linalg.solve(K - (2 * np.pi * f) ** 2 * M, load) for f in frequencies_hz])
     freqs = _lowest(K, M, FREQUENCY_COUNT)
-    return _Row(model, float(m), K.shape[0], static, harmonic, freqs, time.perf_counter() - start)
+    return _Row(model, float(m), K.shape[0], static, harmonic, freqs, time.perf_counter() - start, highest_hz)
 
 
 def verify_coupled(coupled, name: str = "link", *, modes=DEFAULT_MODES, frequencies_hz=DEFAULT_FREQUENCIES_HZ,
@@ -338,7 +339,8 @@ def verify_coupled(coupled, name: str = "link", *, modes=DEFAULT_MODES, frequenc
         for m in counts:
             t0 = time.perf_counter()
             s = np.arange(6 + m)
-            rows.append(_reduced_row(f"CB {m}", m, K_r[np.ix_(s, s)], M_r[np.ix_(s, s)], f_r[s], tip_r[s], freqs, t0))
+            rows.append(_reduced_row(f"CB {m}", m, K_r[np.ix_(s, s)], M_r[np.ix_(s, s)], f_r[s], tip_r[s], freqs, t0,
+                                     float(fixed_hz[m - 1]) if m else math.nan))
     else:
         V = np.hstack([static_modes, fixed])
         K_r, M_r = V.T @ (K @ V), V.T @ (M @ V)
@@ -353,7 +355,8 @@ def verify_coupled(coupled, name: str = "link", *, modes=DEFAULT_MODES, frequenc
             K_c = null.T @ (lam[:k, None] * null)
             M_c = null.T @ null
             rows.append(_reduced_row(f"orthonormal {m}", m, K_c, M_c, null.T @ (W[:, :k].T @ load),
-                                     d @ W[masters[1][:3]][:, :k] @ null, freqs, t0))
+                                     d @ W[masters[1][:3]][:, :k] @ null, freqs, t0,
+                                     float(np.sqrt(lam[k - 1]) / (2 * np.pi))))
     return LinkVerification(name, coupled.fe_model.description, basis, float(force), freqs, full, tuple(rows),
                             shared, fixed_hz)
 

@@ -11,6 +11,7 @@ import pytest
 import skfem
 
 from flexbodies.assembly import assemble
+from flexbodies.frequencies import clamped_frequencies
 from flexbodies.materials import STEEL
 from flexbodies.meshing import Bore, LinkMesh
 from flexbodies.reduction import couple
@@ -50,6 +51,11 @@ def test_full_fe_axial_column_is_the_bar(axial_cb):
     for f, u in zip(axial_cb.frequencies_hz, axial_cb.full.harmonic, strict=True):
         k = 2 * math.pi * f / WAVE_SPEED
         assert u == pytest.approx(FORCE * math.tan(k * LENGTH) / (E * AREA * k), rel=1.5e-2)
+
+
+def test_full_fe_frequencies_are_the_packages_own_clamped_solve(bar, axial_cb):
+    reference = clamped_frequencies(bar.stiffness, bar.mass, bar.coupling, interfaces=(0,), count=6)
+    np.testing.assert_allclose(axial_cb.full.frequencies_hz, reference, rtol=1e-8)
 
 
 def test_full_fe_bending_column_is_the_cantilever(bar):
