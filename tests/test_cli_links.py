@@ -46,3 +46,38 @@ def test_links_command_prints_every_link_and_reuses_the_cache(coarse_reference, 
     assert main(["links", str(coarse_case_file)]) == 0
     rows = [line for line in capsys.readouterr().out.splitlines() if line.split()[:1] in ([link.name] for link in case.links)]
     assert len(rows) == len(case.links) and all(row.rstrip().endswith("hit") for row in rows)
+
+
+def test_link_table_gives_the_ratio_for_every_excitation(coarse_reference):
+    case = coarse_reference
+    table = link_table(case, reduce_links(case))
+    for excitation in case.excitations:
+        column = f"f_exc/f1 {excitation.name} ({excitation.frequency:g} Hz)"
+        np.testing.assert_allclose(table[column], excitation.frequency / table["f1 mounted [Hz]"], rtol=1e-6)
+
+
+@pytest.mark.slow
+def test_links_verify_prints_json_and_a_plot_per_distinct_design(coarse_reference, coarse_case_file, capsys, tmp_path):
+    import json
+
+    plot = tmp_path / "verify.png"
+    assert main(["links", str(coarse_case_file), "--verify", "--modes", "0,3", "--frequencies", "500",
+                 "--basis", "orthonormal", "--json", "--plot", str(plot)]) == 0
+    captured = capsys.readouterr()
+    answer = json.loads(captured.out)
+    designs = {link.model for link in coarse_reference.links}
+    assert len(answer["links"]) == len(designs)
+    for item in answer["links"]:
+        assert [row["model"] for row in item["rows"]] == ["full FE", "orthonormal 0", "orthonormal 3"]
+        assert abs(item["rows"][-1]["static error [%]"]) < 1e-6      # all modes kept: exact
+        assert all(row["wall time [s]"] > 0 for row in item["rows"])
+    assert plot.stat().st_size > 0 and "plot written" in captured.err
+
+
+@pytest.mark.parametrize("options, named", [(["--verify", "--modes", "2,x"], "--modes"),
+                                            (["--verify", "--frequencies", "0"], "--frequencies"),
+                                            (["--json"], "--json"),
+                                            (["--verify", "--plot", "out.pdf"], "--plot")])
+def test_links_verify_refuses_bad_options(coarse_case_file, capsys, options, named):
+    assert main(["links", str(coarse_case_file), *options]) == 2
+    assert named in capsys.readouterr().err

@@ -26,9 +26,10 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.expansion", "workbook.design.kinematics",
     "workbook.design.linear_mount",
-    "workbook.answers", "workbook.answers.amplitude", "workbook.answers.isolation", "workbook.answers.link_stiffness",
+    "workbook.answers", "workbook.answers.amplitude", "workbook.answers.hinge_curves", "workbook.answers.isolation",
+    "workbook.answers.link_stiffness",
     "workbook.answers.link_table", "workbook.answers.model_card", "workbook.answers.results",
-    "workbook.answers.saving",
+    "workbook.answers.saving", "workbook.answers.warning_groups",
     "workbook.cli", "workbook.cli.cache", "workbook.cli.campbell", "workbook.cli.four_pole", "workbook.cli.layout",
     "workbook.cli.links", "workbook.cli.loading", "workbook.cli.main", "workbook.cli.outputs", "workbook.cli.params",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
@@ -60,7 +61,7 @@ INTERNAL_MODULES = (
     "flexbodies.exudyn_body", "flexbodies.frequencies", "flexbodies.geometric_stiffness", "flexbodies.geometry",
     "flexbodies.interfaces", "flexbodies.interior", "flexbodies.invariants", "flexbodies.link",
     "flexbodies.materials", "flexbodies.meshing", "flexbodies.reduced", "flexbodies.reduction",
-    "flexbodies.selection", "flexbodies.validation",
+    "flexbodies.selection", "flexbodies.validation", "flexbodies.verification",
 )
 
 

@@ -28,10 +28,13 @@ def link_table(case: Case, reduced: dict) -> pd.DataFrame:
     -------
     pandas.DataFrame
         Indexed by link name: FE DOF, first free-free and as-mounted
-        frequencies (Hz), the excitation-to-fundamental ratio, fixed-interface
-        modes kept, DOF in the scene, reduction time (s), cache hit, and the
-        reason for the modes kept.
+        frequencies (Hz), the ratio of the highest excitation to the mounted
+        fundamental (the one the mode decision was judged on), then one
+        ``f_exc/f1 <excitation> (<f> Hz)`` column per excitation of the case
+        when it has more than one, fixed-interface modes kept, DOF in the
+        scene, reduction time (s), cache hit, and the reason for the modes kept.
     """
+    excitations = {e.name: e.frequency for e in case.excitations} if len(case.excitations) > 1 else {}
     rows = []
     for link in case.links:
         item = reduced[link.name]
@@ -43,6 +46,8 @@ def link_table(case: Case, reduced: dict) -> pd.DataFrame:
             "f1 free-free [Hz]": float(item.frequencies["free_free_hz"][0]),
             "f1 mounted [Hz]": float(item.frequencies["mounted_hz"][0]),
             "f_exc/f1": ratio if ratio is not None else float("nan"),
+            **{f"f_exc/f1 {name} ({f:g} Hz)": f / float(item.frequencies["mounted_hz"][0])
+               for name, f in excitations.items()},
             "fixed-interface modes": item.n_fixed_interface if flexible else 0,
             "DOF in scene": item.dof if flexible else 6,
             "reduction [s]": sum(item.info.get(stage, 0.0) for stage in _STAGES),

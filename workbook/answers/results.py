@@ -76,6 +76,9 @@ class ExcitationResult(PylonAnswers):
         N.
     window : slice
         Samples of the measured (last) window.
+    hinge_phasors : dict of str to ndarray, complex, shape (3,)
+        Complex amplitude of each force channel, N: frequency-domain answers
+        only (empty for a time-domain run).
     """
 
     name: str
@@ -92,6 +95,7 @@ class ExcitationResult(PylonAnswers):
     pylon_history: np.ndarray = field(repr=False)
     excitation_history: np.ndarray = field(repr=False)
     window: slice = field(repr=False)
+    hinge_phasors: dict = field(default_factory=dict, repr=False)
 
     @property
     def has_histories(self) -> bool:

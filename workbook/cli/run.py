@@ -1,16 +1,24 @@
-"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--time-budget S] [--pylon-impedance CSV]``: run a case.
+"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--time-budget S] [--pylon-impedance CSV] [--hinges SEL]``.
 
 Prints the three-way isolation-efficiency table, the dB table and the model
-card of each run, or the answers as JSON. A case workbook runs the rows of
-its Runs sheet and gets its results written back (:mod:`workbook.cli.workbooks`).
+card of each run, or the answers as JSON; the warnings once per distinct
+text, with the count and frequency range of the runs (a sweep's points)
+that raised them. ``--hinges`` adds the force amplitude and T of a hinge or
+hinge group against frequency (:mod:`workbook.answers.hinge_curves`), and
+``--plot`` draws them. A case workbook runs the rows of its Runs sheet and
+gets its results written back (:mod:`workbook.cli.workbooks`).
 """
 from __future__ import annotations
 
 import argparse
+import contextlib
+import json
+import sys
 from typing import Callable
 
 from workbook.cli import workbooks
 from workbook.cli.loading import is_workbook, load_case, progress_factory
+from workbook.cli.outputs import check_output, write_output
 from workbook.errors import UsageError
 from workbook.model.case import ANALYSIS_METHODS
 
@@ -31,14 +39,35 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--pylon-impedance", metavar="TABLE.csv",
                         help="the pylon's point dynamic stiffness per pin against frequency (CSV, see "
                              "docs/four-pole.md): answers on that flexible pylon, frequency domain only")
+    parser.add_argument("--hinges", metavar="NAME|GROUP",
+                        help="also give the force amplitude and T of a hinge, or of every hinge whose name starts "
+                             "with GROUP (e.g. front; 'pylon': the pylon-side hinges), against frequency")
+    parser.add_argument("--plot", metavar="OUT.png", help="with --hinges: draw their T against frequency as PNG")
     workbooks.add_run_arguments(parser)
     return run
 
 
+def _print_hinges(curves) -> None:
+    table = curves.to_pandas()
+    print(f"\nhinges {curves.selection!r}: force amplitude |F| (N) and T = |F| / |F_exc| per direction")
+    for hinge in curves.hinges:
+        print(f"\n{hinge}:")
+        part = table[hinge]
+        part.columns = [f"{quantity} {axis}" for quantity, axis in part.columns]
+        print(part.to_string(float_format=lambda v: f"{v:10.4g}"))
+
+
 def run(args) -> int:
+    from workbook.answers.saving import save_figure
     from workbook.solve.pipeline import run_case
 
+    if args.plot and not args.hinges:
+        raise UsageError("--plot draws the curves of --hinges: give --hinges NAME|GROUP")
+    check_output("--plot", args.plot, (".png",), [args.case])
     if is_workbook(args.case):
+        if args.hinges:
+            raise UsageError("--hinges is for a JSON case or the reference mount; a case workbook's report has "
+                             "every hinge's answers")
         if args.pylon_impedance:
             raise UsageError("--pylon-impedance: a case workbook takes the table as its 'Pylon impedance' sheet")
         return workbooks.run_workbook(args)
@@ -52,19 +81,45 @@ def run(args) -> int:
                          "every excitation it has and prints its answers (--json: as JSON); nothing was run")
     case = load_case(args.case, rigid=args.rigid, time_budget=args.time_budget, method=args.method,
                      pylon_impedance=args.pylon_impedance)
+    if args.hinges:
+        from workbook.answers.hinge_curves import select_hinges
+
+        select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges])
     result = run_case(case, progress=None if args.no_progress else progress_factory())
+    curves = None
+    if args.hinges:
+        from workbook.answers.hinge_curves import hinge_curves
+
+        curves = hinge_curves(result, args.hinges)
+    figure = curves.plot() if curves is not None and args.plot else None
     if args.json:
-        print(result.to_json(indent=2))
-        return 0
+        if curves is None:
+            print(result.to_json(indent=2))
+        else:
+            table = curves.to_pandas()
+            table.columns = [" ".join(key) for key in table.columns]
+            rows = table.reset_index().to_dict(orient="records")
+            print(json.dumps({**json.loads(result.to_json()), "hinges": rows}, indent=2))
+    else:
+        _print_answers(case, result)
+        if curves is not None:
+            _print_hinges(curves)
+    with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
+        if figure is not None:
+            write_output(args.plot, "plot", "run", lambda target: save_figure(figure, target, dpi=120))
+    return 0
+
+
+def _print_answers(case, result) -> None:
+    from workbook.answers.warning_groups import warning_lines
+
     table = result.table("efficiency")
     levels = result.table("db")
     print(f"{case.name}: pylon isolation efficiency eta = (1 - T) x 100 % (T: pylon force / excitation)\n")
     print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
     print("\n20 log10 T (dB):")
     print(levels.drop(columns="frequency Hz").to_string(float_format=lambda v: f"{v:8.2f}"))
-    for run_result in result.runs:
-        for warning in run_result.warnings:
-            print(f"\nWARNING {run_result.name}: {warning}")
+    for line in warning_lines(result.runs):
+        print("\n" + line)
     for card in result.model_cards.values():
         print("\n" + card.to_text())
-    return 0

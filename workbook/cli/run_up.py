@@ -71,6 +71,7 @@ def _run_ups(case: Case, args) -> list[RunUp]:
 
 
 def run(args) -> int:
+    from workbook.answers.warning_groups import warning_lines
     from workbook.solve.run_up import run_up
 
     check_output("--csv", args.csv, (".csv",), [args.case])
@@ -87,13 +88,8 @@ def run(args) -> int:
         print(answer.frame().to_string(float_format=lambda v: f"{v:10.4g}"))
         print("\nmodes (marked on the plot at the speed equal to their frequency):")
         print(answer.modes_frame().to_string(float_format=lambda v: f"{v:8.2f}"))
-        warnings: dict[str, list[str]] = {}
-        for run_result in answer.result.runs:
-            for warning in run_result.warnings:
-                warnings.setdefault(warning, []).append(run_result.name)
-        for warning, names in warnings.items():
-            where = names[0] if len(names) == 1 else f"{len(names)} speeds from {names[0]} to {names[-1]}"
-            print(f"\nWARNING {where}: {warning}")
+        for line in warning_lines(answer.result.runs):
+            print("\n" + line)
     if args.csv:
         write_output(args.csv, "table", "run-up", lambda target: save_csv(answers[0].frame(), target))
     if figure is not None:

@@ -85,10 +85,11 @@ def _print_summary(runs) -> None:
                               sort=False)
     print("Pylon isolation efficiency eta = (1 - T) x 100 %:")
     print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
+    from workbook.answers.warning_groups import warning_lines
+
     for run in runs:
-        for point in run.result.runs:
-            for warning in point.warnings:
-                print(f"WARNING {run.spec.name} / {point.name}: {warning}")
+        for line in warning_lines(run.result.runs, run.spec.name):
+            print(line)
 
 
 def run_workbook(args) -> int:

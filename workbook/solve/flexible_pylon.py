@@ -155,7 +155,8 @@ def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.nd
         hinge_amplitudes={pin: np.abs(force) for pin, force in zip(pins, pin_forces, strict=True)},
         pylon_hinges=list(pins), steady_change=0.0, steady_tolerance=steady_tolerance,
         warnings=[], time=np.zeros(0), hinge_histories={pin: empty for pin in pins},
-        pylon_history=empty, excitation_history=empty, window=slice(0, 0))
+        pylon_history=empty, excitation_history=empty, window=slice(0, 0),
+        hinge_phasors=dict(zip(pins, np.asarray(pin_forces, dtype=complex), strict=True)))
 
 
 def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], pylon: PylonAt,

@@ -180,7 +180,8 @@ class HarmonicModel:
             hinge_amplitudes={name: np.abs(f) for name, f in response.hinge_forces.items()},
             pylon_hinges=list(self.pylon_hinges), steady_change=0.0, steady_tolerance=steady_tolerance,
             warnings=[], time=np.zeros(0), hinge_histories={name: empty for name in self.hinge_names},
-            pylon_history=empty, excitation_history=empty, window=slice(0, 0))
+            pylon_history=empty, excitation_history=empty, window=slice(0, 0),
+            hinge_phasors=dict(response.hinge_forces))
 
 
 def _central_difference(evaluate, set_value, base: np.ndarray, indices, step: float) -> np.ndarray:

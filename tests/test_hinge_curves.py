@@ -1,0 +1,88 @@
+"""Per-hinge answers against frequency (workbook.answers.hinge_curves) and collected sweep warnings."""
+import dataclasses
+import json
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from workbook.answers.hinge_curves import hinge_curves, select_hinges
+from workbook.answers.warning_groups import group_warnings, warning_lines
+from workbook.cli.main import main
+from workbook.errors import CaseError
+from workbook.model.case import Sweep
+from workbook.model.codec import to_json
+from workbook.solve.pipeline import run_case
+
+
+def test_warnings_are_grouped_by_text_with_count_and_frequency_range():
+    runs = [SimpleNamespace(name=f"sweep @ {f:g} Hz", frequency_hz=f,
+                            warnings=["mode near"] * 2 + (["gap closed"] if f > 30 else []))
+            for f in np.linspace(10.0, 50.0, 25)]
+    groups = group_warnings(runs)
+    assert [(g.text, g.count) for g in groups] == [("mode near", 25), ("gap closed", 12)]
+    lines = warning_lines(runs, "row 1")
+    assert lines == ["WARNING row 1 / 25 points from 10 to 50 Hz: mode near",
+                     f"WARNING row 1 / 12 points from {runs[13].frequency_hz:.6g} to 50 Hz: gap closed"]
+    assert warning_lines(runs[:1]) == ["WARNING sweep @ 10 Hz: mode near"]
+    assert warning_lines([SimpleNamespace(name="a", frequency_hz=5.0, warnings=[])]) == []
+
+
+def test_selection_by_name_prefix_and_pylon():
+    names = ["front-up-left", "front-down-left", "rear-up-left", "front"]
+    assert select_hinges(names, "front-up-left") == ["front-up-left"]
+    assert select_hinges(names, "front") == ["front"]                       # an exact name wins
+    assert select_hinges(names, "front-") == ["front-up-left", "front-down-left"]
+    assert select_hinges(names, "pylon", pylon=["rear-up-left", "front-up-left"]) == ["front-up-left", "rear-up-left"]
+    with pytest.raises(CaseError, match="--hinges.*'aft'.*rear-up-left"):
+        select_hinges(names, "aft")
+
+
+@pytest.fixture(scope="module")
+def swept(coarse_reference):
+    """The coarse reference mount under a 6-point sweep of its LP rotor, frequency domain."""
+    sweep = Sweep.band("LP sweep", coarse_reference.excitations[0], 20.0, 300.0, 6)
+    case = dataclasses.replace(coarse_reference, excitations=(sweep,))
+    return case, run_case(case)
+
+
+@pytest.mark.slow
+def test_pylon_hinges_summed_as_vectors_are_the_pylon_curve(swept):
+    _, result = swept
+    curves = hinge_curves(result, "pylon")
+    assert set(curves.hinges) == set(result.runs[0].pylon_hinges)
+    pylon = np.array([run.pylon_amplitude for run in result.runs])
+    np.testing.assert_allclose(np.abs(curves.group_force()), pylon, rtol=1e-12, atol=1e-9 * pylon.max())
+    # each hinge alone is smaller than the sum of all, and T is |F| over the excitation
+    front = hinge_curves(result, "front")
+    assert front.hinges and all(h.startswith("front") for h in front.hinges)
+    excitation = np.array([run.excitation_amplitude for run in result.runs])
+    np.testing.assert_allclose(front.transmissibility(), front.amplitudes / excitation[:, None, None])
+    table = front.to_pandas()
+    assert table.shape == (6, 6 * len(front.hinges))
+    np.testing.assert_allclose(table[(front.hinges[0], "T", "y")], front.transmissibility()[:, 0, 1])
+
+
+@pytest.mark.slow
+def test_run_command_prints_hinge_tables_a_plot_and_each_warning_once(swept, capsys, tmp_path):
+    case, _ = swept
+    path = tmp_path / "swept.json"
+    path.write_text(to_json(case))
+    plot = tmp_path / "front.png"
+    assert main(["run", str(path), "--no-progress", "--hinges", "front-up", "--plot", str(plot)]) == 0
+    out = capsys.readouterr().out
+    assert "hinges 'front-up'" in out and "front-up-left:" in out and "front-up-right:" in out
+    texts = [line.split(": ", 1)[1] for line in out.splitlines() if line.startswith("WARNING")]
+    assert len(texts) == len(set(texts))                 # one line per distinct warning, never one per point
+    assert plot.stat().st_size > 0
+    assert main(["run", str(path), "--no-progress", "--json", "--hinges", "front-up-left"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert len(answer["hinges"]) == 6 and "front-up-left T x" in answer["hinges"][0]
+
+
+@pytest.mark.parametrize("options, named", [(["--hinges", "aft"], "--hinges"),
+                                            (["--plot", "t.png"], "--plot"),
+                                            (["--hinges", "front", "--plot", "t.pdf"], "--plot")])
+def test_run_command_refuses_bad_hinge_options(options, named, capsys):
+    assert main(["run", "--no-progress", *options]) == 2
+    assert named in capsys.readouterr().err
