@@ -58,7 +58,7 @@ INTERNAL_MODULES = (
     "flexbodies.exudyn_body", "flexbodies.frequencies", "flexbodies.geometric_stiffness", "flexbodies.geometry",
     "flexbodies.interfaces", "flexbodies.interior", "flexbodies.invariants", "flexbodies.link",
     "flexbodies.materials", "flexbodies.meshing", "flexbodies.reduced", "flexbodies.reduction",
-    "flexbodies.selection", "flexbodies.validation",
+    "flexbodies.selection", "flexbodies.stress", "flexbodies.validation",
 )
 
 
