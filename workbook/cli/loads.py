@@ -34,6 +34,10 @@ def _mpa(value) -> str:
     return "-" if value is None else f"{value / 1e6:.1f}"
 
 
+def _triple(values) -> str:
+    return "(" + ", ".join(f"{float(v):.4g}" for v in values) + ")"
+
+
 def _margin(value) -> str:
     return "-" if value is None else f"{value:.2f}"
 
@@ -64,9 +68,8 @@ def run(args) -> int:
         print(f"\n{lc.name} (FS {lc.factor_of_safety:g}"
               + (f", fail-safe: {lc.without_link} removed" if lc.without_link else "") + ")"
               + (f": {lc.description}" if lc.description else ""))
-        print(f"  applied load {[round(v / 1e3, 3) for v in result.applied_force]} kN, pylon force "
-              f"{[round(v / 1e3, 3) for v in result.pylon_force]} kN")
-        print(f"  engine CG displacement {[round(v, 4) for v in d]} mm, rotation {[round(v, 4) for v in r]} mrad")
+        print(f"  applied load {_triple(result.applied_force / 1e3)} kN, pylon force {_triple(result.pylon_force / 1e3)} kN")
+        print(f"  engine CG displacement {_triple(d)} mm, rotation {_triple(r)} mrad")
         print(f"  {'link':16s} {'N kN':>9s} {'sigma_nom MPa':>13s} {'vM MPa':>8s} {'at':>6s} "
               f"{'sigma_1 MPa':>11s} {'at':>6s} {'MS_y':>8s} {'MS_u':>8s}")
         for name, s in result.links.items():
