@@ -86,7 +86,7 @@ class CasingModel:
             shape = {"mesh_sha256": digest, "mesh_file": path.name, "scale": self.scale}
         return {"schema_version": SCHEMA_VERSION, "kind": "casing", **shape,
                 "interfaces": [dataclasses.asdict(i) for i in self.interfaces],
-                "material": dataclasses.asdict(self.material)}
+                "material": self.material.elastic_inputs()}
 
     def couplings(self) -> list[str]:
         """The coupling of each interface: RBE2 for an eye, RBE3 for a bearing plane."""

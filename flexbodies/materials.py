@@ -1,12 +1,16 @@
 """Linear elastic, isotropic materials for the flexible links (SI units)."""
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
 from .errors import LinkModelError
 
-__all__ = ["Material", "STEEL", "TITANIUM", "material"]
+__all__ = ["Material", "STEEL", "TITANIUM", "material", "STRENGTH_FIELDS"]
+
+#: Fields of a :class:`Material` no reduction depends on (left out of a link's fingerprint).
+STRENGTH_FIELDS = ("yield_strength", "ultimate_strength")
 
 
 @dataclass(frozen=True)
@@ -23,6 +27,12 @@ class Material:
         Poisson's ratio nu (dimensionless); must satisfy -1 < nu < 0.5.
     density : float
         Mass density rho in kg/m^3; must be positive.
+    yield_strength : float or None
+        Tensile yield strength (0.2 % proof) in Pa, for the margins of
+        safety at limit load (:mod:`flexbodies.stress`); None: not known.
+    ultimate_strength : float or None
+        Tensile ultimate strength in Pa, for the margins at ultimate load;
+        None: not known. At least the yield strength.
 
     Raises
     ------
@@ -34,10 +44,19 @@ class Material:
     youngs_modulus: float
     poisson_ratio: float
     density: float
+    yield_strength: float | None = None
+    ultimate_strength: float | None = None
 
     def __post_init__(self):
         _check_positive(self.name, "Young's modulus", self.youngs_modulus, "Pa")
         _check_positive(self.name, "density", self.density, "kg/m^3")
+        for what in STRENGTH_FIELDS:
+            if getattr(self, what) is not None:
+                _check_positive(self.name, what.replace("_", " "), getattr(self, what), "Pa")
+        if (self.yield_strength is not None and self.ultimate_strength is not None
+                and self.ultimate_strength < self.yield_strength):
+            raise LinkModelError(f"material {self.name!r}: the ultimate strength ({self.ultimate_strength!r} Pa) "
+                                 f"is below the yield strength ({self.yield_strength!r} Pa)")
         nu = self.poisson_ratio
         if not (math.isfinite(nu) and -1.0 < nu < 0.5):
             raise LinkModelError(
@@ -56,17 +75,28 @@ class Material:
         """Shear modulus G = E / (2 (1 + nu)), in Pa."""
         return self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
 
+    def elastic_inputs(self) -> dict:
+        """The fields a reduction depends on (all but :data:`STRENGTH_FIELDS`), JSON-able."""
+        return {key: value for key, value in dataclasses.asdict(self).items() if key not in STRENGTH_FIELDS}
+
 
 def _check_positive(name: str, what: str, value: float, unit: str) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise LinkModelError(f"material {name!r}: {what} must be a positive number in {unit}, got {value!r}")
 
 
-STEEL = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
-"""Structural steel: E = 210 GPa, nu = 0.3, rho = 7850 kg/m^3."""
+STEEL = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0,
+                 yield_strength=355e6, ultimate_strength=470e6)
+"""Structural steel: E = 210 GPa, nu = 0.3, rho = 7850 kg/m^3; the strengths
+are the minimum values of grade S355 (EN 10025-2:2019, table 7): yield
+strength R_eH = 355 MPa (nominal thickness up to 16 mm) and tensile strength
+R_m = 470 MPa (the lower end of 470 to 630 MPa, thickness 3 to 100 mm)."""
 
-TITANIUM = Material("titanium", youngs_modulus=114e9, poisson_ratio=0.34, density=4430.0)
-"""Titanium alloy Ti-6Al-4V: E = 114 GPa, nu = 0.34, rho = 4430 kg/m^3."""
+TITANIUM = Material("titanium", youngs_modulus=114e9, poisson_ratio=0.34, density=4430.0,
+                    yield_strength=828e6, ultimate_strength=895e6)
+"""Titanium alloy Ti-6Al-4V: E = 114 GPa, nu = 0.34, rho = 4430 kg/m^3; the
+strengths are the minimum values of ASTM B265 grade 5 (annealed sheet and
+plate): yield strength (0.2 % offset) 828 MPa, tensile strength 895 MPa."""
 
 _PRESETS = {m.name: m for m in (STEEL, TITANIUM)}
 

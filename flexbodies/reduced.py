@@ -30,7 +30,7 @@ from .selection import ModeDecision
 __all__ = ["ReducedLink", "ReducedLinkFileError", "save_reduced_link", "load_reduced_link", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "mountwb-reduced-link"
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 #: Floating-frame invariants, named as Exudyn's ObjectFFRFreducedOrder names them.
 FFRF_KEYS = (
@@ -81,6 +81,11 @@ class ReducedLink:
     info : dict
         JSON-able: inputs, input hash, coupling, FE DOF, description,
         versions, timings in s.
+    stress_modes : ndarray, shape (n_fe_nodes, 6, n_modes)
+        Stress shape of each elastic mode at the FE nodes (nodal-averaged,
+        link frame, Voigt order xx, yy, zz, yz, xz, xy), Pa per modal unit;
+        empty, shape (0, 6, 0), for a body reduced without them
+        (:mod:`flexbodies.stress`).
     cache_hit : bool
         True when this object was loaded from the cache.
     """
@@ -95,6 +100,7 @@ class ReducedLink:
     frequencies: dict
     decision: ModeDecision
     info: dict
+    stress_modes: np.ndarray = field(default_factory=lambda: np.zeros((0, 6, 0)), compare=False)
     cache_hit: bool = field(default=False, compare=False)
 
     @property
@@ -148,6 +154,7 @@ def _arrays_of(link: ReducedLink) -> dict:
         "master_nodes": link.master_nodes,
         "surface_triangles": link.surface_triangles,
         "mode_basis": link.mode_basis,
+        "stress_modes": link.stress_modes,
     }
     for i, nodes in enumerate(link.interface_nodes):
         arrays[f"interface_nodes_{i}"] = nodes
@@ -251,6 +258,7 @@ def load_reduced_link(path, key: str | None = None) -> ReducedLink:
             frequencies={key: arrays[f"freq_{key}"] for key in meta["frequency_keys"]},
             decision=ModeDecision(**meta["decision"]),
             info=meta["info"],
+            stress_modes=arrays["stress_modes"],
         )
     except (KeyError, TypeError) as exc:
         raise ReducedLinkFileError(f"{path}: incomplete reduced-link file (missing {exc})") from None

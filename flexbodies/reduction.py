@@ -23,6 +23,7 @@ from .interior import InteriorSolver
 from .invariants import ffrf_invariants
 from .reduced import ReducedLink
 from .selection import ModeDecision
+from .stress import NodalStress
 
 __all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions"]
 
@@ -37,12 +38,16 @@ class CoupledModel:
     coupling : InterfaceCoupling
     stiffness, mass : scipy.sparse.csr_matrix
         ``T^T K T`` and ``T^T M T`` in coupled coordinates.
+    stress : flexbodies.stress.NodalStress or None
+        The mesh's nodal stress operator: when given, the reduction keeps the
+        stress shapes of its modes (:mod:`flexbodies.stress`).
     """
 
     fe_model: FEModel
     coupling: InterfaceCoupling
     stiffness: sp.csr_matrix
     mass: sp.csr_matrix
+    stress: NodalStress | None = None
 
 
 def couple(fe_model, kind="RBE2") -> CoupledModel:
@@ -94,6 +99,11 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     mode_basis = np.vstack([coupling.transform @ modes_q, modes_q[masters_t.ravel()]])
     nodes = np.vstack([fe.nodes, coupling.centres])
     invariants = ffrf_invariants(nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if), mode_basis)
+    stress_modes = np.zeros((0, 6, 0))
+    if coupled.stress is not None:
+        stress_start = time.perf_counter()
+        stress_modes = coupled.stress.of(mode_basis)
+        info = {**info, "stress_shape_seconds": time.perf_counter() - stress_start}
     info = dict(info)
     info.update(
         coupling=coupling.kind,
@@ -113,6 +123,7 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
         frequencies={**frequencies, "fixed_interface_hz": cb.fixed_interface_hz, "reduced_hz": reduced_hz},
         decision=decision,
         info=info,
+        stress_modes=stress_modes,
     )
 
 

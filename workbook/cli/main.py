@@ -28,7 +28,7 @@ import traceback
 from threadpoolctl import threadpool_limits
 
 from workbook.answers.saving import recording_writes
-from workbook.cli import cache, campbell, four_pole, layout, links, rig, run, run_up, study, workbooks
+from workbook.cli import cache, campbell, four_pole, layout, links, loads, rig, run, run_up, study, workbooks
 from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
@@ -52,6 +52,8 @@ COMMANDS = {
     "four-pole": ("the mount's four-pole parameters (dynamic stiffness) against frequency", four_pole.arguments),
     "campbell": ("the Campbell diagram: mounted modes against rotor speed, gyroscopic whirl, critical speeds",
                  campbell.arguments),
+    "loads": ("limit load cases: hinge and link forces, engine displacement, link stresses and margins of safety",
+              loads.arguments),
     "cache": ("the store of reduced links: info, verify (keys and checksums), clear", cache.arguments),
 }
 

@@ -29,6 +29,7 @@ from workbook.errors import CaseError
 from workbook.model import fields
 from workbook.model.casing import CASING, EngineCasing
 from workbook.model.fields import MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
+from workbook.model.load_cases import LoadCase
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_mesh import MeshPylon
@@ -1184,6 +1185,10 @@ class Case:
         The pylon as a user's solid mesh, clamped on its root plane and
         carrying the pins on its bores (None: a rigid pylon); frequency
         domain only, the case's one pylon model.
+    load_cases : tuple of LoadCase
+        Named static limit load cases for the links' strength
+        (:mod:`workbook.model.load_cases`, solved by
+        :mod:`workbook.solve.load_cases`); the runs do not use them.
     """
 
     name: str
@@ -1200,6 +1205,7 @@ class Case:
     pylon_impedance: PylonImpedance | None = None
     pylon_beam: BoxBeamPylon | None = None
     pylon_mesh: MeshPylon | None = None
+    load_cases: tuple[LoadCase, ...] = ()
 
     def __post_init__(self):
         fields.nonempty_name("case", self.name)
@@ -1211,7 +1217,8 @@ class Case:
             raise CaseError("case", "test_rig", self.test_rig, "a ForceTransducers or None")
         groups = (("links", (Link,)), ("hinges", (Hinge,)),
                   ("static_loads", (PointForce, PointMoment, Gravity)),
-                  ("excitations", (*SINGLE_FREQUENCY_KINDS, Sweep, Simultaneous)), ("rotors", (Rotor,)))
+                  ("excitations", (*SINGLE_FREQUENCY_KINDS, Sweep, Simultaneous)), ("rotors", (Rotor,)),
+                  ("load_cases", (LoadCase,)))
         for name, kinds in groups:
             items = tuple(getattr(self, name))
             for item in items:
@@ -1236,6 +1243,8 @@ class Case:
                 raise CaseError("case", "pylon_mesh", self.pylon_mesh.name,
                                 "no pylon mesh when a pylon impedance or a pylon beam is given (one pylon model)")
         links = self.link_map
+        for load_case in self.load_cases:
+            load_case.check(links)
         for hinge in self.hinges:
             for name in ("body_a", "body_b"):
                 body = getattr(hinge, name)
@@ -1341,7 +1350,8 @@ class Case:
         return dataclasses.replace(
             self, name=f"{self.name} without {name}",
             links=tuple(link for link in self.links if link.name != name),
-            hinges=tuple(h for h in self.hinges if name not in h.bodies))
+            hinges=tuple(h for h in self.hinges if name not in h.bodies),
+            load_cases=tuple(c for c in self.load_cases if c.without_link != name))
 
     def with_rigid_links(self) -> "Case":
         """The case with every link rigid."""

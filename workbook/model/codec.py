@@ -15,6 +15,7 @@ from typing import Any
 from workbook.errors import CaseFileError
 from workbook.model import case as _case
 from workbook.model.casing import CasingGeometry, EngineCasing, MountRing
+from workbook.model.load_cases import LoadCase
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_mesh import MeshPylon
@@ -31,7 +32,7 @@ def _registry() -> dict[str, type]:
                _case.PointMoment, _case.Gravity, _case.RotatingForce, _case.HarmonicForce,
                _case.ImbalancePlane, _case.Imbalance, _case.RunUp, _case.Simultaneous,
                _case.Sweep, _case.Rotor, _case.ForceTransducers, _case.AnalysisSettings, _case.Effects,
-               PylonImpedance, BoxBeamPylon, MeshPylon, EngineCasing, CasingGeometry, MountRing,
+               PylonImpedance, BoxBeamPylon, MeshPylon, EngineCasing, CasingGeometry, MountRing, LoadCase,
                flexbodies.LinkModel,
                flexbodies.LinkGeometry, flexbodies.Material, flexbodies.MeshSource, BoreSpec]
     return {cls.__name__: cls for cls in classes}

@@ -1,0 +1,210 @@
+"""Link stresses from the reduced coordinates: stress shapes and what they tell.
+
+At reduction time the stress field of every elastic mode of a link (its
+*stress shape*) is computed once on the link's own mesh and kept with the
+reduced link (:attr:`~flexbodies.reduced.ReducedLink.stress_modes`), so the
+stress of any state of the modal coordinates ``q`` is one matrix product,
+``sigma = S q``, with no FE solve. The rigid-body motion of the floating
+frame carries no stress.
+
+The stress is kept at the FE **nodes**, averaged: each element's stress is
+evaluated at its own nodes (for quadratic tetrahedra the element's linear
+stress field at its corners and mid-edge nodes, no extrapolation from
+integration points needed) and averaged over the elements that share a
+node, weighted by their volume. Nodes, not integration points, because the
+peaks sit on the surface (at the bores and the shank's edges), where no
+integration point lies, because a node has coordinates a report can name,
+and because the node set is that of the mode basis (fewer values than the
+integration points of a quadratic mesh).
+
+Components are in the link frame (x from eye A to eye B, z along the bores),
+in Voigt order :data:`VOIGT`, Pa.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import scipy.sparse as sp
+
+from .materials import Material
+
+if TYPE_CHECKING:  # meshing loads scikit-fem and gmsh: imported where a link is meshed
+    from .meshing import LinkMesh
+    from .reduced import ReducedLink
+
+__all__ = ["VOIGT", "REGIONS", "NodalStress", "nodal_stress_operator", "von_mises", "max_principal",
+           "link_regions", "state_stress"]
+
+#: Stress components, in the order of the stress shapes.
+VOIGT = ("xx", "yy", "zz", "yz", "xz", "xy")
+#: The regions of a link a peak stress is reported in.
+REGIONS = ("eye A", "shank", "eye B")
+
+
+@dataclass(frozen=True)
+class NodalStress:
+    """Nodal-averaged stress of a mesh as a linear map of its nodal displacements.
+
+    Attributes
+    ----------
+    gradients : tuple of 3 scipy.sparse.csr_matrix, shape (n, n)
+        ``gradients[i] @ f`` is the nodal-averaged ``d f / d x_i`` of a
+        nodal scalar field ``f`` (mesh coordinates), 1/m.
+    material : Material
+    rotation : ndarray, shape (3, 3)
+        The link frame against the mesh's: a mesh vector ``v`` is ``rotation @ v``
+        in the link frame.
+    """
+
+    gradients: tuple
+    material: Material
+    rotation: np.ndarray
+
+    def of(self, displacements: np.ndarray) -> np.ndarray:
+        """The stress of node-major displacement fields in the link frame.
+
+        Parameters
+        ----------
+        displacements : ndarray, shape (>= 3 n, k)
+            Node-major displacements in the link frame, m (rows beyond the
+            FE nodes, e.g. master nodes, ignored).
+
+        Returns
+        -------
+        ndarray, shape (n, 6, k)
+            Stress, Voigt order :data:`VOIGT`, Pa.
+        """
+        n = self.gradients[0].shape[0]
+        u = np.asarray(displacements, dtype=float)
+        if u.ndim == 1:
+            u = u[:, None]
+        u = u[: 3 * n].reshape(n, 3, -1)
+        R = np.asarray(self.rotation, dtype=float)
+        u_mesh = np.einsum("ji,njk->nik", R, u)                      # components in the mesh frame
+        flat = u_mesh.reshape(n, -1)
+        grad = np.stack([(g @ flat).reshape(n, 3, -1) for g in self.gradients], axis=2)   # (n, c, i, k)
+        grad = np.einsum("ac,ncik,bi->nabk", R, grad, R)              # du_a/dx_b in the link frame
+        strain = 0.5 * (grad + grad.transpose(0, 2, 1, 3))
+        trace = strain[:, 0, 0] + strain[:, 1, 1] + strain[:, 2, 2]
+        mu, lam = self.material.shear_modulus, self.material.lame_lambda
+        out = np.empty((n, 6, strain.shape[-1]))
+        for row, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
+            out[:, row] = 2 * mu * strain[:, a, b] + (lam * trace if a == b else 0.0)
+        return out
+
+
+def nodal_stress_operator(link_mesh: LinkMesh, material: Material, rotation=None) -> NodalStress:
+    """The nodal-averaged stress operator of a meshed link.
+
+    Parameters
+    ----------
+    link_mesh : LinkMesh
+    material : Material
+    rotation : ndarray, shape (3, 3), optional
+        The link frame against the mesh's (default: the same frame), as
+        returned with the FE model of :func:`flexbodies.link.build_fe_model`.
+
+    Returns
+    -------
+    NodalStress
+    """
+    import skfem
+
+    mesh = link_mesh.mesh
+    element = mesh.elem()
+    local = element.doflocs                                  # the element's nodes, reference coordinates
+    at_nodes = skfem.Basis(mesh, element, quadrature=(local.T, np.ones(len(local))))
+    volume = skfem.Basis(mesh, element).dx.sum(axis=1)       # (elements,)
+    dofs = at_nodes.element_dofs                             # (functions, elements): DOF i is node i
+    n_f, n_e = dofs.shape
+    n = at_nodes.N
+    weight_sum = np.bincount(dofs.ravel(), weights=np.repeat(volume[None, :], n_f, axis=0).ravel(), minlength=n)
+    rows = np.broadcast_to(dofs[:, None, :], (n_f, n_f, n_e))         # (point k, function j, e): node of point k
+    cols = np.broadcast_to(dofs[None, :, :], (n_f, n_f, n_e))         # node of function j
+    weight = volume[None, None, :] / weight_sum[rows]
+    gradients = []
+    for i in range(3):
+        # d phi_j / d x_i at the element's node k: basis.basis[j][0].grad[i] has shape (elements, points)
+        values = np.stack([at_nodes.basis[j][0].grad[i].T for j in range(n_f)], axis=1)   # (k, j, e)
+        matrix = sp.csr_matrix(((values * weight).ravel(), (rows.ravel(), cols.ravel())), shape=(n, n))
+        gradients.append(matrix)
+    return NodalStress(tuple(gradients), material, np.eye(3) if rotation is None else np.asarray(rotation, float))
+
+
+def von_mises(stress: np.ndarray) -> np.ndarray:
+    """Von Mises equivalent stress of Voigt stress (components on axis 1), Pa.
+
+    Parameters
+    ----------
+    stress : ndarray, shape (n, 6, ...)
+        Pa.
+
+    Returns
+    -------
+    ndarray, shape (n, ...)
+    """
+    s = np.asarray(stress)
+    xx, yy, zz, yz, xz, xy = (s[:, i] for i in range(6))
+    return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2) + 3 * (yz**2 + xz**2 + xy**2))
+
+
+def max_principal(stress: np.ndarray) -> np.ndarray:
+    """Largest principal stress of Voigt stress, shape (n, 6) -> (n,), Pa."""
+    s = np.asarray(stress)
+    tensor = np.empty((len(s), 3, 3))
+    for row, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
+        tensor[:, a, b] = tensor[:, b, a] = s[:, row]
+    return np.linalg.eigvalsh(tensor)[:, -1]
+
+
+def link_regions(link: ReducedLink) -> np.ndarray:
+    """Which region of the link each FE node lies in: 0 eye A, 1 shank, 2 eye B (:data:`REGIONS`).
+
+    A node within the eye's outer radius of an eye centre (the bore radius
+    times two for a link read from a mesh file) is in that eye, every other
+    node in the shank.
+
+    Returns
+    -------
+    ndarray of int, shape (n,)
+    """
+    n = int(link.master_nodes[0])
+    nodes = link.nodes[:n]
+    geometry = (link.info.get("inputs") or {}).get("geometry")
+    regions = np.ones(n, dtype=int)
+    for region, (interface, bore_nodes) in ((0, (0, link.interface_nodes[0])), (2, (1, link.interface_nodes[1]))):
+        centre = link.master_position(interface)
+        if geometry is not None:
+            radius = float(geometry["eye_outer_radius"])
+        else:
+            radial = nodes[bore_nodes] - centre
+            radius = 2.0 * float(np.median(np.linalg.norm(radial[:, :2], axis=1)))
+        inside = np.linalg.norm((nodes - centre)[:, :2], axis=1) <= radius * (1 + 1e-9)
+        regions[inside] = region
+    return regions
+
+
+def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
+    """The stress field of a state of a link's modal coordinates, ``S q``.
+
+    Parameters
+    ----------
+    link : ReducedLink
+        Reduced with its stress shapes.
+    modal_coordinates : array_like, shape (n_modes,)
+
+    Returns
+    -------
+    ndarray, shape (n, 6)
+        Stress at the FE nodes, link frame, Voigt order :data:`VOIGT`, Pa.
+    """
+    from .errors import LinkModelError
+
+    shapes = link.stress_modes
+    if shapes.size == 0:
+        raise LinkModelError("this reduced body was reduced without its stress shapes")
+    q = np.asarray(modal_coordinates, dtype=float)
+    n = shapes.shape[0]
+    return (shapes.reshape(6 * n, -1) @ q).reshape(n, 6)
