@@ -24,7 +24,8 @@ _HOMES = {
     "interfaces": ("InterfaceCoupling", "couple_interfaces"),
     "link": ("LinkModel", "MeshSource", "build_fe_model", "default_cache_dir", "reduce_link", "reduce_link_set"),
     "materials": ("STEEL", "TITANIUM", "Material", "material"),
-    "meshing": ("Bore", "BoreSpec", "LinkMesh", "load_mesh", "mesh_link"),
+    "bores": ("Bore", "BoreSpec"),
+    "meshing": ("LinkMesh", "load_mesh", "mesh_link"),
     "reduced": ("ReducedLink", "load_reduced_link", "save_reduced_link"),
     "selection": ("ModeDecision", "decide_modes"),
 }

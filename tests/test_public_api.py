@@ -26,7 +26,7 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 INTERNAL_MODULES = (
     "workbook.answers", "workbook.answers.amplitude", "workbook.answers.isolation", "workbook.answers.link_stiffness",
     "workbook.answers.link_table", "workbook.answers.model_card", "workbook.answers.results",
-    "workbook.answers.saving",
+    "workbook.answers.saving", "workbook.answers.text_table",
     "workbook.cli", "workbook.cli.cache", "workbook.cli.campbell", "workbook.cli.four_pole", "workbook.cli.layout",
     "workbook.cli.links", "workbook.cli.loading", "workbook.cli.main", "workbook.cli.outputs", "workbook.cli.params",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
@@ -53,7 +53,7 @@ INTERNAL_MODULES = (
     "workbook.solve.sweep_grid", "workbook.solve.time_domain",
     "workbook.studies", "workbook.studies.accuracy", "workbook.studies.parallel", "workbook.studies.parametric",
     "workbook.studies.progress", "workbook.studies.sensitivity",
-    "flexbodies.assembly", "flexbodies.atomic", "flexbodies.cache", "flexbodies.cached_reduction",
+    "flexbodies.assembly", "flexbodies.atomic", "flexbodies.bores", "flexbodies.cache", "flexbodies.cached_reduction",
     "flexbodies.casing", "flexbodies.casing_reduction", "flexbodies.craig_bampton", "flexbodies.eigen",
     "flexbodies.exudyn_body", "flexbodies.frequencies", "flexbodies.geometric_stiffness", "flexbodies.geometry",
     "flexbodies.interfaces", "flexbodies.interior", "flexbodies.invariants", "flexbodies.link",

@@ -56,12 +56,10 @@ def run(args) -> int:
     if args.json:
         print(result.to_json(indent=2))
         return 0
-    table = result.table("efficiency")
-    levels = result.table("db")
     print(f"{case.name}: pylon isolation efficiency eta = (1 - T) x 100 % (T: pylon force / excitation)\n")
-    print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
+    print(result.table_text("efficiency"))
     print("\n20 log10 T (dB):")
-    print(levels.drop(columns="frequency Hz").to_string(float_format=lambda v: f"{v:8.2f}"))
+    print(result.table_text("db", frequency=False))
     for run_result in result.runs:
         for warning in run_result.warnings:
             print(f"\nWARNING {run_result.name}: {warning}")

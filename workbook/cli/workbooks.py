@@ -135,7 +135,7 @@ def run_workbook(args) -> int:
         return EXIT_TROUBLE
     _print_summary(runs)
     try:
-        outcome = write_results(book.path, book.sha256, runs, book.tests)
+        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened)
     except OSError as error:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)

@@ -242,13 +242,27 @@ def _warnings(ws, runs: list[RunResult]) -> None:
     print_setup(ws, header_rows=3)
 
 
-def _figure(run: RunResult):
-    import matplotlib.pyplot as plt
+#: Size of a report picture, in: the bar chart of single runs, the transmissibility of a sweep.
+_BARS_SIZE, _SWEEP_SIZE = (7, 4), (8, 4.5)
+#: Fixed margins of a report picture (fractions of the figure): a layout engine's search costs more
+#: than drawing the picture.
+_MARGINS = {"left": 0.1, "right": 0.97, "bottom": 0.16, "top": 0.91}
 
+
+def _draw(fig, run: RunResult) -> bool:
+    """Draw the picture of *run* on the cleared figure *fig*; False for a time-domain run, whose
+    histories are drawn by :meth:`~workbook.answers.results.MountResult.plot_time_histories`."""
     result = run.result
-    if len(result.runs) == 1:
-        return result.plot_time_histories() if result.runs[0].has_histories else result.plot_efficiency()
-    fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
+    single = len(result.runs) == 1
+    if single and result.runs[0].has_histories:
+        return False
+    fig.clear()
+    fig.set_size_inches(_BARS_SIZE if single else _SWEEP_SIZE)
+    fig.subplots_adjust(**_MARGINS)
+    ax = fig.add_subplot()
+    if single:
+        result.draw_efficiency(ax)
+        return True
     frequencies = [p.frequency_hz for p in result.runs]
     for i, d in enumerate(DIRECTIONS):
         ax.loglog(frequencies, [p.transmissibility[i] for p in result.runs], marker="o", ms=3, label=d)
@@ -257,24 +271,37 @@ def _figure(run: RunResult):
     ax.set_ylabel("pylon transmissibility T")
     ax.legend(title="direction")
     ax.set_title(f"{result.case_name}: {run.spec.name}")
-    return fig
+    return True
+
+
+def _png(fig) -> bytes:
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=80)
+    return buffer.getvalue()
 
 
 def _plots(ws, runs: list[RunResult]) -> None:
-    import matplotlib
+    """One picture per run, two side by side, drawn on one reused figure (Agg, no pyplot)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    fig = Figure()
+    FigureCanvasAgg(fig)
     row, height = 1, 0
     for number, run in enumerate(runs):
         column = 1 if number % 2 == 0 else 12      # two pictures side by side (10 default columns each)
         ws.cell(row, column, f"Run '{run.spec.name}'").font = Font(bold=True)
-        fig = _figure(run)
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format="png", dpi=80)
-        plt.close(fig)
-        image = Image(io.BytesIO(buffer.getvalue()))
+        if _draw(fig, run):
+            png = _png(fig)
+        else:
+            import matplotlib
+            import matplotlib.pyplot as plt
+
+            matplotlib.use("Agg")
+            histories = run.result.plot_time_histories()
+            png = _png(histories)
+            plt.close(histories)
+        image = Image(io.BytesIO(png))
         ws.add_image(image, f"{get_column_letter(column)}{row + 1}")
         height = max(height, int(image.height / 20) + 3)
         if number % 2 == 1:
