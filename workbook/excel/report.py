@@ -270,7 +270,7 @@ def _draw(fig, run: RunResult) -> bool:
     ax.set_xlabel("frequency Hz")
     ax.set_ylabel("pylon transmissibility T")
     ax.legend(title="direction")
-    ax.set_title(f"{result.case_name}: {run.spec.name}")
+    ax.set_title(f"{result.case_name}: {run.spec.name}", y=1.0)   # placed: matplotlib's search for a place costs a third of the drawing
     return True
 
 
