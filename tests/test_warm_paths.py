@@ -52,6 +52,17 @@ def test_run_of_a_rigid_case_imports_only_what_it_uses(tmp_path):
     assert imported == []
 
 
+def test_help_and_the_cache_listing_load_no_numerics(tmp_path):
+    """Every command's parser is built for ``--help``: none of them may load SciPy or Exudyn to do it."""
+    for args in (["--help"], ["run", "--help"], ["cache", "info"]):
+        env = dict(os.environ, MOUNTWB_CACHE=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
+        probe = ("import sys\nfrom workbook.cli.main import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n"
+                 "    pass\nprint('MODULES', *sorted(m for m in ('scipy', 'exudyn') if m in sys.modules))")
+        done = subprocess.run([sys.executable, "-c", probe, *args], env=env, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.rpartition("MODULES")[2].split() == [], args
+
+
 def test_warm_run_of_a_json_case_imports_only_what_it_uses(tmp_path):
     from workbook.model.codec import to_json
     from workbook.model.reference import reference_case

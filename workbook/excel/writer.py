@@ -279,12 +279,13 @@ def _kept_note(earlier: list[tuple], computed: set[str]) -> str:
     return f"; the results of {', '.join(repr(run) for run in kept)} are from an earlier run" if kept else ""
 
 
-def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str) -> list[str]:
+def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, frames: dict | None = None) -> list[str]:
     """Add the result sheets of *runs* to an openpyxl *workbook*.
 
     The result sheets a write made before are rewritten: the rows and model
     cards of the runs just computed are replaced, those of every other run
-    are kept as they were (the sheet's note names them).
+    are kept as they were (the sheet's note names them). *frames* are
+    ``result_frames(runs, tests)`` when the caller has them already.
 
     Returns
     -------
@@ -293,7 +294,7 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
     """
     earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)}
     computed = {run.spec.name for run in runs}
-    frames = result_frames(runs, tests)
+    frames = result_frames(runs, tests) if frames is None else frames
     tables = {}
     for name, note in _NOTES.items():
         title = _sheet_title(name)
@@ -399,12 +400,13 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     """
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
-    titles = result_sheet_names(result_frames(runs, tests))
+    frames = result_frames(runs, tests)
+    titles = result_sheet_names(frames)
     with held(path):
         reason, workbook, values = _reason_not_to_overwrite(path, sha256, titles, opened)
         if reason is None:
             log.info("building the new %s with the results", path.name)
-            add_result_sheets(workbook, runs, tests, stamp)
+            add_result_sheets(workbook, runs, tests, stamp, frames)
             data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook, values))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
@@ -415,7 +417,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
                 reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
-    add_result_sheets(separate, runs, tests, stamp)
+    add_result_sheets(separate, runs, tests, stamp, frames)
     target = save_atomic(separate, name_beside(path, "results"))
     log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)
