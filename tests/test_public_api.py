@@ -31,7 +31,7 @@ INTERNAL_MODULES = (
     "workbook.cli.links", "workbook.cli.loading", "workbook.cli.main", "workbook.cli.outputs", "workbook.cli.params",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
     "workbook.excel", "workbook.excel.execute", "workbook.excel.files", "workbook.excel.impedance_sheet",
-    "workbook.excel.layout", "workbook.excel.reader", "workbook.excel.report", "workbook.excel.rig_points",
+    "workbook.excel.layout", "workbook.excel.pictures", "workbook.excel.reader", "workbook.excel.report", "workbook.excel.rig_points",
     "workbook.excel.runs", "workbook.excel.sheets", "workbook.excel.styling", "workbook.excel.template",
     "workbook.excel.writer",
     "workbook.model", "workbook.model.case", "workbook.model.casing", "workbook.model.codec",

@@ -132,3 +132,48 @@ def test_the_writer_takes_the_workbook_the_reader_opened(tmp_path, monkeypatch):
     assert pair is not None and book.opened.take(book.sha256) is None      # handed on once
     assert OpenedWorkbook("0" * 64, *pair).take(book.sha256) is None       # not for other bytes
     assert loads == []
+
+
+def _picture_runs():
+    """Runs as the report takes them: two single runs and a sweep (the answers made up)."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from workbook.answers.results import MountResult
+
+    def point(name, frequency, t):
+        t = np.asarray(t, dtype=float)
+        return SimpleNamespace(name=name, frequency_hz=frequency, transmissibility=t, efficiency=100 * (1 - t),
+                               has_histories=False)
+
+    def run(name, points):
+        return SimpleNamespace(spec=SimpleNamespace(name=name), result=MountResult("made-up mount", points, {}, {}))
+
+    sweep = [point(f"sweep @ {f:g} Hz", f, [0.5 / f, 2 / f, 1 / f]) for f in np.geomspace(5, 300, 12)]
+    return [run("LP rotor", [point("LP rotor", 59.0, [0.03, 0.001, 0.02])]),
+            run("HP rotor", [point("HP rotor", 248.5, [0.001, 0.002, 0.009])]), run("sweep", sweep)]
+
+
+def test_pictures_drawn_in_a_second_process_are_those_drawn_here():
+    from workbook.excel.pictures import draw_pictures, start_pictures
+
+    runs = _picture_runs()
+    pictures = start_pictures(runs)
+    try:
+        drawn = pictures.result()
+    finally:
+        pictures.close()
+    here = draw_pictures(runs)
+    assert len(here) == 3 and all(png.startswith(b"\x89PNG") for png in here)
+    assert drawn == here
+
+
+def test_pictures_not_taken_stop_their_process():
+    from workbook.excel.pictures import start_pictures
+
+    pictures = start_pictures(_picture_runs())
+    process = pictures._process
+    pictures.close()
+    assert process is None or not process.is_alive()
+    assert pictures.result()        # drawn here once the process is gone

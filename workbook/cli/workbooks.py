@@ -101,6 +101,7 @@ def run_workbook(args) -> int:
     """
     from workbook.errors import SimulationError, WorkbookError
     from workbook.excel.execute import run_book, select_runs
+    from workbook.excel.pictures import start_pictures
     from workbook.excel.reader import read_workbook
     from workbook.excel.report import write_report
     from workbook.excel.writer import write_results
@@ -133,21 +134,27 @@ def run_workbook(args) -> int:
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
-    _print_summary(runs)
+    # the report's pictures are drawn in a second process while this one writes the results
+    pictures = start_pictures(runs) if args.report else None
     try:
-        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened)
-    except OSError as error:
-        print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
-              file=sys.stderr)
-        return EXIT_TROUBLE
-    print_written(book.path.name, "results", outcome.path, outcome.reason)
-    if args.report:
+        _print_summary(runs)
         try:
-            report = write_report(args.report, book, runs, outcome, four_pole=pole)
+            outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened)
         except OSError as error:
-            print(f"mountwb run: no report: {error}", file=sys.stderr)
+            print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
+                  file=sys.stderr)
             return EXIT_TROUBLE
-        print_written(args.report, "report", report.path, report.reason)
+        print_written(book.path.name, "results", outcome.path, outcome.reason)
+        if args.report:
+            try:
+                report = write_report(args.report, book, runs, outcome, four_pole=pole, pictures=pictures)
+            except OSError as error:
+                print(f"mountwb run: no report: {error}", file=sys.stderr)
+                return EXIT_TROUBLE
+            print_written(args.report, "report", report.path, report.reason)
+    finally:
+        if pictures is not None:
+            pictures.close()
     if failures:
         print(f"mountwb run: the answers of {len(runs)} run(s) were written; "
               f"{', '.join(repr(f.spec.name) for f in failures)} failed (numerical trouble, above)", file=sys.stderr)

@@ -37,6 +37,7 @@ from openpyxl.utils import get_column_letter
 
 from workbook.answers.isolation import efficiency, level_db
 from workbook.excel.files import new_file_target, save_atomic, signed, untouched
+from workbook.excel.pictures import draw_pictures
 from workbook.excel.reader import CaseBook
 from workbook.excel.styling import FORMATS, print_setup, style_series, write_text_lines
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
@@ -242,65 +243,12 @@ def _warnings(ws, runs: list[RunResult]) -> None:
     print_setup(ws, header_rows=3)
 
 
-#: Size of a report picture, in: the bar chart of single runs, the transmissibility of a sweep.
-_BARS_SIZE, _SWEEP_SIZE = (7, 4), (8, 4.5)
-#: Fixed margins of a report picture (fractions of the figure): a layout engine's search costs more
-#: than drawing the picture.
-_MARGINS = {"left": 0.1, "right": 0.97, "bottom": 0.16, "top": 0.91}
-
-
-def _draw(fig, run: RunResult) -> bool:
-    """Draw the picture of *run* on the cleared figure *fig*; False for a time-domain run, whose
-    histories are drawn by :meth:`~workbook.answers.results.MountResult.plot_time_histories`."""
-    result = run.result
-    single = len(result.runs) == 1
-    if single and result.runs[0].has_histories:
-        return False
-    fig.clear()
-    fig.set_size_inches(_BARS_SIZE if single else _SWEEP_SIZE)
-    fig.subplots_adjust(**_MARGINS)
-    ax = fig.add_subplot()
-    if single:
-        result.draw_efficiency(ax)
-        return True
-    frequencies = [p.frequency_hz for p in result.runs]
-    for i, d in enumerate(DIRECTIONS):
-        ax.loglog(frequencies, [p.transmissibility[i] for p in result.runs], marker="o", ms=3, label=d)
-    ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
-    ax.set_xlabel("frequency Hz")
-    ax.set_ylabel("pylon transmissibility T")
-    ax.legend(title="direction")
-    ax.set_title(f"{result.case_name}: {run.spec.name}", y=1.0)   # placed: matplotlib's search for a place costs a third of the drawing
-    return True
-
-
-def _png(fig) -> bytes:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=80)
-    return buffer.getvalue()
-
-
-def _plots(ws, runs: list[RunResult]) -> None:
-    """One picture per run, two side by side, drawn on one reused figure (Agg, no pyplot)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure()
-    FigureCanvasAgg(fig)
+def _plots(ws, runs: list[RunResult], pictures: list[bytes]) -> None:
+    """The pictures of *runs* (PNG, one per run, :mod:`workbook.excel.pictures`), two side by side."""
     row, height = 1, 0
-    for number, run in enumerate(runs):
+    for number, (run, png) in enumerate(zip(runs, pictures, strict=True)):
         column = 1 if number % 2 == 0 else 12      # two pictures side by side (10 default columns each)
         ws.cell(row, column, f"Run '{run.spec.name}'").font = Font(bold=True)
-        if _draw(fig, run):
-            png = _png(fig)
-        else:
-            import matplotlib
-            import matplotlib.pyplot as plt
-
-            matplotlib.use("Agg")
-            histories = run.result.plot_time_histories()
-            png = _png(histories)
-            plt.close(histories)
         image = Image(io.BytesIO(png))
         ws.add_image(image, f"{get_column_letter(column)}{row + 1}")
         height = max(height, int(image.height / 20) + 3)
@@ -382,7 +330,7 @@ def is_report(path: Path) -> bool:
 
 
 def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
-                 written: WriteOutcome | None = None, *, four_pole=None) -> WriteOutcome:
+                 written: WriteOutcome | None = None, *, four_pole=None, pictures=None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
     An existing *path* is replaced only if it is a report this module wrote,
@@ -401,6 +349,9 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
         the metadata records that file's SHA-256 as it is now.
     four_pole : FourPole, optional
         The mount's four-pole set: a Four-pole sheet (:func:`four_pole_sheet`).
+    pictures : workbook.excel.pictures.Pictures, optional
+        The pictures of *runs*, being drawn (:func:`~workbook.excel.pictures.start_pictures`);
+        default: drawn here.
 
     Returns
     -------
@@ -416,7 +367,7 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     _transmissibility(workbook.create_sheet("Transmissibility"), runs)
     _modes(workbook.create_sheet("Modes"), runs)
     _warnings(workbook.create_sheet("Warnings"), runs)
-    _plots(workbook.create_sheet("Plots"), runs)
+    _plots(workbook.create_sheet("Plots"), runs, draw_pictures(runs) if pictures is None else pictures.result())
     _model_cards(workbook.create_sheet("Model card"), runs)
     if four_pole is not None:
         four_pole_sheet(workbook.create_sheet(FOUR_POLE_SHEET), four_pole)
