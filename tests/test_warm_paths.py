@@ -159,7 +159,8 @@ def test_pictures_drawn_in_a_second_process_are_those_drawn_here():
     from workbook.excel.pictures import draw_pictures, start_pictures
 
     runs = _picture_runs()
-    pictures = start_pictures(runs)
+    pictures = start_pictures()
+    pictures.draw(runs)
     try:
         drawn = pictures.result()
     finally:
@@ -169,10 +170,20 @@ def test_pictures_drawn_in_a_second_process_are_those_drawn_here():
     assert drawn == here
 
 
+def test_a_picture_process_never_given_runs_is_stopped():
+    from workbook.excel.pictures import start_pictures
+
+    pictures = start_pictures()
+    process = pictures._process
+    pictures.close()
+    assert process is None or not process.is_alive()
+
+
 def test_pictures_not_taken_stop_their_process():
     from workbook.excel.pictures import start_pictures
 
-    pictures = start_pictures(_picture_runs())
+    pictures = start_pictures()
+    pictures.draw(_picture_runs())
     process = pictures._process
     pictures.close()
     assert process is None or not process.is_alive()
