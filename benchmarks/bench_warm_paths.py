@@ -20,16 +20,16 @@ that a change of the machine's load hits both alike. Python caches the
 compiled modules of both trees in a temporary folder (``PYTHONPYCACHEPREFIX``),
 as an installed package has them, and a first run of each command fills it.
 
-Measured on a shared 2-core machine under load from other work (load
-average 2 to 3.5, not the idle machine of the targets),
+Measured on the shared 2-core machine of the project (load average 0.3 to
+1.7 from other work while it ran, not the idle machine of the targets),
 ``OPENBLAS_NUM_THREADS=1``, with ``python benchmarks/bench_warm_paths.py
 --before 6ec551f`` (6ec551f: the code before these changes), medians of 5
 (cold: 3)::
 
-    | what                                                    | before  | now     | target |
-    | warm `mountwb run`                                      | 1.43 s  | 1.03 s  | 1 s    |
-    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.27 s  | 3.18 s  | 2 s    |
-    | cold `mountwb run` (empty cache)                        | 15.81 s | 15.28 s | 6 s    |
+    | what                                                    | before  | now    | target |
+    | warm `mountwb run`                                      | 1.45 s  | 1.00 s | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.69 s  | 2.60 s | 2 s    |
+    | cold `mountwb run` (empty cache)                        | 10.62 s | 9.85 s | 6 s    |
     | unneeded packages the warm run imports                  | meshio, pandas, skfem | none | none |
 
 Run from the repository's root::
