@@ -46,6 +46,7 @@ def _run(args: list[str], cache: Path) -> tuple[str, list[str]]:
     return out, modules.split()
 
 
+@pytest.mark.slow  # the links are reduced first (an empty cache)
 def test_run_of_a_rigid_case_imports_only_what_it_uses(tmp_path):
     out, imported = _run(["run", "--rigid", "--no-progress"], tmp_path / "cache")
     assert "pylon isolation efficiency" in out
@@ -64,6 +65,7 @@ def test_help_the_cache_listing_and_a_workbook_check_load_no_numerics(tmp_path):
         assert done.stdout.rpartition("MODULES")[2].split() == [], args
 
 
+@pytest.mark.slow  # the links are reduced first (an empty cache)
 def test_warm_run_of_a_json_case_imports_only_what_it_uses(tmp_path):
     from workbook.model.codec import to_json
     from workbook.model.reference import reference_case
