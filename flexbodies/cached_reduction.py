@@ -82,8 +82,6 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
         One per excitation, in order, each carrying its own decision;
         ``cache_hit`` tells whether it was loaded.
     """
-    from .reduction import reduce_for_decisions
-
     excitations_hz = list(excitations_hz)
     cache = LinkCache(cache_dir, enabled=use_cache)
     fe_hash = record_hash(fingerprint)
@@ -104,6 +102,8 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
         frequencies, decisions, keys, links = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
         if complete(stored):
             return answer(decisions, keys, links, {})
+        from .reduction import reduce_for_decisions  # scikit-fem and the solvers: only when a reduction is made
+
         known = frequencies is not None
         coupled, solver, frequencies, timings = prepare(frequencies)
         if not known:

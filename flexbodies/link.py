@@ -29,7 +29,6 @@ import numpy as np
 from .cache import LinkCache, default_cache_dir
 from .cached_reduction import cached_reductions, record_hash, stored_reductions
 from .errors import LinkModelError
-from .geometric_stiffness import has_stiffening
 from .geometry import LinkGeometry, default_element_size
 from .materials import STEEL, Material
 from .reduced import SCHEMA_VERSION, ReducedLink
@@ -233,7 +232,11 @@ def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_
     _, _, _, links = stored_reductions(cache, record_hash(model.fingerprint()), _decider(modes), list(excitations_hz))
     if links is None or any(link is None for link in links):
         return False
-    return not stiffening or has_stiffening(model, cache_dir=cache_dir)
+    if not stiffening:
+        return True
+    from .geometric_stiffness import has_stiffening  # SciPy's solvers: not for a workbook check
+
+    return has_stiffening(model, cache_dir=cache_dir)
 
 
 def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
@@ -263,7 +266,7 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         One per excitation, in order, each carrying its own decision.
     """
     def prepare(frequencies):
-        from .geometric_stiffness import coupled_stiffening, save_stiffening
+        from .geometric_stiffness import coupled_stiffening, has_stiffening, save_stiffening
         from .interior import InteriorSolver
         from .reduction import couple
         from .stress import nodal_stress_operator

@@ -154,6 +154,11 @@ class MountResult:
         """
         import pandas as pd
 
+        rows, columns = self._table_rows(quantity)
+        return pd.DataFrame.from_dict(rows, orient="index", columns=columns).rename_axis("run")
+
+    def _table_rows(self, quantity: str) -> tuple[dict[str, list[float]], list[str]]:
+        """The rows (run name -> frequency and x, y, z) and the columns of :meth:`table`."""
         values = {"efficiency": lambda r: r.efficiency, "transmissibility": lambda r: r.transmissibility,
                   "db": lambda r: level_db(r.transmissibility), "amplitude": lambda r: r.pylon_amplitude}
         if quantity not in values:
@@ -161,7 +166,31 @@ class MountResult:
         units = {"efficiency": "eta %", "transmissibility": "T", "db": "dB", "amplitude": "N"}
         rows = {run.name: [run.frequency_hz, *values[quantity](run)] for run in self.runs}
         columns = ["frequency Hz"] + [f"{units[quantity]} {d}" for d in DIRECTIONS]
-        return pd.DataFrame.from_dict(rows, orient="index", columns=columns).rename_axis("run")
+        return rows, columns
+
+    def table_text(self, quantity: str = "efficiency", *, frequency: bool = True,
+                   float_format=lambda v: f"{v:8.2f}") -> str:
+        """:meth:`table` as text, as ``table(quantity).to_string(float_format=float_format)`` gives it,
+        without importing pandas for a table of finite numbers.
+
+        Parameters
+        ----------
+        quantity : {"efficiency", "transmissibility", "db", "amplitude"}
+        frequency : bool
+            False leaves out the frequency column.
+        float_format : callable
+            Text of one value.
+        """
+        from workbook.answers.text_table import text_table
+
+        rows, columns = self._table_rows(quantity)
+        if not frequency:
+            rows, columns = {name: values[1:] for name, values in rows.items()}, columns[1:]
+        text = text_table("run", rows, columns, float_format) if len(rows) == len(self.runs) else None
+        if text is not None:
+            return text
+        table = self.table(quantity)
+        return (table if frequency else table.drop(columns="frequency Hz")).to_string(float_format=float_format)
 
     def to_frame(self):
         """Every answer in long form: one row per run, location (hinge or
@@ -283,18 +312,22 @@ class MountResult:
         """
         import matplotlib.pyplot as plt
 
-        table = self.table("efficiency")
         fig, ax = plt.subplots(figsize=(7, 4), constrained_layout=True)
+        self.draw_efficiency(ax)
+        return fig
+
+    def draw_efficiency(self, ax) -> None:
+        """Draw :meth:`plot_efficiency`'s bar chart on the matplotlib axes *ax*."""
+        rows, _ = self._table_rows("efficiency")
         width = 0.8 / len(DIRECTIONS)
-        positions = np.arange(len(table))
+        positions = np.arange(len(rows))
         for i, axis in enumerate(DIRECTIONS):
-            bars = ax.bar(positions + (i - 1) * width, table[f"eta % {axis}"], width, label=axis)
+            bars = ax.bar(positions + (i - 1) * width, [values[1 + i] for values in rows.values()], width, label=axis)
             ax.bar_label(bars, fmt="%.1f", fontsize="small")
-        ax.set_xticks(positions, [f"{name}\n{f:g} Hz" for name, f in zip(table.index, table["frequency Hz"], strict=True)])
+        ax.set_xticks(positions, [f"{name}\n{values[0]:g} Hz" for name, values in rows.items()])
         ax.set_ylabel("isolation efficiency %")
         ax.legend(title="direction")
-        ax.set_title(f"{self.case_name}: pylon isolation efficiency")
-        return fig
+        ax.set_title(f"{self.case_name}: pylon isolation efficiency", y=1.0)   # placed, not searched for
 
 
 def _direction_answers(amplitude: np.ndarray, reference: float) -> dict[str, dict[str, float | None]]:

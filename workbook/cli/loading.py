@@ -10,13 +10,16 @@ import dataclasses
 import json
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from workbook.errors import CaseError, UsageError
 from workbook.model.case import AnalysisMethod, Case
 from workbook.model.codec import from_json
 from workbook.model.pylon_impedance import read_impedance_csv
 from workbook.model.reference import reference_case
-from workbook.solve.stages import ProgressFactory
+
+if TYPE_CHECKING:   # the stages module loads the scene builder and SciPy: not for a command's --help
+    from workbook.solve.stages import ProgressFactory
 
 __all__ = ["WORKBOOK_SUFFIXES", "is_workbook", "load_case", "progress_factory"]
 

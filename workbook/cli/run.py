@@ -58,7 +58,6 @@ def _print_hinges(curves) -> None:
 
 
 def run(args) -> int:
-    from workbook.answers.saving import save_figure
     from workbook.solve.pipeline import run_case
 
     if args.plot and not args.hinges:
@@ -106,6 +105,8 @@ def run(args) -> int:
             _print_hinges(curves)
     with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
         if figure is not None:
+            from workbook.answers.saving import save_figure
+
             write_output(args.plot, "plot", "run", lambda target: save_figure(figure, target, dpi=120))
     return 0
 
@@ -113,12 +114,10 @@ def run(args) -> int:
 def _print_answers(case, result) -> None:
     from workbook.answers.warning_groups import warning_lines
 
-    table = result.table("efficiency")
-    levels = result.table("db")
     print(f"{case.name}: pylon isolation efficiency eta = (1 - T) x 100 % (T: pylon force / excitation)\n")
-    print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
+    print(result.table_text("efficiency"))
     print("\n20 log10 T (dB):")
-    print(levels.drop(columns="frequency Hz").to_string(float_format=lambda v: f"{v:8.2f}"))
+    print(result.table_text("db", frequency=False))
     for line in warning_lines(result.runs):
         print("\n" + line)
     for card in result.model_cards.values():

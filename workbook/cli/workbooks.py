@@ -100,12 +100,10 @@ def run_workbook(args) -> int:
     written and the exit code is 1; when a run found its input bad while
     running, nothing is written and the exit code is 2.
     """
-    from workbook.errors import SimulationError, WorkbookError
-    from workbook.excel.execute import run_book, select_runs
+    from workbook.errors import WorkbookError
+    from workbook.excel.execute import select_runs
+    from workbook.excel.pictures import start_pictures
     from workbook.excel.reader import read_workbook
-    from workbook.excel.report import write_report
-    from workbook.excel.writer import write_results
-    from workbook.solve.four_pole_set import report_four_pole
 
     if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None) \
             or getattr(args, "method", None):
@@ -122,6 +120,24 @@ def run_workbook(args) -> int:
     except WorkbookError as error:
         return _report_problems(error)
     progress = None if getattr(args, "no_progress", False) else progress_factory()
+    # the report's pictures: a second process imports matplotlib while the runs are computed, and
+    # draws them while this one writes the results
+    pictures = start_pictures() if args.report else None
+    try:
+        return _run_and_write(args, book, selected, progress, pictures)
+    finally:
+        if pictures is not None:
+            pictures.close()
+
+
+def _run_and_write(args, book, selected, progress, pictures) -> int:
+    """The runs of :func:`run_workbook`, their results written back and the report."""
+    from workbook.errors import SimulationError
+    from workbook.excel.execute import run_book
+    from workbook.excel.report import write_report
+    from workbook.excel.writer import write_results
+    from workbook.solve.four_pole_set import report_four_pole
+
     runs, failures = run_book(book, selected, progress=progress)
     for failure in failures:
         print(f"mountwb run: {failure}", file=sys.stderr)
@@ -134,9 +150,11 @@ def run_workbook(args) -> int:
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
+    if pictures is not None:
+        pictures.draw(runs)
     _print_summary(runs)
     try:
-        outcome = write_results(book.path, book.sha256, runs, book.tests)
+        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened)
     except OSError as error:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)
@@ -144,7 +162,7 @@ def run_workbook(args) -> int:
     print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
-            report = write_report(args.report, book, runs, outcome, four_pole=pole)
+            report = write_report(args.report, book, runs, outcome, four_pole=pole, pictures=pictures)
         except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE

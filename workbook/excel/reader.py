@@ -24,7 +24,7 @@ from workbook.excel.files import bounded_file_problem
 from workbook.excel.impedance_sheet import SHEET as IMPEDANCE_SHEET
 from workbook.excel.impedance_sheet import with_impedance_sheet
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
-from workbook.excel.sheets import Record, SheetReader, open_workbook
+from workbook.excel.sheets import OpenedWorkbook, Record, SheetReader, open_workbook, read_workbook_bytes
 from workbook.model import case as cm
 from workbook.model.casing import DEFAULT_BEARING_STIFFNESS, CasingGeometry, EngineCasing, MountRing
 
@@ -48,6 +48,9 @@ class CaseBook:
     tests : tuple of TestPoint
     sha256 : str
         Hash of the file's bytes.
+    opened : OpenedWorkbook or None
+        The workbook as read, for :func:`~workbook.excel.writer.write_results` (which then does not
+        open the file again).
     """
 
     path: Path
@@ -55,6 +58,7 @@ class CaseBook:
     runs: tuple
     tests: tuple
     sha256: str
+    opened: OpenedWorkbook | None = dataclasses.field(default=None, compare=False, repr=False)
 
     def run_case(self, run: RunSpec) -> cm.Case:
         """The case of one run (see :func:`~workbook.excel.runs.case_for_run`)."""
@@ -658,7 +662,9 @@ def read_workbook(path: str | Path) -> CaseBook:
         With every problem found.
     """
     path = Path(path)
-    formulas, values = open_workbook(path)
+    data = read_workbook_bytes(path)
+    sha256 = hashlib.sha256(data).hexdigest()
+    formulas, values = open_workbook(path, data)
     reader = _CaseReader(path, formulas, values)
     tables = {table.sheet: reader.table(table) for table in L.TABLES}
     reader.sheet_title(IMPEDANCE_SHEET)
@@ -675,5 +681,5 @@ def read_workbook(path: str | Path) -> CaseBook:
     if reader.problems:
         raise WorkbookError(reader.problems)
     log.info("read %s: %d links, %d hinges, %d runs", path.name, len(case.links), len(case.hinges), len(runs))
-    return CaseBook(path, case, tuple(run for _, run in runs), tuple(tests),
-                    hashlib.sha256(path.read_bytes()).hexdigest())
+    return CaseBook(path, case, tuple(run for _, run in runs), tuple(tests), sha256,
+                    OpenedWorkbook(sha256, formulas, values))

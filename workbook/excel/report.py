@@ -37,6 +37,7 @@ from openpyxl.utils import get_column_letter
 
 from workbook.answers.isolation import efficiency, level_db
 from workbook.excel.files import new_file_target, save_atomic, signed, untouched
+from workbook.excel.pictures import draw_pictures
 from workbook.excel.reader import CaseBook
 from workbook.excel.styling import FORMATS, print_setup, style_series, write_text_lines
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
@@ -242,39 +243,13 @@ def _warnings(ws, runs: list[RunResult]) -> None:
     print_setup(ws, header_rows=3)
 
 
-def _figure(run: RunResult):
-    import matplotlib.pyplot as plt
-
-    result = run.result
-    if len(result.runs) == 1:
-        return result.plot_time_histories() if result.runs[0].has_histories else result.plot_efficiency()
-    fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
-    frequencies = [p.frequency_hz for p in result.runs]
-    for i, d in enumerate(DIRECTIONS):
-        ax.loglog(frequencies, [p.transmissibility[i] for p in result.runs], marker="o", ms=3, label=d)
-    ax.axhline(1.0, color="0.6", lw=0.8, ls="--")
-    ax.set_xlabel("frequency Hz")
-    ax.set_ylabel("pylon transmissibility T")
-    ax.legend(title="direction")
-    ax.set_title(f"{result.case_name}: {run.spec.name}")
-    return fig
-
-
-def _plots(ws, runs: list[RunResult]) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def _plots(ws, runs: list[RunResult], pictures: list[bytes]) -> None:
+    """The pictures of *runs* (PNG, one per run, :mod:`workbook.excel.pictures`), two side by side."""
     row, height = 1, 0
-    for number, run in enumerate(runs):
+    for number, (run, png) in enumerate(zip(runs, pictures, strict=True)):
         column = 1 if number % 2 == 0 else 12      # two pictures side by side (10 default columns each)
         ws.cell(row, column, f"Run '{run.spec.name}'").font = Font(bold=True)
-        fig = _figure(run)
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format="png", dpi=80)
-        plt.close(fig)
-        image = Image(io.BytesIO(buffer.getvalue()))
+        image = Image(io.BytesIO(png))
         ws.add_image(image, f"{get_column_letter(column)}{row + 1}")
         height = max(height, int(image.height / 20) + 3)
         if number % 2 == 1:
@@ -355,7 +330,7 @@ def is_report(path: Path) -> bool:
 
 
 def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
-                 written: WriteOutcome | None = None, *, four_pole=None) -> WriteOutcome:
+                 written: WriteOutcome | None = None, *, four_pole=None, pictures=None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
     An existing *path* is replaced only if it is a report this module wrote,
@@ -374,6 +349,9 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
         the metadata records that file's SHA-256 as it is now.
     four_pole : FourPole, optional
         The mount's four-pole set: a Four-pole sheet (:func:`four_pole_sheet`).
+    pictures : workbook.excel.pictures.Pictures, optional
+        The pictures of *runs*, being drawn (:func:`~workbook.excel.pictures.start_pictures`);
+        default: drawn here.
 
     Returns
     -------
@@ -389,7 +367,7 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     _transmissibility(workbook.create_sheet("Transmissibility"), runs)
     _modes(workbook.create_sheet("Modes"), runs)
     _warnings(workbook.create_sheet("Warnings"), runs)
-    _plots(workbook.create_sheet("Plots"), runs)
+    _plots(workbook.create_sheet("Plots"), runs, draw_pictures(runs) if pictures is None else pictures.result())
     _model_cards(workbook.create_sheet("Model card"), runs)
     if four_pole is not None:
         four_pole_sheet(workbook.create_sheet(FOUR_POLE_SHEET), four_pole)

@@ -26,7 +26,7 @@ from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
 from workbook.model.units import DIMENSIONLESS, si_factor
 
-__all__ = ["Record", "SheetReader", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
+__all__ = ["Record", "SheetReader", "OpenedWorkbook", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
            "MAX_FILE_BYTES", "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
 
 
@@ -610,8 +610,60 @@ def _too_large(path: Path) -> Problem | None:
     return None
 
 
-def open_workbook(path: str | Path):
-    """Open a workbook twice: with formulas and with the cached values.
+class OpenedWorkbook:
+    """A case workbook as the reader opened it, handed on once to the writer of its results.
+
+    The writer adds its sheets to the workbook the reader opened instead of
+    opening the file again; it takes the pair only while the file's SHA-256
+    is the one read (:meth:`take`), and only once (it changes the workbook).
+
+    Parameters
+    ----------
+    sha256 : str
+        SHA-256 of the bytes both workbooks were loaded from.
+    formulas, values : openpyxl.Workbook
+        Loaded with formulas (and rich text), and with the cached values.
+    """
+
+    def __init__(self, sha256: str, formulas, values):
+        self.sha256 = sha256
+        self._pair: tuple | None = (formulas, values)
+
+    def take(self, sha256: str) -> tuple | None:
+        """``(formulas, values)`` if they were loaded from bytes of this *sha256* and not taken yet, else None."""
+        if self._pair is None or sha256 != self.sha256:
+            return None
+        pair, self._pair = self._pair, None
+        return pair
+
+
+def read_workbook_bytes(path: Path) -> bytes:
+    """The bytes of a case workbook, checked before openpyxl sees them.
+
+    Raises
+    ------
+    WorkbookError
+        The file is missing, not an .xlsx workbook, or too large (see :func:`open_workbook`).
+    """
+    if not path.is_file():
+        raise WorkbookError([Problem(path.name, None, None, None, str(path), "an existing workbook file")])
+    if not zipfile.is_zipfile(path):
+        raise WorkbookError([_not_a_workbook(path)])
+    problem = _too_large(path)
+    if problem is not None:
+        raise WorkbookError([problem])
+    return path.read_bytes()
+
+
+def open_workbook(path: str | Path, data: bytes | None = None):
+    """Open a workbook twice: with formulas (and rich text, kept for the writer) and with the cached values.
+
+    Parameters
+    ----------
+    path : str or Path
+    data : bytes, optional
+        The file's bytes, read by :func:`read_workbook_bytes` (default: read here); both
+        workbooks are loaded from them, so that the file is read once.
 
     Returns
     -------
@@ -624,20 +676,19 @@ def open_workbook(path: str | Path):
         password-protected one, named as such), corrupt, or larger than
         :data:`MAX_FILE_BYTES` (:data:`MAX_UNPACKED_BYTES` unpacked).
     """
+    import io
+
     from openpyxl import load_workbook
 
     path = Path(path)
-    if not path.is_file():
-        raise WorkbookError([Problem(path.name, None, None, None, str(path), "an existing workbook file")])
-    if not zipfile.is_zipfile(path):
-        raise WorkbookError([_not_a_workbook(path)])
-    problem = _too_large(path)
-    if problem is not None:
-        raise WorkbookError([problem])
+    if data is None:
+        data = read_workbook_bytes(path)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            return (load_workbook(path, data_only=False), load_workbook(path, data_only=True))
+            # rich text changes no formula, the only cells the reader takes from this one (the writer keeps it)
+            return (load_workbook(io.BytesIO(data), data_only=False, rich_text=True),
+                    load_workbook(io.BytesIO(data), data_only=True))
     except Exception as exc:  # openpyxl raises many kinds for a damaged file
         raise WorkbookError([Problem(path.name, None, None, None, f"{type(exc).__name__}: {exc}",
                                      "a readable Excel .xlsx workbook")]) from None

@@ -279,12 +279,13 @@ def _kept_note(earlier: list[tuple], computed: set[str]) -> str:
     return f"; the results of {', '.join(repr(run) for run in kept)} are from an earlier run" if kept else ""
 
 
-def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str) -> list[str]:
+def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, frames: dict | None = None) -> list[str]:
     """Add the result sheets of *runs* to an openpyxl *workbook*.
 
     The result sheets a write made before are rewritten: the rows and model
     cards of the runs just computed are replaced, those of every other run
-    are kept as they were (the sheet's note names them).
+    are kept as they were (the sheet's note names them). *frames* are
+    ``result_frames(runs, tests)`` when the caller has them already.
 
     Returns
     -------
@@ -293,7 +294,7 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str)
     """
     earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)}
     computed = {run.spec.name for run in runs}
-    frames = result_frames(runs, tests)
+    frames = result_frames(runs, tests) if frames is None else frames
     tables = {}
     for name, note in _NOTES.items():
         title = _sheet_title(name)
@@ -327,34 +328,45 @@ def _conflicts(workbook, titles: list[str]) -> list[str]:
     return [title for title in titles if title in workbook.sheetnames and not is_result_sheet(workbook[title])]
 
 
-def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str]):
-    """(reason or None, the loaded workbook or None)."""
+def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=None):
+    """(reason or None, the loaded workbook or None, the cached values' workbook or None).
+
+    *opened* (an :class:`~workbook.excel.sheets.OpenedWorkbook`) gives the workbook as the reader
+    loaded it, when the file on disk still has its SHA-256; otherwise the file is loaded here.
+    """
     lock = lock_file(path)
     if lock is not None:
-        return lock_message(lock), None
+        return lock_message(lock), None, None
     refused = read_only_message(path)
     if refused is not None:
-        return refused, None
-    if hashlib.sha256(path.read_bytes()).hexdigest() != sha256:
-        return "it changed on disk while the runs were computed", None
+        return refused, None, None
+    current = hashlib.sha256(path.read_bytes()).hexdigest()
+    if current != sha256:
+        return "it changed on disk while the runs were computed", None, None
     dropped = unsupported_content(path)
     if dropped:
-        return f"it holds content this program cannot keep ({', '.join(dropped)})", None
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        workbook = load_workbook(path, rich_text=True)
+        return f"it holds content this program cannot keep ({', '.join(dropped)})", None, None
+    pair = opened.take(current) if opened is not None else None
+    if pair is not None:
+        workbook, values = pair
+    else:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            workbook, values = load_workbook(path, rich_text=True), None
     conflicts = _conflicts(workbook, titles)
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
-                "rename them to write the results into the workbook"), None
-    return None, workbook
+                "rename them to write the results into the workbook"), None, None
+    return None, workbook, values
 
 
-def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]:
-    """The values Excel cached for the formula cells of *workbook* (read from *path*), by sheet number."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        values = load_workbook(path, data_only=True)
+def _cached_formula_values(path: Path, workbook, values=None) -> dict[int, dict[str, object]]:
+    """The values Excel cached for the formula cells of *workbook* (read from *path*, or given as the
+    workbook *values* loaded with ``data_only=True``), by sheet number."""
+    if values is None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            values = load_workbook(path, data_only=True)
     cached: dict[int, dict[str, object]] = {}
     for number, ws in enumerate(workbook.worksheets, start=1):
         if ws.title not in values.sheetnames:
@@ -366,7 +378,8 @@ def _cached_formula_values(path: Path, workbook) -> dict[int, dict[str, object]]
     return cached
 
 
-def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = ()) -> WriteOutcome:
+def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = (), *,
+                  opened=None) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
     Parameters
@@ -377,6 +390,9 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         Its hash when it was read (a changed file is not overwritten).
     runs : list of RunResult
     tests : tuple of TestPoint
+    opened : OpenedWorkbook, optional
+        The workbook as read (``CaseBook.opened``): its sheets are written into
+        without loading the file again, while the file is unchanged.
 
     Returns
     -------
@@ -384,13 +400,14 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     """
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
-    titles = result_sheet_names(result_frames(runs, tests))
+    frames = result_frames(runs, tests)
+    titles = result_sheet_names(frames)
     with held(path):
-        reason, workbook = _reason_not_to_overwrite(path, sha256, titles)
+        reason, workbook, values = _reason_not_to_overwrite(path, sha256, titles, opened)
         if reason is None:
             log.info("building the new %s with the results", path.name)
-            add_result_sheets(workbook, runs, tests, stamp)
-            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook))
+            add_result_sheets(workbook, runs, tests, stamp, frames)
+            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook, values))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
         if reason is None:
@@ -400,7 +417,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
                 reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
-    add_result_sheets(separate, runs, tests, stamp)
+    add_result_sheets(separate, runs, tests, stamp, frames)
     target = save_atomic(separate, name_beside(path, "results"))
     log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)

@@ -26,7 +26,7 @@ __all__ = ["to_dict", "from_dict", "to_json", "from_json"]
 def _registry() -> dict[str, type]:
     """Classes a case may contain, by name."""
     import flexbodies
-    from flexbodies.meshing import BoreSpec
+    from flexbodies.bores import BoreSpec
 
     classes = [_case.Case, _case.Engine, _case.Link, _case.Hinge, _case.PointForce,
                _case.PointMoment, _case.Gravity, _case.RotatingForce, _case.HarmonicForce,

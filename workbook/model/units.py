@@ -13,6 +13,10 @@ Two conventions differ from a plain pint conversion:
   revolution as 2 pi radians, would give 2 pi/60 Hz).
 
 A dimensionless column takes ``-``, ``1``, an empty cell or ``%``.
+
+A column's own SI unit and the common units of a table of known factors
+(mm, kN/mm, t, GPa, rpm, ...) are converted without pint: its registry
+takes about half a second to build, and is built only for another unit.
 """
 from __future__ import annotations
 
@@ -51,6 +55,30 @@ def _parse(text: str):
         raise UnitProblem("a known unit") from None
 
 
+#: The SI unit texts of the sheets' columns: a unit cell holding its column's own SI unit needs no conversion.
+_SI_UNITS = frozenset(("1/s", "Hz", "N", "N*m", "N*s/m", "N/m", "Pa", "deg", "kg", "kg*m", "kg*m^2", "kg/m^3", "m",
+                       "m/s^2", "s"))
+
+#: (unit text, SI unit) -> the factor pint gives, for the units engineers type most (the template's among
+#: them): a sheet written in these needs no pint registry. ``tests/test_warm_paths.py`` checks every entry
+#: against pint, to the last bit.
+_KNOWN = {
+    ("mm", "m"): 0.001, ("cm", "m"): 0.01, ("km", "m"): 1000.0,
+    ("GPa", "Pa"): 1e9, ("MPa", "Pa"): 1e6, ("kPa", "Pa"): 1000.0, ("N/mm^2", "Pa"): 1e6,
+    ("kN", "N"): 1000.0, ("MN", "N"): 1e6,
+    ("kN/mm", "N/m"): 1e6, ("N/mm", "N/m"): 1000.0, ("MN/m", "N/m"): 1e6, ("kN/m", "N/m"): 1000.0,
+    ("N*s/mm", "N*s/m"): 1000.0, ("kN*s/m", "N*s/m"): 1000.0,
+    ("t", "kg"): 1000.0, ("g", "kg"): 0.001,
+    ("kg*mm^2", "kg*m^2"): 1e-06, ("t*m^2", "kg*m^2"): 1000.0,
+    ("g*mm", "kg*m"): 1e-06, ("kg*mm", "kg*m"): 0.001,
+    ("g/cm^3", "kg/m^3"): 999.9999999999999, ("t/m^3", "kg/m^3"): 1000.0,
+    ("kN*m", "N*m"): 1000.0, ("N*mm", "N*m"): 0.001,
+    ("ms", "s"): 0.001, ("rpm", "Hz"): 0.016666666666666666, ("kHz", "Hz"): 1000.0,
+    ("1/min", "1/s"): 0.016666666666666666,
+    ("g", "m/s^2"): 9.80665, ("rad", "deg"): 57.29577951308232, ("%", DIMENSIONLESS): 0.01,
+}
+
+
 @functools.lru_cache(maxsize=None)
 def si_factor(text: str, si_unit: str) -> float:
     """Factor from the unit *text* to the column's *si_unit*.
@@ -74,6 +102,16 @@ def si_factor(text: str, si_unit: str) -> float:
         Unknown unit, or a unit of another dimension.
     """
     text = text.strip()
+    if text == si_unit and si_unit in _SI_UNITS:
+        return 1.0
+    known = _KNOWN.get((text, si_unit))
+    if known is not None:
+        return known
+    return _pint_factor(text, si_unit)
+
+
+def _pint_factor(text: str, si_unit: str) -> float:
+    """:func:`si_factor` by pint, for a stripped *text*."""
     if si_unit == DIMENSIONLESS:
         if text in ("", "-", "1"):
             return 1.0

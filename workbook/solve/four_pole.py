@@ -60,7 +60,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
@@ -116,6 +115,7 @@ def checked_frequencies(frequencies_hz) -> np.ndarray:
 
 def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) -> np.ndarray:
     """``matrix^-1 rhs``, or a FourPoleError naming *what* is singular at *frequency_hz*."""
+    import scipy.linalg as sla  # here: the command line's parser takes this module's defaults
     if matrix.size == 0:
         return np.zeros((0, rhs.shape[1]), dtype=complex)
     with warnings.catch_warnings():
@@ -435,6 +435,7 @@ def _engine_first(basis: np.ndarray, engine: np.ndarray) -> np.ndarray:
     """An orthogonal turn R of the independent coordinates after which the
     first six are the engine's node coordinates and the others leave the
     engine still (``basis @ R`` has ``[I 0]`` in the engine's rows)."""
+    import scipy.linalg as sla  # here: the command line's parser takes this module's defaults
     rows = basis[engine]
     if not np.allclose(rows @ rows.T, np.eye(len(engine)), atol=1e-9):
         raise FourPoleError("the engine's coordinates are constrained in the linearisation: no four-pole set")
@@ -465,6 +466,7 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
     workbook.errors.FourPoleError
         A singular set.
     """
+    import scipy.linalg as sla  # here: the command line's parser takes this module's defaults
     frequencies = checked_frequencies(frequencies_hz)
     mount = mount_case(case)
     center = np.asarray(case.engine.center_of_mass, dtype=float)

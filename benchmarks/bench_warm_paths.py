@@ -1,0 +1,157 @@
+"""Warm paths: the wall time of the commands a user runs most, now and (optionally) before, side by side.
+
+Measured, each the median of its repeats, every repeat a new process of
+this source tree (``python -m workbook.cli.main``):
+
+- ``mountwb run`` with the reduction cache filled (both rotors of the
+  reference mount);
+- ``mountwb run cases/reference.xlsx --report r.xlsx`` with the cache filled
+  (both rotors and the 25-point sweep, written back into a fresh copy of the
+  workbook, plus the report), the second run of the workbook;
+- ``mountwb run`` with an empty cache (a new, empty cache folder each time:
+  the three distinct links reduced side by side, one worker process per
+  core);
+- which of pandas, pint, matplotlib, openpyxl, scikit-fem, meshio and gmsh
+  the warm ``mountwb run`` imports (none is needed).
+
+``--before REV`` measures the source tree of the git revision REV the same
+way, interleaved with this one (``git archive`` into a temporary folder), so
+that a change of the machine's load hits both alike. Python caches the
+compiled modules of both trees in a temporary folder (``PYTHONPYCACHEPREFIX``),
+as an installed package has them, and a first run of each command fills it.
+
+Measured on the shared 2-core machine of the project (load average 0.3 to
+1.7 from other work while it ran, not the idle machine of the targets),
+``OPENBLAS_NUM_THREADS=1``, with ``python benchmarks/bench_warm_paths.py
+--before 6ec551f`` (6ec551f: the code before these changes), medians of 5
+(cold: 3)::
+
+    | what                                                    | before  | now    | target |
+    | warm `mountwb run`                                      | 1.45 s  | 1.00 s | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.69 s  | 2.60 s | 2 s    |
+    | cold `mountwb run` (empty cache)                        | 10.62 s | 9.85 s | 6 s    |
+    | unneeded packages the warm run imports                  | meshio, pandas, skfem | none | none |
+
+Run from the repository's root::
+
+    python benchmarks/bench_warm_paths.py [--repeats 5] [--cold-repeats 3] [--before REV]
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+#: Packages the warm ``mountwb run`` of the reference mount has no use for.
+NOT_NEEDED = ("pandas", "pint", "matplotlib", "openpyxl", "skfem", "meshio", "gmsh")
+
+_PROBE = """
+import sys
+from workbook.cli.main import main
+code = main(sys.argv[1:])
+print("MODULES " + " ".join(sorted(m for m in {not_needed!r} if m in sys.modules)))
+sys.exit(code)
+"""
+
+
+def _environment(tree: Path, cache: Path, pycache: Path) -> dict:
+    env = dict(os.environ, MOUNTWB_CACHE=str(cache), PYTHONPATH=str(tree), OPENBLAS_NUM_THREADS="1",
+               PYTHONPYCACHEPREFIX=str(pycache))
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
+    return env
+
+
+def _command(tree: Path, args: list[str], cache: Path, pycache: Path, cwd: Path) -> float:
+    """Wall time of one ``mountwb ARGS`` process of the source tree *tree*, s."""
+    start = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "workbook.cli.main", *args, "--no-progress"], check=True, cwd=cwd,
+                   env=_environment(tree, cache, pycache), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
+def _imported(tree: Path, cache: Path, pycache: Path, cwd: Path) -> list[str]:
+    """The packages of :data:`NOT_NEEDED` a warm ``mountwb run`` of *tree* imports."""
+    done = subprocess.run([sys.executable, "-c", _PROBE.format(not_needed=NOT_NEEDED), "run", "--no-progress"],
+                          check=True, cwd=cwd, env=_environment(tree, cache, pycache), capture_output=True, text=True)
+    return done.stdout.rpartition("MODULES")[2].split()
+
+
+def _workbook_run(tree: Path, cache: Path, pycache: Path, folder: Path, label: str) -> float:
+    copy = folder / f"reference-{label}.xlsx"
+    shutil.copy(ROOT / "cases" / "reference.xlsx", copy)
+    report = folder / f"report-{label}.xlsx"
+    report.unlink(missing_ok=True)
+    return _command(tree, ["run", str(copy), "--report", str(report)], cache, pycache, folder)
+
+
+def measure(trees: dict[str, Path], repeats: int, cold_repeats: int, folder: Path) -> dict:
+    """Median wall times per tree: warm run, warm workbook with report, cold run; and the warm run's imports."""
+    pycache = folder / "pycache"
+    caches = {name: folder / f"cache-{name}" for name in trees}
+    times: dict[str, dict[str, list[float]]] = {name: {"warm": [], "report": [], "cold": []} for name in trees}
+    for name, tree in trees.items():   # fill the caches and the compiled modules; the first workbook run
+        _command(tree, ["run"], caches[name], pycache, folder)
+        _workbook_run(tree, caches[name], pycache, folder, f"{name}-first")
+    for i in range(repeats):           # interleaved: a change of the machine's load hits every tree alike
+        for name, tree in trees.items():
+            times[name]["warm"].append(_command(tree, ["run"], caches[name], pycache, folder))
+            times[name]["report"].append(_workbook_run(tree, caches[name], pycache, folder, f"{name}-{i}"))
+    for i in range(cold_repeats):
+        for name, tree in trees.items():
+            empty = folder / f"cold-{name}-{i}"
+            times[name]["cold"].append(_command(tree, ["run"], empty, pycache, folder))
+            shutil.rmtree(empty, ignore_errors=True)
+    return {name: {**{what: statistics.median(values) for what, values in times[name].items()},
+                   "imports": _imported(trees[name], caches[name], pycache, folder)} for name in trees}
+
+
+def _source_tree(revision: str, folder: Path) -> Path:
+    """The files of git revision *revision* of this repository, unpacked into *folder*."""
+    folder.mkdir()
+    archive = subprocess.run(["git", "archive", revision], cwd=ROOT, check=True, capture_output=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
+    return folder
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=5, help="repeats of the warm commands")
+    parser.add_argument("--cold-repeats", type=int, default=3, help="repeats of the cold run")
+    parser.add_argument("--before", metavar="REV", help="also measure the source tree of this git revision")
+    args = parser.parse_args(argv)
+    folder = Path(tempfile.mkdtemp(prefix="bench-warm-"))
+    try:
+        trees = {"now": ROOT}
+        if args.before:
+            trees = {"before": _source_tree(args.before, folder / "before"), **trees}
+        results = measure(trees, args.repeats, args.cold_repeats, folder)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    load = os.getloadavg()[0]
+    print(f"Reference mount, medians of new processes, 1 BLAS thread, {os.cpu_count()} cores, "
+          f"load average {load:.1f} at the end (targets: an idle machine)")
+    names = list(results)
+    print("| what | " + " | ".join(names) + " | target | met (now) |")
+    print("|---|" + "---|" * len(names) + "---|---|")
+    rows = [("warm `mountwb run`", "warm", args.repeats, 1.0),
+            ("warm `mountwb run cases/reference.xlsx --report r.xlsx` (second run)", "report", args.repeats, 2.0),
+            ("cold `mountwb run` (empty cache)", "cold", args.cold_repeats, 6.0)]
+    for what, key, repeats, target in rows:
+        values = " | ".join(f"{results[name][key]:.2f} s" for name in names)
+        met = "yes" if results["now"][key] <= target else "no"
+        print(f"| {what}, {repeats} repeats | {values} | <= {target:g} s | {met} |")
+    imports = " | ".join(", ".join(results[name]["imports"]) or "none" for name in names)
+    print(f"| packages of {', '.join(NOT_NEEDED)} the warm run imports | {imports} | none | "
+          f"{'yes' if not results['now']['imports'] else 'no'} |")
+
+
+if __name__ == "__main__":
+    main()
