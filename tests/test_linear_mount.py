@@ -68,3 +68,23 @@ def test_a_change_it_cannot_follow_is_named(mount):
     moved = dataclasses.replace(case.engine, center_of_mass=(-0.5, 0.0, -0.03))
     with pytest.raises(OutsideDesignModel, match="a new preparation"):
         mount.evaluate(dataclasses.replace(case, engine=moved))
+
+
+def test_study_rows_on_the_prepared_mount_equal_the_pipeline_rows(mount):
+    """A Latin-hypercube study over hinge stiffness and loss factor: each row answered by the prepared
+    mount equals the same row through Exudyn; a row it does not follow (a link removed) goes through Exudyn."""
+    from workbook.studies.parallel import EXUDYN_PATH, NUMPY_PATH, run_rows
+    from workbook.studies.parametric import latin_hypercube, row_case, study_cases
+
+    rows = latin_hypercube({"hinge_stiffness": (5e7, 1.6e9), "hinge_loss_factor": (0.0, 0.1)}, 2, seed=3)
+    cases = study_cases(mount.case, rows) + [row_case(mount.case, {"removed_link": "rear-middle"}, 2)]
+    fast = run_rows(cases, design_model=mount)
+    exact = run_rows(cases)
+    assert [o.path for o in fast] == [NUMPY_PATH, NUMPY_PATH, EXUDYN_PATH]
+    assert {o.path for o in exact} == {EXUDYN_PATH}
+    for f, e in zip(fast, exact, strict=True):
+        assert f.status == e.status == "ok" and len(f.runs) == len(e.runs) == 2
+        for f_run, e_run in zip(f.runs, e.runs, strict=True):
+            t_fast = np.array([f_run[f"T {d}"] for d in "xyz"])
+            t_exact = np.array([e_run[f"T {d}"] for d in "xyz"])
+            assert _normwise(t_fast, t_exact) < 5e-6

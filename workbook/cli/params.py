@@ -13,6 +13,13 @@ the sensitivity plot go to ``--output`` (``parameter-study.*``, or
 :data:`workbook.studies.progress.PROGRESS_INTERVAL` s gives the rows done,
 rows per second and the time left.
 
+Rows that change only what a design evaluation follows (hinge springs and
+loss factors, transducer springs, engine mass properties, excitation
+amplitudes) are answered by the case's linear mount, prepared once
+(:class:`workbook.LinearMount`), in NumPy; the others, and every row with
+``--exudyn`` or ``--dask``, by the Exudyn pipeline. The table's ``path``
+column says which.
+
 The table file is kept up to date as rows finish, so an interrupted study
 keeps every finished row; ``--resume`` runs only the rows the table does not
 hold. A study whose rows all ran but some failed exits with
@@ -45,6 +52,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--dask", metavar="ADDRESS", help="run on the Dask scheduler at ADDRESS instead")
     parser.add_argument("--format", choices=TABLE_FORMATS, default="csv", help="table file format (csv)")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
+    parser.add_argument("--exudyn", action="store_true",
+                        help="answer every row through Exudyn (default: the rows that change only hinge and "
+                             "transducer springs, engine mass properties or excitation amplitudes are answered "
+                             "by the case's linear mount in NumPy, equal to 1e-6)")
     parser.add_argument("--resume", action="store_true",
                         help="keep the rows the table in --output already holds and run only the missing ones")
 
@@ -89,6 +100,24 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
     return latin_hypercube(bounds, lhs, seed) if lhs is not None else grid(values)
 
 
+def _design_model(case, cases):
+    """The linear mount of *case* when it follows at least one row's case (said on stderr), else None."""
+    import time
+
+    from workbook.model.case import Case
+    from workbook.studies.parallel import prepare_design_model
+
+    start = time.perf_counter()
+    model = prepare_design_model(case)
+    if isinstance(model, str):
+        print(f"every row through Exudyn: {model}", file=sys.stderr)
+        return None
+    followed = sum(isinstance(row, Case) and model.follows(row) for row in cases)
+    print(f"linear mount prepared in {time.perf_counter() - start:.1f} s: {followed} of {len(cases)} rows "
+          "answered by it in NumPy, the others by Exudyn", file=sys.stderr)
+    return model if followed else None
+
+
 def run_parameter_study(args) -> int:
     """Run ``study params``; print the table, a summary line and the files written.
 
@@ -106,7 +135,7 @@ def run_parameter_study(args) -> int:
 
     matplotlib.use("Agg")
 
-    from workbook.studies.parallel import run_rows
+    from workbook.studies.parallel import NUMPY_PATH, run_rows
     from workbook.studies.parametric import study_cases
     from workbook.studies.progress import StudyProgress
     from workbook.studies.sensitivity import StudyTable, new_study_table, read_finished, table_path, write_study
@@ -119,10 +148,14 @@ def run_parameter_study(args) -> int:
     where = f"Dask scheduler {args.dask}" if args.dask else f"{args.workers} local process(es)"
     kept = f" ({len(finished)} already in {path})" if args.resume else ""
     print(f"{case.name}: {len(rows)} study rows{kept} on {where}", file=sys.stderr)
+    cases = study_cases(case, rows)
+    design_model = None
+    if not args.exudyn and not args.dask:
+        design_model = _design_model(case, cases)
     try:
         with StudyProgress(len(rows), len(finished), stream=sys.stderr) as progress:
-            outcomes = run_rows(study_cases(case, rows), workers=args.workers, dask=args.dask, finished=finished,
-                                record=table.add, progress=progress.update)
+            outcomes = run_rows(cases, workers=args.workers, dask=args.dask, finished=finished,
+                                record=table.add, progress=progress.update, design_model=design_model)
             table.flush()
     except KeyboardInterrupt as interrupt:
         table.flush()
@@ -135,6 +168,10 @@ def run_parameter_study(args) -> int:
         print(f"row {outcome.index} failed: {outcome.error}")
     for written in write_study(frame, list(rows[0]) if rows else [], path):
         print(written)
+    fast = sum(outcome.path == NUMPY_PATH for outcome in outcomes)
+    if fast:
+        print(f"{fast} of {len(rows)} rows answered by the prepared linear mount in NumPy (column 'path'), "
+              f"the others by Exudyn")
     print(f"{len(rows) - len(failed)} of {len(rows)} rows ok, {len(failed)} failed"
           + (f" (rows {', '.join(str(o.index) for o in failed)}; exit code {EXIT_FAILED_ROWS})" if failed else ""))
     return EXIT_FAILED_ROWS if failed else EXIT_OK

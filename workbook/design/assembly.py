@@ -2,12 +2,10 @@
 
 The arithmetic of :mod:`workbook.design.linear_mount`, on plain arrays:
 
-- :func:`channel_state`: each force channel's marker separation and its
-  Jacobian at a change of state ``dq`` (second order);
 - :func:`static_state`: Newton on the preload equilibrium in the
   independent coordinates (Euler parameters renormalised);
-- :func:`linear_matrices`: M, K, D, H, the channel outputs and the
-  excitation inputs at a state, projected on the independent coordinates.
+- :func:`tangent_stiffness`, :func:`rest_matrices` and :func:`projection`:
+  the linearisation at a state, projected on the independent coordinates.
 
 A channel with stiffness S (3x3, N/m) has the potential ``d^T S d / 2``:
 generalised force ``J^T S d`` and tangent stiffness
@@ -19,15 +17,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
+from workbook.design.channel_set import ChannelState
 from workbook.design.expansion import SceneExpansion
 
-__all__ = ["ChannelSprings", "StateLoads", "Projection", "channel_state", "rest_matrices", "static_residual",
-           "channel_force", "normal_components",
-           "tangent_stiffness", "static_state", "projection", "NEWTON_TOLERANCE", "NEWTON_STEPS"]
+__all__ = ["ChannelSprings", "StateLoads", "Projection", "total", "rest_matrices", "static_residual",
+           "normal_components", "without_normal", "tangent_stiffness", "static_state", "projection",
+           "NEWTON_TOLERANCE", "NEWTON_STEPS"]
 
-#: Newton on the preload ends when the update is below this (relative to the state change).
+#: Newton on the preload ends when the error it leaves is below this (relative to the state change):
+#: when the last update is below its square root (quadratic convergence leaves an error of order its square).
 NEWTON_TOLERANCE = 1e-10
 #: Smallest state change the tolerance is relative to (m, rad, modal coordinates).
 STATE_SCALE = 1e-3
@@ -70,41 +69,26 @@ class StateLoads:
     force: np.ndarray
 
 
-def channel_state(expansion: SceneExpansion, dq: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Marker separation (m), its Jacobian and Hessian of every channel at the state change *dq*."""
-    q = expansion.reference + expansion.state + dq
-    return [geometry.separation(q) for geometry in expansion.channels.values()]
+def total(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
+    """The total coordinates (reference plus state) at the state change *dq*."""
+    return expansion.reference + expansion.state + dq
 
 
-def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, size: int, loads: StateLoads
+def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """M, K, D of the rest of the scene at the state change *dq*, full coordinates."""
-    mass, stiffness, damping = (np.zeros((size, size)) for _ in range(3))
-    for block in expansion.blocks:
-        local = dq[block.coordinates]
-        rows = np.ix_(block.coordinates, block.coordinates)
-        mass[rows] = block.mass + block.mass_slope @ local
-        stiffness[rows] = block.stiffness + block.stiffness_slope @ local
-        damping[rows] = block.damping + block.damping_slope @ local
+    mass, stiffness, damping = expansion.rest.matrices(dq)
     for indices, added in loads.modal_stiffness:
         stiffness[np.ix_(indices, indices)] += added
-    q = expansion.reference + expansion.state + dq
+    q = total(expansion, dq)
     for indices, added in loads.mass:
         mass[np.ix_(indices, indices)] += added(q[indices])
     return mass, stiffness, damping
 
 
-def channel_force(expansion: SceneExpansion, springs: ChannelSprings, states) -> np.ndarray:
-    """``sum_c J_c^T S_c d_c``: the channels' generalised force with the true position Jacobians, full coordinates."""
-    force = np.zeros(len(expansion.state))
-    for (separation, jacobian, _), geometry, stiffness in zip(states, expansion.channels.values(), springs.stiffness,
-                                                              strict=True):
-        force[geometry.coordinates] += jacobian.T @ (stiffness @ separation)
-    return force
-
-
-def normal_components(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarray) -> list[tuple]:
-    """Per Euler-parameter node: its coordinates, unit parameters and ``theta . force / |theta|``.
+def normal_components(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """Per Euler-parameter node: its unit parameters (E, 4) and ``theta . force / |theta|`` (E,).
 
     Exudyn applies a force to such a node through ``G^T``, which has no
     component along the parameters themselves; the true Jacobian of a
@@ -112,47 +96,43 @@ def normal_components(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarr
     force) and its derivative, ``-(theta . f) / |theta|^2`` on the tangent
     directions (added to the stiffness): the same linearisation as Exudyn's.
     """
-    q = expansion.reference + expansion.state + dq
-    parts = []
-    for indices in expansion.euler_blocks:
-        norm = np.linalg.norm(q[indices])
-        parts.append((indices, q[indices] / norm, float(q[indices] @ force[indices]) / norm))
-    return parts
+    theta = total(expansion, dq)[expansion.euler_blocks]
+    norm = np.linalg.norm(theta, axis=1)
+    return theta / norm[:, None], np.einsum("ei,ei->e", theta, force[expansion.euler_blocks]) / norm
+
+
+def without_normal(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarray) -> np.ndarray:
+    """*force* (N,) with its normal components on the Euler parameters removed (:func:`normal_components`)."""
+    unit, normal = normal_components(expansion, dq, force)
+    out = force.copy()
+    out[expansion.euler_blocks] -= normal[:, None] * unit
+    return out
 
 
 def static_residual(expansion: SceneExpansion, dq: np.ndarray, springs: ChannelSprings, base_force: np.ndarray,
-                    loads: StateLoads, states) -> np.ndarray:
+                    loads: StateLoads, state: ChannelState) -> np.ndarray:
     """Internal minus applied generalised force at the state change *dq*, full coordinates.
 
     *base_force* is the rest's internal force at the prepared state (minus the
     channels' there). The rest's force grows with its stiffness at the mid
     state (second order)."""
-    residual = base_force - loads.force
-    for block in expansion.blocks:
-        local = dq[block.coordinates]
-        residual[block.coordinates] += (block.stiffness + 0.5 * (block.stiffness_slope @ local)) @ local
-    q = expansion.reference + expansion.state + dq
+    residual = base_force - loads.force + expansion.rest.force_change(dq)
+    q = total(expansion, dq)
     for indices, added in loads.modal_stiffness:
         residual[indices] += added @ q[indices]
-    force = channel_force(expansion, springs, states)
-    for indices, unit, normal in normal_components(expansion, dq, force):
-        force[indices] -= normal * unit
-    return residual + force
+    return residual + without_normal(expansion, dq, expansion.channels.force(state, springs.stiffness))
 
 
 def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest_stiffness: np.ndarray,
-                      springs: ChannelSprings, states) -> np.ndarray:
+                      springs: ChannelSprings, state: ChannelState) -> np.ndarray:
     """The rest's stiffness plus every channel's ``J^T S J + (S d) . H``, full coordinates, with
     Exudyn's term of the normal force components (:func:`normal_components`)."""
-    stiffness = rest_stiffness.copy()
-    for indices, _, normal in normal_components(expansion, dq, channel_force(expansion, springs, states)):
-        stiffness[np.ix_(indices, indices)] -= normal / np.linalg.norm(
-            (expansion.reference + expansion.state + dq)[indices]) * np.eye(4)
-    for (separation, jacobian, hessian), geometry, spring in zip(states, expansion.channels.values(),
-                                                                 springs.stiffness, strict=True):
-        force = spring @ separation
-        rows = np.ix_(geometry.coordinates, geometry.coordinates)
-        stiffness[rows] += jacobian.T @ spring @ jacobian + np.tensordot(force, hessian, axes=1)
+    channels = expansion.channels
+    stiffness = rest_stiffness + channels.matrix(state, springs.stiffness, stiffness=springs.stiffness)
+    _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
+    theta = total(expansion, dq)[expansion.euler_blocks]
+    diagonal = expansion.euler_blocks
+    stiffness[diagonal, diagonal] -= (normal / np.linalg.norm(theta, axis=1))[:, None]
     return stiffness
 
 
@@ -162,46 +142,45 @@ class Projection:
 
     Attributes
     ----------
-    free : ndarray of int
-        Coordinates that are independent as they are.
-    euler : list of (ndarray of int, ndarray (4, 3))
-        Each Euler-parameter node's coordinates and its tangent basis.
-    size : int
-        Number of independent coordinates.
+    basis : ndarray, shape (N, n)
+        The free coordinates as they are, then each Euler-parameter node's
+        three tangent directions.
     """
 
-    free: np.ndarray
-    euler: list
-    size: int
+    basis: np.ndarray
+
+    @property
+    def size(self) -> int:
+        """n, the independent coordinates."""
+        return self.basis.shape[1]
 
     def columns(self, matrix: np.ndarray) -> np.ndarray:
-        """``matrix @ basis`` for a matrix with the full coordinates as columns."""
-        parts = [matrix[:, self.free]] + [matrix[:, indices] @ tangent for indices, tangent in self.euler]
-        return np.concatenate(parts, axis=1)
+        """``matrix @ basis``."""
+        return matrix @ self.basis
 
     def rows(self, matrix: np.ndarray) -> np.ndarray:
         """``basis.T @ matrix`` for a matrix (or vector) with the full coordinates as rows."""
-        parts = [matrix[self.free]] + [tangent.T @ matrix[indices] for indices, tangent in self.euler]
-        return np.concatenate(parts, axis=0)
+        return self.basis.T @ matrix
 
     def both(self, matrix: np.ndarray) -> np.ndarray:
         """``basis.T @ matrix @ basis``."""
-        return self.rows(self.columns(matrix))
-
-
-def _euler_tangent(theta: np.ndarray) -> np.ndarray:
-    """An orthonormal basis (4, 3) of the directions normal to *theta* (unit Euler parameters)."""
-    t0, t1, t2, t3 = theta
-    return np.array([[-t1, t0, t3, -t2], [-t2, -t3, t0, t1], [-t3, t2, -t1, t0]]).T
+        return self.basis.T @ matrix @ self.basis
 
 
 def projection(expansion: SceneExpansion, dq: np.ndarray) -> Projection:
     """The independent coordinates at the state change *dq*."""
-    q = expansion.reference + expansion.state + dq
-    constrained = np.concatenate(expansion.euler_blocks) if expansion.euler_blocks else np.zeros(0, dtype=int)
-    free = np.setdiff1d(np.arange(len(q)), constrained)
-    euler = [(indices, _euler_tangent(q[indices])) for indices in expansion.euler_blocks]
-    return Projection(free, euler, len(free) + 3 * len(euler))
+    q = total(expansion, dq)
+    euler = expansion.euler_blocks
+    free = expansion.free
+    basis = np.zeros((len(q), len(free) + 3 * len(euler)))
+    basis[free, np.arange(len(free))] = 1.0
+    t0, t1, t2, t3 = (q[euler] / np.linalg.norm(q[euler], axis=1)[:, None]).T
+    # an orthonormal basis (4, 3) of the directions normal to the unit parameters, per node
+    tangents = np.stack([np.stack([-t1, t0, t3, -t2], axis=1), np.stack([-t2, -t3, t0, t1], axis=1),
+                         np.stack([-t3, t2, -t1, t0], axis=1)], axis=2)
+    columns = len(free) + 3 * np.arange(len(euler))[:, None, None] + np.arange(3)[None, None, :]
+    basis[euler[:, :, None], columns] = tangents
+    return Projection(basis)
 
 
 def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force: np.ndarray, loads: StateLoads,
@@ -220,31 +199,17 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         The projected tangent stiffness is singular or Newton did not converge.
     """
     dq = start.copy()
-    size = len(dq)
     for step in range(1, NEWTON_STEPS + 1):
-        states = channel_state(expansion, dq)
-        _, rest_stiffness, _ = rest_matrices(expansion, dq, size, loads)
+        state = expansion.channels.state(total(expansion, dq))
+        _, rest_stiffness, _ = rest_matrices(expansion, dq, loads)
         basis = projection(expansion, dq)
-        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, springs, states))
-        residual = basis.rows(static_residual(expansion, dq, springs, base_force, loads, states))
-        update = sla.solve(stiffness, -residual, assume_a="sym", check_finite=False)
-        full_update = _expand(basis, update, size)
-        dq = dq + full_update
-        q = expansion.reference + expansion.state + dq
-        for indices in expansion.euler_blocks:
-            q[indices] /= np.linalg.norm(q[indices])
+        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, springs, state))
+        residual = basis.rows(static_residual(expansion, dq, springs, base_force, loads, state))
+        update = np.linalg.solve(stiffness, -residual)
+        full_update = basis.basis @ update
+        q = total(expansion, dq + full_update)
+        q[expansion.euler_blocks] /= np.linalg.norm(q[expansion.euler_blocks], axis=1)[:, None]
         dq = q - expansion.reference - expansion.state
-        if np.abs(full_update).max() <= NEWTON_TOLERANCE * max(np.abs(dq).max(), STATE_SCALE):
+        if np.abs(full_update).max() <= np.sqrt(NEWTON_TOLERANCE) * max(np.abs(dq).max(), STATE_SCALE):
             return dq, step
     raise np.linalg.LinAlgError(f"the preload did not converge in {NEWTON_STEPS} Newton steps")
-
-
-def _expand(basis: Projection, independent: np.ndarray, size: int) -> np.ndarray:
-    """``basis @ independent``: the full coordinates of an independent vector."""
-    full = np.zeros(size)
-    full[basis.free] = independent[:len(basis.free)]
-    column = len(basis.free)
-    for indices, tangent in basis.euler:
-        full[indices] += tangent @ independent[column:column + 3]
-        column += 3
-    return full

@@ -25,17 +25,19 @@ neglected terms are of the order of the squared rotations, about 1e-8.
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
+from workbook.design.channel_set import ChannelSet
 from workbook.design.kinematics import identify
 from workbook.errors import OutsideDesignModel, SimulationError
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
 from workbook.solve.modes import body_coordinates as _body_coordinates
 
-__all__ = ["ChannelGeometry", "BodyBlock", "SceneExpansion", "expand_scene"]
+__all__ = ["RestBlocks", "SceneExpansion", "expand_scene"]
 
 #: Coordinate step of the position derivatives (m, rad, Euler parameters,
 #: modal coordinates: all of order 1 or below).
@@ -45,50 +47,24 @@ MATRIX_STEP = 1e-5
 
 
 @dataclass(frozen=True)
-class ChannelGeometry:
-    """A force channel's two marker points; its separation is ``d = p_1 - p_0``.
+class RestBlocks:
+    """M, K and D of the rest of the scene, one block per body, with their slopes.
+
+    The blocks are stacked and padded with the spare coordinate N (zero
+    entries), so that every block is evaluated at once.
 
     Attributes
     ----------
-    name : str
-    coordinates : ndarray of int, shape (m,)
-        Full ODE2 coordinates of its two markers' bodies.
-    points : tuple of PointKinematics
-        Marker 0 and marker 1.
-    """
-
-    name: str
-    coordinates: np.ndarray
-    points: tuple
-
-    def separation(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """d (m), its Jacobian (3, m) and Hessian (3, m, m) at the total coordinates *q* (full)."""
-        m = len(self.coordinates)
-        separation = np.zeros(3)
-        jacobian = np.zeros((3, m))
-        hessian = np.zeros((3, m, m))
-        for sign, point in zip((-1.0, 1.0), self.points, strict=True):
-            p, j, h = point.expand(q[point.coordinates])
-            at = np.searchsorted(self.coordinates, point.coordinates)
-            separation += sign * p
-            jacobian[:, at] += sign * j
-            hessian[np.ix_(range(3), at, at)] += sign * h
-        return separation, jacobian, hessian
-
-
-@dataclass(frozen=True)
-class BodyBlock:
-    """M, K and D of one body of the rest of the scene, with their slopes.
-
-    Attributes
-    ----------
-    coordinates : ndarray of int, shape (m,)
-    mass, stiffness, damping : ndarray, shape (m, m)
+    size : int
+        N, the full coordinates.
+    coordinates : ndarray of int, shape (B, b)
+    mass, stiffness, damping : ndarray, shape (B, b, b)
         At the prepared state.
-    mass_slope, stiffness_slope, damping_slope : ndarray, shape (m, m, m)
-        ``[:, :, j]`` is the derivative with respect to coordinate j.
+    mass_slope, stiffness_slope, damping_slope : ndarray, shape (B, b, b, b)
+        ``[..., j]`` is the derivative with respect to the block's coordinate j.
     """
 
+    size: int
     coordinates: np.ndarray
     mass: np.ndarray
     stiffness: np.ndarray
@@ -96,6 +72,28 @@ class BodyBlock:
     mass_slope: np.ndarray
     stiffness_slope: np.ndarray
     damping_slope: np.ndarray
+
+    def _local(self, dq: np.ndarray) -> np.ndarray:
+        return np.append(dq, 0.0)[self.coordinates]
+
+    def matrices(self, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """M, K, D (N, N) at the state change *dq* (first order in it)."""
+        local = self._local(dq)
+        rows, columns = self.coordinates[:, :, None], self.coordinates[:, None, :]
+        out = []
+        for matrix, slope in ((self.mass, self.mass_slope), (self.stiffness, self.stiffness_slope),
+                              (self.damping, self.damping_slope)):
+            full = np.zeros((self.size + 1, self.size + 1))
+            full[rows, columns] = matrix + np.einsum("bijk,bk->bij", slope, local)
+            out.append(full[:self.size, :self.size])
+        return out[0], out[1], out[2]
+
+    def force_change(self, dq: np.ndarray) -> np.ndarray:
+        """The change of the rest's internal force over *dq* (N,): its stiffness at the mid state times *dq*."""
+        local = self._local(dq)
+        stiffness = self.stiffness + 0.5 * np.einsum("bijk,bk->bij", self.stiffness_slope, local)
+        change = np.einsum("bij,bj->bi", stiffness, local)
+        return np.bincount(self.coordinates.ravel(), change.ravel(), self.size + 1)[:self.size]
 
 
 @dataclass(frozen=True)
@@ -109,11 +107,13 @@ class SceneExpansion:
         coordinates: relative to the reference ones).
     reference : ndarray, shape (N,)
         Exudyn's reference coordinates; a node's configuration is their sum.
-    channels : dict of str to ChannelGeometry
+    channel_names : list of str
         Every force channel, in the scene's order.
-    blocks : list of BodyBlock
-        The rest of the scene, one block per body.
-    euler_blocks : list of ndarray of int, shape (4,)
+    channels : ChannelSet
+        Their marker points.
+    rest : RestBlocks
+        The rest of the scene.
+    euler_blocks : ndarray of int, shape (E, 4)
         Coordinates of each Euler-parameter node (one constraint each).
     points : dict of tuple to PointKinematics
         The engine's excitation points by their rounded coordinates.
@@ -121,10 +121,16 @@ class SceneExpansion:
 
     state: np.ndarray
     reference: np.ndarray
-    channels: dict
-    blocks: list
-    euler_blocks: list
+    channel_names: list
+    channels: ChannelSet
+    rest: RestBlocks
+    euler_blocks: np.ndarray
     points: dict
+
+    @functools.cached_property
+    def free(self) -> np.ndarray:
+        """The coordinates that are not Euler parameters (independent as they are)."""
+        return np.setdiff1d(np.arange(len(self.state)), self.euler_blocks.ravel())
 
 
 def _marker_coordinates(mbs, marker: int) -> np.ndarray:
@@ -223,15 +229,26 @@ def _channels_released(scene: Scene):
     return restore
 
 
-def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> list[BodyBlock]:
+def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
+    size = len(base)
+    blocks = list(_body_coordinates(scene).values())
+    width = max(len(block) for block in blocks)
+    coordinates = np.full((len(blocks), width), size, dtype=int)
+    for k, block in enumerate(blocks):
+        coordinates[k, :len(block)] = block
+    rows, columns = coordinates[:, :, None], coordinates[:, None, :]
+
+    def padded(matrix: np.ndarray) -> np.ndarray:
+        full = np.zeros((size + 1, size + 1))
+        full[:size, :size] = matrix
+        return full[rows, columns]
+
     restore = _channels_released(scene)
     try:
         set_state(base)
-        mass, stiffness, damping = _rest_matrices(scene.mbs)
-        blocks = list(_body_coordinates(scene).values())
-        largest = max(len(block) for block in blocks)
-        slopes = [[np.zeros((len(b), len(b), len(b))) for b in blocks] for _ in range(3)]
-        for i in range(largest):
+        matrices = [padded(m) for m in _rest_matrices(scene.mbs)]
+        slopes = [np.zeros((len(blocks), width, width, width)) for _ in range(3)]
+        for i in range(width):
             shifted = []
             for sign in (1.0, -1.0):
                 state = base.copy()
@@ -239,26 +256,21 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> list[BodyBlock]:
                     if i < len(block):
                         state[block[i]] += sign * MATRIX_STEP
                 set_state(state)
-                shifted.append(_rest_matrices(scene.mbs))
-            for k, block in enumerate(blocks):
-                if i < len(block):
-                    rows = np.ix_(block, block)
-                    for m in range(3):
-                        slopes[m][k][:, :, i] = (shifted[0][m][rows] - shifted[1][m][rows]) / (2 * MATRIX_STEP)
+                shifted.append([padded(m) for m in _rest_matrices(scene.mbs)])
+            for m in range(3):
+                slopes[m][:, :, :, i] = (shifted[0][m] - shifted[1][m]) / (2 * MATRIX_STEP)
     finally:
         set_state(base)
         restore()
-    return [BodyBlock(block, mass[np.ix_(block, block)], stiffness[np.ix_(block, block)],
-                      damping[np.ix_(block, block)], slopes[0][k], slopes[1][k], slopes[2][k])
-            for k, block in enumerate(blocks)]
+    return RestBlocks(size, coordinates, *matrices, *slopes)
 
 
-def _euler_blocks(scene: Scene) -> list[np.ndarray]:
+def _euler_blocks(scene: Scene) -> np.ndarray:
     import exudyn as exu
 
     mbs = scene.mbs
     if mbs.systemData.AEsize() == 0:
-        return []
+        return np.zeros((0, 4), dtype=int)
     settings = exu.SimulationSettings()
     settings.solution.file.write = False
     with solver_output():
@@ -271,7 +283,7 @@ def _euler_blocks(scene: Scene) -> list[np.ndarray]:
             raise SimulationError(f"scene of {scene.case.name!r}: a constraint other than an Euler-parameter "
                                   "normalisation; the design evaluation does not know it")
         blocks.append(support)
-    return blocks
+    return np.array(blocks, dtype=int).reshape(-1, 4)
 
 
 def expand_scene(scene: Scene, points: list) -> SceneExpansion:
@@ -323,11 +335,9 @@ def expand_scene(scene: Scene, points: list) -> SceneExpansion:
                       zip(marker_coordinates + [engine_coordinates] * len(points), expanded, strict=True)]
     except ValueError as error:
         raise OutsideDesignModel(scene.case.name, f"a marker it does not know ({error})") from None
-    channels = {}
-    for k, (name, _) in enumerate(channel_markers):
-        pair = (kinematics[2 * k], kinematics[2 * k + 1])
-        channels[name] = ChannelGeometry(name, np.union1d(pair[0].coordinates, pair[1].coordinates), pair)
+    pairs = [(kinematics[2 * k], kinematics[2 * k + 1]) for k in range(len(channel_markers))]
     offset = 2 * len(channel_markers)
     point_geometry = {tuple(np.round(np.asarray(p, dtype=float), 12)): kinematics[offset + k]
                       for k, p in enumerate(points)}
-    return SceneExpansion(base, reference, channels, _rest_blocks(scene, set_state, base), _euler_blocks(scene), point_geometry)
+    return SceneExpansion(base, reference, [name for name, _ in channel_markers], ChannelSet.of(pairs, len(base)),
+                          _rest_blocks(scene, set_state, base), _euler_blocks(scene), point_geometry)

@@ -29,44 +29,51 @@ from workbook.design.assembly import (
     ChannelSprings,
     Projection,
     StateLoads,
-    channel_force,
-    channel_state,
-    normal_components,
     projection,
     rest_matrices,
     static_state,
     tangent_stiffness,
+    total,
+    without_normal,
 )
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, UnstablePreloadError
 from workbook.model.case import Case, Engine, Gravity, Simultaneous, SingleFrequencyExcitation, Sweep
-from workbook.scene.bearing import hinge_matrix
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.harmonic import point_phasors
 from workbook.solve.stages import link_warnings
 
-__all__ = ["LinearMount", "DesignAnswer", "channel_springs"]
+__all__ = ["LinearMount", "DesignAnswer", "channel_frames", "channel_springs"]
 
 
-def channel_springs(case: Case, channels: list[str]) -> ChannelSprings:
-    """The springs of the force channels *channels* (hinges, then transducers) of *case*."""
+def channel_frames(case: Case, channels: list[str]) -> np.ndarray:
+    """Each force channel's directions as rows (C, 3, 3): a hinge's frame, a transducer's global axes."""
+    from workbook.scene.bearing import hinge_frame
+
+    by_name = {hinge.name: hinge for hinge in case.hinges}
+    return np.array([hinge_frame(case, by_name[name]) if name in by_name else np.eye(3) for name in channels])
+
+
+def channel_springs(case: Case, channels: list[str], frames: np.ndarray) -> ChannelSprings:
+    """The springs of the force channels *channels* (hinges, then transducers) of *case*, in their
+    *frames* (:func:`channel_frames`)."""
     hinge_loss, _ = loss_factors(case)
     by_name = {hinge.name: hinge for hinge in case.hinges}
-    stiffness, damping, structural = (np.zeros((len(channels), 3, 3)) for _ in range(3))
+    values = np.zeros((3, len(channels), 3))        # stiffness, damping, loss factor per direction
     for k, name in enumerate(channels):
         hinge = by_name.get(name)
         if hinge is None:
             rig = case.test_rig
             assert rig is not None
-            stiffness[k] = np.diag(rig.stiffness)
-            damping[k] = np.diag(rig.damping)
+            values[0, k], values[1, k] = rig.stiffness, rig.damping
             continue
-        stiffness[k] = hinge_matrix(case, hinge, "stiffness")
+        values[0, k] = hinge.values("stiffness")
         if case.effects.hinge_damping:
-            damping[k] = hinge_matrix(case, hinge, "damping")
+            values[1, k] = hinge.values("damping")
         if name in hinge_loss:
-            structural[k] = hinge_matrix(case, hinge, "loss_factor") @ stiffness[k]
-    return ChannelSprings(stiffness, damping, structural)
+            values[2, k] = hinge.values("loss_factor")
+    stiffness, damping, loss = np.einsum("cia,xci,cib->xcab", frames, values, frames)
+    return ChannelSprings(stiffness, damping, loss @ stiffness)
 
 
 @dataclass(frozen=True)
@@ -80,6 +87,7 @@ class _FlexibleLink:
     stiffness_damping: float           # Rayleigh beta, s
     loss_factor: float
     reduced_stiffness: np.ndarray      # K_r of the prepared scene (stiffened there or not)
+    unloaded_hz: float                 # first pinned-pinned frequency without tension
     stiffening: object = field(repr=False)   # flexbodies LinkStiffening
 
 
@@ -132,7 +140,8 @@ def _normalised(case: Case, base: Case) -> Case:
     rig = case.test_rig
     if rig is not None and base.test_rig is not None:
         rig = dataclasses.replace(rig, stiffness=base.test_rig.stiffness, damping=base.test_rig.damping)
-    return dataclasses.replace(case, hinges=hinges, engine=engine, test_rig=rig, excitations=base.excitations)
+    return dataclasses.replace(case, name=base.name, hinges=hinges, engine=engine, test_rig=rig,
+                               excitations=base.excitations)
 
 
 class LinearMount:
@@ -146,6 +155,7 @@ class LinearMount:
         self.case = case
         self.items = items
         self.channels = channels
+        self.frames = channel_frames(case, channels)
         self.pylon = pylon
         self._cards = cards
         self._preloads = preloads
@@ -211,6 +221,14 @@ class LinearMount:
                                                  f"case has no excitation at ({point})")
         _check_mode_decisions(case, base)
 
+    def follows(self, case: Case) -> bool:
+        """Whether :meth:`evaluate` answers *case* (:meth:`check` passes)."""
+        try:
+            self.check(case)
+        except OutsideDesignModel:
+            return False
+        return True
+
     def evaluate(self, case: Case) -> DesignAnswer:
         """Answer the design *case* (the prepared case with other springs, masses or excitations).
 
@@ -224,7 +242,7 @@ class LinearMount:
         """
         start = time.perf_counter()
         self.check(case)
-        springs = channel_springs(case, self.channels)
+        springs = channel_springs(case, self.channels, self.frames)
         runs, static = [], {}
         for item in case.excitations:
             prepared = self.items[item.name]
@@ -264,17 +282,15 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
     expansion = expand_scene(scene, points)
     size = len(expansion.state)
     forces = scene.hinge_forces()
-    base_springs = channel_springs(case, channels)
-    states = channel_state(expansion, np.zeros(size))
-    own = np.array([base_springs.stiffness[k] @ states[k][0] for k in range(len(channels))])
+    base_springs = channel_springs(case, channels, channel_frames(case, channels))
+    state = expansion.channels.state(total(expansion, np.zeros(size)))
+    own = np.einsum("cab,cb->ca", base_springs.stiffness, state.separation)
     exudyn = np.array([forces[name] for name in channels])
     scale = max(np.abs(exudyn).max(), 1e-300)
     sign = 1.0 if np.abs(own - exudyn).max() <= np.abs(own + exudyn).max() else -1.0
     if np.abs(sign * own - exudyn).max() > 1e-6 * scale:
         raise OutsideDesignModel(case.name, "a force channel whose force is not its spring's (a user law)")
-    base_force = -channel_force(expansion, base_springs, states)
-    for indices, unit, normal in normal_components(expansion, np.zeros(size), -base_force):
-        base_force[indices] += normal * unit
+    base_force = -without_normal(expansion, np.zeros(size), expansion.channels.force(state, base_springs.stiffness))
     names = [link.name for link in case.links]
     compression = np.zeros((len(names), len(channels), 3))
     hinge_names = [hinge.name for hinge in case.hinges]
@@ -297,7 +313,8 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
                 link.name, np.arange(start_index, start_index + reduced_stiffness.shape[0]),
                 stiffening.project(reduced.mode_basis), float(reduced.info.get("axial_tension_N", 0.0)),
                 link.stiffness_damping if case.effects.link_damping else 0.0,
-                loss_factors(case)[1].get(link.name, 0.0), reduced_stiffness, stiffening))
+                loss_factors(case)[1].get(link.name, 0.0), reduced_stiffness,
+                float(stiffening.pinned_hz(0.0, 1)[0]), stiffening))
             if link.modal_damping > 0 and case.effects.link_damping:
                 raise OutsideDesignModel(case.name, f"link {link.name!r}: modal damping on a stiffened link")
     engine = np.arange(scene.mbs.GetNodeODE2Index(scene.engine.node), scene.mbs.GetNodeODE2Index(scene.engine.node) + 6)
@@ -349,8 +366,8 @@ def _state_loads(case: Case, prepared: _Item, tensions: dict) -> StateLoads:
 
 
 def _channel_forces(prepared: _Item, springs: ChannelSprings, dq: np.ndarray) -> np.ndarray:
-    states = channel_state(prepared.expansion, dq)
-    return prepared.sign * np.array([s @ sep for s, (sep, _, _) in zip(springs.stiffness, states, strict=True)])
+    separation = prepared.expansion.channels.state(total(prepared.expansion, dq)).separation
+    return prepared.sign * np.einsum("cab,cb->ca", springs.stiffness, separation)
 
 
 def _solve_state(case: Case, prepared: _Item, springs: ChannelSprings) -> _State:
@@ -374,7 +391,7 @@ def _solve_state(case: Case, prepared: _Item, springs: ChannelSprings) -> _State
         chosen = []
         for link in prepared.links:
             tension = -compression[link.name]
-            unloaded = float(link.stiffening.pinned_hz(0.0, 1)[0])
+            unloaded = link.unloaded_hz
             if -tension >= link.stiffening.buckling_load:
                 raise BucklingError(case.name, link.name, -tension, link.stiffening.buckling_load, unloaded)
             shift = abs(float(link.stiffening.pinned_hz(tension, 1)[0]) / unloaded - 1.0)
@@ -407,18 +424,15 @@ class _Harmonic:
 
 
 def _harmonic(case: Case, prepared: _Item, springs: ChannelSprings, state: _State) -> _Harmonic:
-    expansion, size, dq = prepared.expansion, prepared.size, state.dq
-    states = channel_state(expansion, dq)
-    mass, rest_stiffness, damping = rest_matrices(expansion, dq, size, state.loads)
-    stiffness = tangent_stiffness(expansion, dq, rest_stiffness, springs, states)
-    structural = np.zeros((size, size))
-    outputs = [np.zeros((3 * len(states), size)) for _ in range(3)]
-    for k, ((_, jacobian, _), geometry) in enumerate(zip(states, expansion.channels.values(), strict=True)):
-        rows = np.ix_(geometry.coordinates, geometry.coordinates)
-        damping[rows] += jacobian.T @ springs.damping[k] @ jacobian
-        structural[rows] += prepared.sign * jacobian.T @ springs.structural[k] @ jacobian
-        for output, spring in zip(outputs, (springs.stiffness, springs.damping, springs.structural), strict=True):
-            output[3 * k:3 * k + 3, geometry.coordinates] = prepared.sign * spring[k] @ jacobian
+    expansion, dq = prepared.expansion, state.dq
+    channels = expansion.channels
+    at = channels.state(total(expansion, dq))
+    mass, rest_stiffness, damping = rest_matrices(expansion, dq, state.loads)
+    stiffness = tangent_stiffness(expansion, dq, rest_stiffness, springs, at)
+    damping += channels.matrix(at, springs.damping)
+    structural = prepared.sign * channels.matrix(at, springs.structural)
+    outputs = [prepared.sign * channels.outputs(at, spring)
+               for spring in (springs.stiffness, springs.damping, springs.structural)]
     for link in prepared.links:
         added = (state.tensions.get(link.name, 0.0) - link.base_tension) * link.geometric
         block = np.ix_(link.modal, link.modal)
@@ -426,10 +440,10 @@ def _harmonic(case: Case, prepared: _Item, springs: ChannelSprings, state: _Stat
         structural[block] += link.loss_factor * (link.reduced_stiffness + added)
     basis = projection(expansion, dq)
     inputs = {}
-    q = expansion.reference + expansion.state + dq
+    q = total(expansion, dq)
     for key, point in expansion.points.items():
         _, jacobian, _ = point.expand(q[point.coordinates])
-        full = np.zeros((size, 3))
+        full = np.zeros((prepared.size, 3))
         full[point.coordinates] = jacobian.T
         inputs[key] = basis.rows(full)
     return _Harmonic(basis.both(mass), basis.both(stiffness), basis.both(damping), basis.both(structural),

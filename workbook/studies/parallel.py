@@ -32,6 +32,7 @@ written as rows finish), so an interrupt loses only the rows in flight.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import itertools
 import logging
 import multiprocessing
@@ -43,14 +44,18 @@ import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 from workbook.answers.isolation import efficiency
-from workbook.errors import Terminated, interruption
+from workbook.errors import OutsideDesignModel, Terminated, interruption
 from workbook.model.case import DIRECTIONS, Case
 from workbook.processes import end_with_parent, stop_workers
 
-__all__ = ["RowOutcome", "prepare", "run_row", "run_rows", "SERIAL", "ROWS_PER_WORKER"]
+if TYPE_CHECKING:
+    from workbook.design.linear_mount import LinearMount
+
+__all__ = ["RowOutcome", "prepare", "prepare_design_model", "run_row", "run_rows", "SERIAL", "ROWS_PER_WORKER",
+           "NUMPY_PATH", "EXUDYN_PATH"]
 
 log = logging.getLogger(__name__)
 
@@ -60,6 +65,16 @@ SERIAL = 1
 #: pool, which bounds the memory a run might still leave behind (measured in
 #: docs/reliability.md, "Memory over many runs").
 ROWS_PER_WORKER = 200
+#: Rows per worker in one chunk when the study has a prepared linear mount: its NumPy rows gather no
+#: memory (the bound is for Exudyn's runs), and each fresh pool costs seconds of start-up.
+DESIGN_ROWS_PER_WORKER = 5000
+#: The row was answered by the prepared linear mount in NumPy.
+NUMPY_PATH = "NumPy"
+#: The row was answered by the Exudyn pipeline.
+EXUDYN_PATH = "Exudyn"
+
+#: The linear mount prepared for the study's base case, in this process (None: every row through Exudyn).
+_design_model: LinearMount | None = None
 
 
 @dataclass
@@ -79,6 +94,10 @@ class RowOutcome:
         ``"<ErrorType>: message"`` of a failed row, else "".
     wall_time : float
         s.
+    path : str
+        How the row was answered: :data:`NUMPY_PATH` (the prepared linear
+        mount, :class:`workbook.LinearMount`) or :data:`EXUDYN_PATH`
+        (:func:`workbook.run_case`); "" for a row that did not run.
     """
 
     index: int
@@ -86,6 +105,7 @@ class RowOutcome:
     status: str = "ok"
     error: str = ""
     wall_time: float = 0.0
+    path: str = ""
 
 
 def _failed(index: int, error: BaseException, wall_time: float = 0.0) -> RowOutcome:
@@ -132,8 +152,33 @@ def prepare(cases: dict[int, Case | BaseException]) -> dict[int, Case | RowOutco
     return prepared
 
 
+def prepare_design_model(base: Case):
+    """The linear mount of a study's *base* case, or the reason it has none.
+
+    Returns
+    -------
+    LinearMount or str
+        The prepared mount, or the plain-words reason (a time-domain case,
+        a flexible pylon...) why every row goes through Exudyn.
+    """
+    from threadpoolctl import threadpool_limits
+
+    from workbook.design.linear_mount import LinearMount
+    from workbook.errors import SimulationError
+
+    try:
+        with threadpool_limits(limits=1):
+            return LinearMount.prepare(base)
+    except SimulationError as error:     # OutsideDesignModel, or the base case itself does not solve
+        return str(error)
+
+
 def run_row(index: int, case: Case) -> RowOutcome:
     """Run every excitation of one row's case; never raises but for an interrupt.
+
+    A row the study's prepared linear mount follows (its springs, engine
+    mass properties or excitation amplitudes changed) is answered by it in
+    NumPy, any other by :func:`workbook.run_case`.
 
     Parameters
     ----------
@@ -155,14 +200,22 @@ def run_row(index: int, case: Case) -> RowOutcome:
     from workbook.solve.pipeline import run_case
 
     start = time.perf_counter()
+    path = EXUDYN_PATH
     try:
         with threadpool_limits(limits=1):
-            result = run_case(case)
+            result = None
+            if _design_model is not None:
+                try:
+                    result, path = _design_model.evaluate(case).result, NUMPY_PATH
+                except OutsideDesignModel:      # a change the prepared mount does not follow
+                    pass
+            if result is None:
+                result = run_case(case)
     except Exception as error:
         interrupt = interruption(error)
         if interrupt is not None:
             raise interrupt from None
-        return _failed(index, error, time.perf_counter() - start)
+        return dataclasses.replace(_failed(index, error, time.perf_counter() - start), path=path)
     runs = []
     for run in result.runs:
         t = run.transmissibility
@@ -170,14 +223,14 @@ def run_row(index: int, case: Case) -> RowOutcome:
                      **{f"T {d}": float(v) for d, v in zip(DIRECTIONS, t, strict=True)},
                      **{f"eta % {d}": float(v) for d, v in zip(DIRECTIONS, efficiency(t), strict=True)},
                      "steady": run.steady})
-    return RowOutcome(index, runs, wall_time=time.perf_counter() - start)
+    return RowOutcome(index, runs, wall_time=time.perf_counter() - start, path=path)
 
 
 def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: str | None = None,
              progress: Callable[[int, int], None] | None = None,
              finished: dict[int, RowOutcome] | None = None,
              record: Callable[[RowOutcome], None] | None = None,
-             rows_per_worker: int = ROWS_PER_WORKER) -> list[RowOutcome]:
+             rows_per_worker: int = ROWS_PER_WORKER, design_model: LinearMount | None = None) -> list[RowOutcome]:
     """Run the rows' cases and return their outcomes in row order.
 
     Parameters
@@ -196,6 +249,10 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         ``record(outcome)`` as soon as each row finishes, in finishing order.
     rows_per_worker : int
         Local processes: rows per worker in one chunk of rows (a fresh pool each chunk).
+    design_model : LinearMount, optional
+        The base case's prepared linear mount (:func:`prepare_design_model`):
+        the rows it follows are answered by it, here and in local processes
+        (a Dask cluster runs every row through Exudyn).
 
     Returns
     -------
@@ -227,15 +284,27 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
     if dask is not None:
         _run_dask(pending, dask, done)
     elif workers <= SERIAL or len(pending) <= 1:
-        with _signals_seen() as seen:
+        with _signals_seen() as seen, _using(design_model):
             for index, case in pending.items():
                 outcome = run_row(index, case)
                 if seen:        # a signal a library swallowed during the row: its outcome is dropped, --resume reruns it
                     raise Terminated() if signal.SIGTERM in seen else KeyboardInterrupt()
                 done(outcome)
     else:
-        _run_processes(pending, workers, done, rows_per_worker)
+        chunk = rows_per_worker if design_model is None else max(rows_per_worker, DESIGN_ROWS_PER_WORKER)
+        _run_processes(pending, workers, done, chunk, design_model)
     return [outcomes[i] for i in range(total)]
+
+
+@contextlib.contextmanager
+def _using(design_model: LinearMount | None):
+    """Answer the rows of this process with *design_model* where it follows them."""
+    global _design_model
+    previous, _design_model = _design_model, design_model
+    try:
+        yield
+    finally:
+        _design_model = previous
 
 
 @contextlib.contextmanager
@@ -274,12 +343,13 @@ def _signals_seen():
 _started = None
 
 
-def _worker_init(started) -> None:
+def _worker_init(started, design_model: LinearMount | None) -> None:
     """Set up a worker: Ctrl-C is the parent's to handle (it stops the workers),
-    and the worker ends when its parent is gone (killed with no chance to stop it)."""
-    global _started
+    the worker ends when its parent is gone (killed with no chance to stop it),
+    and it answers the rows *design_model* follows with it."""
+    global _started, _design_model
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _started = started
+    _started, _design_model = started, design_model
     end_with_parent()
 
 
@@ -301,7 +371,8 @@ def _death(exitcode: int | None) -> str:
     return f"exited with code {exitcode}"
 
 
-def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[dict, dict, dict]:
+def _pool_round(pending: dict, workers: int, done: Callable, context, design_model: LinearMount | None
+                ) -> tuple[dict, dict, dict]:
     """Run *pending* in a fresh pool until every row is done or the pool breaks.
 
     Returns
@@ -316,7 +387,7 @@ def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[d
     started = context.SimpleQueue()
     before = set(multiprocessing.active_children())
     pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
-                               initializer=_worker_init, initargs=(started,))
+                               initializer=_worker_init, initargs=(started, design_model))
     processes = set()
     broken = {}
     try:
@@ -344,7 +415,8 @@ def _pool_round(pending: dict, workers: int, done: Callable, context) -> tuple[d
     return lost, {i: case for i, case in broken.items() if i not in pids}, deaths
 
 
-def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker: int) -> None:
+def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker: int,
+                   design_model: LinearMount | None) -> None:
     if rows_per_worker < 1:
         raise ValueError(f"rows_per_worker must be at least 1, got {rows_per_worker}")
     context = multiprocessing.get_context("spawn")
@@ -352,14 +424,14 @@ def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker:
     while pending:
         chunk = dict(itertools.islice(pending.items(), workers * rows_per_worker))
         later = {i: case for i, case in pending.items() if i not in chunk}
-        lost, unstarted, _ = _pool_round(chunk, workers, done, context)
+        lost, unstarted, _ = _pool_round(chunk, workers, done, context, design_model)
         pending = {**unstarted, **later}
         if lost:
             log.warning("a worker process died; rows %s, which were running, are retried one at a time",
                         ", ".join(map(str, sorted(lost))))
         suspects.update(lost)
     for index, case in suspects.items():  # alone, so that a death now is the row's own
-        lost, unstarted, deaths = _pool_round({index: case}, 1, done, context)
+        lost, unstarted, deaths = _pool_round({index: case}, 1, done, context, design_model)
         if index in lost or index in unstarted:
             how = deaths.get(index, "ended before it started the row")
             done(RowOutcome(index, [], "failed", f"WorkerDied: the worker process running this row {how}, "

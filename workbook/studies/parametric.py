@@ -11,6 +11,7 @@ name               unit   what it sets
 =================  =====  ====================================================
 hinge_stiffness    N/m    translational stiffness of every hinge
 hinge_damping      N s/m  translational damping of every hinge
+hinge_loss_factor  -      structural loss factor of every hinge
 clearance          m      radial clearance of every hinge
 section_scale      -      factor on the cross-section of every link (shank width
                           and thickness, eye thickness)
@@ -117,6 +118,8 @@ PARAMETERS = {p.name: p for p in (
               lambda case, v: _hinges(case, stiffness=float(v))),
     Parameter("hinge_damping", "N*s/m", "translational damping of every hinge",
               lambda case, v: _hinges(case, damping=float(v))),
+    Parameter("hinge_loss_factor", "-", "structural loss factor of every hinge",
+              lambda case, v: _hinges(case, loss_factor=float(v))),
     Parameter("clearance", "m", "radial clearance of every hinge",
               lambda case, v: _hinges(case, radial_clearance=float(v))),
     Parameter("section_scale", "-", "factor on the cross-section of every link (shank width and thickness, "

@@ -39,6 +39,9 @@ TABLE_FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
 #: after every row, a long study's growing table would cost more than its rows
 #: (docs/reliability.md, ``benchmarks/bench_study_table.py``).
 WRITE_INTERVAL = 2.0
+#: Columns of a row's wall time, how it was answered (:data:`workbook.studies.parallel.NUMPY_PATH` or
+#: ``EXUDYN_PATH``), its status and error.
+TAIL = ("wall time s", "path", "status", "error")
 #: Columns of a run's answers.
 ANSWERS = ("run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS), *(f"eta % {d}" for d in DIRECTIONS), "steady")
 
@@ -62,11 +65,12 @@ def study_frame(rows: tuple, outcomes: list):
     records = []
     for outcome in outcomes:
         common = {"row": outcome.index, **rows[outcome.index]}
-        tail = {"wall time s": outcome.wall_time, "status": outcome.status, "error": outcome.error}
+        tail = {"wall time s": outcome.wall_time, "path": outcome.path, "status": outcome.status,
+                "error": outcome.error}
         for run in outcome.runs or [{}]:
             records.append({**common, **run, **tail})
     names = list(rows[0]) if rows else []
-    columns = ["row", *names, *ANSWERS, "wall time s", "status", "error"]
+    columns = ["row", *names, *ANSWERS, *TAIL]
     # every column, also when every row failed
     return pd.DataFrame.from_records(records, columns=columns)
 
@@ -219,7 +223,10 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
     except (ValueError, OSError, ImportError) as error:
         raise UsageError(f"{path}: cannot resume from it, it is not a readable study table ({error})") from None
     names = list(rows[0]) if rows else []
-    expected = ["row", *names, *ANSWERS, "wall time s", "status", "error"]
+    expected = ["row", *names, *ANSWERS, *TAIL]
+    if list(frame.columns) == [name for name in expected if name != "path"]:
+        frame = frame.assign(path="")                # a table written before the path column
+        frame = frame[expected]
     if list(frame.columns) != expected:
         raise UsageError(f"{path}: cannot resume from it: its columns are {', '.join(map(str, frame.columns))}; "
                          f"this study's are {', '.join(expected)}")
@@ -242,7 +249,8 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
              **{f"eta % {d}": float(r[f"eta % {d}"]) for d in DIRECTIONS},
              "steady": str(r["steady"]).lower() == "true"} for _, r in table.iterrows()]
         message = "" if pd.isna(first["error"]) else str(first["error"])
-        finished[index] = RowOutcome(index, runs, status, message, float(first["wall time s"]))
+        path_taken = "" if pd.isna(first["path"]) else str(first["path"])
+        finished[index] = RowOutcome(index, runs, status, message, float(first["wall time s"]), path_taken)
     return finished
 
 

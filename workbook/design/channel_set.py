@@ -1,0 +1,208 @@
+"""Every force channel's marker kinematics at once, and the channels' force, stiffness and outputs.
+
+The batched form of :class:`~workbook.design.expansion.ChannelGeometry`:
+the two marker points of every channel are evaluated together, kind by
+kind (:mod:`workbook.design.kinematics`), on coordinates padded to one
+length with a spare coordinate (index N, always zero) that collects the
+padding. A channel with stiffness S (3x3) adds ``J^T S d`` to the
+generalised force, ``J^T S J + (S d) . H`` to the tangent stiffness and
+``S J`` to its force output; the sums over channels are scattered into the
+full coordinates by one ``bincount`` each.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from workbook.design.kinematics import EULER, PointKinematics
+
+__all__ = ["ChannelSet", "ChannelState"]
+
+_SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
+
+
+@dataclass(frozen=True)
+class ChannelState:
+    """The channels at one state.
+
+    Attributes
+    ----------
+    separation : ndarray, shape (C, 3)
+        d of every channel, m.
+    jacobian : ndarray, shape (2 C, 3, M)
+        Each marker's position Jacobian on its padded coordinates.
+    hessian : ndarray, shape (2 C, 3, M, M)
+    """
+
+    separation: np.ndarray
+    jacobian: np.ndarray
+    hessian: np.ndarray
+
+
+@dataclass(frozen=True)
+class ChannelSet:
+    """The marker points of C channels, marker 0 and 1 of channel c at rows 2c and 2c + 1.
+
+    Attributes
+    ----------
+    size : int
+        N, the full coordinates.
+    coordinates : ndarray of int, shape (2 C, M)
+        Each point's coordinates (position, rotation, modal), padded with N.
+    local : ndarray, shape (2 C, 3)
+    modal : ndarray, shape (2 C, 3, K)
+        Modal rows, padded with zero columns.
+    kinds : dict of str to ndarray of int
+        The points of each kind (``"ground"``, ``"none"``, ``"euler"``, ``"rxyz"``).
+    """
+
+    size: int
+    coordinates: np.ndarray
+    local: np.ndarray
+    modal: np.ndarray
+    kinds: dict
+
+    @classmethod
+    def of(cls, pairs: list[tuple[PointKinematics, PointKinematics]], size: int) -> "ChannelSet":
+        """The set of the channels whose marker points are *pairs*, on *size* full coordinates."""
+        points = [point for pair in pairs for point in pair]
+        modes = max((p.modal.shape[1] for p in points), default=0)
+        width = max((3 + p.rotations + modes for p in points if len(p.coordinates)), default=3)
+        coordinates = np.full((len(points), width), size, dtype=int)
+        modal = np.zeros((len(points), 3, modes))
+        kinds: dict[str, list[int]] = {"ground": [], "none": [], "euler": [], "rxyz": []}
+        for k, point in enumerate(points):
+            count = len(point.coordinates)
+            if count == 0:
+                kinds["ground"].append(k)
+                continue
+            kinds[point.kind].append(k)
+            coordinates[k, :3 + point.rotations] = point.coordinates[:3 + point.rotations]
+            start = 3 + point.rotations
+            coordinates[k, start:count] = point.coordinates[start:]
+            modal[k, :, :point.modal.shape[1]] = point.modal
+        return cls(size, coordinates, np.array([p.local for p in points], dtype=float).reshape(-1, 3), modal,
+                   {kind: np.array(indices, dtype=int) for kind, indices in kinds.items()})
+
+    @property
+    def count(self) -> int:
+        """C, the number of channels."""
+        return len(self.coordinates) // 2
+
+    def state(self, q: np.ndarray) -> ChannelState:
+        """Separations, Jacobians and Hessians at the total coordinates *q* (N,)."""
+        values = np.append(q, 0.0)[self.coordinates]
+        points, width = self.coordinates.shape
+        position = np.zeros((points, 3))
+        jacobian = np.zeros((points, 3, width))
+        hessian = np.zeros((points, 3, width, width))
+        ground, free = self.kinds["ground"], self.kinds["none"]
+        position[ground] = self.local[ground]
+        jacobian[:, :, :3] = np.eye(3)
+        jacobian[ground] = 0.0
+        position[free] = values[free, :3] + self.local[free]
+        self._euler(values, position, jacobian, hessian)
+        self._rxyz(values, position, jacobian, hessian)
+        return ChannelState(position[1::2] - position[0::2], jacobian, hessian)
+
+    def _euler(self, values, position, jacobian, hessian) -> None:
+        index = self.kinds["euler"]
+        if not len(index):
+            return
+        modes = self.modal.shape[2]
+        shapes = self.modal[index]
+        w = self.local[index] + np.einsum("pak,pk->pa", shapes, values[index, 7:7 + modes])
+        e = values[index, 3:7]
+        a = np.einsum("abij,pj->pabi", EULER, e)                 # A = I + a . e
+        rotation = np.eye(3) + np.einsum("pabi,pi->pab", a, e)
+        position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
+        jacobian[index, :, 3:7] = 2 * np.einsum("pabi,pb->pai", a, w)
+        jacobian[index, :, 7:7 + modes] = rotation @ shapes
+        hessian[index, :, 3:7, 3:7] = 2 * np.einsum("abij,pb->paij", EULER, w)
+        mixed = 2 * np.einsum("pabi,pbk->paik", a, shapes)
+        hessian[index, :, 3:7, 7:7 + modes] = mixed
+        hessian[index, :, 7:7 + modes, 3:7] = mixed.transpose(0, 1, 3, 2)
+
+    def _rxyz(self, values, position, jacobian, hessian) -> None:
+        index = self.kinds["rxyz"]
+        if not len(index):
+            return
+        modes = self.modal.shape[2]
+        shapes = self.modal[index]
+        w = self.local[index] + np.einsum("pak,pk->pa", shapes, values[index, 6:6 + modes])
+        x, y, z = np.moveaxis(_axis_derivatives(values[index, 3:6]), 1, 0)   # (p, order, 3, 3) each
+
+        def product(orders: tuple[int, int, int]) -> np.ndarray:
+            # d^i R_x d^j R_y d^k R_z of the derivative orders (i, j, k)
+            return x[:, orders[0]] @ y[:, orders[1]] @ z[:, orders[2]]
+
+        rotation = product((0, 0, 0))
+        firsts = np.stack([product((1, 0, 0)), product((0, 1, 0)), product((0, 0, 1))], axis=1)
+        position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
+        jacobian[index, :, 3:6] = np.einsum("piab,pb->pai", firsts, w)
+        jacobian[index, :, 6:6 + modes] = rotation @ shapes
+        for i in range(3):
+            for j in range(i, 3):
+                orders = tuple(int(k == i) + int(k == j) for k in range(3))
+                second = np.einsum("pab,pb->pa", product(orders), w)  # type: ignore[arg-type]
+                hessian[index, :, 3 + i, 3 + j] = hessian[index, :, 3 + j, 3 + i] = second
+        mixed = np.einsum("piab,pbk->paik", firsts, shapes)
+        hessian[index, :, 3:6, 6:6 + modes] = mixed
+        hessian[index, :, 6:6 + modes, 3:6] = mixed.transpose(0, 1, 3, 2)
+
+    def force(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
+        """``sum_c J_c^T S_c d_c`` (N,) for the springs *stiffness* (C, 3, 3), N/m."""
+        on_points = self._on_points(np.einsum("cab,cb->ca", stiffness, state.separation))
+        generalised = np.einsum("pam,pa->pm", state.jacobian, on_points)
+        return np.bincount(self.coordinates.ravel(), generalised.ravel(), self.size + 1)[:self.size]
+
+    def matrix(self, state: ChannelState, springs: np.ndarray, *, stiffness: np.ndarray | None = None) -> np.ndarray:
+        """``sum_c J_c^T S_c J_c`` (N, N) of the matrices *springs* (C, 3, 3); with *stiffness*, also
+        ``sum_c (S_c d_c) . H_c`` of those springs (the tangent stiffness)."""
+        jacobian = self._channel_jacobians(state)
+        blocks = np.einsum("csan,ctam->cstnm", jacobian, np.einsum("cab,ctbm->ctam", springs, jacobian))
+        rows = self.coordinates.reshape(self.count, 2, 1, -1, 1)
+        columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
+        index, values = [(rows * (self.size + 1) + columns).ravel()], [blocks.ravel()]
+        if stiffness is not None:
+            on_points = self._on_points(np.einsum("cab,cb->ca", stiffness, state.separation))
+            own = self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]
+            index.append(own.ravel())
+            values.append(np.einsum("pa,pamn->pmn", on_points, state.hessian).ravel())
+        full = np.bincount(np.concatenate(index), np.concatenate(values), (self.size + 1) ** 2)
+        return full.reshape(self.size + 1, self.size + 1)[:self.size, :self.size]
+
+    def outputs(self, state: ChannelState, springs: np.ndarray) -> np.ndarray:
+        """``S_c J_c`` of every channel stacked: shape (3 C, N)."""
+        product = np.einsum("cab,ctbm->ctam", springs, self._channel_jacobians(state))
+        rows = 3 * np.arange(self.count).reshape(-1, 1, 1, 1) + np.arange(3).reshape(1, 1, 3, 1)
+        columns = self.coordinates.reshape(self.count, 2, 1, -1)
+        index = (rows * (self.size + 1) + columns).ravel()
+        full = np.bincount(index, product.ravel(), 3 * self.count * (self.size + 1))
+        return full.reshape(3 * self.count, self.size + 1)[:, :self.size]
+
+    def _on_points(self, channel_force: np.ndarray) -> np.ndarray:
+        """A force per channel (C, 3) as the force on each marker's Jacobian row (2 C, 3)."""
+        return (channel_force[:, None, :] * _SIGNS[None, :, None]).reshape(-1, 3)
+
+    def _channel_jacobians(self, state: ChannelState) -> np.ndarray:
+        """Each channel's two marker Jacobians with the sign of d: shape (C, 2, 3, M)."""
+        return state.jacobian.reshape(self.count, 2, 3, -1) * _SIGNS[None, :, None, None]
+
+
+def _axis_derivatives(angles: np.ndarray) -> np.ndarray:
+    """``d^k R_axis / d angle^k`` for the angles (p, 3): shape (p, 3 axes, 3 orders, 3, 3)."""
+    c, s = np.cos(angles), np.sin(angles)
+    cosines = np.stack([c, -s, -c], axis=-1)          # (p, axis, order)
+    sines = np.stack([s, c, -s], axis=-1)
+    one = np.array([1.0, 0.0, 0.0])
+    out = np.zeros(angles.shape + (3, 3, 3))
+    for axis, (i, j) in enumerate(((1, 2), (0, 2), (0, 1))):
+        out[:, axis, :, axis, axis] = one
+        out[:, axis, :, i, i] = cosines[:, axis]
+        out[:, axis, :, j, j] = cosines[:, axis]
+        sign = 1.0 if axis == 1 else -1.0            # R_y has +s above the diagonal
+        out[:, axis, :, i, j] = sign * sines[:, axis]
+        out[:, axis, :, j, i] = -sign * sines[:, axis]
+    return out
