@@ -1,5 +1,6 @@
 """The truncation-error estimate (workbook.solve.truncation) against explicit modes and more modes."""
 import dataclasses
+import json
 
 import numpy as np
 import pytest
@@ -72,3 +73,25 @@ def test_estimate_grows_as_the_fourth_power_of_frequency(answers):
     # quasi-static, the correction -w^4 R changes the loaded directions' T (y, z) as f^4: a factor 16
     # per octave (x, loaded only through inertia coupling, has a T of its own growing as f^2)
     np.testing.assert_allclose(low[1][1:] / low[0][1:], 16.0, rtol=0.05)
+
+
+def test_compare_complete_gives_the_complete_models_curves_next_to_the_cases(answers, coarse_reference, capsys,
+                                                                           tmp_path):
+    from workbook.cli.main import main
+    from workbook.model.codec import to_json
+
+    excitation, found = answers
+    case = dataclasses.replace(coarse_reference, excitations=(excitation,), links=tuple(
+        dataclasses.replace(link, modes=0) for link in coarse_reference.links))
+    path = tmp_path / "hp.json"
+    path.write_text(to_json(case))
+    plot = tmp_path / "fig9.png"
+    assert main(["run", str(path), "--no-progress", "--json", "--hinges", "pylon", "--compare", "complete",
+                 "--plot", str(plot)]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert plot.stat().st_size > 0
+    for rows, (t, _, _) in ((answer["hinges"], found[0]), (answer["hinges_complete"], found[20])):
+        (row,) = rows
+        pylon = np.abs(sum(row[key] for key in row if key.endswith(" T x")))
+        assert pylon >= t[0] * (1 - 1e-9)          # the hinges' |T| summed bound the pylon's |sum|
+    assert answer["runs"][0]["truncation_error"]["x"] == pytest.approx(found[0][1][0], rel=1e-6)
