@@ -22,13 +22,19 @@ import numpy as np
 from .cache import LinkCache
 from .reduced import package_version, with_decision
 
-__all__ = ["record_hash", "stored_reductions", "cached_reductions"]
+__all__ = ["record_hash", "entry_key", "stored_reductions", "cached_reductions"]
 
 
 def record_hash(record: dict) -> str:
     """Short SHA-256 of a JSON-able record (the key of a cache entry)."""
     text = json.dumps(record, sort_keys=True, default=lambda v: np.asarray(v).tolist())
     return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def entry_key(fe_hash: str, decision) -> str:
+    """The key of one stored reduction: the body's FE hash and the decision's modes (entries
+    keep the omitted modes' residual mass since ``"basis": 2``)."""
+    return record_hash({"fe": fe_hash, "modes": decision.key, "basis": 2})
 
 
 def stored_reductions(cache: LinkCache, fe_hash: str, decide: Callable, excitations_hz) -> tuple:
@@ -52,7 +58,7 @@ def stored_reductions(cache: LinkCache, fe_hash: str, decide: Callable, excitati
     if frequencies is None:
         return None, None, None, None
     decisions = [decide(frequencies, f) for f in excitations_hz]
-    keys = [record_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+    keys = [entry_key(fe_hash, d) for d in decisions]
     return frequencies, decisions, keys, [cache.load_link(key) for key in keys]
 
 
@@ -109,7 +115,7 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
         if not known:
             cache.write_summary(fe_hash, frequencies)
             decisions = [decide(frequencies, f) for f in excitations_hz]
-            keys = [record_hash({"fe": fe_hash, "modes": d.key}) for d in decisions]
+            keys = [entry_key(fe_hash, d) for d in decisions]
             links = [None] * len(decisions)
         missing = {key: decision for key, decision, link in zip(keys, decisions, links, strict=True) if link is None}
         infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}

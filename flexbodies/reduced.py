@@ -86,6 +86,12 @@ class ReducedLink:
         link frame, Voigt order xx, yy, zz, yz, xz, xy), Pa per modal unit;
         empty, shape (0, 6, 0), for a body reduced without them
         (:mod:`flexbodies.stress`).
+    residual_mass : ndarray, shape (6 + n_modes, 6 + n_modes)
+        The omitted fixed-interface modes' residual mass R
+        (:func:`flexbodies.reduction.residual_mass`), kg s^2: their
+        dynamic stiffness is ``-w^4 R`` on the body frame's translation and
+        rotation (body frame) and the modal coordinates; shape (0, 0) when
+        not computed.
     cache_hit : bool
         True when this object was loaded from the cache.
     """
@@ -101,6 +107,7 @@ class ReducedLink:
     decision: ModeDecision
     info: dict
     stress_modes: np.ndarray = field(default_factory=lambda: np.zeros((0, 6, 0)), compare=False)
+    residual_mass: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)), compare=False)
     cache_hit: bool = field(default=False, compare=False)
 
     @property
@@ -155,6 +162,7 @@ def _arrays_of(link: ReducedLink) -> dict:
         "surface_triangles": link.surface_triangles,
         "mode_basis": link.mode_basis,
         "stress_modes": link.stress_modes,
+        "residual_mass": link.residual_mass,
     }
     for i, nodes in enumerate(link.interface_nodes):
         arrays[f"interface_nodes_{i}"] = nodes
@@ -259,6 +267,7 @@ def load_reduced_link(path, key: str | None = None) -> ReducedLink:
             decision=ModeDecision(**meta["decision"]),
             info=meta["info"],
             stress_modes=arrays["stress_modes"],
+            residual_mass=arrays.get("residual_mass", np.zeros((0, 0))),
         )
     except (KeyError, TypeError) as exc:
         raise ReducedLinkFileError(f"{path}: incomplete reduced-link file (missing {exc})") from None

@@ -18,14 +18,15 @@ import scipy.sparse as sp
 from .assembly import FEModel
 from .craig_bampton import CraigBamptonBasis, elastic_modes, fixed_interface_set, kept_count
 from .frequencies import free_free_frequencies, mounted_frequencies
-from .interfaces import InterfaceCoupling, couple_interfaces
+from .interfaces import InterfaceCoupling, couple_interfaces, rigid_motion_rows
 from .interior import InteriorSolver
 from .invariants import ffrf_invariants
 from .reduced import ReducedLink
 from .selection import ModeDecision
 from .stress import NodalStress
 
-__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions"]
+__all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions",
+           "residual_mass"]
 
 
 @dataclass(frozen=True)
@@ -69,8 +70,43 @@ def _padded(matrix: sp.spmatrix, extra: int) -> sp.csr_matrix:
     return sp.block_diag((matrix, sp.csr_matrix((extra, extra))), format="csr")
 
 
+def residual_mass(coupled: CoupledModel, solver: InteriorSolver, cb: CraigBamptonBasis,
+                  modes_q: np.ndarray) -> np.ndarray:
+    """The omitted fixed-interface modes' residual mass in the body's coordinates.
+
+    A motion ``u = W x`` of the body (``x``: its frame's translation, m, and
+    rotation, rad, in the body frame, then its elastic modal coordinates)
+    loads the held interior with the inertia force ``w^2 f``, ``f = (M W x)_i``.
+    The fixed-interface modes ``j`` the basis omits answer it and act back
+    on ``x`` with the dynamic stiffness ``-w^4 sum_j f^T phi_j phi_j^T f /
+    (w_j^2 - w^2)``, which is ``-w^4 R`` to leading order in ``(w / w_j)^2``,
+
+        R = f^T (K_ii^-1 - Phi_k Omega_k^-2 Phi_k^T) f,
+
+    the residual flexibility of the omitted modes (``K_ii^-1`` less the kept
+    modes' part) seen through ``f``: no omitted mode is computed.
+
+    Returns
+    -------
+    ndarray, shape (6 + n_modes, 6 + n_modes)
+        R, kg s^2 (per unit coordinate).
+    """
+    coupling = coupled.coupling
+    carry = np.zeros((len(solver.masters), 6))        # master DOF of a rigid motion about the frame origin
+    for interface, dofs in enumerate(coupling.master_dofs):
+        carry[dofs[:3] - solver.masters[0]] = rigid_motion_rows(coupling.centres[interface:interface + 1])[0]
+        carry[dofs[3:] - solver.masters[0], 3:] = np.eye(3)
+    motion = np.hstack([solver.static_modes() @ carry, modes_q])
+    force = (coupled.mass @ motion)[solver.interior]
+    fixed = cb.vectors[solver.interior, cb.n_static:]
+    omega_sq = (2 * np.pi * np.asarray(cb.fixed_interface_hz)) ** 2
+    projected = fixed.T @ force
+    residual = force.T @ solver.factor.solve(force) - projected.T @ (projected / omega_sq[:, None])
+    return 0.5 * (residual + residual.T)
+
+
 def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeDecision, frequencies: dict,
-                   info: dict) -> ReducedLink:
+                   info: dict, solver: InteriorSolver | None = None) -> ReducedLink:
     """The reduced link of a Craig-Bampton basis: elastic modes, node-wise basis, floating-frame invariants.
 
     Parameters
@@ -84,6 +120,9 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     info : dict
         JSON-able facts about the inputs, stored with the link; reduction
         timings and sizes are added.
+    solver : InteriorSolver, optional
+        The factorisation ``cb`` was made with: the link then keeps its
+        :func:`residual_mass`.
 
     Returns
     -------
@@ -99,6 +138,7 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     mode_basis = np.vstack([coupling.transform @ modes_q, modes_q[masters_t.ravel()]])
     nodes = np.vstack([fe.nodes, coupling.centres])
     invariants = ffrf_invariants(nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if), mode_basis)
+    residual = np.zeros((0, 0)) if solver is None else residual_mass(coupled, solver, cb, modes_q)
     stress_modes = np.zeros((0, 6, 0))
     if coupled.stress is not None:
         stress_start = time.perf_counter()
@@ -124,6 +164,7 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
         decision=decision,
         info=info,
         stress_modes=stress_modes,
+        residual_mass=residual,
     )
 
 
@@ -170,5 +211,5 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
         keep = kept_count(fixed_hz, decision.count, decision.cutoff_hz)
         cb = CraigBamptonBasis(np.hstack([static, fixed[:, :keep]]), solver.masters, fixed_hz[:keep])
         links.append(reduce_coupled(coupled, cb, decision, frequencies,
-                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared}))
+                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared}, solver))
     return links

@@ -82,6 +82,7 @@ def test_run_command_prints_hinge_tables_a_plot_and_each_warning_once(swept, cap
 
 @pytest.mark.parametrize("options, named", [(["--hinges", "aft"], "--hinges"),
                                             (["--plot", "t.png"], "--plot"),
+                                            (["--compare", "complete"], "--compare"),
                                             (["--hinges", "front", "--plot", "t.pdf"], "--plot")])
 def test_run_command_refuses_bad_hinge_options(options, named, capsys):
     assert main(["run", "--no-progress", *options]) == 2

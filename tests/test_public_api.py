@@ -56,7 +56,7 @@ INTERNAL_MODULES = (
     "workbook.solve.pylon_structure", "workbook.solve.response_sweep", "workbook.solve.run_up",
     "workbook.solve.simultaneous", "workbook.solve.stages", "workbook.solve.steady_start",
     "workbook.solve.step_accuracy", "workbook.solve.stress_stiffening", "workbook.solve.sweep",
-    "workbook.solve.sweep_grid", "workbook.solve.time_domain",
+    "workbook.solve.sweep_grid", "workbook.solve.time_domain", "workbook.solve.truncation",
     "workbook.studies", "workbook.studies.accuracy", "workbook.studies.parallel", "workbook.studies.parametric",
     "workbook.studies.progress", "workbook.studies.sensitivity",
     "flexbodies.assembly", "flexbodies.atomic", "flexbodies.bores", "flexbodies.cache", "flexbodies.cached_reduction",

@@ -105,8 +105,15 @@ class HingeCurves:
         index = pd.MultiIndex.from_arrays([list(self.runs), self.frequencies_hz], names=["run", "frequency Hz"])
         return pd.DataFrame(values, index=index, columns=columns)
 
-    def plot(self):
+    def plot(self, compare: HingeCurves | None = None, labels=("", "")):
         """T of each hinge against frequency, one panel per direction (log axes for a range of frequencies).
+
+        Parameters
+        ----------
+        compare : HingeCurves, optional
+            The same hinges of another model, overlaid dashed in the same colours.
+        labels : (str, str)
+            Appended to the hinge names of this model and of *compare* in the legend.
 
         Returns
         -------
@@ -119,9 +126,14 @@ class HingeCurves:
         f = self.frequencies_hz[order]
         T = self.transmissibility()[order]
         spread = len(f) > 1 and f[-1] > 2 * f[0]
+        other = None if compare is None else compare.transmissibility()[np.argsort(compare.frequencies_hz)]
         for i, axis in enumerate(DIRECTIONS):
             for h, hinge in enumerate(self.hinges):
-                axes[i].plot(f, np.maximum(T[:, h, i], 1e-12), "-" if len(f) > 1 else "o", lw=1.0, label=hinge)
+                line, = axes[i].plot(f, np.maximum(T[:, h, i], 1e-12), "-" if len(f) > 1 else "o", lw=1.0,
+                                     label=f"{hinge} {labels[0]}".strip())
+                if other is not None:
+                    axes[i].plot(f, np.maximum(other[:, h, i], 1e-12), "--" if len(f) > 1 else "x", lw=1.0,
+                                 color=line.get_color(), label=f"{hinge} {labels[1]}".strip())
             if spread:
                 axes[i].set_xscale("log")
             axes[i].set_yscale("log")

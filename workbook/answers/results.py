@@ -79,6 +79,10 @@ class ExcitationResult(PylonAnswers):
     hinge_phasors : dict of str to ndarray, complex, shape (3,)
         Complex amplitude of each force channel, N: frequency-domain answers
         only (empty for a time-domain run).
+    truncation_error : ndarray, shape (3,), or None
+        Estimated relative error of T per direction that the links' omitted
+        fixed-interface modes leave (:mod:`workbook.solve.truncation`);
+        None when not estimated (time domain, flexible pylon).
     """
 
     name: str
@@ -96,6 +100,7 @@ class ExcitationResult(PylonAnswers):
     excitation_history: np.ndarray = field(repr=False)
     window: slice = field(repr=False)
     hinge_phasors: dict = field(default_factory=dict, repr=False)
+    truncation_error: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def has_histories(self) -> bool:
@@ -228,6 +233,8 @@ class MountResult:
                 "hinges": {name: _direction_answers(a, run.excitation_amplitude)
                            for name, a in run.hinge_amplitudes.items()},
                 "pylon_hinges": list(run.pylon_hinges),
+                "truncation_error": None if run.truncation_error is None else
+                dict(zip(DIRECTIONS, map(float, run.truncation_error), strict=True)),
                 "steady": run.steady, "steady_change": run.steady_change, "warnings": list(run.warnings),
                 "static_hinge_forces_n": {name: list(map(float, f))
                                           for name, f in self.preloads[run.name].hinge_forces.items()},

@@ -5,7 +5,8 @@ card of each run, or the answers as JSON; the warnings once per distinct
 text, with the count and frequency range of the runs (a sweep's points)
 that raised them. ``--hinges`` adds the force amplitude and T of a hinge or
 hinge group against frequency (:mod:`workbook.answers.hinge_curves`), and
-``--plot`` draws them. A case workbook runs the rows of its Runs sheet and
+``--plot`` draws them; ``--compare complete`` overlays those of the complete
+model (:func:`workbook.solve.truncation.complete_model`: the seed study's Fig. 9). A case workbook runs the rows of its Runs sheet and
 gets its results written back (:mod:`workbook.cli.workbooks`).
 """
 from __future__ import annotations
@@ -43,13 +44,16 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="also give the force amplitude and T of a hinge, or of every hinge whose name starts "
                              "with GROUP (e.g. front; 'pylon': the pylon-side hinges), against frequency")
     parser.add_argument("--plot", metavar="OUT.png", help="with --hinges: draw their T against frequency as PNG")
+    parser.add_argument("--compare", choices=("complete",),
+                        help="with --hinges: overlay the complete model's curves (every flexible link with "
+                             "20 fixed-interface modes) on the case's own (the low-frequency model by default)")
     workbooks.add_run_arguments(parser)
     return run
 
 
-def _print_hinges(curves) -> None:
+def _print_hinges(curves, model: str = "") -> None:
     table = curves.to_pandas()
-    print(f"\nhinges {curves.selection!r}: force amplitude |F| (N) and T = |F| / |F_exc| per direction")
+    print(f"\nhinges {curves.selection!r}{model}: force amplitude |F| (N) and T = |F| / |F_exc| per direction")
     for hinge in curves.hinges:
         print(f"\n{hinge}:")
         part = table[hinge]
@@ -57,11 +61,19 @@ def _print_hinges(curves) -> None:
         print(part.to_string(float_format=lambda v: f"{v:10.4g}"))
 
 
+def _rows(curves) -> list:
+    table = curves.to_pandas()
+    table.columns = [" ".join(key) for key in table.columns]
+    return table.reset_index().to_dict(orient="records")
+
+
 def run(args) -> int:
     from workbook.solve.pipeline import run_case
 
     if args.plot and not args.hinges:
         raise UsageError("--plot draws the curves of --hinges: give --hinges NAME|GROUP")
+    if args.compare and not args.hinges:
+        raise UsageError("--compare overlays the curves of --hinges: give --hinges NAME|GROUP")
     check_output("--plot", args.plot, (".png",), [args.case])
     if is_workbook(args.case):
         if args.hinges:
@@ -85,24 +97,30 @@ def run(args) -> int:
 
         select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges])
     result = run_case(case, progress=None if args.no_progress else progress_factory())
-    curves = None
+    curves = complete = None
     if args.hinges:
         from workbook.answers.hinge_curves import hinge_curves
 
         curves = hinge_curves(result, args.hinges)
-    figure = curves.plot() if curves is not None and args.plot else None
+        if args.compare:
+            from workbook.solve.truncation import complete_model
+
+            complete = hinge_curves(run_case(complete_model(case), progress=None if args.no_progress
+                                             else progress_factory()), args.hinges)
+    labels = ("(case's modes)", "(complete: 20 modes per link)")
+    figure = curves.plot(complete, labels if complete else ("", "")) if curves is not None and args.plot else None
     if args.json:
         if curves is None:
             print(result.to_json(indent=2))
         else:
-            table = curves.to_pandas()
-            table.columns = [" ".join(key) for key in table.columns]
-            rows = table.reset_index().to_dict(orient="records")
-            print(json.dumps({**json.loads(result.to_json()), "hinges": rows}, indent=2))
+            extra = {"hinges": _rows(curves)} | ({"hinges_complete": _rows(complete)} if complete else {})
+            print(json.dumps({**json.loads(result.to_json()), **extra}, indent=2))
     else:
         _print_answers(case, result)
         if curves is not None:
-            _print_hinges(curves)
+            _print_hinges(curves, f" {labels[0]}" if complete else "")
+        if complete is not None:
+            _print_hinges(complete, f" {labels[1]}")
     with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
         if figure is not None:
             from workbook.answers.saving import save_figure

@@ -47,6 +47,7 @@ from workbook.model.case import ENGINE, SingleFrequencyExcitation
 from workbook.scene.bearing import hinge_matrix
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.modes import Linearization, linearize
+from workbook.solve.truncation import residual_stiffness
 
 __all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "point_phasors", "FrequencyResponse"]
 
@@ -114,6 +115,9 @@ class HarmonicModel:
         C_h, the hysteretic channel force per coordinate, N/m ... (zero
         without loss factors or when the scene holds their viscous
         equivalent instead); H is ``linearization.structural``.
+    residual_mass : ndarray, shape (n, n), or None
+        R_z, the residual mass of the modes the flexible links omit, kg s^2
+        (:mod:`workbook.solve.truncation`); None when not known.
     """
 
     linearization: Linearization
@@ -123,6 +127,7 @@ class HarmonicModel:
     damping_output: np.ndarray
     engine_point_jacobian: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     structural_output: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # None: zeros
+    residual_mass: np.ndarray | None = field(default=None, repr=False)
     _inputs: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -150,20 +155,24 @@ class HarmonicModel:
         forces (one, or one per imbalance plane), shape (n,)."""
         return sum(self.input_matrix(point) @ phasor for point, phasor in point_phasors(excitation))
 
-    def motion(self, frequency_hz: float, load: np.ndarray) -> np.ndarray:
+    def motion(self, frequency_hz: float, load: np.ndarray, added=None) -> np.ndarray:
         """Steady-state motion phasor ``z_hat`` (independent coordinates, shape (n,)) for the
-        generalised force phasor *load* (shape (n,)) at *frequency_hz*."""
+        generalised force phasor *load* (shape (n,)) at *frequency_hz*; *added*: a dynamic
+        stiffness (shape (n, n)) added to the scene's."""
         lin = self.linearization
         omega = 2 * np.pi * frequency_hz
         dynamic = lin.stiffness - omega ** 2 * lin.mass + 1j * omega * lin.damping
         if lin.structural is not None:
             dynamic = dynamic + 1j * lin.structural
+        if added is not None:
+            dynamic = dynamic + added
         return sla.solve(dynamic, load, check_finite=False)
 
-    def respond_generalised(self, frequency_hz: float, load: np.ndarray) -> FrequencyResponse:
-        """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*."""
+    def respond_generalised(self, frequency_hz: float, load: np.ndarray, added=None) -> FrequencyResponse:
+        """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*
+        (*added*: see :meth:`motion`)."""
         omega = 2 * np.pi * frequency_hz
-        motion = self.motion(frequency_hz, load)
+        motion = self.motion(frequency_hz, load, added)
         outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
         forces = (outputs @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces, strict=True))
@@ -252,7 +261,7 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
     log.info("harmonic model of %r: %d independent coordinates, %d force channels", scene.case.name,
              lin.mass.shape[0], len(names))
     return HarmonicModel(lin, names, list(scene.pylon_channels), stiffness, damping, point_jacobian,
-                         structural_output)
+                         structural_output, residual_stiffness(scene, lin.basis))
 
 
 def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.ndarray, names: list,

@@ -43,6 +43,7 @@ from workbook.solve.steady_start import STEADY, choose_start, steady_start
 from workbook.solve.stress_stiffening import stiffen_links
 from workbook.solve.sweep_grid import add_grid_warnings
 from workbook.solve.time_domain import TimeHistories, extract, integrate, plan_run
+from workbook.solve.truncation import describe_truncation, truncation_error
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
            "RESONANCE_BAND"]
@@ -293,7 +294,12 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
             result.warnings.extend(linearised_gap_warnings(gaps, prepared.preload.hinge_forces,
                                                            result.hinge_amplitudes))
             timings = dict(prepared.timings, **{"harmonic solve": time.perf_counter() - start})
-            card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method, solver)
+            if model.residual_mass is not None:
+                start = time.perf_counter()
+                result.truncation_error = truncation_error(model, excitation)
+                timings["truncation estimate"] = time.perf_counter() - start
+            card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method,
+                              {**solver, "truncation error": describe_truncation(result.truncation_error)})
             card.run_name = excitation.name
             runs.append(result)
             cards[result.name] = card
