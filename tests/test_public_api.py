@@ -45,7 +45,7 @@ INTERNAL_MODULES = (
     "workbook.model.pylon_mesh", "workbook.model.reference", "workbook.model.units",
     "workbook.processes",
     "workbook.rig", "workbook.rig.channel_map", "workbook.rig.correlation", "workbook.rig.plots", "workbook.rig.records",
-    "workbook.rig.synthetic", "workbook.rig.uff",
+    "workbook.rig.synthetic", "workbook.rig.uff", "workbook.rig.frf", "workbook.rig.modal",
     "workbook.scene", "workbook.scene.bearing", "workbook.scene.build", "workbook.scene.engine_casing",
     "workbook.scene.excitation", "workbook.scene.hinge_law", "workbook.scene.link_workers",
     "workbook.scene.mode_budget", "workbook.scene.structural_damping",

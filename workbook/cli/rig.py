@@ -17,7 +17,18 @@ A lab's CSV with its own channel names is read with ``--map MAP.json``
   (:mod:`workbook.rig.plots`); with ``--case``, measured against simulated T;
 - ``mountwb rig synthesize OUT.csv [CASE] [--run NAME] [--rigid] [--noise F]
   [--drift F] [--seed N] [--rate HZ] [--duration S]``: a synthetic record
-  made from a simulation (:mod:`workbook.rig.synthetic`).
+  made from a simulation (:mod:`workbook.rig.synthetic`);
+- ``mountwb rig frf RECORD [--map MAP.json] [--segment S] [--band LOW HIGH] [--case [CASE]] [--rigid]
+  [--run NAME] [--points N] [--output OUT.png] [--json]``: H1 of the pylon force per unit
+  excitation per direction with coherence, its peaks, and with ``--case`` the
+  simulated sweep of the run (:mod:`workbook.rig.frf`);
+- ``mountwb rig order RECORD [--map MAP.json] [--frame S] [--case [CASE]] [--rigid] [--run NAME]
+  [--points N] [--output OUT.png] [--json]``: the 1x order track of a run-up
+  record against the rotor frequency, and the simulated T of the run;
+- ``mountwb rig modes [CASE] (--test MODES.uff | --record RECORD) [--rigid] [--upper HZ]
+  [--output MAC.png] [--csv OUT.csv] [--json]``: the case's mounted modes against
+  test modes (UFF 55 + 15, or peaks of a record's H1): frequency errors and
+  the MAC matrix (:mod:`workbook.rig.modal`).
 
 A bad record exits with code 2 and a message naming file, line and column.
 """
@@ -37,7 +48,7 @@ from workbook.model.case import AnalysisSettings, Case
 if TYPE_CHECKING:
     from workbook.rig.records import RigRecord
 
-__all__ = ["arguments", "simulate_run", "read_any_record"]
+__all__ = ["arguments", "simulate_run", "simulated_transmissibility", "read_any_record"]
 
 _DEFAULT_PERIODS = AnalysisSettings().measured_periods
 
@@ -72,6 +83,42 @@ def simulate_run(case: Case, run: str, *, histories: bool = False) -> Excitation
     if histories:
         return run_excitation(case, excitations[run])[0]
     return run_case(dataclasses.replace(case, excitations=(excitations[run],))).runs[0]
+
+
+def simulated_transmissibility(case: Case, run: str, low_hz: float, high_hz: float, points: int):
+    """T per direction of a simulated sweep of the excitation *run* of *case* over a band.
+
+    Parameters
+    ----------
+    case : Case
+    run : str
+        A single-frequency excitation of *case*: the sweep's template.
+    low_hz, high_hz : float
+        Band, Hz.
+    points : int
+        Frequencies, evenly spaced.
+
+    Returns
+    -------
+    frequencies : ndarray, shape (points,)
+        Hz.
+    transmissibility : ndarray, shape (points, 3)
+
+    Raises
+    ------
+    UsageError
+        No excitation of that name.
+    """
+    from workbook.model.case import Sweep
+    from workbook.solve.sweep import run_sweep
+
+    excitations = {e.name: e for e in case.single_frequency_excitations()}
+    if run not in excitations:
+        raise UsageError(f"case {case.name!r} has no excitation {run!r} to sweep; it has {', '.join(excitations)} "
+                         "(--run NAME)")
+    sweep = Sweep.band(f"{run} sweep", excitations[run], max(low_hz, 0.1), high_hz, points, "linear")
+    answer = run_sweep(dataclasses.replace(case, excitations=(sweep,)), sweep)
+    return answer.frequencies, answer.transmissibility()
 
 
 def read_any_record(path: str, channel_map: str | None = None) -> RigRecord:
@@ -123,9 +170,15 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                                  "frequency at least 12.5 times a period; 4096 for the reference mount)")
     synthesize.add_argument("--duration", type=float, default=4.0, help="record length, s (4)")
 
+    _correlation_arguments(modes)
+
     def rig(args) -> int:
         if args.mode == "synthesize":
             return _synthesize(args)
+        if args.mode in ("frf", "order"):
+            return _frf_or_order(args)
+        if args.mode == "modes":
+            return _modes(args)
         from workbook.rig.correlation import PEAK_SEARCH, comparison_frame, measure
 
         inputs = [args.record, args.map, getattr(args, "case", None) or None]
@@ -186,4 +239,181 @@ def _synthesize(args) -> int:
     record = synthetic_record(result, transducers, sample_rate_hz=rate, duration=args.duration,
                               noise=args.noise, drift=args.drift, seed=args.seed)
     write_output(args.output, "rig record", "rig", lambda target: write_record(target, record))
+    return 0
+
+
+def _correlation_arguments(modes) -> None:
+    frf = modes.add_parser("frf", help="H1 of the pylon force per unit excitation with coherence, per direction, "
+                                       "of a broadband or swept record")
+    order = modes.add_parser("order", help="1x order track of a run-up record against the rotor frequency")
+    for sub in (frf, order):
+        sub.add_argument("record", help="rig record: CSV, or UFF dataset 58 time histories (.uff, .unv)")
+        sub.add_argument("--map", metavar="MAP.json", help="channel map of a lab's CSV (docs/rig-correlation.md)")
+        sub.add_argument("--case", nargs="?", const="", metavar="CASE",
+                         help="also simulate a sweep of the run over the band (JSON or .xlsx workbook; --case "
+                              "alone: the reference mount)")
+        sub.add_argument("--rigid", action="store_true", help="make every link rigid")
+        sub.add_argument("--run", help="excitation of the case to sweep (default: the record's run)")
+        sub.add_argument("--points", type=int, default=40, help="frequencies of the simulated sweep (40)")
+        sub.add_argument("--output", metavar="OUT.png", help="also plot T (and coherence) to this PNG")
+        sub.add_argument("--json", action="store_true", help="print the curves as JSON")
+    frf.add_argument("--segment", type=float, default=1.0, help="Welch segment, s: resolution 1/S Hz (1)")
+    frf.add_argument("--band", type=float, nargs=2, metavar=("LOW", "HIGH"),
+                     help="frequencies shown, Hz (default: 1/S up to 0.4 x the sample rate)")
+    order.add_argument("--frame", type=float, default=1.0, help="frame length, s (1); frames overlap by half")
+    modal = modes.add_parser("modes", help="the case's mounted modes against test modes: frequency errors and MAC")
+    modal.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    source = modal.add_mutually_exclusive_group(required=True)
+    source.add_argument("--test", metavar="MODES.uff", help="test modes: UFF datasets 55 and 15 (node coordinates, m)")
+    source.add_argument("--record", metavar="RECORD", help="identify test modes by peak picking on a record's H1")
+    modal.add_argument("--map", metavar="MAP.json", help="channel map of the record (a lab's CSV)")
+    modal.add_argument("--segment", type=float, default=1.0, help="Welch segment of the record's H1, s (1)")
+    modal.add_argument("--rigid", action="store_true", help="make every link rigid")
+    modal.add_argument("--upper", type=float, default=None,
+                       help="highest frequency, Hz (default: 1.5 x the highest test mode)")
+    modal.add_argument("--output", metavar="MAC.png", help="plot the MAC matrix (test modes with shapes)")
+    modal.add_argument("--csv", metavar="OUT.csv", help="also write the pairing table")
+    modal.add_argument("--json", action="store_true", help="print the pairing as JSON")
+
+
+def _simulated(args, record: RigRecord, low: float, high: float):
+    if args.case is None:
+        return None
+    case = load_case(args.case or None, rigid=args.rigid)
+    return simulated_transmissibility(case, args.run or record.run, low, high, args.points)
+
+
+def _curves(frequencies, values) -> dict:
+    from workbook.model.case import DIRECTIONS
+
+    return {"frequency_hz": [float(f) for f in frequencies],
+            **{direction: [None if v != v else float(v) for v in values[:, i]] for i, direction in enumerate(DIRECTIONS)}}
+
+
+def _frf_or_order(args) -> int:
+    import json
+
+    import numpy as np
+
+    from workbook.model.case import DIRECTIONS
+    from workbook.rig import frf as frfs
+
+    check_output("--output", args.output, (".png",), [args.record, args.map, args.case or None])
+    record = read_any_record(args.record, args.map)
+    if args.mode == "frf":
+        answer = frfs.record_frf(record, args.segment)
+        low, high = args.band if args.band else (1.0 / answer.segment_s, 0.4 * record.sample_rate_hz)
+        shown = answer.band(low, high)
+        frequencies, measured = answer.frequencies_hz[shown], answer.transmissibility[shown]
+    else:
+        track = frfs.order_track(record, args.frame)
+        frequencies, measured = track.frequency_hz, track.transmissibility
+        low, high = float(frequencies.min()), float(frequencies.max())
+    simulated = _simulated(args, record, low, high)
+    errors = None
+    if simulated is not None:
+        interpolated = np.column_stack([np.interp(frequencies, simulated[0], simulated[1][:, a]) for a in range(3)])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            errors = 100 * (interpolated - measured) / measured
+    if args.json:
+        output: dict = {"record": record.path, "run": record.run, "T": _curves(frequencies, measured)}
+        if args.mode == "frf":
+            output.update(segment_s=answer.segment_s, averages=answer.averages,
+                          coherence=_curves(frequencies, answer.coherence[shown]))
+        else:
+            output.update(frame_s=track.frame_s, time_s=[float(t) for t in track.time_s],
+                          excitation_N=[float(v) for v in track.excitation_amplitude],
+                          pylon_N=_curves(frequencies, track.pylon_amplitude))
+        if simulated is not None:
+            output["simulated T"] = _curves(*simulated)
+        print(json.dumps(output, indent=1))
+    elif args.mode == "frf":
+        coherence = answer.coherence[shown]
+        print(f"{record.path}: run {record.run!r}, H1 of pylon force / excitation, {answer.averages} averages of "
+              f"{answer.segment_s:g} s, {low:g} to {high:g} Hz")
+        for axis, direction in enumerate(DIRECTIONS):
+            if np.isnan(answer.h1[:, axis]).all():
+                print(f"{direction}: not excited")
+                continue
+            line = f"{direction}: mean coherence {np.mean(coherence[:, axis]):.3f}, T max {np.nanmax(measured[:, axis]):.4g}"
+            if errors is not None:
+                good = coherence[:, axis] >= 0.8
+                line += f", simulated - test: median |error| {np.nanmedian(np.abs(errors[good, axis])):.2f} % " \
+                        f"where coherence >= 0.8"
+            print(line)
+        from workbook.rig.modal import identify_peaks
+
+        peaks = identify_peaks(answer, low, high)
+        for number, (f, zeta) in enumerate(zip(peaks.frequencies_hz, peaks.damping_ratios, strict=True), start=1):
+            print(f"peak {number}: {f:.3f} Hz, half-power damping ratio {100 * zeta:.2f} %")
+    else:
+        print(f"{record.path}: run {record.run!r}, 1x order track, {len(frequencies)} frames of {track.frame_s:g} s")
+        step = max(1, len(frequencies) // 20)
+        for index in range(0, len(frequencies), step):
+            t = "  ".join(f"T {d} {v:9.4g}" for d, v in zip(DIRECTIONS, measured[index], strict=True))
+            extra = "" if errors is None else "  error % " + " ".join(f"{e:+7.2f}" for e in errors[index])
+            print(f"{frequencies[index]:8.3f} Hz  |F_exc| {track.excitation_amplitude[index]:9.4g} N  {t}{extra}")
+    if args.output:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from workbook.answers.saving import save_figure
+
+        figure = frfs.plot_frf(answer, simulated) if args.mode == "frf" else frfs.plot_order_track(track, simulated)
+        write_output(args.output, "FRF plot" if args.mode == "frf" else "order track plot", "rig",
+                     lambda target: save_figure(figure, target))
+    return 0
+
+
+def _modes(args) -> int:
+    import json
+
+    import numpy as np
+
+    from workbook.rig import modal
+
+    inputs = [args.test, args.record, args.map, args.case]
+    check_output("--output", args.output, (".png",), inputs)
+    check_output("--csv", args.csv, (".csv",), inputs)
+    if args.test:
+        test = modal.read_uff_modes(args.test)
+    else:
+        from workbook.rig.frf import record_frf
+
+        record = read_any_record(args.record, args.map)
+        frf = record_frf(record, args.segment)
+        test = modal.identify_peaks(frf, 1.0 / frf.segment_s, 0.4 * record.sample_rate_hz)
+        if not len(test.frequencies_hz):
+            raise UsageError(f"{args.record}: no peak in the record's H1 to pair (coherence >= 0.8)")
+    if args.output and test.shapes is None:
+        raise UsageError("--output draws the MAC matrix: it needs test shapes (--test MODES.uff)")
+    case = load_case(args.case, rigid=args.rigid)
+    upper = args.upper if args.upper is not None else 1.5 * float(np.max(test.frequencies_hz))
+    simulated = modal.case_modes(case, upper)
+    if not simulated:
+        raise UsageError(f"case {case.name!r} has no mounted mode up to {upper:g} Hz (--upper)")
+    shapes = None
+    if test.shapes is not None:
+        shapes = modal.shapes_at_points(np.array([m.engine_shape for m in simulated]), np.array(case.engine.center_of_mass),
+                                        test.points, test.dofs)
+    pairing = modal.pair_modes(test, np.array([m.frequency_hz for m in simulated]), shapes)
+    table = pairing.frame()
+    table["sim motion"] = [simulated[j - 1].description for j in table["sim mode"]]
+    if args.json:
+        print(json.dumps({"test": test.source, "pairs": json.loads(table.reset_index().to_json(orient="records")),
+                          "MAC": None if pairing.mac is None else pairing.mac.round(4).tolist()}, indent=1))
+    else:
+        print(f"{test.source}: {len(test.frequencies_hz)} test modes, {len(simulated)} mounted modes of "
+              f"{case.name!r} up to {upper:g} Hz; error = (sim - test) / test x 100 %")
+        print(table.to_string(float_format=lambda v: f"{v:9.4g}"))
+    if args.csv:
+        write_output(args.csv, "mode pairing", "rig", lambda target: save_csv(table, target))
+    if args.output:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        from workbook.answers.saving import save_figure
+
+        figure = modal.plot_mac(pairing)
+        write_output(args.output, "MAC plot", "rig", lambda target: save_figure(figure, target))
     return 0

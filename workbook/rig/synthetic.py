@@ -24,7 +24,8 @@ from workbook.answers.results import ExcitationResult
 from workbook.rig.correlation import MIN_SAMPLES_PER_PERIOD
 from workbook.rig.records import RigRecord
 
-__all__ = ["synthetic_record", "default_sample_rate", "REFERENCE_TRANSDUCERS", "RATE_MARGIN"]
+__all__ = ["synthetic_record", "broadband_record", "run_up_record", "default_sample_rate", "REFERENCE_TRANSDUCERS",
+           "RATE_MARGIN"]
 
 #: A default record samples the highest frequency this many times more
 #: often than :data:`~workbook.rig.correlation.MIN_SAMPLES_PER_PERIOD` (at least).
@@ -112,3 +113,100 @@ def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate
         notes={"made by": f"workbook.rig.synthetic.synthetic_record from a simulation: noise {noise:g} x amplitude, "
                           f"speed drift {drift:g}, seed {seed}",
                "simulated T x y z": " ".join(f"{t:.6g}" for t in result.transmissibility)})
+
+
+def broadband_record(frf, *, sample_rate_hz: float = 1024.0, duration: float = 64.0, noise: float = 0.0,
+                     seed: int = 0, run: str = "broadband") -> RigRecord:
+    """A shaker record: independent white-noise excitation per direction through a known FRF.
+
+    The excitation in each direction is Gaussian white noise of unit
+    standard deviation (N); the pylon force in direction d is the excitation
+    in d filtered by ``frf(f)[:, d]`` (periodic: the FFT of the whole record
+    times the FRF at its bins), one transducer ``"pylon"`` carrying the
+    hinge ``"pylon"``. White noise of standard deviation *noise* x (the
+    pylon force's) is added to each pylon channel.
+
+    Parameters
+    ----------
+    frf : callable
+        ``frf(frequencies_hz)`` -> complex ndarray, shape (n, 3): pylon force
+        per unit excitation force per direction.
+    sample_rate_hz : float
+        Hz.
+    duration : float
+        s.
+    noise : float
+        Response noise relative to the response's standard deviation.
+    seed : int
+    run : str
+
+    Returns
+    -------
+    RigRecord
+    """
+    samples = int(round(duration * sample_rate_hz))
+    rng = np.random.default_rng(seed)
+    excitation = rng.normal(0.0, 1.0, (samples, 3))
+    frequencies = np.fft.rfftfreq(samples, 1.0 / sample_rate_hz)
+    pylon = np.fft.irfft(np.fft.rfft(excitation, axis=0) * frf(frequencies), n=samples, axis=0)
+    pylon += rng.normal(0.0, 1.0, pylon.shape) * noise * pylon.std(axis=0)
+    time = np.arange(samples) / sample_rate_hz
+    return RigRecord(time, {"pylon": pylon}, excitation, {"pylon": ("pylon",)}, sample_rate_hz,
+                     float(sample_rate_hz / MIN_SAMPLES_PER_PERIOD), run,
+                     notes={"made by": f"workbook.rig.synthetic.broadband_record: white noise through a known FRF, "
+                                       f"response noise {noise:g}, seed {seed}"})
+
+
+def run_up_record(answer, transducers: dict, *, sample_rate_hz: float = 2048.0, duration: float = 30.0,
+                  noise: float = 0.0, seed: int = 0) -> RigRecord:
+    """A run-up record from a simulated run-up: the speed rising linearly over the run-up's range.
+
+    The rotor frequency rises linearly from the run-up's first to its last
+    speed, ``phi(t) = 2 pi int f dt``; each channel is
+    ``Re(X(f(t)) exp(i phi(t)))`` with ``X(f)`` the simulated complex
+    amplitude (excitation resultant, each transducer's sum of hinge
+    phasors), interpolated linearly in f between the run-up's speeds: the
+    quasi-steady response of a slow run-up. White noise of standard
+    deviation *noise* x (the channel's largest amplitude) is added.
+
+    Parameters
+    ----------
+    answer : RunUpAnswer or SweepAnswer
+        A frequency-domain answer (its runs keep their hinge phasors).
+    transducers : dict of str to sequence of str
+        Pylon-side hinges carried by each transducer.
+    sample_rate_hz : float
+        Hz.
+    duration : float
+        s.
+    noise : float
+    seed : int
+
+    Returns
+    -------
+    RigRecord
+    """
+    from workbook.solve.harmonic import excitation_phasor
+
+    speeds = answer.frequencies
+    time = np.arange(int(round(duration * sample_rate_hz))) / sample_rate_hz
+    rotor = speeds[0] + (speeds[-1] - speeds[0]) * time / duration
+    phase = 2 * np.pi * (speeds[0] * time + (speeds[-1] - speeds[0]) * time ** 2 / (2 * duration))
+    rng = np.random.default_rng(seed)
+    rotation = np.exp(1j * phase)[:, None]
+
+    def channel(phasors: np.ndarray) -> np.ndarray:
+        values = np.column_stack([np.interp(rotor, speeds, phasors[:, a].real)
+                                  + 1j * np.interp(rotor, speeds, phasors[:, a].imag) for a in range(3)])
+        signal = np.real(values * rotation)
+        return signal + rng.normal(0.0, noise * np.abs(phasors).max(), signal.shape)
+
+    runs = answer.result.runs
+    excitation = np.array([excitation_phasor(point) for point in answer.sweep.expand()])
+    forces = {name: channel(np.array([sum(run.hinge_phasors[h] for h in hinges) for run in runs]))
+              for name, hinges in transducers.items()}
+    return RigRecord(time, forces, channel(excitation), {name: tuple(h) for name, h in transducers.items()},
+                     sample_rate_hz, float(speeds[-1]), answer.sweep.name,
+                     notes={"made by": f"workbook.rig.synthetic.run_up_record from a simulated run-up from "
+                                       f"{speeds[0]:g} to {speeds[-1]:g} Hz in {duration:g} s, noise {noise:g}, "
+                                       f"seed {seed}"})
