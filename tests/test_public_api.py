@@ -49,7 +49,7 @@ INTERNAL_MODULES = (
     "workbook.scene.excitation", "workbook.scene.hinge_law", "workbook.scene.link_workers",
     "workbook.scene.mode_budget", "workbook.scene.structural_damping",
     "workbook.solve", "workbook.solve.campbell", "workbook.solve.flexible_pylon", "workbook.solve.four_pole",
-    "workbook.solve.four_pole_set",
+    "workbook.solve.four_pole_set", "workbook.solve.fatigue",
     "workbook.solve.guards", "workbook.solve.harmonic", "workbook.solve.load_cases", "workbook.solve.method", "workbook.solve.modes",
     "workbook.solve.pipeline", "workbook.solve.preload", "workbook.solve.pylon_beam", "workbook.solve.pylon_mesh",
     "workbook.solve.pylon_structure", "workbook.solve.response_sweep", "workbook.solve.run_up",

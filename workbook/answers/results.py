@@ -79,6 +79,10 @@ class ExcitationResult(PylonAnswers):
     hinge_phasors : dict of str to ndarray, complex, shape (3,)
         Complex amplitude of each force channel, N: frequency-domain answers
         only (empty for a time-domain run).
+    link_phasors : dict of str to ndarray, complex, shape (n_modes,)
+        Complex amplitude of each flexible link's modal coordinates, whose
+        stress is ``S q`` (:func:`flexbodies.stress.state_stress`):
+        frequency-domain answers on a rigid pylon only (else empty).
     """
 
     name: str
@@ -96,6 +100,7 @@ class ExcitationResult(PylonAnswers):
     excitation_history: np.ndarray = field(repr=False)
     window: slice = field(repr=False)
     hinge_phasors: dict = field(default_factory=dict, repr=False)
+    link_phasors: dict = field(default_factory=dict, repr=False)
 
     @property
     def has_histories(self) -> bool:
