@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # meshing loads scikit-fem and gmsh: imported where a link is
 
 __all__ = ["VOIGT", "REGIONS", "NodalStress", "nodal_stress_operator", "von_mises", "max_principal",
            "link_regions", "state_stress", "alternating_von_mises", "signed_von_mises", "goodman_factor",
-           "gerber_factor"]
+           "gerber_factor", "write_vtu"]
 
 #: Stress components, in the order of the stress shapes.
 VOIGT = ("xx", "yy", "zz", "yz", "xz", "xy")
@@ -290,3 +290,28 @@ def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
     q = np.asarray(modal_coordinates)
     n = shapes.shape[0]
     return (shapes.reshape(6 * n, -1) @ q).reshape(n, 6)
+
+
+def write_vtu(path, link: ReducedLink, fields: dict, modes: int = 0):
+    """Write a link's surface with nodal fields as a VTU file (meshio) that ParaView opens.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.vtu`` file.
+    link : ReducedLink
+        Its surface triangles and FE nodes (link frame, m).
+    fields : dict of str to ndarray, shape (n,) or (n, k)
+        Point data at the FE nodes (e.g. a stress field, shape (n, 6), Pa).
+    modes : int
+        Also write the displacement of this many of the link's elastic modes
+        (``mode 1``, ..., m per modal unit).
+    """
+    import meshio
+
+    n = int(link.master_nodes[0])
+    data = {name: np.asarray(value, dtype=float) for name, value in fields.items()}
+    for k in range(min(modes, link.n_modes)):
+        data[f"mode {k + 1}"] = link.mode_basis[: 3 * n, k].reshape(n, 3)
+    meshio.write(str(path), meshio.Mesh(link.nodes[:n], [("triangle", np.asarray(link.surface_triangles))],
+                                        point_data=data))

@@ -1,14 +1,18 @@
 """Dynamic link stresses and fatigue factors (workbook.solve.fatigue, flexbodies.stress):
 the multiaxial criterion, Goodman and Gerber by hand, the quasi-static limit, the reference mount."""
 import dataclasses
+import json
 
 import numpy as np
 import pytest
 
 from flexbodies.materials import STEEL
 from flexbodies.stress import alternating_von_mises, gerber_factor, goodman_factor, state_stress, von_mises
-from workbook.errors import CaseError
+from workbook.cli.main import main
+from workbook.errors import EXIT_BAD_INPUT, CaseError
 from workbook.model.case import PointForce
+from workbook.model.codec import to_json
+from workbook.model.load_cases import LoadCase
 from workbook.scene.build import build_scene, reduce_links
 from workbook.solve.fatigue import solve_fatigue
 from workbook.solve.load_cases import link_coordinates
@@ -99,3 +103,33 @@ def test_a_material_without_endurance_strength_is_refused(coarse_reference):
                                                              for x in coarse_reference.links))
     with pytest.raises(CaseError, match=f"link '{link.name}', field 'material.endurance_strength'"):
         solve_fatigue(case)
+
+
+@pytest.mark.slow
+def test_the_stress_command_prints_json_and_writes_vtu(coarse_reference, tmp_path, capsys):
+    import meshio
+
+    path = tmp_path / "case.json"
+    path.write_text(to_json(dataclasses.replace(coarse_reference, load_cases=(LoadCase("cruise", thrust=23e3),))))
+    assert main(["stress", str(path), "--vtu", str(tmp_path / "vtu"), "--json"]) == 0
+    answer = json.loads(capsys.readouterr().out)
+    assert answer["load_cases"][0]["load_case"] == "cruise"
+    lp = answer["fatigue"]["excitations"][0]
+    assert lp["excitation"] == "LP rotor" and lp["links"]["rear-middle"]["goodman"] > 1
+    mesh = meshio.read(tmp_path / "vtu" / "rear-middle.vtu")
+    preload = mesh.point_data["preload stress"]
+    np.testing.assert_allclose(mesh.point_data["preload von Mises"], von_mises(preload), rtol=1e-12)
+    assert mesh.point_data["LP rotor alternating von Mises"].max() == pytest.approx(
+        lp["links"]["rear-middle"]["peak_alternating"], rel=1e-12)
+    assert mesh.point_data["mode 1"].shape == (len(preload), 3)
+
+
+def test_the_stress_command_names_a_missing_endurance_strength(coarse_reference, tmp_path, capsys):
+    path = tmp_path / "case.json"
+    path.write_text(to_json(coarse_reference))
+    bad = json.loads(path.read_text())
+    text = json.dumps(bad).replace('"endurance_strength": 235000000.0', '"endurance_strength": null', 1)
+    assert text != json.dumps(bad)
+    path.write_text(text)
+    assert main(["stress", str(path)]) == EXIT_BAD_INPUT
+    assert "material.endurance_strength" in capsys.readouterr().err

@@ -32,6 +32,7 @@ INTERNAL_MODULES = (
     "workbook.answers.saving", "workbook.answers.text_table", "workbook.answers.warning_groups",
     "workbook.cli", "workbook.cli.cache", "workbook.cli.campbell", "workbook.cli.four_pole", "workbook.cli.layout",
     "workbook.cli.links", "workbook.cli.loading", "workbook.cli.loads", "workbook.cli.main", "workbook.cli.outputs",
+    "workbook.cli.stress",
     "workbook.cli.params",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
     "workbook.excel", "workbook.excel.execute", "workbook.excel.files", "workbook.excel.impedance_sheet",

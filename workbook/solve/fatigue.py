@@ -111,12 +111,15 @@ class FatigueResult:
     stress_seconds : float
         Wall time of the stress recovery and the factors, all links and
         excitations, s.
+    reduced : dict of str to flexbodies.ReducedLink
+        The flexible links of that run (their meshes and stress shapes).
     """
 
     case: str
     excitations: list
     mean_stress: dict = field(repr=False)
     stress_seconds: float
+    reduced: dict = field(repr=False)
 
     def to_dict(self) -> dict:
         """JSON-ready, SI units (without the stress fields)."""
@@ -202,6 +205,7 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
                         "a rigid pylon: the link stresses are recovered on the mount's own scene")
     answers: list = []
     mean_stress: dict = {}
+    first: dict = {}
     seconds = 0.0
     for item in case.excitations:
         points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
@@ -225,5 +229,6 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
                 answers.append(ExcitationFatigue(point.name, point.frequency, links, amplitudes))
             if not mean_stress:
                 mean_stress = {name: state_stress(scene.reduced[name], q) for name, q in means.items()}
-    return FatigueResult(case.name, answers, mean_stress, seconds)
+                first = {name: scene.reduced[name] for name in means}
+    return FatigueResult(case.name, answers, mean_stress, seconds, first)
 
