@@ -10,7 +10,7 @@ from .errors import LinkModelError
 __all__ = ["Material", "STEEL", "TITANIUM", "material", "STRENGTH_FIELDS"]
 
 #: Fields of a :class:`Material` no reduction depends on (left out of a link's fingerprint).
-STRENGTH_FIELDS = ("yield_strength", "ultimate_strength")
+STRENGTH_FIELDS = ("yield_strength", "ultimate_strength", "endurance_strength")
 
 
 @dataclass(frozen=True)
@@ -33,6 +33,11 @@ class Material:
     ultimate_strength : float or None
         Tensile ultimate strength in Pa, for the margins at ultimate load;
         None: not known. At least the yield strength.
+    endurance_strength : float or None
+        Fully reversed (R = -1) fatigue strength of unnotched specimens at
+        10^7 cycles or more, in Pa, for the fatigue safety factors
+        (:mod:`workbook.solve.fatigue`); None: not known. At most the
+        ultimate strength.
 
     Raises
     ------
@@ -46,6 +51,7 @@ class Material:
     density: float
     yield_strength: float | None = None
     ultimate_strength: float | None = None
+    endurance_strength: float | None = None
 
     def __post_init__(self):
         _check_positive(self.name, "Young's modulus", self.youngs_modulus, "Pa")
@@ -57,6 +63,10 @@ class Material:
                 and self.ultimate_strength < self.yield_strength):
             raise LinkModelError(f"material {self.name!r}: the ultimate strength ({self.ultimate_strength!r} Pa) "
                                  f"is below the yield strength ({self.yield_strength!r} Pa)")
+        if (self.endurance_strength is not None and self.ultimate_strength is not None
+                and self.endurance_strength > self.ultimate_strength):
+            raise LinkModelError(f"material {self.name!r}: the endurance strength ({self.endurance_strength!r} Pa) "
+                                 f"is above the ultimate strength ({self.ultimate_strength!r} Pa)")
         nu = self.poisson_ratio
         if not (math.isfinite(nu) and -1.0 < nu < 0.5):
             raise LinkModelError(
@@ -86,17 +96,26 @@ def _check_positive(name: str, what: str, value: float, unit: str) -> None:
 
 
 STEEL = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0,
-                 yield_strength=355e6, ultimate_strength=470e6)
+                 yield_strength=355e6, ultimate_strength=470e6, endurance_strength=235e6)
 """Structural steel: E = 210 GPa, nu = 0.3, rho = 7850 kg/m^3; the strengths
 are the minimum values of grade S355 (EN 10025-2:2019, table 7): yield
 strength R_eH = 355 MPa (nominal thickness up to 16 mm) and tensile strength
-R_m = 470 MPa (the lower end of 470 to 630 MPa, thickness 3 to 100 mm)."""
+R_m = 470 MPa (the lower end of 470 to 630 MPa, thickness 3 to 100 mm). The
+endurance strength, 235 MPa, is the rotating-beam estimate
+S_e' = 0.5 R_m for steels with R_m up to 1400 MPa (Budynas and Nisbett,
+*Shigley's Mechanical Engineering Design*, 10th ed., eq. 6-8), with no
+surface, size or reliability factors."""
 
 TITANIUM = Material("titanium", youngs_modulus=114e9, poisson_ratio=0.34, density=4430.0,
-                    yield_strength=828e6, ultimate_strength=895e6)
+                    yield_strength=828e6, ultimate_strength=895e6, endurance_strength=510e6)
 """Titanium alloy Ti-6Al-4V: E = 114 GPa, nu = 0.34, rho = 4430 kg/m^3; the
 strengths are the minimum values of ASTM B265 grade 5 (annealed sheet and
-plate): yield strength (0.2 % offset) 828 MPa, tensile strength 895 MPa."""
+plate): yield strength (0.2 % offset) 828 MPa, tensile strength 895 MPa. The
+endurance strength, 510 MPa, is the unnotched (K_t = 1) fatigue strength at
+10^7 cycles of annealed Ti-6Al-4V in ASM's property data (ASM Aerospace
+Specification Metals data sheet "Titanium Ti-6Al-4V (Grade 5), Annealed";
+240 MPa with a K_t = 3.3 notch; the stress ratio is not stated there and is
+taken as fully reversed), a typical, not a minimum value."""
 
 _PRESETS = {m.name: m for m in (STEEL, TITANIUM)}
 

@@ -35,7 +35,8 @@ if TYPE_CHECKING:  # meshing loads scikit-fem and gmsh: imported where a link is
     from .reduced import ReducedLink
 
 __all__ = ["VOIGT", "REGIONS", "NodalStress", "nodal_stress_operator", "von_mises", "max_principal",
-           "link_regions", "state_stress"]
+           "link_regions", "state_stress", "alternating_von_mises", "signed_von_mises", "goodman_factor",
+           "gerber_factor", "write_vtu"]
 
 #: Stress components, in the order of the stress shapes.
 VOIGT = ("xx", "yy", "zz", "yz", "xz", "xy")
@@ -150,6 +151,85 @@ def von_mises(stress: np.ndarray) -> np.ndarray:
     return np.sqrt(0.5 * ((xx - yy) ** 2 + (yy - zz) ** 2 + (zz - xx) ** 2) + 3 * (yz**2 + xz**2 + xy**2))
 
 
+def _von_mises_product(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The bilinear form of the von Mises stress, ``von_mises(s)**2 == _von_mises_product(s, s)``, Pa^2."""
+    normal = 0.5 * sum((a[:, i] - a[:, j]) * (b[:, i] - b[:, j]) for i, j in ((0, 1), (1, 2), (2, 0)))
+    return normal + 3 * (a[:, 3] * b[:, 3] + a[:, 4] * b[:, 4] + a[:, 5] * b[:, 5])
+
+
+def alternating_von_mises(amplitude: np.ndarray) -> np.ndarray:
+    """Alternating equivalent stress of a harmonic stress ``Re(S exp(i w t))``, Pa.
+
+    The largest von Mises stress over the cycle,
+    ``max_phi von_mises(Re(S exp(i phi)))``: the stress path is an ellipse,
+    and this is half its major axis in the von Mises norm (its longest chord
+    over two). With ``A = Re S``, ``B = Im S`` and ``<.,.>`` the von Mises
+    bilinear form it is ``sqrt((a + b)/2 + sqrt(((a - b)/2)^2 + c^2))``,
+    ``a = <A, A>``, ``b = <B, B>``, ``c = <A, B>``. For proportional stress
+    (all components in phase) it is the von Mises stress of ``|S|``.
+
+    Parameters
+    ----------
+    amplitude : ndarray, complex, shape (n, 6)
+        Complex amplitude, Voigt order :data:`VOIGT`, Pa.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    s = np.asarray(amplitude, dtype=complex)
+    real, imag = s.real, s.imag
+    a, b, c = _von_mises_product(real, real), _von_mises_product(imag, imag), _von_mises_product(real, imag)
+    return np.sqrt(np.maximum(0.5 * (a + b) + np.sqrt(0.25 * (a - b) ** 2 + c**2), 0.0))
+
+
+def signed_von_mises(stress: np.ndarray) -> np.ndarray:
+    """Von Mises stress signed as the hydrostatic stress (negative when the trace is), shape (n, 6) -> (n,), Pa.
+
+    The equivalent mean stress of the fatigue factors: a compressive mean
+    (negative trace) counts as negative and earns no credit.
+    """
+    s = np.asarray(stress)
+    return np.where(s[:, 0] + s[:, 1] + s[:, 2] < 0, -1.0, 1.0) * von_mises(s)
+
+
+def goodman_factor(alternating, mean, endurance: float, ultimate: float) -> np.ndarray:
+    """Fatigue safety factor by the modified Goodman line.
+
+    ``1 / n = sigma_a / S_e + sigma_m / S_u`` for a tensile mean; a
+    compressive mean is taken as zero (``n = S_e / sigma_a``).
+
+    Parameters
+    ----------
+    alternating, mean : array_like
+        Equivalent alternating and (signed) mean stress, Pa.
+    endurance, ultimate : float
+        Endurance strength S_e and ultimate strength S_u, Pa.
+
+    Returns
+    -------
+    ndarray
+        The factor n (inf where nothing alternates and the mean is not tensile).
+    """
+    load = np.asarray(alternating, float) / endurance + np.maximum(np.asarray(mean, float), 0.0) / ultimate
+    with np.errstate(divide="ignore"):
+        return 1.0 / load
+
+
+def gerber_factor(alternating, mean, endurance: float, ultimate: float) -> np.ndarray:
+    """Fatigue safety factor by the Gerber parabola ``n sigma_a / S_e + (n sigma_m / S_u)^2 = 1``.
+
+    ``n = 2 S_e / (sigma_a + sqrt(sigma_a^2 + (2 sigma_m S_e / S_u)^2))``,
+    the root of Shigley's eq. 6-47 written without cancellation; a
+    compressive mean is taken as zero (``n = S_e / sigma_a``). Parameters
+    and return as :func:`goodman_factor`.
+    """
+    sa = np.asarray(alternating, float)
+    sm = np.maximum(np.asarray(mean, float), 0.0)
+    with np.errstate(divide="ignore"):
+        return 2 * endurance / (sa + np.sqrt(sa**2 + (2 * sm * endurance / ultimate) ** 2))
+
+
 def max_principal(stress: np.ndarray) -> np.ndarray:
     """Largest principal stress of Voigt stress, shape (n, 6) -> (n,), Pa."""
     s = np.asarray(stress)
@@ -194,17 +274,44 @@ def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
     link : ReducedLink
         Reduced with its stress shapes.
     modal_coordinates : array_like, shape (n_modes,)
+        Real, or complex for the amplitude of a harmonic state.
 
     Returns
     -------
     ndarray, shape (n, 6)
-        Stress at the FE nodes, link frame, Voigt order :data:`VOIGT`, Pa.
+        Stress at the FE nodes (complex for complex coordinates), link
+        frame, Voigt order :data:`VOIGT`, Pa.
     """
     from .errors import LinkModelError
 
     shapes = link.stress_modes
     if shapes.size == 0:
         raise LinkModelError("this reduced body was reduced without its stress shapes")
-    q = np.asarray(modal_coordinates, dtype=float)
+    q = np.asarray(modal_coordinates)
     n = shapes.shape[0]
     return (shapes.reshape(6 * n, -1) @ q).reshape(n, 6)
+
+
+def write_vtu(path, link: ReducedLink, fields: dict, modes: int = 0):
+    """Write a link's surface with nodal fields as a VTU file (meshio) that ParaView opens.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.vtu`` file.
+    link : ReducedLink
+        Its surface triangles and FE nodes (link frame, m).
+    fields : dict of str to ndarray, shape (n,) or (n, k)
+        Point data at the FE nodes (e.g. a stress field, shape (n, 6), Pa).
+    modes : int
+        Also write the displacement of this many of the link's elastic modes
+        (``mode 1``, ..., m per modal unit).
+    """
+    import meshio
+
+    n = int(link.master_nodes[0])
+    data = {name: np.asarray(value, dtype=float) for name, value in fields.items()}
+    for k in range(min(modes, link.n_modes)):
+        data[f"mode {k + 1}"] = link.mode_basis[: 3 * n, k].reshape(n, 3)
+    meshio.write(str(path), meshio.Mesh(link.nodes[:n], [("triangle", np.asarray(link.surface_triangles))],
+                                        point_data=data))

@@ -45,6 +45,13 @@ def test_four_pole_doc_is_current(cache_dir):
     assert not failures, "\n\n".join(failures)
 
 
+@pytest.mark.slow
+def test_stress_doc_is_current(cache_dir):
+    script = importlib.import_module("make_stress_docs")
+    failures = _differences(script.DOCUMENT, "make_stress_docs.py", script.sections())
+    assert not failures, "\n\n".join(failures)
+
+
 def _untimed_failures(name: str) -> list[str]:
     """Differences of every section of docs script *name* but its measured wall times (``TIMED``)."""
     script = importlib.import_module(name)

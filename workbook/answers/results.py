@@ -83,6 +83,10 @@ class ExcitationResult(PylonAnswers):
         Estimated relative error of T per direction that the links' omitted
         fixed-interface modes leave (:mod:`workbook.solve.truncation`);
         None when not estimated (time domain, flexible pylon).
+    link_phasors : dict of str to ndarray, complex, shape (n_modes,)
+        Complex amplitude of each flexible link's modal coordinates, whose
+        stress is ``S q`` (:func:`flexbodies.stress.state_stress`):
+        frequency-domain answers on a rigid pylon only (else empty).
     """
 
     name: str
@@ -101,6 +105,7 @@ class ExcitationResult(PylonAnswers):
     window: slice = field(repr=False)
     hinge_phasors: dict = field(default_factory=dict, repr=False)
     truncation_error: np.ndarray | None = field(default=None, repr=False)
+    link_phasors: dict = field(default_factory=dict, repr=False)
 
     @property
     def has_histories(self) -> bool:

@@ -17,7 +17,7 @@ from typing import Callable
 from workbook.cli.loading import load_case
 from workbook.errors import UsageError
 
-__all__ = ["arguments"]
+__all__ = ["arguments", "chosen_load_cases", "print_load_cases"]
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
@@ -42,23 +42,41 @@ def _margin(value) -> str:
     return "-" if value is None else f"{value:.2f}"
 
 
-def run(args) -> int:
-    from workbook.model.load_cases import reference_load_cases
-    from workbook.solve.load_cases import solve_load_cases
+def chosen_load_cases(case, names) -> tuple:
+    """The load cases of *case* (or the reference set when it has none), only those *names* when given.
 
-    case = load_case(args.case, run=args.run, rigid=args.rigid)
+    Raises
+    ------
+    UsageError
+        A name that is not a load case of the case.
+    """
+    from workbook.model.load_cases import reference_load_cases
+
     chosen = case.load_cases or reference_load_cases()
-    if args.load_case:
+    if names:
         known = {c.name: c for c in chosen}
-        missing = [name for name in args.load_case if name not in known]
+        missing = [name for name in names if name not in known]
         if missing:
             raise UsageError(f"--load-case {missing[0]!r}: not a load case of {case.name!r} "
                              f"(load cases: {', '.join(known)})")
-        chosen = tuple(known[name] for name in args.load_case)
-    results = solve_load_cases(case, chosen)
+        chosen = tuple(known[name] for name in names)
+    return tuple(chosen)
+
+
+def run(args) -> int:
+    from workbook.solve.load_cases import solve_load_cases
+
+    case = load_case(args.case, run=args.run, rigid=args.rigid)
+    results = solve_load_cases(case, chosen_load_cases(case, args.load_case))
     if args.json:
         print(json.dumps({"case": case.name, "load_cases": [r.to_dict() for r in results]}, indent=1))
         return 0
+    print_load_cases(case, results)
+    return 0
+
+
+def print_load_cases(case, results) -> None:
+    """Print the tables of solved load cases of *case*."""
     source = "the case's" if case.load_cases else "the reference set of"
     print(f"{case.name}: {len(results)} limit load case(s), {source} load cases; margins of safety "
           "MS_y = F_ty / sigma_vM - 1 at limit load, MS_u = F_tu / (FS sigma_vM) - 1 at ultimate load")
@@ -77,4 +95,3 @@ def run(args) -> int:
                   f"{s.von_mises_region or '-':>6s} {_mpa(s.max_principal):>11s} {s.max_principal_region or '-':>6s} "
                   f"{_margin(s.yield_margin):>8s} {_margin(s.ultimate_margin):>8s}")
         print(f"  stress recovery of all links: {result.stress_seconds:.3f} s")
-    return 0

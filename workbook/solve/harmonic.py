@@ -118,6 +118,9 @@ class HarmonicModel:
     residual_mass : ndarray, shape (n, n), or None
         R_z, the residual mass of the modes the flexible links omit, kg s^2
         (:mod:`workbook.solve.truncation`); None when not known.
+    link_coordinates : dict of str to slice
+        The elastic (modal) coordinates of each flexible link among the full
+        coordinates: its modal coordinates are ``basis[rows] @ z``.
     """
 
     linearization: Linearization
@@ -128,6 +131,7 @@ class HarmonicModel:
     engine_point_jacobian: Callable[[np.ndarray], np.ndarray] = field(repr=False)
     structural_output: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # None: zeros
     residual_mass: np.ndarray | None = field(default=None, repr=False)
+    link_coordinates: dict = field(default_factory=dict, repr=False)
     _inputs: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -171,8 +175,15 @@ class HarmonicModel:
     def respond_generalised(self, frequency_hz: float, load: np.ndarray, added=None) -> FrequencyResponse:
         """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*
         (*added*: see :meth:`motion`)."""
+        return self._forces(frequency_hz, self.motion(frequency_hz, load, added))
+
+    def link_phasors(self, motion: np.ndarray) -> dict:
+        """Modal-coordinate phasors of each flexible link for the motion phasor *motion* (shape (n,))."""
+        basis = self.linearization.basis
+        return {name: basis[rows] @ motion for name, rows in self.link_coordinates.items()}
+
+    def _forces(self, frequency_hz: float, motion: np.ndarray) -> FrequencyResponse:
         omega = 2 * np.pi * frequency_hz
-        motion = self.motion(frequency_hz, load, added)
         outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
         forces = (outputs @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces, strict=True))
@@ -181,7 +192,8 @@ class HarmonicModel:
 
     def result(self, excitation: SingleFrequencyExcitation, steady_tolerance: float) -> ExcitationResult:
         """The answers of *excitation* as an :class:`ExcitationResult` (no time histories)."""
-        response = self.respond_generalised(excitation.frequency, self.excitation_input(excitation))
+        motion = self.motion(excitation.frequency, self.excitation_input(excitation))
+        response = self._forces(excitation.frequency, motion)
         empty = np.zeros((0, 3))
         return ExcitationResult(
             name=excitation.name, frequency_hz=excitation.frequency,
@@ -190,7 +202,7 @@ class HarmonicModel:
             pylon_hinges=list(self.pylon_hinges), steady_change=0.0, steady_tolerance=steady_tolerance,
             warnings=[], time=np.zeros(0), hinge_histories={name: empty for name in self.hinge_names},
             pylon_history=empty, excitation_history=empty, window=slice(0, 0),
-            hinge_phasors=dict(response.hinge_forces))
+            hinge_phasors=dict(response.hinge_forces), link_phasors=self.link_phasors(motion))
 
 
 def _central_difference(evaluate, set_value, base: np.ndarray, indices, step: float) -> np.ndarray:
@@ -258,10 +270,13 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
         partial = _central_difference(position, set_q, q0, engine_coordinates, COORDINATE_STEP)
         return partial @ lin.basis[engine_coordinates]
 
+    links = {name: slice(mbs.GetNodeODE2Index(items.nodes[1]),
+                         mbs.GetNodeODE2Index(items.nodes[1]) + scene.reduced[name].n_modes)
+             for name, items in scene.links.items() if items.flexible}
     log.info("harmonic model of %r: %d independent coordinates, %d force channels", scene.case.name,
              lin.mass.shape[0], len(names))
     return HarmonicModel(lin, names, list(scene.pylon_channels), stiffness, damping, point_jacobian,
-                         structural_output, residual_stiffness(scene, lin.basis))
+                         structural_output, residual_stiffness(scene, lin.basis), links)
 
 
 def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.ndarray, names: list,

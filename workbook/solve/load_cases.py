@@ -32,8 +32,8 @@ from workbook.scene.build import build_scene, reduce_links
 from workbook.solve.preload import link_compression, solve_preload
 from workbook.solve.stress_stiffening import stiffen_links
 
-__all__ = ["LinkStress", "LoadCaseResult", "load_case_scene_case", "link_stress", "solve_load_case",
-           "solve_load_cases"]
+__all__ = ["LinkStress", "LoadCaseResult", "load_case_scene_case", "link_stress", "link_coordinates",
+           "solve_load_case", "solve_load_cases"]
 
 
 @dataclass(frozen=True)
@@ -176,6 +176,19 @@ def link_stress(link, reduced, modal_coordinates, axial_force: float, rotation, 
         ultimate_margin=_margin(material.ultimate_strength, factor_of_safety * float(vm[i])))
 
 
+def link_coordinates(scene) -> dict:
+    """The modal coordinates of every flexible link of *scene* in its current state.
+
+    Returns
+    -------
+    dict of str to ndarray, shape (n_modes,)
+    """
+    import exudyn as exu
+
+    return {name: np.array(scene.mbs.GetNodeOutput(items.nodes[1], exu.OutputVariableType.Coordinates))
+            for name, items in scene.links.items() if items.flexible}
+
+
 def solve_load_case(case: Case, load_case: LoadCase, *, reduced: dict | None = None) -> LoadCaseResult:
     """Solve one limit load case of *case* (see the module).
 
@@ -210,11 +223,10 @@ def solve_load_case(case: Case, load_case: LoadCase, *, reduced: dict | None = N
             coordinates = np.array(scene.mbs.GetNodeOutput(scene.engine.node, exu.OutputVariableType.Coordinates))
             start = time.perf_counter()
             links = {}
+            modal = link_coordinates(scene)
             for link in solved.links:
-                items = scene.links[link.name]
-                q = (np.array(scene.mbs.GetNodeOutput(items.nodes[1], exu.OutputVariableType.Coordinates))
-                     if items.flexible else None)
-                links[link.name] = link_stress(link, scene.reduced[link.name], q, tension[link.name], items.rotation,
+                links[link.name] = link_stress(link, scene.reduced[link.name], modal.get(link.name),
+                                               tension[link.name], scene.links[link.name].rotation,
                                                load_case.factor_of_safety)
             seconds = time.perf_counter() - start
     except BaseException:

@@ -1,0 +1,91 @@
+"""``mountwb stress [CASE] [--run R] [--load-case NAME] [--vtu DIR] [--json]``.
+
+Everything the package says of the links' strength: the static margins of
+the limit load cases (the tables of ``mountwb loads``,
+:mod:`workbook.solve.load_cases`), then per rotor excitation and link the
+dynamic stress on the preload and the fatigue safety factors by Goodman and
+Gerber (:mod:`workbook.solve.fatigue`). ``--vtu DIR`` writes each flexible
+link's surface with its preload stress, the dynamic stress amplitude of each
+excitation and its first mode shapes, one VTU file per link (ParaView).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Callable
+
+from workbook.cli.loading import load_case
+
+__all__ = ["arguments"]
+
+#: Mode shapes written with each link's VTU file.
+VTU_MODES = 6
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    parser.add_argument("--run", metavar="R", help="case workbook: take the case of this row of the Runs sheet")
+    parser.add_argument("--load-case", dest="load_case", metavar="NAME", action="append",
+                        help="solve only this load case (repeatable)")
+    parser.add_argument("--vtu", metavar="DIR", help="write each link's mesh with its stress fields as DIR/<link>.vtu")
+    parser.add_argument("--json", action="store_true", help="print everything as JSON (SI units) instead of tables")
+    return run
+
+
+def run(args) -> int:
+    from workbook.cli.loads import chosen_load_cases, print_load_cases
+    from workbook.solve.fatigue import solve_fatigue
+    from workbook.solve.load_cases import solve_load_cases
+
+    case = load_case(args.case, run=args.run)
+    chosen = chosen_load_cases(case, args.load_case)
+    fatigue = solve_fatigue(case)
+    results = solve_load_cases(case, chosen) if chosen else []
+    if args.vtu:
+        write_fields(Path(args.vtu), fatigue)
+    if args.json:
+        print(json.dumps({"case": case.name, "load_cases": [r.to_dict() for r in results],
+                          "fatigue": fatigue.to_dict()}, indent=1))
+        return 0
+    print_load_cases(case, results)
+    print("\nfatigue on the preload (the case's static loads): alternating stress sigma_a = largest von Mises "
+          "over the cycle, mean sigma_m = von Mises of the preload stress signed by its hydrostatic part; "
+          "Goodman 1/n = sigma_a/S_e + sigma_m/S_u, Gerber n sigma_a/S_e + (n sigma_m/S_u)^2 = 1")
+    for answer in fatigue.excitations:
+        print(f"\n{answer.excitation} ({answer.frequency_hz:g} Hz)")
+        print(f"  {'link':16s} {'peak sigma_a MPa':>16s} {'sigma_a MPa':>11s} {'sigma_m MPa':>11s} "
+              f"{'Goodman':>9s} {'Gerber':>9s} {'at':>6s}")
+        for name, f in answer.links.items():
+            print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
+                  f"{f.goodman:9.3g} {f.gerber:9.3g} {f.region:>6s}")
+    print(f"\nstress recovery and fatigue factors, all links and excitations: {fatigue.stress_seconds:.3f} s")
+    if args.vtu:
+        print(f"VTU files: {args.vtu}/<link>.vtu")
+    return 0
+
+
+def write_fields(directory: Path, fatigue) -> list[Path]:
+    """Write ``directory/<link>.vtu`` for each flexible link of a :class:`~workbook.solve.fatigue.FatigueResult`.
+
+    Point data: ``preload stress`` (Voigt xx, yy, zz, yz, xz, xy, Pa, link
+    frame) and its ``preload von Mises``; per excitation its ``alternating
+    von Mises`` and the real and imaginary parts of its stress amplitude
+    (Pa); the first :data:`VTU_MODES` mode shapes.
+    """
+    from flexbodies.stress import alternating_von_mises, von_mises, write_vtu
+
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name, link in fatigue.reduced.items():
+        mean = fatigue.mean_stress[name]
+        fields = {"preload stress": mean, "preload von Mises": von_mises(mean)}
+        for answer in fatigue.excitations:
+            amplitude = answer.amplitudes[name]
+            fields[f"{answer.excitation} alternating von Mises"] = alternating_von_mises(amplitude)
+            fields[f"{answer.excitation} amplitude (real)"] = amplitude.real
+            fields[f"{answer.excitation} amplitude (imaginary)"] = amplitude.imag
+        path = directory / f"{name}.vtu"
+        write_vtu(path, link, fields, modes=VTU_MODES)
+        written.append(path)
+    return written
