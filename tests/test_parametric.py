@@ -76,6 +76,22 @@ def test_row_case_sets_every_parameter(base):
         row_case(base, {"hinge_stiffness": 0.0}, 0)
 
 
+def test_hinge_parameters_by_group_and_direction(base):
+    case = row_case(base, {"hinge_stiffness/front/axial": 1e8, "hinge_loss_factor/all/radial": 0.05,
+                           "engine_mass": 2500.0}, 1)
+    for hinge, before in zip(case.hinges, base.hinges, strict=True):
+        axial = 1e8 if hinge.name.startswith("front") else before.values("stiffness")[2]
+        np.testing.assert_array_equal(hinge.values("stiffness"), [*before.values("stiffness")[:2], axial])
+        np.testing.assert_array_equal(hinge.values("loss_factor"), [0.05, 0.05, before.values("loss_factor")[2]])
+    assert case.engine.mass == 2500.0 and case.engine.inertia == base.engine.inertia
+    with pytest.raises(ValueError, match="DIRECTION: radial1"):
+        row_case(base, {"hinge_stiffness/front/up": 1e8}, 0)
+    with pytest.raises(CaseError, match="start of hinge names"):
+        row_case(base, {"hinge_damping/middle": 1.0}, 0)
+    with pytest.raises(CaseError, match="test-rig force transducers"):
+        row_case(base, {"transducer_stiffness": 1e8}, 0)
+
+
 def test_processes_equal_serial_and_failing_rows_are_reported(base, rows, serial):
     processes = study_frame(rows, run_rows(study_cases(base, rows), workers=2))
     pd.testing.assert_frame_equal(_answers(processes), _answers(serial), check_exact=True)

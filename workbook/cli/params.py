@@ -32,7 +32,7 @@ import os
 import sys
 
 from workbook.cli.loading import load_case
-from workbook.errors import EXIT_FAILED_ROWS, EXIT_OK, UsageError
+from workbook.errors import EXIT_FAILED_ROWS, EXIT_OK, InputError, UsageError
 
 __all__ = ["add_arguments", "run_parameter_study", "parse_vary"]
 
@@ -43,7 +43,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from workbook.studies.sensitivity import TABLE_FORMATS
 
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=SPEC",
-                       help=f"parameter ({', '.join(PARAMETERS)}) and its values: a,b,c or low:high:points "
+                       help=f"parameter ({', '.join(PARAMETERS)}; a hinge parameter also as NAME/GROUP[/DIRECTION], "
+                            "e.g. hinge_stiffness/front/axial) and its values: a,b,c or low:high:points "
                             "(with --lhs: low:high); SI units")
     parser.add_argument("--lhs", type=int, metavar="N", help="N Latin-hypercube samples over the --vary bounds")
     parser.add_argument("--seed", type=int, default=0, help="Latin-hypercube seed (0)")
@@ -72,7 +73,7 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
     ValueError
         A malformed option, naming it.
     """
-    from workbook.studies.parametric import PARAMETERS, grid, latin_hypercube, linear_range
+    from workbook.studies.parametric import grid, latin_hypercube, linear_range, parameter
 
     if not specs:
         raise UsageError("a parameter study needs at least one --vary NAME=SPEC")
@@ -80,9 +81,13 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
     for spec in specs:
         name, sep, text = spec.partition("=")
         name = name.strip()
-        if not sep or name not in PARAMETERS:
-            raise UsageError(f"--vary {spec!r}: expected NAME=SPEC with NAME one of {', '.join(PARAMETERS)}")
-        numeric = PARAMETERS[name].numeric
+        if not sep:
+            raise UsageError(f"--vary {spec!r}: expected NAME=SPEC")
+        try:
+            parameter(name)
+        except InputError as error:
+            raise UsageError(f"--vary {spec!r}: {error}") from None
+        numeric = parameter(name).numeric
         try:
             parts = text.split(":")
             if lhs is not None:

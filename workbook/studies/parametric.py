@@ -18,7 +18,15 @@ section_scale      -      factor on the cross-section of every link (shank width
 material           text   preset material of every link (steel, titanium)
 frequency          Hz     frequency of every single-frequency excitation
 removed_link       text   a link removed with its hinges (``none``: all kept)
+transducer_stiffness N/m  stiffness of every test-rig force transducer, x y z
+engine_mass        kg     the engine's mass (its inertia kept)
 =================  =====  ====================================================
+
+A hinge parameter may name a group of hinges and a direction of the hinge
+frame: ``hinge_stiffness/front`` sets the hinges whose names start with
+``front``, ``hinge_loss_factor/thrust/axial`` their axial loss factor
+(directions ``radial1``, ``radial2``, ``radial``: both, ``axial``; the
+group ``all``: every hinge). :func:`parameter` reads such a name.
 
 Rows come from lists or ranges (:func:`grid`, all combinations) or from a
 Latin hypercube over ranges (:func:`latin_hypercube`).
@@ -36,7 +44,7 @@ import numpy as np
 from workbook.errors import CaseError, InputError
 from workbook.model.case import Case, HarmonicForce, RotatingForce
 
-__all__ = ["Parameter", "PARAMETERS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases",
+__all__ = ["Parameter", "PARAMETERS", "parameter", "HINGE_DIRECTIONS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases",
            "MAX_STUDY_ROWS"]
 
 
@@ -66,6 +74,60 @@ class Parameter:
 
 def _hinges(case: Case, **changes) -> Case:
     return dataclasses.replace(case, hinges=tuple(dataclasses.replace(h, **changes) for h in case.hinges))
+
+
+#: Directions of a hinge's frame a hinge parameter may name, as indices of its three values.
+HINGE_DIRECTIONS = {"radial1": (0,), "radial2": (1,), "radial": (0, 1), "axial": (2,)}
+#: The group of every hinge in a qualified hinge parameter.
+ALL_HINGES = "all"
+
+
+def _hinge_values(case: Case, field_name: str, value: float, group: str, direction: str, name: str) -> Case:
+    """*case* with *field_name* of the hinges of *group* (all: every hinge) set to *value* in *direction*."""
+    names = [h.name for h in case.hinges]
+    chosen = {n for n in names if group == ALL_HINGES or n.startswith(group)}
+    if not chosen:
+        raise CaseError("study", name, group, f"the start of hinge names or {ALL_HINGES!r}; hinges: {', '.join(names)}")
+    hinges = []
+    for hinge in case.hinges:
+        if hinge.name in chosen:
+            values = hinge.values(field_name).copy()
+            values[list(HINGE_DIRECTIONS.get(direction, (0, 1, 2)))] = value
+            changed: Any = tuple(float(v) for v in values)
+            hinge = dataclasses.replace(hinge, **{field_name: changed})
+        hinges.append(hinge)
+    return dataclasses.replace(case, hinges=tuple(hinges))
+
+
+def _transducers(case: Case, stiffness: float) -> Case:
+    if case.test_rig is None:
+        raise CaseError("study", "transducer_stiffness", stiffness, "a case with test-rig force transducers")
+    return dataclasses.replace(case, test_rig=dataclasses.replace(case.test_rig, stiffness=(float(stiffness),) * 3))
+
+
+def parameter(name: str) -> Parameter:
+    """The study parameter *name*: one of :data:`PARAMETERS`, or a hinge parameter qualified by a group
+    and a direction (module text).
+
+    Raises
+    ------
+    InputError
+        An unknown name, group syntax or direction, naming it and what is known.
+    """
+    if name in PARAMETERS:
+        return PARAMETERS[name]
+    base, _, qualifier = name.partition("/")
+    group, _, direction = qualifier.partition("/")
+    field_name = {"hinge_stiffness": "stiffness", "hinge_damping": "damping", "hinge_loss_factor": "loss_factor"}
+    if base not in field_name or not group or (direction and direction not in HINGE_DIRECTIONS):
+        raise InputError(f"unknown study parameter {name!r}; known: {', '.join(PARAMETERS)}, and hinge_stiffness, "
+                         f"hinge_damping or hinge_loss_factor as NAME/GROUP or NAME/GROUP/DIRECTION (GROUP: the "
+                         f"start of hinge names or {ALL_HINGES!r}; DIRECTION: {', '.join(HINGE_DIRECTIONS)})")
+    where = "every hinge" if group == ALL_HINGES else f"the hinges whose names start with {group!r}"
+    general = PARAMETERS[base]
+    return Parameter(name, general.unit, f"{general.help.split(' of every hinge')[0]} of {where}"
+                     + (f", {direction}" if direction else ""),
+                     lambda case, v: _hinge_values(case, field_name[base], float(v), group, direction, name))
 
 
 def _link_models(case: Case, change: Callable, parameter: str, value: Any) -> Case:
@@ -129,6 +191,10 @@ PARAMETERS = {p.name: p for p in (
     Parameter("frequency", "Hz", "frequency of every single-frequency excitation", _frequency),
     Parameter("removed_link", "text", "a link removed with its hinges (none: all kept)",
               lambda case, name: case if name == "none" else case.without_link(name)),
+    Parameter("transducer_stiffness", "N/m", "stiffness of every test-rig force transducer in x, y and z",
+              _transducers),
+    Parameter("engine_mass", "kg", "the engine's mass (its inertia kept)",
+              lambda case, v: dataclasses.replace(case, engine=dataclasses.replace(case.engine, mass=float(v)))),
 )}
 
 
@@ -144,10 +210,8 @@ def _check_rows(count: int, what: str) -> None:
 
 
 def _check_names(names) -> None:
-    unknown = [n for n in names if n not in PARAMETERS]
-    if unknown:
-        raise InputError(f"unknown study parameter(s) {', '.join(map(repr, unknown))}; "
-                         f"known: {', '.join(PARAMETERS)}")
+    for name in names:
+        parameter(name)
 
 
 def grid(values: dict[str, list]) -> tuple[dict, ...]:
@@ -195,7 +259,7 @@ def latin_hypercube(bounds: dict[str, tuple[float, float]], samples: int, seed: 
     from scipy.stats import qmc
 
     _check_names(bounds)
-    text = [n for n in bounds if not PARAMETERS[n].numeric]
+    text = [n for n in bounds if not parameter(n).numeric]
     if text:
         raise InputError(f"a Latin hypercube needs numeric ranges; {', '.join(text)} takes a list")
     if samples < 1:
@@ -217,7 +281,7 @@ def row_case(case: Case, row: dict, index: int) -> Case:
     """
     _check_names(row)
     for name, value in row.items():
-        case = PARAMETERS[name].apply(case, value)
+        case = parameter(name).apply(case, value)
     return dataclasses.replace(case, name=f"{case.name} / row {index}")
 
 

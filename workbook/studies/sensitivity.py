@@ -27,7 +27,7 @@ from workbook.answers.saving import free_stem, save_csv, save_figure
 from workbook.errors import UsageError
 from workbook.model.case import DIRECTIONS
 from workbook.studies.parallel import RowOutcome
-from workbook.studies.parametric import PARAMETERS
+from workbook.studies.parametric import parameter
 
 __all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "StudyTable", "table_path",
            "new_study_table", "STUDY_STEM", "read_finished", "WRITE_INTERVAL"]
@@ -99,7 +99,7 @@ def plot_sensitivity(frame, parameters: list[str]):
         data = ok[ok["run"] == run]
         for j, name in enumerate(parameters):
             ax = axes[i, j]
-            if PARAMETERS[name].numeric:
+            if parameter(name).numeric:
                 x = data[name].astype(float)
             else:
                 labels = list(dict.fromkeys(ok[name]))
@@ -107,7 +107,7 @@ def plot_sensitivity(frame, parameters: list[str]):
                 ax.set_xticks(range(len(labels)), labels)
             for axis in DIRECTIONS:
                 ax.plot(x, data[f"T {axis}"], "o", ms=4, alpha=0.7, label=f"T {axis}")
-            unit = PARAMETERS[name].unit
+            unit = parameter(name).unit
             ax.set_xlabel(name if unit in ("-", "text") else f"{name} [{unit}]")
             if j == 0:
                 ax.set_ylabel(f"{run}\nT")
@@ -261,8 +261,8 @@ def _study_workbook(frame, parameters: list[str]):
 
     from workbook.excel.styling import write_frame
 
-    headers = {name: f"{name.replace('_', ' ')} {PARAMETERS[name].unit}" for name in parameters
-               if PARAMETERS[name].numeric}
+    headers = {name: f"{name.replace('_', ' ')} {parameter(name).unit}" for name in parameters
+               if parameter(name).numeric}
     workbook = Workbook()
     workbook.active.title = "Parameter study"
     write_frame(workbook.active, frame.rename(columns=headers),
