@@ -88,3 +88,20 @@ def test_study_rows_on_the_prepared_mount_equal_the_pipeline_rows(mount):
             t_fast = np.array([f_run[f"T {d}"] for d in "xyz"])
             t_exact = np.array([e_run[f"T {d}"] for d in "xyz"])
             assert _normwise(t_fast, t_exact) < 5e-6
+
+
+def test_design_derivatives_equal_differences_of_evaluations(mount):
+    """dT/dp and d|F|/dp by the direct method against central differences of whole evaluations, for
+    parameters that reach the preload (stiffness, engine mass), the stress stiffening and the harmonic
+    answer only (loss factor, damping)."""
+    from workbook.design.sensitivity import design_sensitivity, difference_sensitivity
+
+    values = {"hinge_stiffness/front": 5e7, "hinge_stiffness/rear/axial": 3e7, "hinge_loss_factor/thrust": 0.05,
+              "engine_mass": 2300.0, "hinge_damping/all": 200.0}
+    direct, differences = design_sensitivity(mount, values), difference_sensitivity(mount, values)
+    np.testing.assert_allclose(direct.transmissibility, differences.transmissibility, rtol=1e-12)
+    for j in range(len(values)):
+        assert _normwise(direct.gradient[..., j], differences.gradient[..., j]) < 1e-5
+        assert _normwise(direct.hinge_gradient[..., j], differences.hinge_gradient[..., j]) < 1e-5
+    assert np.all(np.abs(direct.gradient).max(axis=(0, 1)) > 0)
+    assert direct.to_pandas().shape == (6, 5)

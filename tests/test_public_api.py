@@ -25,7 +25,7 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 #: Modules of the implementation: importable, but their names may change between versions.
 INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.channel_set", "workbook.design.expansion",
-    "workbook.design.kinematics",
+    "workbook.design.kinematics", "workbook.design.sensitivity",
     "workbook.design.linear_mount",
     "workbook.answers", "workbook.answers.amplitude", "workbook.answers.hinge_curves", "workbook.answers.isolation",
     "workbook.answers.link_stiffness",

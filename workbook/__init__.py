@@ -38,6 +38,7 @@ _HOMES = {
     "solve.modes": ("mounted_modes", "Mode"),
     "solve.campbell": ("campbell", "CampbellDiagram"),
     "design.linear_mount": ("LinearMount", "DesignAnswer"),
+    "design.sensitivity": ("DesignSensitivity", "design_sensitivity"),
     "answers.results": ("MountResult", "ExcitationResult"),
     "answers.isolation": ("transmissibility", "efficiency", "level_db"),
     "excel.reader": ("read_workbook", "CaseBook"),

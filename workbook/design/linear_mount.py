@@ -43,7 +43,7 @@ from workbook.scene.build import Scene, loss_factors
 from workbook.solve.harmonic import point_phasors
 from workbook.solve.stages import link_warnings
 
-__all__ = ["LinearMount", "DesignAnswer", "channel_frames", "channel_springs"]
+__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "channel_frames", "channel_springs"]
 
 
 def channel_frames(case: Case, channels: list[str]) -> np.ndarray:
@@ -214,7 +214,7 @@ class LinearMount:
             raise OutsideDesignModel(case.name, "other excitations")
         for item in case.excitations:
             prepared = self.items[item.name]
-            for excitation in _points_of(item):
+            for excitation in points_of(item):
                 for point, _ in point_phasors(excitation):
                     if tuple(np.round(np.asarray(point, dtype=float), 12)) not in prepared.expansion.points:
                         raise OutsideDesignModel(case.name, f"{excitation.name!r} acts at a point the prepared "
@@ -241,21 +241,33 @@ class LinearMount:
             or is excited on an undamped resonance.
         """
         start = time.perf_counter()
-        self.check(case)
-        springs = channel_springs(case, self.channels, self.frames)
         runs, static = [], {}
-        for item in case.excitations:
-            prepared = self.items[item.name]
-            state = _solve_state(case, prepared, springs)
-            model = _harmonic(case, prepared, springs, state)
-            static[item.name] = dict(zip(self.channels, state.forces, strict=True))
-            for excitation in _points_of(item):
-                runs.append(_answer(case, prepared, model, excitation, self.channels, self.pylon))
+        for item, solution in zip(case.excitations, self.solve_items(case), strict=True):
+            static[item.name] = dict(zip(self.channels, solution.state.forces, strict=True))
+            for excitation in points_of(item):
+                runs.append(_answer(case, solution.prepared, solution.model, excitation, self.channels, self.pylon))
         result = MountResult(case.name, runs, dict(self._cards), dict(self._preloads))
         return DesignAnswer(result, static, time.perf_counter() - start)
 
+    def solve_items(self, case: Case) -> list["ItemSolution"]:
+        """The preload and the linear model of every excitation item of the design *case*.
 
-def _points_of(item) -> tuple:
+        Raises
+        ------
+        As :meth:`evaluate`.
+        """
+        self.check(case)
+        springs = channel_springs(case, self.channels, self.frames)
+        solutions = []
+        for item in case.excitations:
+            prepared = self.items[item.name]
+            state = _solve_state(case, prepared, springs)
+            solutions.append(ItemSolution(prepared, springs, state, linear_model(case, prepared, springs, state)))
+        return solutions
+
+
+def points_of(item) -> tuple:
+    """The single-frequency excitations of an excitation item (a sweep's points, a simultaneous set's parts)."""
     return item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
 
 
@@ -264,9 +276,9 @@ def _check_mode_decisions(case: Case, base: Case) -> None:
     from workbook.scene.build import link_jobs
 
     for item, base_item in zip(case.excitations, base.excitations, strict=True):
-        if max(p.frequency for p in _points_of(item)) == max(p.frequency for p in _points_of(base_item)):
+        if max(p.frequency for p in points_of(item)) == max(p.frequency for p in points_of(base_item)):
             continue
-        highest = max(_points_of(item), key=lambda point: point.frequency)
+        highest = max(points_of(item), key=lambda point: point.frequency)
         new = {name: job.modes for job, names in link_jobs(case, highest).items() for name in names}
         if any(case.link_modes(name) == "auto" for name in new):
             raise OutsideDesignModel(case.name, f"{item.name!r} at another frequency: the links' automatic mode "
@@ -331,6 +343,7 @@ class _State:
     tensions: dict             # used in K_r + P K_G,r per flexible link (0: not stiffened)
     forces: np.ndarray         # (channels, 3) static channel forces, N
     loads: StateLoads
+    passes: tuple = ()         # (dq, tensions, loads) of each preload solve, the last being this state's
 
 
 def _engine_rotation_map(angles: np.ndarray) -> np.ndarray:
@@ -381,8 +394,10 @@ def _solve_state(case: Case, prepared: _Item, springs: ChannelSprings) -> _State
         except np.linalg.LinAlgError as error:
             raise UnstablePreloadError(f"{case.name}: the design's preload has no stable equilibrium ({error})",
                                        []) from None
+        passes.append((dq, tensions, loads))
         return dq, _channel_forces(prepared, springs, dq), loads
 
+    passes: list = []
     dq, forces, loads = solve({}, np.zeros(prepared.size))
     tensions: dict = {}
     if prepared.links:
@@ -399,21 +414,21 @@ def _solve_state(case: Case, prepared: _Item, springs: ChannelSprings) -> _State
                 chosen.append(link.name)
             tensions[link.name] = tension
         used = {name: tensions[name] for name in chosen}
-        passes = 0
-        while chosen and passes < MAX_PASSES:
+        while chosen and len(passes) <= MAX_PASSES:
             dq, forces, loads = solve(used, dq)
-            passes += 1
             new = dict(zip(names, -np.einsum("lcx,cx->l", prepared.compression, forces), strict=True))
             change = max(abs(new[name] - used[name]) for name in chosen) / max(abs(used[name]) for name in chosen)
-            if change <= TENSION_TOLERANCE or passes == MAX_PASSES:
+            if change <= TENSION_TOLERANCE or len(passes) > MAX_PASSES:
                 break
             used = {name: new[name] for name in chosen}
         tensions = used
-    return _State(dq, tensions, forces, loads)
+    return _State(dq, tensions, forces, loads, tuple(passes))
 
 
 @dataclass(frozen=True)
 class _Harmonic:
+    """The projected linear model at a state: ``Z = K - w^2 M + i (w D + H)``, outputs ``C_k + i (C_h + w C_d)``."""
+
     mass: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
@@ -422,8 +437,33 @@ class _Harmonic:
     basis: Projection
     inputs: dict                # point -> (n, 3)
 
+    def dynamic(self, omega: float) -> np.ndarray:
+        """Z at the circular frequency *omega* (rad/s), shape (n, n)."""
+        return self.stiffness - omega ** 2 * self.mass + 1j * (omega * self.damping + self.structural)
 
-def _harmonic(case: Case, prepared: _Item, springs: ChannelSprings, state: _State) -> _Harmonic:
+    def output(self, omega: float) -> np.ndarray:
+        """The channel force phasors per motion phasor at *omega*, shape (3 C, n)."""
+        stiffness_output, damping_output, structural_output = self.outputs
+        return stiffness_output + 1j * (structural_output + omega * damping_output)
+
+    def load(self, excitation: SingleFrequencyExcitation) -> np.ndarray:
+        """The generalised force phasor of *excitation*, shape (n,)."""
+        return sum(self.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))] @ phasor
+                   for p, phasor in point_phasors(excitation))
+
+
+@dataclass(frozen=True)
+class ItemSolution:
+    """One excitation item of a design, solved: what :mod:`workbook.design.sensitivity` differentiates."""
+
+    prepared: _Item
+    springs: ChannelSprings
+    state: _State
+    model: _Harmonic
+
+
+def linear_model(case: Case, prepared: _Item, springs: ChannelSprings, state: _State) -> _Harmonic:
+    """The projected linear model of the item *prepared* at the preloaded *state*."""
     expansion, dq = prepared.expansion, state.dq
     channels = expansion.channels
     at = channels.state(total(expansion, dq))
@@ -453,16 +493,12 @@ def _harmonic(case: Case, prepared: _Item, springs: ChannelSprings, state: _Stat
 def _answer(case: Case, prepared: _Item, model: _Harmonic, excitation: SingleFrequencyExcitation,
             channels: list[str], pylon: list[str]) -> ExcitationResult:
     omega = 2 * np.pi * excitation.frequency
-    load = sum(model.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))] @ phasor
-               for p, phasor in point_phasors(excitation))
-    dynamic = model.stiffness - omega ** 2 * model.mass + 1j * (omega * model.damping + model.structural)
     try:
-        motion = sla.solve(dynamic, load, check_finite=False)
+        motion = sla.solve(model.dynamic(omega), model.load(excitation), check_finite=False)
     except (np.linalg.LinAlgError, sla.LinAlgWarning) as error:
         raise ResonanceError(f"{case.name} / {excitation.name}: the design is excited on an undamped resonance at "
                              f"{excitation.frequency:g} Hz ({error})") from None
-    stiffness_output, damping_output, structural_output = model.outputs
-    forces = ((stiffness_output + 1j * (structural_output + omega * damping_output)) @ motion).reshape(-1, 3)
+    forces = (model.output(omega) @ motion).reshape(-1, 3)
     amplitudes = dict(zip(channels, np.abs(forces), strict=True))
     pylon_force = forces[[channels.index(name) for name in pylon]].sum(axis=0)
     empty = np.zeros((0, 3))

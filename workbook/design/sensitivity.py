@@ -1,0 +1,265 @@
+"""Derivatives of a design's T and hinge forces with respect to its parameters (the direct method).
+
+A parameter (a name of :func:`workbook.studies.parametric.parameter`:
+hinge stiffness, damping or loss factor, per hinge group and direction,
+transducer stiffness, engine mass) changes the channel springs and the
+engine's mass linearly; those changes are exact differences of the
+springs at two values. Through them it moves, in order:
+
+1. each preload solve of the stress-stiffening passes: ``dq = -K_t^-1
+   (dR/dp + dR/dP dP/dp)``, the tensions P of a pass being the previous
+   pass's link forces (``dP = -compression . dF``);
+2. the linear model at the final state: its explicit change, the change of
+   the links' stiffening with the tensions, and its change along ``dq``
+   (the one part differenced: central, a state step of
+   :data:`STATE_STEP`);
+3. each answer: ``du = Z^-1 (df - dZ u)``, ``dy = dC u + C du`` and
+   ``d|y| = Re(conj(y) dy) / |y|``.
+
+:func:`difference_sensitivity` differences whole evaluations, the check
+of :func:`design_sensitivity` (``tests/test_design_sensitivity.py``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+
+from workbook.design.assembly import (
+    ChannelSprings,
+    projection,
+    rest_matrices,
+    tangent_stiffness,
+    total,
+    without_normal,
+)
+from workbook.design.linear_mount import DesignAnswer, ItemSolution, LinearMount, linear_model, points_of
+from workbook.model.case import DIRECTIONS, Case, Gravity
+
+__all__ = ["DesignSensitivity", "design_sensitivity", "difference_sensitivity", "design_case", "STATE_STEP"]
+
+#: Largest coordinate change (m, rad, modal coordinates) of the central difference along the state change.
+STATE_STEP = 1e-6
+
+
+@dataclass(frozen=True)
+class DesignSensitivity:
+    """A design's answers and their derivatives with respect to its parameters.
+
+    Attributes
+    ----------
+    parameters : list of str
+    values : ndarray, shape (P,)
+        The design's parameter values (SI units).
+    answer : DesignAnswer
+    runs : list of str
+    channels : list of str
+        Force channels (hinges, then transducers).
+    transmissibility : ndarray, shape (R, 3)
+        T per run and direction.
+    gradient : ndarray, shape (R, 3, P)
+        dT/dp, per unit of each parameter.
+    hinge_amplitudes : ndarray, shape (R, C, 3)
+        |F| per run, channel and direction, N.
+    hinge_gradient : ndarray, shape (R, C, 3, P)
+        d|F|/dp.
+    method : str
+        ``"direct"`` or ``"central differences"``.
+    seconds : float
+        Wall time, s.
+    """
+
+    parameters: list
+    values: np.ndarray
+    answer: DesignAnswer
+    runs: list
+    channels: list
+    transmissibility: np.ndarray
+    gradient: np.ndarray
+    hinge_amplitudes: np.ndarray
+    hinge_gradient: np.ndarray
+    method: str
+    seconds: float
+
+    def to_pandas(self):
+        """dT/dp as a table: one row per run and direction, one column per parameter."""
+        import pandas as pd
+
+        index = pd.MultiIndex.from_product([self.runs, [f"T {d}" for d in DIRECTIONS]], names=["run", "answer"])
+        return pd.DataFrame(self.gradient.reshape(-1, len(self.parameters)), index=index,
+                            columns=[f"d/d {name}" for name in self.parameters])
+
+
+def design_case(mount: LinearMount, values: dict) -> Case:
+    """The prepared case with the parameter *values* put in (its name kept)."""
+    from workbook.studies.parametric import parameter
+
+    case = mount.case
+    for name, value in values.items():
+        case = parameter(name).apply(case, value)
+    return case
+
+
+def _answers(answer: DesignAnswer, channels: list) -> tuple[list, np.ndarray, np.ndarray]:
+    runs = answer.result.runs
+    return ([run.name for run in runs], np.array([run.transmissibility for run in runs]),
+            np.array([[run.hinge_amplitudes[name] for name in channels] for run in runs]))
+
+
+def difference_sensitivity(mount: LinearMount, values: dict, relative_step: float = 1e-4) -> DesignSensitivity:
+    """The derivatives by central differences of whole evaluations (step *relative_step* of each value,
+    or of 1 where the value is 0)."""
+    start = time.perf_counter()
+    answer = mount.evaluate(design_case(mount, values))
+    runs, t, hinges = _answers(answer, mount.channels)
+    gradient = np.zeros(t.shape + (len(values),))
+    hinge_gradient = np.zeros(hinges.shape + (len(values),))
+    for j, (name, value) in enumerate(values.items()):
+        step = relative_step * (abs(value) or 1.0)
+        sides = [_answers(mount.evaluate(design_case(mount, {**values, name: value + sign * step})), mount.channels)
+                 for sign in (1.0, -1.0)]
+        gradient[..., j] = (sides[0][1] - sides[1][1]) / (2 * step)
+        hinge_gradient[..., j] = (sides[0][2] - sides[1][2]) / (2 * step)
+    return DesignSensitivity(list(values), np.array(list(values.values()), dtype=float), answer, runs,
+                             list(mount.channels), t, gradient, hinges, hinge_gradient, "central differences",
+                             time.perf_counter() - start)
+
+
+def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
+    """The design with the parameter *values* (name to SI value) answered, with dT/dp and d|F|/dp.
+
+    Raises
+    ------
+    OutsideDesignModel
+        A parameter the prepared mount does not follow.
+    workbook.errors.SimulationError
+        As :meth:`LinearMount.evaluate`.
+    """
+    start = time.perf_counter()
+    case = design_case(mount, values)
+    solutions = mount.solve_items(case)
+    changes = [_parameter_change(mount, values, name) for name in values]
+    answer = mount.evaluate(case)
+    runs, t, hinges = _answers(answer, mount.channels)
+    gradient = np.zeros(t.shape + (len(values),))
+    hinge_gradient = np.zeros(hinges.shape + (len(values),))
+    pylon = [mount.channels.index(name) for name in mount.pylon]
+    row = 0
+    for item, solution in zip(case.excitations, solutions, strict=True):
+        models = [_model_change(case, solution, springs, mass) for springs, mass in changes]
+        for excitation in points_of(item):
+            omega = 2 * np.pi * excitation.frequency
+            model = solution.model
+            lu = sla.lu_factor(model.dynamic(omega), check_finite=False)
+            motion = sla.lu_solve(lu, model.load(excitation), check_finite=False)
+            output = model.output(omega)
+            forces = (output @ motion).reshape(-1, 3)
+            pylon_force = forces[pylon].sum(axis=0)
+            for j, change in enumerate(models):
+                d_motion = sla.lu_solve(lu, change.load(excitation) - change.dynamic(omega) @ motion,
+                                        check_finite=False)
+                d_forces = (change.output(omega) @ motion + output @ d_motion).reshape(-1, 3)
+                hinge_gradient[row, :, :, j] = _amplitude_change(forces, d_forces)
+                gradient[row, :, j] = _amplitude_change(pylon_force, d_forces[pylon].sum(axis=0)) \
+                    / excitation.force_amplitude
+            row += 1
+    return DesignSensitivity(list(values), np.array(list(values.values()), dtype=float), answer, runs,
+                             list(mount.channels), t, gradient, hinges, hinge_gradient, "direct",
+                             time.perf_counter() - start)
+
+
+def _amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
+    """``d|y| = Re(conj(y) dy) / |y|`` (0 where y is 0)."""
+    size = np.abs(phasor)
+    return np.divide(np.real(np.conj(phasor) * change), size, out=np.zeros(size.shape), where=size > 0)
+
+
+def _parameter_change(mount: LinearMount, values: dict, name: str) -> tuple[ChannelSprings, float]:
+    """d(springs)/dp and d(engine mass)/dp: exact forward differences, both being linear in each parameter."""
+    from workbook.design.linear_mount import channel_springs
+
+    value = values[name]
+    step = 1e-3 * (abs(value) or 1.0)
+    sides = [design_case(mount, {**values, name: value + step}), design_case(mount, values)]
+    springs = [channel_springs(case, mount.channels, mount.frames) for case in sides]
+    change = ChannelSprings(*((a - b) / step for a, b in zip(dataclasses.astuple(springs[0]),
+                                                             dataclasses.astuple(springs[1]), strict=True)))
+    return change, (sides[0].engine.mass - sides[1].engine.mass) / step
+
+
+def _state_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """d(dq)/dp of the final preload solve and d(tension)/dp of each stiffened link, in pass order."""
+    prepared, base = solution.prepared, solution.springs
+    expansion = prepared.expansion
+    channels = expansion.channels
+    gravity = np.zeros(prepared.size)
+    if case.effects.preload:
+        for load in case.static_loads:
+            if isinstance(load, Gravity):
+                gravity[prepared.engine[:3]] += np.asarray(load.acceleration)
+    d_tension = np.zeros(len(prepared.links))
+    d_state = np.zeros(prepared.size)
+    d_forces = None
+    for dq, tensions, loads in solution.state.passes:
+        if d_forces is not None:
+            names = [link.name for link in case.links]
+            by_link = -np.einsum("lcx,cx->l", prepared.compression, d_forces)
+            d_tension = np.array([by_link[names.index(link.name)] if link.name in tensions else 0.0
+                                  for link in prepared.links])
+        at = channels.state(total(expansion, dq))
+        residual = without_normal(expansion, dq, channels.force(at, springs.stiffness)) - mass * gravity
+        q = total(expansion, dq)
+        for link, change in zip(prepared.links, d_tension, strict=True):
+            residual[link.modal] += change * (link.geometric @ q[link.modal])
+        _, rest_stiffness, _ = rest_matrices(expansion, dq, loads)
+        basis = projection(expansion, dq)
+        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, base, at))
+        d_state = basis.basis @ np.linalg.solve(stiffness, -basis.rows(residual))
+        jacobian_force = channels.outputs(at, base.stiffness) @ d_state
+        d_forces = prepared.sign * (np.einsum("cab,cb->ca", springs.stiffness, at.separation)
+                                    + jacobian_force.reshape(-1, 3))
+    return d_state, d_tension
+
+
+def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float):
+    """The derivative of the item's linear model (a model of the same form: Z, C and f are linear in it)."""
+    prepared, state, model = solution.prepared, solution.state, solution.model
+    expansion = prepared.expansion
+    d_state, d_tension = _state_change(case, solution, springs, mass)
+    # along the state change: central differences of the whole linear model
+    step = STATE_STEP / max(np.abs(d_state).max(), 1e-300)
+    sides = [linear_model(case, prepared, solution.springs, dataclasses.replace(state, dq=state.dq + sign * step
+                                                                                 * d_state))
+             for sign in (1.0, -1.0)]
+    basis = model.basis
+    at = expansion.channels.state(total(expansion, state.dq))
+    channels = expansion.channels
+    stiffness = basis.both(tangent_stiffness(expansion, state.dq, np.zeros((prepared.size,) * 2), springs, at))
+    damping = basis.both(channels.matrix(at, springs.damping))
+    structural = prepared.sign * basis.both(channels.matrix(at, springs.structural))
+    engine_mass = np.zeros((prepared.size,) * 2)
+    engine_mass[prepared.engine[:3], prepared.engine[:3]] = mass
+    added_mass = basis.both(engine_mass)
+    for link, change in zip(prepared.links, d_tension, strict=True):
+        geometric = np.zeros((prepared.size,) * 2)
+        geometric[np.ix_(link.modal, link.modal)] = change * link.geometric
+        projected = basis.both(geometric)
+        stiffness = stiffness + projected
+        damping = damping + link.stiffness_damping * projected
+        structural = structural + link.loss_factor * projected
+    outputs = tuple(prepared.sign * channels.outputs(at, spring) @ basis.basis
+                    for spring in (springs.stiffness, springs.damping, springs.structural))
+
+    def along(field: str):
+        return (getattr(sides[0], field) - getattr(sides[1], field)) / (2 * step)
+
+    return dataclasses.replace(
+        model, mass=added_mass + along("mass"), stiffness=stiffness + along("stiffness"),
+        damping=damping + along("damping"), structural=structural + along("structural"),
+        outputs=tuple(o + (a - b) / (2 * step) for o, a, b in zip(outputs, sides[0].outputs, sides[1].outputs,
+                                                                   strict=True)),
+        inputs={key: (sides[0].inputs[key] - sides[1].inputs[key]) / (2 * step) for key in model.inputs})
