@@ -3,7 +3,10 @@
 Prints, for hinge designs with every hinge's stiffness scaled per direction
 (random factors 1 to 4), the median wall time of one design (both rotors)
 by each path and the largest normwise difference of T and of the hinge
-forces. Run with ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
+forces; then the median time of the derivatives of T and the hinge forces
+with respect to five parameters by the direct method and by central
+differences of whole evaluations, and their largest difference. Run with
+``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
 import dataclasses
 import statistics
@@ -13,6 +16,10 @@ import time
 import numpy as np
 
 import workbook as wb
+from workbook.design.sensitivity import difference_sensitivity
+
+PARAMETERS = ("hinge_stiffness/front", "hinge_stiffness/rear/axial", "hinge_loss_factor/thrust", "engine_mass",
+              "hinge_damping/all")
 
 
 def main(count: int = 5) -> None:
@@ -37,6 +44,17 @@ def main(count: int = 5) -> None:
             t_errors.append(np.abs(f.transmissibility - e.transmissibility).max() / e.transmissibility.max())
             hinge_errors.append(max(np.abs(f.hinge_amplitudes[n] - e.hinge_amplitudes[n]).max()
                                     / e.hinge_amplitudes[n].max() for n in e.hinge_amplitudes))
+    direct_times, difference_times, gradient_errors = [], [], []
+    for _ in range(count):
+        values = {"hinge_stiffness/front": rng.uniform(2e7, 8e7), "hinge_stiffness/rear/axial": rng.uniform(2e7, 8e7),
+                  "hinge_loss_factor/thrust": rng.uniform(0.02, 0.1), "engine_mass": rng.uniform(2000, 2600),
+                  "hinge_damping/all": rng.uniform(100, 500)}
+        direct = wb.design_sensitivity(mount, values)
+        differences = difference_sensitivity(mount, values)
+        direct_times.append(direct.seconds)
+        difference_times.append(differences.seconds)
+        scale = np.abs(differences.gradient).max(axis=(0, 1))
+        gradient_errors.append(float((np.abs(direct.gradient - differences.gradient).max(axis=(0, 1)) / scale).max()))
     fast_median, exact_median = statistics.median(fast_times), statistics.median(exact_times)
     print(f"reference mount, {count} hinge designs, both rotors (preparation {prepare_seconds:.2f} s)")
     print(f"{'path':<24}{'median s/design':>16}{'designs/s':>11}")
@@ -44,6 +62,12 @@ def main(count: int = 5) -> None:
     print(f"{'Exudyn (run_case)':<24}{exact_median:>16.4f}{1 / exact_median:>11.1f}")
     print(f"speed-up {exact_median / fast_median:.1f}x; largest difference: T {max(t_errors):.1e}, "
           f"hinge forces {max(hinge_errors):.1e} (normwise)")
+    print(f"\nderivatives of T and hinge forces with respect to {len(PARAMETERS)} parameters "
+          f"({', '.join(PARAMETERS)}), {count} designs")
+    print(f"{'method':<24}{'median s/design':>16}")
+    print(f"{'direct (design_sensitivity)':<24}{statistics.median(direct_times):>16.4f}")
+    print(f"{'central differences':<24}{statistics.median(difference_times):>16.4f}")
+    print(f"largest difference of dT/dp, relative to each parameter's largest: {max(gradient_errors):.1e}")
 
 
 if __name__ == "__main__":
