@@ -138,49 +138,61 @@ def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest_stiffness:
 
 @dataclass(frozen=True)
 class Projection:
-    """The null space of the Euler-parameter constraints at a state: ``q = basis @ x``.
+    """The null space of the Euler-parameter constraints at a state: ``q = B x``.
+
+    B keeps the free coordinates as they are and gives each Euler-parameter
+    node three tangent directions; it is applied block by block, never formed.
 
     Attributes
     ----------
-    basis : ndarray, shape (N, n)
-        The free coordinates as they are, then each Euler-parameter node's
-        three tangent directions.
+    free : ndarray of int, shape (f,)
+        The coordinates that are independent as they are.
+    euler : ndarray of int, shape (E, 4)
+        Each Euler-parameter node's coordinates.
+    tangents : ndarray, shape (E, 4, 3)
+        Each node's orthonormal tangent basis.
+    size : int
+        N, the full coordinates.
     """
 
-    basis: np.ndarray
+    free: np.ndarray
+    euler: np.ndarray
+    tangents: np.ndarray
+    size: int
 
-    @property
-    def size(self) -> int:
-        """n, the independent coordinates."""
-        return self.basis.shape[1]
+    def expand(self, independent: np.ndarray) -> np.ndarray:
+        """``B @ independent`` (first axis: the f + 3 E independent coordinates)."""
+        count = len(self.free)
+        full = np.zeros((self.size,) + independent.shape[1:], dtype=independent.dtype)
+        full[self.free] = independent[:count]
+        nodes = independent[count:].reshape((len(self.euler), 3) + independent.shape[1:])
+        full[self.euler] = np.einsum("eki,ei...->ek...", self.tangents, nodes)
+        return full
 
     def columns(self, matrix: np.ndarray) -> np.ndarray:
-        """``matrix @ basis``."""
-        return matrix @ self.basis
+        """``matrix @ B``."""
+        nodes = np.einsum("mek,eki->mei", matrix[:, self.euler], self.tangents)
+        return np.concatenate([matrix[:, self.free], nodes.reshape(len(matrix), -1)], axis=1)
 
     def rows(self, matrix: np.ndarray) -> np.ndarray:
-        """``basis.T @ matrix`` for a matrix (or vector) with the full coordinates as rows."""
-        return self.basis.T @ matrix
+        """``B.T @ matrix`` for a matrix (or vector) with the full coordinates as rows."""
+        nodes = np.einsum("eki,ek...->ei...", self.tangents, matrix[self.euler])
+        return np.concatenate([matrix[self.free], nodes.reshape((-1,) + matrix.shape[1:])], axis=0)
 
     def both(self, matrix: np.ndarray) -> np.ndarray:
-        """``basis.T @ matrix @ basis``."""
-        return self.basis.T @ matrix @ self.basis
+        """``B.T @ matrix @ B``."""
+        return self.rows(self.columns(matrix))
 
 
 def projection(expansion: SceneExpansion, dq: np.ndarray) -> Projection:
     """The independent coordinates at the state change *dq*."""
     q = total(expansion, dq)
     euler = expansion.euler_blocks
-    free = expansion.free
-    basis = np.zeros((len(q), len(free) + 3 * len(euler)))
-    basis[free, np.arange(len(free))] = 1.0
     t0, t1, t2, t3 = (q[euler] / np.linalg.norm(q[euler], axis=1)[:, None]).T
     # an orthonormal basis (4, 3) of the directions normal to the unit parameters, per node
     tangents = np.stack([np.stack([-t1, t0, t3, -t2], axis=1), np.stack([-t2, -t3, t0, t1], axis=1),
                          np.stack([-t3, t2, -t1, t0], axis=1)], axis=2)
-    columns = len(free) + 3 * np.arange(len(euler))[:, None, None] + np.arange(3)[None, None, :]
-    basis[euler[:, :, None], columns] = tangents
-    return Projection(basis)
+    return Projection(expansion.free, euler, tangents, len(q))
 
 
 def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force: np.ndarray, loads: StateLoads,
@@ -206,7 +218,7 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, springs, state))
         residual = basis.rows(static_residual(expansion, dq, springs, base_force, loads, state))
         update = np.linalg.solve(stiffness, -residual)
-        full_update = basis.basis @ update
+        full_update = basis.expand(update)
         q = total(expansion, dq + full_update)
         q[expansion.euler_blocks] /= np.linalg.norm(q[expansion.euler_blocks], axis=1)[:, None]
         dq = q - expansion.reference - expansion.state

@@ -32,12 +32,13 @@ class ChannelState:
         d of every channel, m.
     jacobian : ndarray, shape (2 C, 3, M)
         Each marker's position Jacobian on its padded coordinates.
-    hessian : ndarray, shape (2 C, 3, M, M)
+    hessian : ndarray, shape (2 C, 3, M, M), or None
+        None when not asked for.
     """
 
     separation: np.ndarray
     jacobian: np.ndarray
-    hessian: np.ndarray
+    hessian: np.ndarray | None
 
 
 @dataclass(frozen=True)
@@ -90,13 +91,13 @@ class ChannelSet:
         """C, the number of channels."""
         return len(self.coordinates) // 2
 
-    def state(self, q: np.ndarray) -> ChannelState:
-        """Separations, Jacobians and Hessians at the total coordinates *q* (N,)."""
+    def state(self, q: np.ndarray, *, second: bool = True) -> ChannelState:
+        """Separations, Jacobians and (with *second*) Hessians at the total coordinates *q* (N,)."""
         values = np.append(q, 0.0)[self.coordinates]
         points, width = self.coordinates.shape
         position = np.zeros((points, 3))
         jacobian = np.zeros((points, 3, width))
-        hessian = np.zeros((points, 3, width, width))
+        hessian = np.zeros((points, 3, width, width)) if second else None
         ground, free = self.kinds["ground"], self.kinds["none"]
         position[ground] = self.local[ground]
         jacobian[:, :, :3] = np.eye(3)
@@ -119,6 +120,8 @@ class ChannelSet:
         position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
         jacobian[index, :, 3:7] = 2 * np.einsum("pabi,pb->pai", a, w)
         jacobian[index, :, 7:7 + modes] = rotation @ shapes
+        if hessian is None:
+            return
         hessian[index, :, 3:7, 3:7] = 2 * np.einsum("abij,pb->paij", EULER, w)
         mixed = 2 * np.einsum("pabi,pbk->paik", a, shapes)
         hessian[index, :, 3:7, 7:7 + modes] = mixed
@@ -142,6 +145,8 @@ class ChannelSet:
         position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
         jacobian[index, :, 3:6] = np.einsum("piab,pb->pai", firsts, w)
         jacobian[index, :, 6:6 + modes] = rotation @ shapes
+        if hessian is None:
+            return
         for i in range(3):
             for j in range(i, 3):
                 orders = tuple(int(k == i) + int(k == j) for k in range(3))
@@ -166,6 +171,7 @@ class ChannelSet:
         columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
         index, values = [(rows * (self.size + 1) + columns).ravel()], [blocks.ravel()]
         if stiffness is not None:
+            assert state.hessian is not None, "the tangent stiffness needs the Hessians"
             on_points = self._on_points(np.einsum("cab,cb->ca", stiffness, state.separation))
             own = self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]
             index.append(own.ravel())

@@ -379,7 +379,7 @@ def _state_loads(case: Case, prepared: _Item, tensions: dict) -> StateLoads:
 
 
 def _channel_forces(prepared: _Item, springs: ChannelSprings, dq: np.ndarray) -> np.ndarray:
-    separation = prepared.expansion.channels.state(total(prepared.expansion, dq)).separation
+    separation = prepared.expansion.channels.state(total(prepared.expansion, dq), second=False).separation
     return prepared.sign * np.einsum("cab,cb->ca", springs.stiffness, separation)
 
 

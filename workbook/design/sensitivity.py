@@ -218,7 +218,7 @@ def _state_change(case: Case, solution: ItemSolution, springs: ChannelSprings, m
         _, rest_stiffness, _ = rest_matrices(expansion, dq, loads)
         basis = projection(expansion, dq)
         stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, base, at))
-        d_state = basis.basis @ np.linalg.solve(stiffness, -basis.rows(residual))
+        d_state = basis.expand(np.linalg.solve(stiffness, -basis.rows(residual)))
         jacobian_force = channels.outputs(at, base.stiffness) @ d_state
         d_forces = prepared.sign * (np.einsum("cab,cb->ca", springs.stiffness, at.separation)
                                     + jacobian_force.reshape(-1, 3))
@@ -251,7 +251,7 @@ def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, m
         stiffness = stiffness + projected
         damping = damping + link.stiffness_damping * projected
         structural = structural + link.loss_factor * projected
-    outputs = tuple(prepared.sign * channels.outputs(at, spring) @ basis.basis
+    outputs = tuple(basis.columns(prepared.sign * channels.outputs(at, spring))
                     for spring in (springs.stiffness, springs.damping, springs.structural))
 
     def along(field: str):
