@@ -95,3 +95,20 @@ def test_compare_complete_gives_the_complete_models_curves_next_to_the_cases(ans
         pylon = np.abs(sum(row[key] for key in row if key.endswith(" T x")))
         assert pylon >= t[0] * (1 - 1e-9)          # the hinges' |T| summed bound the pylon's |sum|
     assert answer["runs"][0]["truncation_error"]["x"] == pytest.approx(found[0][1][0], rel=1e-6)
+
+
+def test_accuracy_target_adds_modes_until_the_estimate_is_within_it(coarse_reference, answers):
+    """--accuracy: a loose target stops at the case's own modes; a tight one goes on to 20 modes per link
+    (reduced for the fixture already), each step's estimate being the largest of its runs."""
+    from workbook.solve.truncation import run_to_accuracy
+
+    case = dataclasses.replace(coarse_reference, excitations=coarse_reference.excitations[1:])  # HP only
+    result, steps = run_to_accuracy(case, 0.5, ladder=(20,))
+    assert [s.modes for s in steps] == ["as the case says"]
+    assert steps[0].estimate == pytest.approx(float(np.nanmax(result.runs[0].truncation_error)))
+    result, steps = run_to_accuracy(case, steps[0].estimate / 10, ladder=(20,))
+    assert [s.modes for s in steps] == ["as the case says", "20 per link"]
+    assert steps[1].estimate < steps[0].estimate / 10
+    assert not any("stays above" in warning for warning in result.runs[0].warnings)
+    result, steps = run_to_accuracy(case, steps[1].estimate / 10, ladder=(20,))
+    assert "stays above" in result.runs[0].warnings[-1]

@@ -1,4 +1,4 @@
-"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--time-budget S] [--pylon-impedance CSV] [--hinges SEL]``.
+"""``mountwb run [CASE] [--json] [--rigid] [--method M] [--pylon-impedance CSV] [--hinges SEL] [--accuracy E]``.
 
 Prints the three-way isolation-efficiency table, the dB table and the model
 card of each run, or the answers as JSON; the warnings once per distinct
@@ -6,8 +6,12 @@ text, with the count and frequency range of the runs (a sweep's points)
 that raised them. ``--hinges`` adds the force amplitude and T of a hinge or
 hinge group against frequency (:mod:`workbook.answers.hinge_curves`), and
 ``--plot`` draws them; ``--compare complete`` overlays those of the complete
-model (:func:`workbook.solve.truncation.complete_model`: the seed study's Fig. 9). A case workbook runs the rows of its Runs sheet and
-gets its results written back (:mod:`workbook.cli.workbooks`).
+model (:func:`workbook.solve.truncation.complete_model`: the seed study's
+Fig. 9). ``--accuracy 0.5%`` runs the case again with more fixed-interface
+modes per link until the estimated truncation error of every T is within
+it (:func:`workbook.solve.truncation.run_to_accuracy`). A case workbook runs
+the rows of its Runs sheet and gets its results written back
+(:mod:`workbook.cli.workbooks`).
 """
 from __future__ import annotations
 
@@ -47,8 +51,23 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--compare", choices=("complete",),
                         help="with --hinges: overlay the complete model's curves (every flexible link with "
                              "20 fixed-interface modes) on the case's own (the low-frequency model by default)")
+    parser.add_argument("--accuracy", type=_fraction, metavar="E",
+                        help="largest estimated truncation error of T, e.g. 0.5%% or 0.005: the links whose "
+                             "mode rule is auto get more fixed-interface modes (6, 12, 20) until every run's "
+                             "estimate is within it")
     workbooks.add_run_arguments(parser)
     return run
+
+
+def _fraction(text: str) -> float:
+    """A fraction from ``0.5%`` or ``0.005`` (argparse type)."""
+    try:
+        value = float(text[:-1]) / 100 if text.endswith("%") else float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a fraction such as 0.5% or 0.005, got {text!r}") from None
+    if not 0 < value < 1:
+        raise argparse.ArgumentTypeError(f"expected a fraction between 0 and 100 %, got {text!r}")
+    return value
 
 
 def _print_hinges(curves, model: str = "") -> None:
@@ -79,6 +98,9 @@ def run(args) -> int:
         if args.hinges:
             raise UsageError("--hinges is for a JSON case or the reference mount; a case workbook's report has "
                              "every hinge's answers")
+        if args.accuracy:
+            raise UsageError("--accuracy is for a JSON case or the reference mount; in a case workbook give the "
+                             "links' modes in the Links sheet")
         if args.pylon_impedance:
             raise UsageError("--pylon-impedance: a case workbook takes the table as its 'Pylon impedance' sheet")
         return workbooks.run_workbook(args)
@@ -96,7 +118,13 @@ def run(args) -> int:
         from workbook.answers.hinge_curves import select_hinges
 
         select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges])
-    result = run_case(case, progress=None if args.no_progress else progress_factory())
+    steps = []
+    if args.accuracy:
+        from workbook.solve.truncation import run_to_accuracy
+
+        result, steps = run_to_accuracy(case, args.accuracy, progress=None if args.no_progress else progress_factory())
+    else:
+        result = run_case(case, progress=None if args.no_progress else progress_factory())
     curves = complete = None
     if args.hinges:
         from workbook.answers.hinge_curves import hinge_curves
@@ -110,12 +138,18 @@ def run(args) -> int:
     labels = ("(case's modes)", "(complete: 20 modes per link)")
     figure = curves.plot(complete, labels if complete else ("", "")) if curves is not None and args.plot else None
     if args.json:
-        if curves is None:
-            print(result.to_json(indent=2))
-        else:
-            extra = {"hinges": _rows(curves)} | ({"hinges_complete": _rows(complete)} if complete else {})
-            print(json.dumps({**json.loads(result.to_json()), **extra}, indent=2))
+        extra = ({"hinges": _rows(curves)} if curves else {}) | ({"hinges_complete": _rows(complete)}
+                                                                  if complete else {})
+        if steps:
+            extra["accuracy"] = [{"modes": step.modes, "estimate %": 100 * step.estimate, "seconds": step.seconds}
+                                 for step in steps]
+        print(json.dumps({**json.loads(result.to_json()), **extra}, indent=2) if extra else result.to_json(indent=2))
     else:
+        if steps:
+            print(f"--accuracy {100 * args.accuracy:g} %: largest estimated truncation error of T per model run")
+            for step in steps:
+                print(f"  links' modes {step.modes:<18} {100 * step.estimate:8.3g} %  ({step.seconds:.1f} s)")
+            print()
         _print_answers(case, result)
         if curves is not None:
             _print_hinges(curves, f" {labels[0]}" if complete else "")

@@ -20,9 +20,12 @@ casing's omitted modes are not estimated.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-__all__ = ["residual_stiffness", "truncation_error", "describe_truncation", "complete_model", "COMPLETE_MODES"]
+__all__ = ["residual_stiffness", "truncation_error", "describe_truncation", "complete_model", "COMPLETE_MODES",
+           "with_modes", "run_to_accuracy", "MODE_LADDER", "AccuracyStep"]
 
 #: Coordinate step of the frame's central differences (m, Euler parameters).
 FRAME_STEP = 1e-7
@@ -129,10 +132,92 @@ def describe_truncation(error: np.ndarray | None) -> str:
 COMPLETE_MODES = 20
 
 
-def complete_model(case):
-    """*case* with every flexible link keeping :data:`COMPLETE_MODES` fixed-interface modes."""
+#: Fixed-interface modes per link that :func:`run_to_accuracy` tries in turn after the case's own.
+MODE_LADDER = (6, 12, COMPLETE_MODES)
+
+
+def with_modes(case, modes: int, *, automatic_only: bool = False):
+    """*case* with every flexible link (or only those whose mode rule is ``auto``) keeping *modes*
+    fixed-interface modes."""
     import dataclasses
 
     return dataclasses.replace(case, links=tuple(
-        dataclasses.replace(link, modes=COMPLETE_MODES) if case.link_is_flexible(link.name) else link
+        dataclasses.replace(link, modes=modes)
+        if case.link_is_flexible(link.name) and (link.modes == "auto" or not automatic_only) else link
         for link in case.links))
+
+
+def complete_model(case):
+    """*case* with every flexible link keeping :data:`COMPLETE_MODES` fixed-interface modes."""
+    return with_modes(case, COMPLETE_MODES)
+
+
+@dataclass(frozen=True)
+class AccuracyStep:
+    """One model :func:`run_to_accuracy` ran.
+
+    Attributes
+    ----------
+    modes : str
+        The links' modes (``"as the case says"`` or ``"N per link"``).
+    estimate : float
+        The largest estimated truncation error of T over runs and directions (fraction).
+    seconds : float
+        Wall time of the run, s.
+    """
+
+    modes: str
+    estimate: float
+    seconds: float
+
+
+def run_to_accuracy(case, target: float, *, progress=None, ladder: tuple = MODE_LADDER):
+    """Run *case*, then again with more fixed-interface modes on the links whose mode rule is ``auto``
+    (:data:`MODE_LADDER`), until every run's estimated truncation error of T is at most *target*.
+
+    Parameters
+    ----------
+    case : Case
+    target : float
+        Largest estimated relative error of T (fraction, e.g. 0.005).
+    progress : callable, optional
+        As :func:`workbook.run_case`.
+    ladder : tuple of int
+        Fixed-interface modes per link to try in turn.
+
+    Returns
+    -------
+    result : MountResult
+        The first answer within *target*, or the last tried; if that misses
+        *target*, each of its runs carries a warning saying by how much.
+    steps : list of AccuracyStep
+
+    Raises
+    ------
+    UsageError
+        A run without an estimate (time domain, a flexible pylon).
+    """
+    import time
+
+    from workbook.errors import UsageError
+    from workbook.solve.pipeline import run_case
+
+    models = [("as the case says", case)]
+    if any(case.link_is_flexible(link.name) and link.modes == "auto" for link in case.links):
+        models += [(f"{modes} per link", with_modes(case, modes, automatic_only=True)) for modes in ladder]
+    steps: list[AccuracyStep] = []
+    for label, candidate in models:
+        start = time.perf_counter()
+        result = run_case(candidate, progress=progress)
+        estimates = [run.truncation_error for run in result.runs]
+        if any(estimate is None for estimate in estimates):
+            raise UsageError(f"--accuracy: {case.name} has runs without a truncation-error estimate (time-domain "
+                             "or flexible-pylon answers, or reductions cached without residual mass)")
+        worst = float(max(np.nanmax(estimate) for estimate in estimates))
+        steps.append(AccuracyStep(label, worst, time.perf_counter() - start))
+        if worst <= target:
+            return result, steps
+    for run in result.runs:
+        run.warnings.append(f"the estimated truncation error {100 * steps[-1].estimate:.3g} % of T stays above the "
+                            f"target {100 * target:.3g} % with the links' modes {steps[-1].modes}")
+    return result, steps
