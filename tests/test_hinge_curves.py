@@ -10,9 +10,10 @@ from workbook.answers.hinge_curves import hinge_curves, select_hinges
 from workbook.answers.warning_groups import group_warnings, warning_lines
 from workbook.cli.main import main
 from workbook.errors import CaseError
-from workbook.model.case import Sweep
+from workbook.model.case import RunUp, Sweep
 from workbook.model.codec import to_json
 from workbook.solve.pipeline import run_case
+from workbook.solve.run_up import run_up
 
 
 def test_warnings_are_grouped_by_text_with_count_and_frequency_range():
@@ -87,3 +88,24 @@ def test_run_command_prints_hinge_tables_a_plot_and_each_warning_once(swept, cap
 def test_run_command_refuses_bad_hinge_options(options, named, capsys):
     assert main(["run", "--no-progress", *options]) == 2
     assert named in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_run_up_command_gives_the_hinge_curves_of_its_speeds(coarse_reference, capsys, tmp_path):
+    """mountwb run-up --hinges: a table per chosen hinge over the run-up's speeds, the same numbers as the
+    hinge curves of the run-up's result, and their plot."""
+    path = tmp_path / "coarse.json"
+    path.write_text(to_json(coarse_reference))
+    plot = tmp_path / "hinges.png"
+    options = ["--excitation", "LP rotor", "--from", "2000", "--to", "4000", "--points", "3", "--unbalance", "0.01"]
+    assert main(["run-up", str(path), *options, "--hinges", "front-up-left", "--hinges-plot", str(plot)]) == 0
+    out = capsys.readouterr().out
+    assert "hinges 'front-up-left'" in out and plot.stat().st_size > 0
+    rows = out.split("front-up-left:\n", 1)[1].splitlines()[2:5]
+    item = dataclasses.replace(coarse_reference.excitations[0], amplitude=None, unbalance=0.01)
+    expected = hinge_curves(run_up(coarse_reference, RunUp.speeds("LP rotor run-up", item, 2000, 4000, 3, "rpm"))
+                            .result, "front-up-left")
+    for row, force in zip(rows, expected.amplitudes[:, 0, 2], strict=True):
+        assert float(row.split()[-4]) == pytest.approx(force, rel=1e-3)       # |F| N z, printed to 4 digits
+    assert main(["run-up", str(path), *options, "--hinges-plot", str(tmp_path / "x.png")]) == 2
+    assert "--hinges-plot" in capsys.readouterr().err

@@ -105,6 +105,16 @@ class HingeCurves:
         index = pd.MultiIndex.from_arrays([list(self.runs), self.frequencies_hz], names=["run", "frequency Hz"])
         return pd.DataFrame(values, index=index, columns=columns)
 
+    def to_text(self, model: str = "") -> str:
+        """The table per hinge as text (*model*: words after the selection in the heading)."""
+        table = self.to_pandas()
+        parts = [f"hinges {self.selection!r}{model}: force amplitude |F| (N) and T = |F| / |F_exc| per direction"]
+        for hinge in self.hinges:
+            part = table[hinge]
+            part.columns = [f"{quantity} {axis}" for quantity, axis in part.columns]
+            parts.append(f"{hinge}:\n{part.to_string(float_format=lambda v: f'{v:10.4g}')}")
+        return "\n\n".join(parts)
+
     def plot(self, compare: HingeCurves | None = None, labels=("", "")):
         """T of each hinge against frequency, one panel per direction (log axes for a range of frequencies).
 

@@ -70,16 +70,6 @@ def _fraction(text: str) -> float:
     return value
 
 
-def _print_hinges(curves, model: str = "") -> None:
-    table = curves.to_pandas()
-    print(f"\nhinges {curves.selection!r}{model}: force amplitude |F| (N) and T = |F| / |F_exc| per direction")
-    for hinge in curves.hinges:
-        print(f"\n{hinge}:")
-        part = table[hinge]
-        part.columns = [f"{quantity} {axis}" for quantity, axis in part.columns]
-        print(part.to_string(float_format=lambda v: f"{v:10.4g}"))
-
-
 def _rows(curves) -> list:
     table = curves.to_pandas()
     table.columns = [" ".join(key) for key in table.columns]
@@ -152,9 +142,9 @@ def run(args) -> int:
             print()
         _print_answers(case, result)
         if curves is not None:
-            _print_hinges(curves, f" {labels[0]}" if complete else "")
+            print("\n" + curves.to_text(f" {labels[0]}" if complete else ""))
         if complete is not None:
-            _print_hinges(complete, f" {labels[1]}")
+            print("\n" + complete.to_text(f" {labels[1]}"))
     with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
         if figure is not None:
             from workbook.answers.saving import save_figure

@@ -1,8 +1,11 @@
-"""``mountwb run-up [CASE] [--excitation NAME --from S --to S --points N --unit rpm|Hz] [--csv OUT] [--plot OUT.png]``.
+"""``mountwb run-up [CASE] [--excitation NAME --from S --to S --points N --unit rpm|Hz] [--csv OUT] [--plot OUT.png]
+[--hinges NAME|GROUP [--hinges-plot OUT.png]]``.
 
 A rotor imbalance over a speed range, its force growing as U w^2
 (:mod:`workbook.solve.run_up`): per speed the excitation force, the
-pylon-force amplitude and T per direction, the mounted modes, and one plot.
+pylon-force amplitude and T per direction, the mounted modes, and one plot;
+with ``--hinges`` also each chosen hinge's force amplitude and T per speed
+(:mod:`workbook.answers.hinge_curves`).
 Without ``--from``/``--to`` the case's own run-ups run (an Excitations row
 with a run-up speed unit, or a :class:`~workbook.model.case.RunUp` in a JSON
 case); with them, the imbalance ``--excitation`` (a rotating force or an
@@ -39,6 +42,10 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
     parser.add_argument("--csv", metavar="OUT.csv", help="write the table as CSV (one run-up)")
     parser.add_argument("--plot", metavar="OUT.png", help="write the plot as PNG (one run-up)")
+    parser.add_argument("--hinges", metavar="NAME|GROUP",
+                        help="also give the force amplitude and T of a hinge, or of every hinge whose name starts "
+                             "with GROUP (e.g. front; 'pylon': the pylon-side hinges), against speed")
+    parser.add_argument("--hinges-plot", metavar="OUT.png", help="with --hinges: draw their T against frequency")
     return run
 
 
@@ -76,12 +83,26 @@ def run(args) -> int:
 
     check_output("--csv", args.csv, (".csv",), [args.case])
     check_output("--plot", args.plot, (".png",), [args.case])
+    check_output("--hinges-plot", args.hinges_plot, (".png",), [args.case])
+    if args.hinges_plot and not args.hinges:
+        raise UsageError("--hinges-plot draws the curves of --hinges: give --hinges NAME|GROUP")
     case = load_case(args.case, rigid=args.rigid)
+    if args.hinges:
+        from workbook.answers.hinge_curves import select_hinges
+
+        select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges])
     items = _run_ups(case, args)
-    if (args.csv or args.plot) and len(items) > 1:
-        raise UsageError(f"--csv/--plot write one run-up; the case has {len(items)}: choose one with --excitation")
+    if (args.csv or args.plot or args.hinges_plot) and len(items) > 1:
+        raise UsageError(f"--csv/--plot/--hinges-plot write one run-up; the case has {len(items)}: choose one with "
+                         f"--excitation")
     answers = [run_up(case, item) for item in items]
     figure = answers[0].plot() if args.plot else None
+    curves = None
+    if args.hinges:
+        from workbook.answers.hinge_curves import hinge_curves
+
+        curves = [hinge_curves(answer.result, args.hinges) for answer in answers]
+    hinge_figure = curves[0].plot() if curves and args.hinges_plot else None
     for answer in answers:
         print(f"{case.name}: run-up {answer.sweep.name}, force U w^2 per plane; pylon force amplitude and "
               f"T = |F_pylon| / |F| per direction\n")
@@ -90,8 +111,13 @@ def run(args) -> int:
         print(answer.modes_frame().to_string(float_format=lambda v: f"{v:8.2f}"))
         for line in warning_lines(answer.result.runs):
             print("\n" + line)
+        if curves is not None:
+            print("\n" + curves[answers.index(answer)].to_text())
     if args.csv:
         write_output(args.csv, "table", "run-up", lambda target: save_csv(answers[0].frame(), target))
     if figure is not None:
         write_output(args.plot, "plot", "run-up", lambda target: save_figure(figure, target, dpi=120))
+    if hinge_figure is not None:
+        write_output(args.hinges_plot, "hinge plot", "run-up",
+                     lambda target: save_figure(hinge_figure, target, dpi=120))
     return 0
