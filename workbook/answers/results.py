@@ -67,7 +67,8 @@ class ExcitationResult(PylonAnswers):
     steady_tolerance : float
     warnings : list of str
     time : ndarray, shape (n,)
-        s.
+        s; time-domain answers only (empty in the frequency domain, as the
+        histories below).
     hinge_histories : dict of str to ndarray, shape (n, 3)
         N.
     pylon_history : ndarray, shape (n, 3)
@@ -98,11 +99,11 @@ class ExcitationResult(PylonAnswers):
     steady_change: float
     steady_tolerance: float
     warnings: list
-    time: np.ndarray = field(repr=False)
-    hinge_histories: dict = field(repr=False)
-    pylon_history: np.ndarray = field(repr=False)
-    excitation_history: np.ndarray = field(repr=False)
-    window: slice = field(repr=False)
+    time: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    hinge_histories: dict = field(default_factory=dict, repr=False)
+    pylon_history: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
+    excitation_history: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)), repr=False)
+    window: slice = field(default_factory=lambda: slice(0, 0), repr=False)
     hinge_phasors: dict = field(default_factory=dict, repr=False)
     truncation_error: np.ndarray | None = field(default=None, repr=False)
     link_phasors: dict = field(default_factory=dict, repr=False)

@@ -501,10 +501,7 @@ def _answer(case: Case, prepared: _Item, model: _Harmonic, excitation: SingleFre
     forces = (model.output(omega) @ motion).reshape(-1, 3)
     amplitudes = dict(zip(channels, np.abs(forces), strict=True))
     pylon_force = forces[[channels.index(name) for name in pylon]].sum(axis=0)
-    empty = np.zeros((0, 3))
     return ExcitationResult(
         name=excitation.name, frequency_hz=excitation.frequency, excitation_amplitude=excitation.force_amplitude,
         pylon_amplitude=np.abs(pylon_force), hinge_amplitudes=amplitudes, pylon_hinges=list(pylon),
-        steady_change=0.0, steady_tolerance=case.analysis.steady_tolerance, warnings=list(prepared.warnings),
-        time=np.zeros(0), hinge_histories={name: empty for name in channels}, pylon_history=empty,
-        excitation_history=empty, window=slice(0, 0))
+        steady_change=0.0, steady_tolerance=case.analysis.steady_tolerance, warnings=list(prepared.warnings))

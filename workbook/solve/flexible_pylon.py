@@ -148,14 +148,12 @@ def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> Pylon
 
 def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.ndarray,
             steady_tolerance: float) -> ExcitationResult:
-    empty = np.zeros((0, 3))
     return ExcitationResult(
         name=excitation.name, frequency_hz=excitation.frequency,
         excitation_amplitude=excitation.force_amplitude, pylon_amplitude=np.abs(pin_forces.sum(axis=0)),
         hinge_amplitudes={pin: np.abs(force) for pin, force in zip(pins, pin_forces, strict=True)},
         pylon_hinges=list(pins), steady_change=0.0, steady_tolerance=steady_tolerance,
-        warnings=[], time=np.zeros(0), hinge_histories={pin: empty for pin in pins},
-        pylon_history=empty, excitation_history=empty, window=slice(0, 0),
+        warnings=[],
         hinge_phasors=dict(zip(pins, np.asarray(pin_forces, dtype=complex), strict=True)))
 
 

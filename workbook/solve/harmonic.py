@@ -194,14 +194,12 @@ class HarmonicModel:
         """The answers of *excitation* as an :class:`ExcitationResult` (no time histories)."""
         motion = self.motion(excitation.frequency, self.excitation_input(excitation))
         response = self._forces(excitation.frequency, motion)
-        empty = np.zeros((0, 3))
         return ExcitationResult(
             name=excitation.name, frequency_hz=excitation.frequency,
             excitation_amplitude=excitation.force_amplitude, pylon_amplitude=np.abs(response.pylon_force),
             hinge_amplitudes={name: np.abs(f) for name, f in response.hinge_forces.items()},
             pylon_hinges=list(self.pylon_hinges), steady_change=0.0, steady_tolerance=steady_tolerance,
-            warnings=[], time=np.zeros(0), hinge_histories={name: empty for name in self.hinge_names},
-            pylon_history=empty, excitation_history=empty, window=slice(0, 0),
+            warnings=[],
             hinge_phasors=dict(response.hinge_forces), link_phasors=self.link_phasors(motion))
 
 
