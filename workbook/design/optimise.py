@@ -29,9 +29,11 @@ gives a two-objective front by NSGA-II (pymoo).
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -55,7 +57,7 @@ MARGIN = 1e-6
 #: A constraint whose normalised slack is below this is reported active.
 ACTIVE = 1e-4
 #: Normalised violation above which a design counts as infeasible.
-FEASIBLE = 1e-9
+FEASIBLE = MARGIN / 2
 #: Parameters on a logarithmic scale when their range is positive.
 _LOG = ("hinge_stiffness", "hinge_damping", "transducer_stiffness")
 #: Parameters the fast path follows.
@@ -120,7 +122,7 @@ class Constraint:
     """A constraint: ``quantity <= limit``, or mounted modes outside the band ``limit`` (low, high), Hz."""
 
     quantity: str
-    limit: float | tuple
+    limit: Any          # float, or (low, high) for a band
 
     @property
     def text(self) -> str:
@@ -267,15 +269,15 @@ class _Problem:
             statics = [(solution.engine_static, np.array([d[solution.prepared.engine] for _, d in changes]
                                                           ).T.reshape(6, -1))
                        for solution, changes in zip(s.solutions, s.changes, strict=True)]
-            pairs = zip(s.solutions, s.changes, strict=True)
+            pairs = list(zip(s.solutions, s.changes, strict=True))
         else:
             case = design_case(self.mount, values)
             answer = self.mount.evaluate(case)
             t = np.array([run.transmissibility for run in answer.result.runs])
             dt = np.zeros(t.shape + (len(x),))
             statics = [(answer.engine_static[item], np.zeros((6, 0))) for item in self.items]
-            pairs = ((solution, []) for solution in self.mount.solve_items(case)) \
-                if any(rule.quantity == MODES_OUTSIDE for rule in self.constraints) else iter(())
+            pairs = [(solution, []) for solution in self.mount.solve_items(case)] \
+                if any(rule.quantity == MODES_OUTSIDE for rule in self.constraints) else []
         modes = [_mounted_modes(solution, changes) for solution, changes in pairs]
         measures, g, dg = [], [], []
         for k, (item, (static, d_static)) in enumerate(zip(self.items, statics, strict=True)):
@@ -318,7 +320,7 @@ class ParetoFront:
     """
 
     objectives: tuple
-    designs: object
+    designs: Any
     evaluations: int
     seconds: float
 
@@ -360,10 +362,10 @@ class OptimisationResult:
     constraints: list
     objective: str
     values: dict
-    table: object
-    history: object
+    table: Any
+    history: Any
     starts: list
-    result: object
+    result: Any
     fast_difference: float
     evaluations: int
     seconds: float
@@ -593,7 +595,7 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     if starts > 1:
         positions += list(qmc.LatinHypercube(d=len(chosen), seed=seed).random(starts - 1))
     history: list = []
-    ends = []
+    ends: list[dict[str, Any]] = []
     for k, x0 in enumerate(positions):
         try:
             x, message, iterations = _run_start(problem, objective, weight, x0, k, history, maxiter)
@@ -610,12 +612,13 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     after = problem.point(best["x"])
     optimum = design_case(mount, after.values)
     result = run_case(optimum)
-    fast_difference = float(np.abs(np.array([run.transmissibility for run in result.runs]) - after.t).max())
+    exact = np.array([run.transmissibility for run in result.runs])
+    fast_difference = float(np.abs(exact - after.t).max())
     front = pareto(case, variables, pareto_objectives, rules, population, generations, seed, mount) \
         if pareto_objectives else None
     return OptimisationResult(
         optimum, mount.case, chosen, rules, objective, after.values,
-        _table(problem, objective, weight, before, after, runs), pd.DataFrame(history, columns=[
+        _table(problem, objective, weight, before, dataclasses.replace(after, t=exact), runs), pd.DataFrame(history, columns=[
             "start", "iteration", "objective", "violation"]),
         [{k: v for k, v in end.items() if k != "x"} for end in ends], result, fast_difference,
         problem.evaluations, time.perf_counter() - begin, front)
