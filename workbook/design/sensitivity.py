@@ -63,9 +63,9 @@ class DesignSensitivity:
     gradient : ndarray, shape (R, 3, P)
         dT/dp, per unit of each parameter.
     hinge_amplitudes : ndarray, shape (R, C, 3)
-        |F| per run, channel and direction, N.
+        ``|F|`` per run, channel and direction, N.
     hinge_gradient : ndarray, shape (R, C, 3, P)
-        d|F|/dp.
+        ``d|F|/dp``.
     method : str
         ``"direct"`` or ``"central differences"``.
     seconds : float
