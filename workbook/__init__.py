@@ -39,6 +39,7 @@ _HOMES = {
     "solve.campbell": ("campbell", "CampbellDiagram"),
     "design.linear_mount": ("LinearMount", "DesignAnswer"),
     "design.sensitivity": ("DesignSensitivity", "design_sensitivity"),
+    "design.optimise": ("optimise", "pareto", "OptimisationResult", "ParetoFront"),
     "answers.results": ("MountResult", "ExcitationResult"),
     "answers.isolation": ("transmissibility", "efficiency", "level_db"),
     "excel.reader": ("read_workbook", "CaseBook"),
@@ -50,7 +51,7 @@ _HOMES = {
     "studies.parallel": ("run_rows", "RowOutcome"),
     "errors": ("MountwbError", "InputError", "CaseError", "WorkbookError", "RecordError", "UsageError", "SimulationError", "MechanismError",
                "EquilibriumError", "ResonanceError", "FourPoleError", "UnstablePreloadError", "BucklingError",
-               "OutsideDesignModel", "Terminated"),
+               "OutsideDesignModel", "InfeasibleProblem", "Terminated"),
 }
 __getattr__, __dir__, _NAMES = lazy_names(__name__, _HOMES)
 __all__ = ["__version__", *_NAMES]

@@ -31,6 +31,7 @@ __all__ = ["MountwbError", "InputError", "CaseFileError", "UnwritableCase",
            "CaseError", "UnitProblem", "Problem", "WorkbookError", "TableError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
            "MechanismError", "EquilibriumError", "FourPoleError", "OutsideDesignModel", "UnstablePreloadError", "BucklingError", "UsageError",
+           "InfeasibleProblem",
            "BAD_INPUT",
            "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
            "EXIT_INTERRUPTED", "EXIT_TERMINATED", "EXIT_FAILED_ROWS", "Terminated", "interruption", "exit_code"]
@@ -310,6 +311,26 @@ class BucklingError(SimulationError):
 
 class UsageError(InputError):
     """A command-line option or argument that cannot be used, with what it takes."""
+
+
+class InfeasibleProblem(InputError):
+    """An optimisation problem without a design that meets its constraints within the variables' ranges.
+
+    Attributes
+    ----------
+    violated : list of str
+        The constraints still violated at the design closest to meeting them
+        all, with their values there.
+    bounds : list of str
+        The variables held at an end of their range there.
+    """
+
+    def __init__(self, violated: list[str], bounds: list[str]):
+        self.violated, self.bounds = list(violated), list(bounds)
+        held = f"; with {', '.join(self.bounds)}" if self.bounds else ""
+        super().__init__(f"no design within the variables' ranges meets the constraints: the constraints "
+                         f"{'; '.join(self.violated)} conflict{held} (the design closest to meeting them all). "
+                         "Widen the ranges or relax these limits")
 
 
 #: The errors that are the user's input, not the solution (exit 2).

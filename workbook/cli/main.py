@@ -28,7 +28,7 @@ import traceback
 from threadpoolctl import threadpool_limits
 
 from workbook.answers.saving import recording_writes
-from workbook.cli import cache, campbell, four_pole, layout, links, loads, rig, run, run_up, stress, study, workbooks
+from workbook.cli import cache, campbell, four_pole, layout, links, loads, optimise, rig, run, run_up, stress, study, workbooks
 from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
@@ -56,6 +56,9 @@ COMMANDS = {
               loads.arguments),
     "stress": ("link strength: the load cases' static margins, then per rotor excitation the dynamic stress on the "
                "preload and the fatigue factors (Goodman, Gerber); --vtu writes the stress fields", stress.arguments),
+    "optimise": ("optimise the design on the fast linear mount: the worst T (dB) or a weighted mean within static "
+                 "displacement and mode-band constraints; before/after table, the optimised case, a Pareto front",
+                 optimise.arguments),
     "cache": ("the store of reduced links: info, verify (keys and checksums), clear", cache.arguments),
 }
 

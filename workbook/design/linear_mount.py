@@ -124,11 +124,14 @@ class DesignAnswer:
         Per excitation item, the preload force of every channel, N.
     seconds : float
         Wall time of the evaluation, s.
+    engine_static : dict of str to ndarray
+        Per excitation item, :attr:`ItemSolution.engine_static`.
     """
 
     result: MountResult
     static_hinge_forces: dict
     seconds: float
+    engine_static: dict = field(default_factory=dict)
 
 
 def _normalised(case: Case, base: Case) -> Case:
@@ -241,13 +244,14 @@ class LinearMount:
             or is excited on an undamped resonance.
         """
         start = time.perf_counter()
-        runs, static = [], {}
+        runs, static, engine = [], {}, {}
         for item, solution in zip(case.excitations, self.solve_items(case), strict=True):
             static[item.name] = dict(zip(self.channels, solution.state.forces, strict=True))
+            engine[item.name] = solution.engine_static
             for excitation in points_of(item):
                 runs.append(_answer(case, solution.prepared, solution.model, excitation, self.channels, self.pylon))
         result = MountResult(case.name, runs, dict(self._cards), dict(self._preloads))
-        return DesignAnswer(result, static, time.perf_counter() - start)
+        return DesignAnswer(result, static, time.perf_counter() - start, engine)
 
     def solve_items(self, case: Case) -> list["ItemSolution"]:
         """The preload and the linear model of every excitation item of the design *case*.
@@ -460,6 +464,12 @@ class ItemSolution:
     springs: ChannelSprings
     state: _State
     model: _Harmonic
+
+    @property
+    def engine_static(self) -> np.ndarray:
+        """The engine's static displacement at its centre of gravity (m) and its Rxyz rotation (rad)
+        under the preload, shape (6,): its node coordinates, as ``mountwb loads`` gives them."""
+        return (self.prepared.expansion.state + self.state.dq)[self.prepared.engine]
 
 
 def linear_model(case: Case, prepared: _Item, springs: ChannelSprings, state: _State) -> _Harmonic:

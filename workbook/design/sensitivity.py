@@ -63,13 +63,20 @@ class DesignSensitivity:
     gradient : ndarray, shape (R, 3, P)
         dT/dp, per unit of each parameter.
     hinge_amplitudes : ndarray, shape (R, C, 3)
-        |F| per run, channel and direction, N.
+        ``|F|`` per run, channel and direction, N.
     hinge_gradient : ndarray, shape (R, C, 3, P)
-        d|F|/dp.
+        ``d|F|/dp``.
     method : str
         ``"direct"`` or ``"central differences"``.
     seconds : float
         Wall time, s.
+    solutions : list of ItemSolution
+        The direct method's solved excitation items (empty for differences).
+    changes : list of list of (model, ndarray)
+        Per item and parameter, the derivative of the item's linear model
+        (a model of the same form) and of its state ``dq`` (empty for
+        differences): what :mod:`workbook.design.optimise` differentiates
+        the engine's static displacement and the mounted modes with.
     """
 
     parameters: list
@@ -83,6 +90,8 @@ class DesignSensitivity:
     hinge_gradient: np.ndarray
     method: str
     seconds: float
+    solutions: list = dataclasses.field(default_factory=list)
+    changes: list = dataclasses.field(default_factory=list)
 
     def to_pandas(self):
         """dT/dp as a table: one row per run and direction, one column per parameter."""
@@ -148,8 +157,10 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     hinge_gradient = np.zeros(hinges.shape + (len(values),))
     pylon = [mount.channels.index(name) for name in mount.pylon]
     row = 0
+    item_changes = []
     for item, solution in zip(case.excitations, solutions, strict=True):
-        models = [_model_change(case, solution, springs, mass) for springs, mass in changes]
+        item_changes.append([_model_change(case, solution, springs, mass) for springs, mass in changes])
+        models = [model for model, _ in item_changes[-1]]
         for excitation in points_of(item):
             omega = 2 * np.pi * excitation.frequency
             model = solution.model
@@ -168,7 +179,7 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
             row += 1
     return DesignSensitivity(list(values), np.array(list(values.values()), dtype=float), answer, runs,
                              list(mount.channels), t, gradient, hinges, hinge_gradient, "direct",
-                             time.perf_counter() - start)
+                             time.perf_counter() - start, solutions, item_changes)
 
 
 def _amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
@@ -226,7 +237,8 @@ def _state_change(case: Case, solution: ItemSolution, springs: ChannelSprings, m
 
 
 def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float):
-    """The derivative of the item's linear model (a model of the same form: Z, C and f are linear in it)."""
+    """The derivative of the item's linear model (a model of the same form: Z, C and f are linear in it)
+    and of its state ``dq``."""
     prepared, state, model = solution.prepared, solution.state, solution.model
     expansion = prepared.expansion
     d_state, d_tension = _state_change(case, solution, springs, mass)
@@ -262,4 +274,4 @@ def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, m
         damping=damping + along("damping"), structural=structural + along("structural"),
         outputs=tuple(o + (a - b) / (2 * step) for o, a, b in zip(outputs, sides[0].outputs, sides[1].outputs,
                                                                    strict=True)),
-        inputs={key: (sides[0].inputs[key] - sides[1].inputs[key]) / (2 * step) for key in model.inputs})
+        inputs={key: (sides[0].inputs[key] - sides[1].inputs[key]) / (2 * step) for key in model.inputs}), d_state

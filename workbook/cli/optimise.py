@@ -1,0 +1,102 @@
+"""``mountwb optimise [CASE] --vary NAME=LOW:HIGH ... [--objective worst|weighted] [--constraint C ...]
+[--starts N] [--pareto [A,B]] [--output DIR] [--json]``.
+
+Optimises the case's design on the fast linear mount
+(:mod:`workbook.design.optimise`): prints the before/after table (the
+objective, T per run and direction, every constraint with its value and
+whether it is active, each variable), each start's end, and the optimum's
+model card; ``--output DIR`` writes the optimised case (``optimum.json``,
+which ``mountwb run`` runs, and ``optimum.xlsx`` when a case workbook can
+hold it), the table, the history and the plot.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Callable
+
+from workbook.cli.loading import load_case
+from workbook.errors import UsageError
+
+__all__ = ["arguments", "varied"]
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
+    parser.add_argument("--run", metavar="R", help="case workbook: take the case of this row of the Runs sheet")
+    parser.add_argument("--vary", action="append", metavar="NAME=LOW:HIGH", required=True,
+                        help="a design variable and its range, SI units (a study parameter: hinge_stiffness, "
+                             "hinge_loss_factor, hinge_damping, per group and direction as "
+                             "hinge_stiffness/front/axial; transducer_stiffness; engine_mass); repeatable")
+    parser.add_argument("--objective", choices=("worst", "weighted"), default="worst",
+                        help="worst: the worst T over runs and directions, dB (default); weighted: the mean of T")
+    parser.add_argument("--constraint", action="append", default=[], metavar="C",
+                        help="displacement<=M, sag<=M (the engine CG's static displacement under the preload), "
+                             "rotation<=RAD, or modes_outside=LOW:HIGH (Hz); repeatable")
+    parser.add_argument("--starts", type=int, default=3, help="SLSQP starts: the case's design, then a Latin "
+                        "hypercube (default 3)")
+    parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
+                        help="also the NSGA-II front of two objectives (default worst,displacement; each worst, "
+                             "worst/RUN, displacement, sag or rotation)")
+    parser.add_argument("--population", type=int, default=50, help="--pareto: designs per generation (default 50)")
+    parser.add_argument("--generations", type=int, default=20, help="--pareto: generations (default 20)")
+    parser.add_argument("--output", metavar="DIR", help="write the optimised case, the table, history and plot here")
+    parser.add_argument("--json", action="store_true", help="print the table and the starts as JSON")
+    return run
+
+
+def varied(texts: list[str]) -> dict:
+    """``NAME=LOW:HIGH`` texts as ``{name: (low, high)}``.
+
+    Raises
+    ------
+    UsageError
+        A text of another form, naming it.
+    """
+    ranges = {}
+    for text in texts:
+        name, _, span = text.partition("=")
+        try:
+            low, high = (float(v) for v in span.split(":"))
+        except ValueError:
+            raise UsageError(f"--vary {text!r}: expected NAME=LOW:HIGH, e.g. hinge_stiffness/front=5e6:2e8") from None
+        ranges[name.strip()] = (low, high)
+    return ranges
+
+
+def run(args) -> int:
+    from workbook.design.optimise import optimise
+
+    objectives = tuple(args.pareto.split(",")) if args.pareto else None
+    if objectives is not None and len(objectives) != 2:
+        raise UsageError(f"--pareto {args.pareto!r}: expected two objectives A,B")
+    case = load_case(args.case, run=args.run)
+    result = optimise(case, varied(args.vary), objective=args.objective, constraints=args.constraint,
+                      starts=args.starts, pareto_objectives=objectives, population=args.population,
+                      generations=args.generations)
+    written = result.write(args.output) if args.output else []
+    if args.json:
+        table = result.table.reset_index()
+        print(json.dumps({"case": case.name, "objective": args.objective, "values": result.values,
+                          "table": table.to_dict(orient="records"), "starts": result.starts,
+                          "evaluations": result.evaluations, "seconds": result.seconds,
+                          "fast_difference": result.fast_difference, "written": [str(p) for p in written]},
+                         indent=1, default=float))
+        return 0
+    print(f"{case.name}: {len(result.variables)} variable(s), {result.evaluations} designs with derivatives, "
+          f"{result.seconds:.1f} s; T of the optimum by the full pipeline (the fast path differs by "
+          f"{result.fast_difference:.1e})\n")
+    print(result.table.to_string(float_format=lambda v: f"{v:.6g}"))
+    print("\nstarts:")
+    for end in result.starts:
+        print(f"  {end['start']}: objective {end['objective']:.6g}, violation {end['violation']:.1e}, "
+              f"{end['iterations']} iterations: {end['message']}")
+    if result.pareto is not None:
+        print(f"\nPareto front ({', '.join(result.pareto.objectives)}): {len(result.pareto.designs)} designs, "
+              f"{result.pareto.evaluations} evaluations, {result.pareto.seconds:.1f} s")
+        print(result.pareto.designs.to_string(float_format=lambda v: f"{v:.5g}"))
+    for card in result.result.model_cards.values():
+        print("\n" + card.to_text())
+    for path in written:
+        print(f"written: {path}")
+    return 0

@@ -1,0 +1,705 @@
+"""Design optimisation on the fast linear mount: the best isolation within stated constraints.
+
+A problem is a case, its *variables* (study parameter names of
+:func:`workbook.studies.parametric.parameter` with a range each), an
+objective and constraints:
+
+- objective ``"worst"``: the worst T over every run (rotor, sweep point) and
+  direction, in dB, in the smooth epigraph form: minimise ``t`` subject to
+  ``20 log10 T_k <= t`` for every run and direction k;
+  ``"weighted"``: the weighted mean of T over runs and directions;
+- constraints (:func:`constraint` reads their text): the engine's static
+  displacement at its centre of gravity under the preload (``displacement``:
+  its length, ``sag``: downwards, m), its static rotation (``rotation``: the
+  length of its Rxyz angles, rad), and mounted modes outside a band
+  (``modes_outside=LOW:HIGH``, Hz: ``((f - c) / h)^2 >= 1`` for the band's
+  centre c and half-width h, the mounted mode nearest the band counting);
+  every variable within its range.
+
+:func:`optimise` runs SLSQP (SciPy) from several starts (the case's own
+design, then a Latin hypercube) on variables scaled to [0, 1], on a
+logarithmic scale for stiffness and damping, with the analytic derivatives
+of :func:`workbook.design.sensitivity.design_sensitivity` (the mounted
+modes' by their left and right eigenvectors). Every evaluation is on the
+fast path (:class:`~workbook.design.linear_mount.LinearMount`); a variable
+that needs a new link reduction (``section_scale``) is refused. The optimum
+is run once more through :func:`workbook.run_case`, whose T the result
+reports and ``mountwb run`` on the written case reproduces. :func:`pareto`
+gives a two-objective front by NSGA-II (pymoo).
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import scipy.linalg as sla
+
+from workbook.design.linear_mount import DesignAnswer, LinearMount
+from workbook.design.sensitivity import design_case, design_sensitivity
+from workbook.errors import InfeasibleProblem, InputError, SimulationError
+from workbook.model.case import DIRECTIONS, Case
+
+__all__ = ["Variable", "Constraint", "constraint", "variable", "optimise", "pareto", "OptimisationResult",
+           "ParetoFront", "OBJECTIVES", "QUANTITIES", "MARGIN"]
+
+#: Objectives of :func:`optimise`.
+OBJECTIVES = ("worst", "weighted")
+#: Constraint quantities bounded from above, and their units.
+QUANTITIES = {"displacement": "m", "sag": "m", "rotation": "rad"}
+#: The band constraint's name.
+MODES_OUTSIDE = "modes_outside"
+#: Relative margin inside each stated limit the optimiser aims at, so that its optimum meets the limit.
+MARGIN = 1e-6
+#: A constraint whose normalised slack is below this is reported active.
+ACTIVE = 1e-4
+#: Normalised violation above which a design counts as infeasible.
+FEASIBLE = MARGIN / 2
+#: Parameters on a logarithmic scale when their range is positive.
+_LOG = ("hinge_stiffness", "hinge_damping", "transducer_stiffness")
+#: Parameters the fast path follows.
+_FAST = ("hinge_stiffness", "hinge_damping", "hinge_loss_factor", "transducer_stiffness", "engine_mass")
+
+
+@dataclass(frozen=True)
+class Variable:
+    """A design variable: a study parameter and its range (SI units)."""
+
+    name: str
+    low: float
+    high: float
+
+    @property
+    def log(self) -> bool:
+        """Whether it is scaled logarithmically (stiffness, damping with a positive range)."""
+        return self.name.partition("/")[0] in _LOG and self.low > 0
+
+    def value(self, x: float) -> float:
+        """The value at the scaled position *x* in [0, 1]."""
+        if self.log:
+            return float(self.low * (self.high / self.low) ** x)
+        return float(self.low + x * (self.high - self.low))
+
+    def scaled(self, value: float) -> float:
+        """The scaled position of *value* (the inverse of :meth:`value`)."""
+        if self.log:
+            return float(np.log(value / self.low) / np.log(self.high / self.low))
+        return float((value - self.low) / (self.high - self.low))
+
+    def slope(self, x: float) -> float:
+        """d value / d x at *x*."""
+        return self.value(x) * np.log(self.high / self.low) if self.log else self.high - self.low
+
+
+def variable(name: str, low: float, high: float) -> Variable:
+    """The variable *name* over [low, high].
+
+    Raises
+    ------
+    InputError
+        A parameter the fast path cannot follow (``section_scale`` needs a
+        new link reduction per design), an unknown name, or an empty range.
+    """
+    from workbook.studies.parametric import parameter
+
+    parameter(name)
+    if name.partition("/")[0] not in _FAST:
+        raise InputError(f"variable {name!r}: the optimiser varies only what the fast linear mount follows "
+                         f"({', '.join(_FAST)}, per hinge group and direction); {name} needs a new preparation "
+                         "(section_scale: a new link reduction) per design: use 'mountwb study params' for it")
+    if not (np.isfinite(low) and np.isfinite(high) and high > low):
+        raise InputError(f"variable {name!r}: found the range {low:g}:{high:g}, expected LOW:HIGH with LOW < HIGH")
+    if name.partition("/")[0] in _LOG and low < 0:
+        raise InputError(f"variable {name!r}: found LOW {low:g}, expected a stiffness or damping >= 0")
+    return Variable(name, float(low), float(high))
+
+
+@dataclass(frozen=True)
+class Constraint:
+    """A constraint: ``quantity <= limit``, or mounted modes outside the band ``limit`` (low, high), Hz."""
+
+    quantity: str
+    limit: Any          # float, or (low, high) for a band
+
+    @property
+    def text(self) -> str:
+        """As :func:`constraint` reads it."""
+        if self.quantity == MODES_OUTSIDE:
+            return f"{MODES_OUTSIDE}={self.limit[0]:g}:{self.limit[1]:g}"
+        return f"{self.quantity}<={self.limit:g}"
+
+
+def constraint(text: str) -> Constraint:
+    """Read a constraint: ``displacement<=M``, ``sag<=M``, ``rotation<=RAD`` or ``modes_outside=LOW:HIGH`` (Hz).
+
+    Raises
+    ------
+    InputError
+        Naming the text and what is expected.
+    """
+    expected = (f"expected {', '.join(f'{q}<=VALUE ({u})' for q, u in QUANTITIES.items())} or "
+                f"{MODES_OUTSIDE}=LOW:HIGH (Hz)")
+    quantity, sign, rest = text.replace(" ", "").partition("<=")
+    try:
+        if sign and quantity in QUANTITIES and float(rest) > 0:
+            return Constraint(quantity, float(rest))
+        quantity, sign, rest = text.replace(" ", "").partition("=")
+        if sign and quantity == MODES_OUTSIDE:
+            low, high = (float(v) for v in rest.split(":"))
+            if 0 <= low < high:
+                return Constraint(quantity, (low, high))
+    except ValueError:
+        pass
+    raise InputError(f"constraint {text!r}: {expected}, the value positive and LOW < HIGH")
+
+
+def current_value(case: Case, name: str) -> float:
+    """The value the variable *name* has in *case* (a hinge group's first hinge, in the first of its directions)."""
+    from workbook.studies.parametric import ALL_HINGES, HINGE_DIRECTIONS
+
+    base, _, qualifier = name.partition("/")
+    group, _, direction = qualifier.partition("/")
+    if base == "engine_mass":
+        return float(case.engine.mass)
+    if base == "transducer_stiffness":
+        assert case.test_rig is not None     # parameter() refuses it on a case without transducers
+        return float(case.test_rig.stiffness[0])
+    hinge = next(h for h in case.hinges if group in ("", ALL_HINGES) or h.name.startswith(group))
+    return float(hinge.values(base.removeprefix("hinge_"))[HINGE_DIRECTIONS.get(direction, (0,))[0]])
+
+
+@dataclass
+class _Point:
+    """One design answered: T with its scaled gradient, and the constraints' rows."""
+
+    x: np.ndarray
+    values: dict
+    answer: DesignAnswer
+    t: np.ndarray                   # (R, 3)
+    dt: np.ndarray                  # (R, 3, n) per scaled variable
+    measures: list                  # per constraint row: (label, value, limit text)
+    g: np.ndarray                   # normalised slack, >= 0 feasible
+    dg: np.ndarray                  # (rows, n)
+
+
+def _mounted_modes(solution, changes) -> tuple[np.ndarray, np.ndarray]:
+    """Mounted mode frequencies (Hz) of an item and their derivatives (modes, P), undamped, without gyroscopics."""
+    from workbook.solve.modes import ENGINE_SHARE
+
+    mass, stiffness = solution.model.mass, solution.model.stiffness
+    eigenvalues, left, right = sla.eig(stiffness, mass, left=True, right=True)
+    free = solution.prepared.expansion.free
+    engine = np.searchsorted(free, solution.prepared.engine)
+    energy = np.einsum("im,ij,jm->m", right.conj(), mass, right).real
+    share = np.einsum("im,ij,jm->m", right[engine].conj(), mass[np.ix_(engine, engine)], right[engine]).real / energy
+    keep = np.isfinite(eigenvalues) & (eigenvalues.real > 0) & (share >= ENGINE_SHARE)
+    lam, x, y = eigenvalues[keep].real, right[:, keep], left[:, keep]
+    hz = np.sqrt(lam) / (2 * np.pi)
+    norm = np.einsum("im,ij,jm->m", y.conj(), mass, x)
+    d_lam = np.array([np.einsum("im,ij,jm->m", y.conj(), model.stiffness, x)
+                      - lam * np.einsum("im,ij,jm->m", y.conj(), model.mass, x) for model, _ in changes]).T
+    return hz, (d_lam / norm[:, None]).real / (8 * np.pi ** 2 * hz[:, None])
+
+
+def _measure(item: str, rule: Constraint, static: np.ndarray, d_static: np.ndarray, modes) -> tuple:
+    """One constraint on one excitation item's design.
+
+    Parameters
+    ----------
+    static, d_static : ndarray, shapes (6,) and (6, P)
+        The engine's static displacement and rotation, and their derivatives.
+    modes : (ndarray, ndarray) or None
+        Mounted mode frequencies (Hz) and their derivatives (modes, P); None without a band constraint.
+
+    Returns
+    -------
+    (label, value, slack, slack's gradient (P,))
+        The slack normalised (>= 0: met).
+    """
+    if rule.quantity == MODES_OUTSIDE:
+        hz, d_hz = modes
+        low, high = rule.limit
+        centre, half = (low + high) / 2, (high - low) / 2 * (1 + MARGIN)
+        k = int(np.argmin(np.abs(hz - centre)))
+        return (f"nearest mounted mode, Hz ({item})", float(hz[k]), ((hz[k] - centre) / half) ** 2 - 1,
+                2 * (hz[k] - centre) / half ** 2 * d_hz[k])
+    part = slice(3, 6) if rule.quantity == "rotation" else slice(0, 3)
+    vector, d_vector = static[part], d_static[part]
+    if rule.quantity == "sag":
+        value, gradient = float(-vector[2]), -d_vector[2]
+    else:
+        value = float(np.linalg.norm(vector))
+        gradient = vector @ d_vector / max(value, 1e-300)
+    return (f"{rule.quantity}, {QUANTITIES[rule.quantity]} ({item})", value,
+            (rule.limit * (1 - MARGIN) - value) / rule.limit, -gradient / rule.limit)
+
+
+class _Problem:
+    """The scaled problem, each design answered once (the last one kept)."""
+
+    def __init__(self, mount: LinearMount, variables: list[Variable], constraints: list[Constraint],
+                 derivatives: bool = True):
+        self.mount, self.variables, self.constraints = mount, variables, constraints
+        self.derivatives = derivatives
+        self.items = [item.name for item in mount.case.excitations]
+        self.evaluations = 0
+        self._cache: dict = {}
+
+    def values(self, x: np.ndarray) -> dict:
+        return {v.name: v.value(float(xi)) for v, xi in zip(self.variables, x, strict=True)}
+
+    def point(self, x: np.ndarray) -> _Point:
+        """The design at the scaled position *x* (put within [0, 1])."""
+        x = np.clip(np.asarray(x, dtype=float), 0.0, 1.0)
+        key = x.tobytes()
+        if key not in self._cache:
+            slope = np.array([v.slope(float(xi)) for v, xi in zip(self.variables, x, strict=True)])
+            self._cache = {key: self.answer(self.values(x), x, slope)}    # SLSQP asks for one design at a time
+        return self._cache[key]
+
+    def answer(self, values: dict, x: np.ndarray, slope: np.ndarray) -> _Point:
+        """The design with the parameter *values*; derivatives per scaled variable (*slope*: d value / d x)."""
+        self.evaluations += 1
+        if self.derivatives:
+            s = design_sensitivity(self.mount, values)
+            answer, t, dt = s.answer, s.transmissibility, s.gradient * slope
+            statics = [(solution.engine_static, np.array([d[solution.prepared.engine] for _, d in changes]
+                                                          ).T.reshape(6, -1))
+                       for solution, changes in zip(s.solutions, s.changes, strict=True)]
+            pairs = list(zip(s.solutions, s.changes, strict=True))
+        else:
+            case = design_case(self.mount, values)
+            answer = self.mount.evaluate(case)
+            t = np.array([run.transmissibility for run in answer.result.runs])
+            dt = np.zeros(t.shape + (len(x),))
+            statics = [(answer.engine_static[item], np.zeros((6, 0))) for item in self.items]
+            pairs = [(solution, []) for solution in self.mount.solve_items(case)] \
+                if any(rule.quantity == MODES_OUTSIDE for rule in self.constraints) else []
+        modes = [_mounted_modes(solution, changes) for solution, changes in pairs]
+        measures, g, dg = [], [], []
+        for k, (item, (static, d_static)) in enumerate(zip(self.items, statics, strict=True)):
+            for rule in self.constraints:
+                label, value, slack, d_slack = _measure(item, rule, static, d_static, modes[k] if modes else None)
+                measures.append((label, value, rule.text))
+                g.append(slack)
+                dg.append(d_slack * slope if self.derivatives else np.zeros(len(x)))
+        return _Point(x, values, answer, t, dt, measures, np.array(g), np.array(dg).reshape(len(g), len(x)))
+
+    def violation(self, point: _Point) -> float:
+        """The largest normalised violation (0: feasible)."""
+        return float(max(0.0, -point.g.min())) if len(point.g) else 0.0
+
+
+def _levels(point: _Point) -> tuple[np.ndarray, np.ndarray]:
+    """20 log10 T per run and direction (flattened) and its gradient (R 3, n)."""
+    t = np.maximum(point.t.reshape(-1), 1e-12)
+    return 20 * np.log10(t), 20 / np.log(10) * point.dt.reshape(len(t), -1) / t[:, None]
+
+
+def _objective_value(kind: str, weights: np.ndarray, point: _Point) -> float:
+    """The objective at *point*: worst T in dB, or the weighted mean of T."""
+    if kind == "worst":
+        return float(_levels(point)[0].max())
+    return float(weights.reshape(-1) @ point.t.reshape(-1) / weights.sum())
+
+
+@dataclass
+class ParetoFront:
+    """A two-objective front (NSGA-II).
+
+    Attributes
+    ----------
+    objectives : tuple of str
+    designs : pandas.DataFrame
+        One row per non-dominated design: the variables, then both objectives.
+    evaluations : int
+    seconds : float
+    """
+
+    objectives: tuple
+    designs: Any
+    evaluations: int
+    seconds: float
+
+
+@dataclass
+class OptimisationResult:
+    """What :func:`optimise` found.
+
+    Attributes
+    ----------
+    case : Case
+        The optimised case (written by :meth:`write`).
+    before : Case
+    variables, constraints : list
+    objective : str
+    values : dict
+        The optimum's variable values, SI units.
+    table : pandas.DataFrame
+        Before and after: the objective, every constraint (value, limit,
+        active) and each variable.
+    history : pandas.DataFrame
+        Per start and SLSQP iteration: objective and largest normalised violation.
+    starts : list of dict
+        Per start: its end, objective, violation, iterations, message.
+    result : MountResult
+        The optimum run by :func:`workbook.run_case` (the T reported).
+    fast_difference : float
+        Largest difference of the fast path's T from *result*'s at the optimum.
+    evaluations : int
+        Designs answered with derivatives.
+    seconds : float
+        Wall time (preparation, starts and the final run), s.
+    pareto : ParetoFront or None
+    """
+
+    case: Case
+    before: Case
+    variables: list
+    constraints: list
+    objective: str
+    values: dict
+    table: Any
+    history: Any
+    starts: list
+    result: Any
+    fast_difference: float
+    evaluations: int
+    seconds: float
+    pareto: ParetoFront | None = field(default=None)
+
+    def to_pandas(self):
+        """The before/after table."""
+        return self.table
+
+    def plot(self, path: str | Path | None = None):
+        """Convergence of every start (and the Pareto front when there is one); saved as PNG at *path*.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        panels = 2 if self.pareto is not None else 1
+        figure, axes = plt.subplots(1, panels, figsize=(6 * panels, 4), squeeze=False)
+        ax = axes[0, 0]
+        for start, rows in self.history.groupby("start"):
+            feasible = rows["violation"] <= FEASIBLE
+            ax.plot(rows["iteration"], rows["objective"], "-", color=f"C{start % 10}", label=f"start {start}")
+            ax.plot(rows["iteration"][~feasible], rows["objective"][~feasible], "x", color=f"C{start % 10}")
+        ax.set_xlabel("SLSQP iteration")
+        ax.set_ylabel("worst T, dB" if self.objective == "worst" else "weighted mean T")
+        ax.set_title("convergence (x: infeasible)")
+        ax.legend(fontsize="small")
+        if self.pareto is not None:
+            first, second = self.pareto.objectives
+            front = self.pareto.designs.sort_values(first)
+            axes[0, 1].plot(front[first], front[second], "o-")
+            axes[0, 1].set_xlabel(first)
+            axes[0, 1].set_ylabel(second)
+            axes[0, 1].set_title(f"Pareto front, {len(front)} designs")
+        figure.tight_layout()
+        if path is not None:
+            figure.savefig(path, dpi=100)
+        return figure
+
+    def write(self, directory: str | Path) -> list[Path]:
+        """Write the optimised case (``optimum.json``; ``optimum.xlsx`` when a case workbook can hold it), the
+        table, the history (CSV), the Pareto front (CSV) and the plot into *directory*.
+
+        Returns
+        -------
+        list of Path
+        """
+        from workbook.errors import UnwritableCase
+        from workbook.excel.files import save_atomic
+        from workbook.excel.template import case_workbook
+        from workbook.model.codec import to_json
+
+        folder = Path(directory)
+        folder.mkdir(parents=True, exist_ok=True)
+        written = [folder / "optimum.json", folder / "table.csv", folder / "history.csv", folder / "convergence.png"]
+        written[0].write_text(to_json(self.case), encoding="utf-8")
+        self.table.to_csv(written[1])
+        self.history.to_csv(written[2], index=False)
+        self.plot(written[3])
+        if self.pareto is not None:
+            written.append(folder / "pareto.csv")
+            self.pareto.designs.to_csv(written[-1], index=False)
+        try:
+            book = case_workbook(self.case, ())
+        except UnwritableCase:
+            return written
+        written.append(save_atomic(book, folder / "optimum.xlsx"))
+        return written
+
+
+def _run_start(problem: _Problem, kind: str, weights: np.ndarray, x0: np.ndarray, start: int,
+               history: list, maxiter: int):
+    """One SLSQP run from *x0*: returns (x, message, iterations)."""
+    from scipy.optimize import minimize
+
+    n = len(x0)
+    epigraph = kind == "worst"
+
+    def split(z):
+        return z[:n] if epigraph else z
+
+    def objective(z):
+        if epigraph:
+            return z[n]
+        return _objective_value(kind, weights, problem.point(z))
+
+    def objective_gradient(z):
+        if epigraph:
+            return np.eye(n + 1)[n]
+        point = problem.point(z)
+        return np.einsum("k,kn->n", weights.reshape(-1), point.dt.reshape(-1, n)) / weights.sum()
+
+    def constraints(z):
+        point = problem.point(split(z))
+        rows = [point.g]
+        if epigraph:
+            rows.append(z[n] - _levels(point)[0])
+        return np.concatenate(rows)
+
+    def constraints_gradient(z):
+        point = problem.point(split(z))
+        rows = [np.hstack([point.dg, np.zeros((len(point.g), 1))]) if epigraph else point.dg]
+        if epigraph:
+            levels = _levels(point)[1]
+            rows.append(np.hstack([-levels, np.ones((len(levels), 1))]))
+        return np.vstack(rows)
+
+    def record(z):
+        point = problem.point(split(z))
+        history.append({"start": start, "iteration": len([h for h in history if h["start"] == start]),
+                        "objective": _objective_value(kind, weights, point), "violation": problem.violation(point)})
+
+    z0 = np.append(x0, _levels(problem.point(x0))[0].max()) if epigraph else x0
+    bounds = [(0.0, 1.0)] * n + ([(-400.0, 400.0)] if epigraph else [])
+    record(z0)
+    answer = minimize(objective, z0, jac=objective_gradient, method="SLSQP", bounds=bounds,
+                      constraints=[{"type": "ineq", "fun": constraints, "jac": constraints_gradient}],
+                      callback=record, options={"maxiter": maxiter, "ftol": 1e-7})
+    return np.clip(split(answer.x), 0.0, 1.0), str(answer.message), int(answer.nit)
+
+
+def _least_violation(problem: _Problem, x0: np.ndarray) -> np.ndarray:
+    """The design within the bounds with the least squared violation, from *x0* (L-BFGS-B)."""
+    from scipy.optimize import minimize
+
+    def violation(x):
+        point = problem.point(x)
+        short = np.minimum(point.g, 0.0)
+        return float(short @ short), 2 * short @ point.dg
+
+    return minimize(violation, x0, jac=True, method="L-BFGS-B", bounds=[(0.0, 1.0)] * len(x0)).x
+
+
+def _table(problem: _Problem, kind: str, weights: np.ndarray, before: _Point, after: _Point, runs: list):
+    import pandas as pd
+
+    rows = [("objective", "worst T (dB)" if kind == "worst" else "weighted mean T",
+             _objective_value(kind, weights, before), _objective_value(kind, weights, after), "", "")]
+    for run, t_before, t_after in zip(runs, before.t, after.t, strict=True):
+        rows += [("T", f"{run} {d}", tb, ta, "", "") for d, tb, ta in zip(DIRECTIONS, t_before, t_after, strict=True)]
+    for (label, value_before, limit), (_, value_after, _), slack in zip(before.measures, after.measures, after.g,
+                                                                         strict=True):
+        rows.append(("constraint", label, value_before, value_after, limit, "active" if slack <= ACTIVE else ""))
+    for v, x in zip(problem.variables, after.x, strict=True):
+        at = "at low" if x <= ACTIVE else "at high" if x >= 1 - ACTIVE else ""
+        rows.append(("variable", v.name, before.values[v.name], after.values[v.name], f"{v.low:g}:{v.high:g}", at))
+    return pd.DataFrame(rows, columns=["kind", "name", "before", "after", "limit", "active"]).set_index(["kind", "name"])
+
+
+def _weights(weights, runs: int) -> np.ndarray:
+    if weights is None:
+        return np.ones((runs, 3))
+    array = np.broadcast_to(np.asarray(weights, dtype=float), (runs, 3))
+    if np.any(array < 0) or array.sum() <= 0:
+        raise InputError(f"weights: found {np.asarray(weights).tolist()}, expected non-negative weights per run "
+                         f"and direction, shape ({runs}, 3), not all zero")
+    return array
+
+
+def optimise(case: Case, variables: dict, objective: str = "worst", constraints=(), starts: int = 4,
+             weights=None, seed: int = 0, maxiter: int = 60, pareto_objectives: tuple | None = None,
+             population: int = 50, generations: int = 20, mount: LinearMount | None = None) -> OptimisationResult:
+    """The design of *case* within *variables* that minimises *objective* subject to *constraints*.
+
+    Parameters
+    ----------
+    case : Case
+    variables : dict of str to (float, float)
+        Study parameter name to its range (low, high), SI units.
+    objective : {"worst", "weighted"}
+        Worst T over runs and directions (dB), or the weighted mean of T.
+    constraints : iterable of Constraint or str
+        See :func:`constraint`.
+    starts : int
+        SLSQP starts: the case's own design (put within the ranges), then a Latin hypercube.
+    weights : array_like, optional
+        Per run and direction, shape (R, 3) or broadcastable (the ``weighted`` objective).
+    seed : int
+        Of the Latin hypercube (and of NSGA-II).
+    maxiter : int
+        SLSQP iterations per start.
+    pareto_objectives : (str, str), optional
+        Also a front of these two objectives (:func:`pareto`).
+    population, generations : int
+        Of the front's NSGA-II.
+    mount : LinearMount, optional
+        *case* prepared already.
+
+    Returns
+    -------
+    OptimisationResult
+
+    Raises
+    ------
+    InputError
+        An unknown objective or constraint, or a variable the fast path cannot vary.
+    InfeasibleProblem
+        No design within the ranges meets the constraints; names those that conflict.
+    workbook.errors.SimulationError
+        As :meth:`LinearMount.evaluate` at the case's own design.
+    """
+    import pandas as pd
+    from scipy.stats import qmc
+
+    from workbook.solve.pipeline import run_case
+
+    begin = time.perf_counter()
+    if objective not in OBJECTIVES:
+        raise InputError(f"objective {objective!r}: expected one of {', '.join(OBJECTIVES)}")
+    if starts < 1:
+        raise InputError(f"starts: found {starts}, expected at least 1")
+    chosen = [variable(name, *bounds) for name, bounds in variables.items()]
+    rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
+    mount = mount or LinearMount.prepare(case)
+    problem = _Problem(mount, chosen, rules)
+    before_values = {v.name: current_value(mount.case, v.name) for v in chosen}
+    start = np.array([v.scaled(before_values[v.name]) for v in chosen])
+    before = problem.answer(before_values, start, np.ones(len(chosen)))
+    runs = [run.name for run in before.answer.result.runs]
+    weight = _weights(weights, len(runs))
+    positions = [np.clip(start, 0, 1)]
+    if starts > 1:
+        positions += list(qmc.LatinHypercube(d=len(chosen), seed=seed).random(starts - 1))
+    history: list = []
+    ends: list[dict[str, Any]] = []
+    for k, x0 in enumerate(positions):
+        try:
+            x, message, iterations = _run_start(problem, objective, weight, x0, k, history, maxiter)
+        except SimulationError as error:
+            ends.append({"start": k, "objective": np.nan, "violation": np.inf, "iterations": 0, "message": str(error)})
+            continue
+        point = problem.point(x)
+        ends.append({"start": k, "x": x, "objective": _objective_value(objective, weight, point),
+                     "violation": problem.violation(point), "iterations": iterations, "message": message})
+    feasible = [end for end in ends if end["violation"] <= FEASIBLE]
+    if not feasible:
+        _raise_infeasible(problem, min(ends, key=lambda end: end["violation"]).get("x", positions[0]))
+    best = min(feasible, key=lambda end: end["objective"])
+    after = problem.point(best["x"])
+    optimum = design_case(mount, after.values)
+    result = run_case(optimum)
+    exact = np.array([run.transmissibility for run in result.runs])
+    fast_difference = float(np.abs(exact - after.t).max())
+    front = pareto(case, variables, pareto_objectives, rules, population, generations, seed, mount) \
+        if pareto_objectives else None
+    return OptimisationResult(
+        optimum, mount.case, chosen, rules, objective, after.values,
+        _table(problem, objective, weight, before, dataclasses.replace(after, t=exact), runs), pd.DataFrame(history, columns=[
+            "start", "iteration", "objective", "violation"]),
+        [{k: v for k, v in end.items() if k != "x"} for end in ends], result, fast_difference,
+        problem.evaluations, time.perf_counter() - begin, front)
+
+
+def _raise_infeasible(problem: _Problem, x0: np.ndarray):
+    closest = problem.point(_least_violation(problem, x0))
+    violated = [f"{label}: {value:.4g} against {limit}"
+                for (label, value, limit), slack in zip(closest.measures, closest.g, strict=True) if slack < -FEASIBLE]
+    held = [f"{v.name} at its {'low' if x <= ACTIVE else 'high'} end {v.value(float(round(x))):g}"
+            for v, x in zip(problem.variables, closest.x, strict=True) if x <= ACTIVE or x >= 1 - ACTIVE]
+    raise InfeasibleProblem(violated or [f"{label}: {value:.4g} against {limit}" for label, value, limit
+                                         in closest.measures], held)
+
+
+def _pareto_measure(name: str, answer: DesignAnswer) -> float:
+    """One front objective of an evaluated design: ``worst`` or ``worst/RUN`` (T, dB), or a displacement quantity."""
+    if name.partition("/")[0] == "worst":
+        run = name.partition("/")[2]
+        t = [r.transmissibility for r in answer.result.runs if not run or r.name == run]
+        return float(20 * np.log10(max(np.max(t), 1e-12)))
+    rule = Constraint(name, 1.0)
+    values = []
+    for static in answer.engine_static.values():
+        vector = static[3:6] if rule.quantity == "rotation" else static[:3]
+        values.append(-vector[2] if rule.quantity == "sag" else float(np.linalg.norm(vector)))
+    return max(values)
+
+
+def pareto(case: Case, variables: dict, objectives: tuple = ("worst", "displacement"), constraints=(),
+           population: int = 50, generations: int = 20, seed: int = 0, mount: LinearMount | None = None) -> ParetoFront:
+    """The front of two objectives by NSGA-II (pymoo) on the fast path.
+
+    Parameters
+    ----------
+    objectives : (str, str)
+        Each ``worst`` (worst T over runs and directions, dB), ``worst/RUN`` (of one run), or one of
+        :data:`QUANTITIES` (the largest over the excitation items).
+    constraints
+        As :func:`optimise`; ``modes_outside`` ones cost a modal solve each.
+    population, generations : int
+
+    Returns
+    -------
+    ParetoFront
+
+    Raises
+    ------
+    InputError
+        An unknown objective.
+    """
+    import pandas as pd
+    from pymoo.algorithms.moo.nsga2 import NSGA2
+    from pymoo.core.problem import ElementwiseProblem
+    from pymoo.optimize import minimize
+
+    begin = time.perf_counter()
+    runs = [e.name for e in case.excitations]
+    known = ["worst", *(f"worst/{run}" for run in runs), *QUANTITIES]
+    for name in objectives:
+        if name not in known:
+            raise InputError(f"Pareto objective {name!r}: expected one of {', '.join(known)}")
+    chosen = [variable(name, *bounds) for name, bounds in variables.items()]
+    rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
+    mount = mount or LinearMount.prepare(case)
+    problem = _Problem(mount, chosen, rules, derivatives=False)
+
+    class Front(ElementwiseProblem):
+        def __init__(self):
+            super().__init__(n_var=len(chosen), n_obj=2, n_ieq_constr=len(rules) * len(runs), xl=0.0, xu=1.0)
+
+        def _evaluate(self, x, out, *args, **kwargs):
+            point = problem.point(x)
+            out["F"] = [_pareto_measure(name, point.answer) for name in objectives]
+            if rules:
+                out["G"] = -point.g
+
+    answer = minimize(Front(), NSGA2(pop_size=population), ("n_gen", generations), seed=seed, verbose=False)
+    designs = np.atleast_2d(answer.X) if answer.X is not None else np.zeros((0, len(chosen)))
+    table = pd.DataFrame([problem.values(x) for x in designs], columns=[v.name for v in chosen])
+    values = np.atleast_2d(answer.F) if answer.F is not None else np.zeros((0, 2))
+    for k, name in enumerate(objectives):
+        table[name] = values[:, k]
+    return ParetoFront(tuple(objectives), table, problem.evaluations, time.perf_counter() - begin)
