@@ -28,7 +28,7 @@ import traceback
 from threadpoolctl import threadpool_limits
 
 from workbook.answers.saving import recording_writes
-from workbook.cli import cache, campbell, four_pole, layout, links, loads, optimise, rig, run, run_up, stress, study, workbooks
+from workbook.cli import cache, campbell, four_pole, layout, links, loads, optimise, rig, run, run_up, stress, study, update, workbooks
 from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
@@ -47,6 +47,8 @@ COMMANDS = {
               study.arguments),
     "rig": ("measured rig records: measured T and eta, the validation table against simulation, "
             "synthetic records", rig.arguments),
+    "update": ("model updating: fit hinge, transducer and engine parameters to rig records by least squares "
+               "(fitted values, standard errors, correlation, error before and after)", update.arguments),
     "run-up": ("a rotor imbalance over a speed range (force U w^2): pylon force and T per direction against speed, "
                "the mounted modes marked", run_up.arguments),
     "four-pole": ("the mount's four-pole parameters (dynamic stiffness) against frequency", four_pole.arguments),

@@ -2,11 +2,13 @@
 
 The steady-state window of a simulated run is written as a Fourier series
 of the rotor frequency f0 (mean plus ``harmonics`` harmonics per channel,
-by :func:`workbook.answers.amplitude.harmonic_amplitude`), and re-evaluated at the
+by :func:`workbook.answers.amplitude.harmonic_amplitude`; of a frequency-domain
+run, its phasors: the 1x response about a zeroed transducer), and re-evaluated at the
 rig's sample times with a rotor phase that drifts: the speed changes
 linearly by ``drift`` (relative) over the record, its mean staying f0,
 ``phi(t) = 2 pi f0 (t + drift (t^2 / (2 D) - t / 2))`` for a record of
-duration D. Each transducer sums its hinges' forces; white noise of
+duration D. Each transducer sums its hinges' forces (on a case with test-rig
+transducers, the forces of the case's transducers under those hinges); white noise of
 standard deviation ``noise`` x (the largest force amplitude of that
 transducer, or of the excitation) is added to each channel. The known
 answer is the simulated transmissibility: the drift is slow, so the rig
@@ -21,6 +23,7 @@ import numpy as np
 from workbook.answers.amplitude import harmonic_amplitude
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
+from workbook.model.case import TRANSDUCER_PREFIX
 from workbook.rig.correlation import MIN_SAMPLES_PER_PERIOD
 from workbook.rig.records import RigRecord
 
@@ -61,7 +64,7 @@ def default_sample_rate(frequencies_hz) -> float:
     return float(2 ** math.ceil(math.log2(MIN_SAMPLES_PER_PERIOD * RATE_MARGIN * max(frequencies_hz))))
 
 
-def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate_hz: float = 2048.0,
+def synthetic_record(result: ExcitationResult, transducers: dict, *, excitation=None, sample_rate_hz: float = 2048.0,
                      duration: float = 4.0, noise: float = 0.005, drift: float = 0.002, harmonics: int = 3,
                      seed: int = 0) -> RigRecord:
     """A rig record of a simulated run with noise and a linear speed drift.
@@ -69,9 +72,12 @@ def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate
     Parameters
     ----------
     result : ExcitationResult
-        A steady simulated run; its measured window is used.
+        A steady simulated run: a time-domain one (its measured window is
+        used) or a frequency-domain one (its phasors; give *excitation*).
     transducers : dict of str to sequence of str
         Pylon-side hinges carried by each transducer.
+    excitation : SingleFrequencyExcitation, optional
+        The run's excitation, whose phasor a frequency-domain run needs.
     sample_rate_hz : float
         Hz.
     duration : float
@@ -81,7 +87,7 @@ def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate
     drift : float
         Relative change of the rotor speed from start to end of the record.
     harmonics : int
-        Harmonics of the rotor frequency kept from the simulation.
+        Harmonics of the rotor frequency kept from a time-domain simulation.
     seed : int
         Seed of the noise generator.
 
@@ -90,29 +96,45 @@ def synthetic_record(result: ExcitationResult, transducers: dict, *, sample_rate
     RigRecord
     """
     f0 = result.frequency_hz
-    window = result.window
-    sim_time = result.time[window]
     time = np.arange(int(round(duration * sample_rate_hz))) / sample_rate_hz
     phase = 2 * np.pi * f0 * (time + drift * (time ** 2 / (2 * duration) - time / 2))
     rng = np.random.default_rng(seed)
+    if result.has_histories:
+        forces, excitation_force = result.hinge_histories, result.excitation_history
+    else:
+        from workbook.solve.harmonic import excitation_phasor
 
-    def resampled(history: np.ndarray) -> np.ndarray:
-        values = history[window]
-        signal = np.broadcast_to(values.mean(axis=0), (len(time), values.shape[1])).copy()
-        for k in range(1, harmonics + 1):
-            phasor = harmonic_amplitude(sim_time, values, k * f0)
+        forces, excitation_force = result.hinge_phasors, excitation_phasor(excitation)
+
+    def resampled(force: np.ndarray) -> np.ndarray:
+        if result.has_histories:
+            values, sim_time = force[result.window], result.time[result.window]
+            mean = values.mean(axis=0)
+            phasors = [harmonic_amplitude(sim_time, values, k * f0) for k in range(1, harmonics + 1)]
+        else:
+            mean, phasors = np.zeros(3), [force]
+        signal = np.broadcast_to(mean, (len(time), len(mean))).copy()
+        for k, phasor in enumerate(phasors, start=1):
             signal += np.real(np.exp(1j * k * phase)[:, None] * phasor[None, :])
-        scale = np.abs(harmonic_amplitude(sim_time, values, f0)).max()
-        return signal + rng.normal(0.0, noise * scale, signal.shape)
+        return signal + rng.normal(0.0, noise * np.abs(phasors[0]).max(), signal.shape)
 
-    forces = {name: resampled(pylon_sum(result.hinge_histories, hinges))
-              for name, hinges in transducers.items()}
+    channels = {name: _carrying(result.pylon_hinges, hinges) for name, hinges in transducers.items()}
     return RigRecord(
-        time, forces, resampled(result.excitation_history),
-        {name: tuple(hinges) for name, hinges in transducers.items()}, sample_rate_hz, f0, result.name,
+        time, {name: resampled(pylon_sum(forces, carried)) for name, carried in channels.items()},
+        resampled(excitation_force), {name: tuple(hinges) for name, hinges in transducers.items()}, sample_rate_hz,
+        f0, result.name,
         notes={"made by": f"workbook.rig.synthetic.synthetic_record from a simulation: noise {noise:g} x amplitude, "
                           f"speed drift {drift:g}, seed {seed}",
                "simulated T x y z": " ".join(f"{t:.6g}" for t in result.transmissibility)})
+
+
+def _carrying(pylon_channels, hinges) -> list:
+    """The force channels that make a transducer carrying *hinges*: the case's test-rig transducers under
+    them (named :func:`~workbook.model.case.transducer_name`), else the hinges themselves."""
+    rig = [name for name in pylon_channels if name.startswith(TRANSDUCER_PREFIX)]
+    if not rig:
+        return list(hinges)
+    return [name for name in rig if set(name[len(TRANSDUCER_PREFIX):].split(" + ")) <= set(hinges)]
 
 
 def broadband_record(frf, *, sample_rate_hz: float = 1024.0, duration: float = 64.0, noise: float = 0.0,

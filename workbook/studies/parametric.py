@@ -44,7 +44,8 @@ import numpy as np
 from workbook.errors import CaseError, InputError
 from workbook.model.case import Case, HarmonicForce, RotatingForce
 
-__all__ = ["Parameter", "PARAMETERS", "parameter", "HINGE_DIRECTIONS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases",
+__all__ = ["Parameter", "PARAMETERS", "parameter", "parameter_value",
+           "HINGE_DIRECTIONS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases",
            "MAX_STUDY_ROWS"]
 
 
@@ -82,12 +83,18 @@ HINGE_DIRECTIONS = {"radial1": (0,), "radial2": (1,), "radial": (0, 1), "axial":
 ALL_HINGES = "all"
 
 
-def _hinge_values(case: Case, field_name: str, value: float, group: str, direction: str, name: str) -> Case:
-    """*case* with *field_name* of the hinges of *group* (all: every hinge) set to *value* in *direction*."""
+def _group(case: Case, group: str, name: str) -> set:
+    """Names of the hinges of *group* (all: every hinge), for the parameter *name*."""
     names = [h.name for h in case.hinges]
     chosen = {n for n in names if group == ALL_HINGES or n.startswith(group)}
     if not chosen:
         raise CaseError("study", name, group, f"the start of hinge names or {ALL_HINGES!r}; hinges: {', '.join(names)}")
+    return chosen
+
+
+def _hinge_values(case: Case, field_name: str, value: float, group: str, direction: str, name: str) -> Case:
+    """*case* with *field_name* of the hinges of *group* (all: every hinge) set to *value* in *direction*."""
+    chosen = _group(case, group, name)
     hinges = []
     for hinge in case.hinges:
         if hinge.name in chosen:
@@ -105,6 +112,27 @@ def _transducers(case: Case, stiffness: float) -> Case:
     return dataclasses.replace(case, test_rig=dataclasses.replace(case.test_rig, stiffness=(float(stiffness),) * 3))
 
 
+#: Case field set by each hinge parameter.
+_HINGE_FIELDS = {"hinge_stiffness": "stiffness", "hinge_damping": "damping", "hinge_loss_factor": "loss_factor"}
+
+
+def _hinge_target(name: str) -> tuple[str, str, str]:
+    """``(base, group, direction)`` of a hinge parameter (group ``all`` when unqualified).
+
+    Raises
+    ------
+    InputError
+        Not a hinge parameter, or a bad group syntax or direction, naming what is known.
+    """
+    base, qualified, qualifier = name.partition("/")
+    group, _, direction = qualifier.partition("/")
+    if base not in _HINGE_FIELDS or (qualified and not group) or (direction and direction not in HINGE_DIRECTIONS):
+        raise InputError(f"unknown study parameter {name!r}; known: {', '.join(PARAMETERS)}, and hinge_stiffness, "
+                         f"hinge_damping or hinge_loss_factor as NAME/GROUP or NAME/GROUP/DIRECTION (GROUP: the "
+                         f"start of hinge names or {ALL_HINGES!r}; DIRECTION: {', '.join(HINGE_DIRECTIONS)})")
+    return base, group or ALL_HINGES, direction
+
+
 def parameter(name: str) -> Parameter:
     """The study parameter *name*: one of :data:`PARAMETERS`, or a hinge parameter qualified by a group
     and a direction (module text).
@@ -116,18 +144,42 @@ def parameter(name: str) -> Parameter:
     """
     if name in PARAMETERS:
         return PARAMETERS[name]
-    base, _, qualifier = name.partition("/")
-    group, _, direction = qualifier.partition("/")
-    field_name = {"hinge_stiffness": "stiffness", "hinge_damping": "damping", "hinge_loss_factor": "loss_factor"}
-    if base not in field_name or not group or (direction and direction not in HINGE_DIRECTIONS):
-        raise InputError(f"unknown study parameter {name!r}; known: {', '.join(PARAMETERS)}, and hinge_stiffness, "
-                         f"hinge_damping or hinge_loss_factor as NAME/GROUP or NAME/GROUP/DIRECTION (GROUP: the "
-                         f"start of hinge names or {ALL_HINGES!r}; DIRECTION: {', '.join(HINGE_DIRECTIONS)})")
+    base, group, direction = _hinge_target(name)
     where = "every hinge" if group == ALL_HINGES else f"the hinges whose names start with {group!r}"
     general = PARAMETERS[base]
     return Parameter(name, general.unit, f"{general.help.split(' of every hinge')[0]} of {where}"
                      + (f", {direction}" if direction else ""),
-                     lambda case, v: _hinge_values(case, field_name[base], float(v), group, direction, name))
+                     lambda case, v: _hinge_values(case, _HINGE_FIELDS[base], float(v), group, direction, name))
+
+
+def parameter_value(case: Case, name: str) -> float:
+    """The value *case* holds of the numeric parameter *name* (SI units; a hinge parameter, the
+    transducer stiffness or the engine mass).
+
+    Raises
+    ------
+    InputError
+        An unknown name, or a parameter without a value in *case*: another kind, no test rig, or hinges
+        (directions) of the group holding different values.
+    """
+    if name == "engine_mass":
+        return float(case.engine.mass)
+    if name == "transducer_stiffness":
+        if case.test_rig is None:
+            raise CaseError("case", name, None, "a case with test-rig force transducers")
+        values = np.asarray(case.test_rig.stiffness, dtype=float)
+    elif name in PARAMETERS and name not in _HINGE_FIELDS:
+        raise InputError(f"{name!r} has no single value in a case to start from; a hinge parameter, "
+                         "transducer_stiffness or engine_mass has")
+    else:
+        base, group, direction = _hinge_target(name)
+        axes = list(HINGE_DIRECTIONS.get(direction, (0, 1, 2)))
+        chosen = _group(case, group, name)
+        values = np.concatenate([h.values(_HINGE_FIELDS[base])[axes] for h in case.hinges if h.name in chosen])
+    if np.ptp(values) > 1e-9 * np.abs(values).max():
+        raise CaseError("case", name, f"{values.min():g} to {values.max():g}",
+                        "one value over its hinges and directions (name a smaller group or a direction)")
+    return float(values[0])
 
 
 def _link_models(case: Case, change: Callable, parameter: str, value: Any) -> Case:
