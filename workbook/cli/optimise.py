@@ -16,9 +16,10 @@ import json
 from typing import Callable
 
 from workbook.cli.loading import load_case
+from workbook.cli.params import parse_ranges
 from workbook.errors import UsageError
 
-__all__ = ["arguments", "varied"]
+__all__ = ["arguments"]
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
@@ -45,25 +46,6 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     return run
 
 
-def varied(texts: list[str]) -> dict:
-    """``NAME=LOW:HIGH`` texts as ``{name: (low, high)}``.
-
-    Raises
-    ------
-    UsageError
-        A text of another form, naming it.
-    """
-    ranges = {}
-    for text in texts:
-        name, _, span = text.partition("=")
-        try:
-            low, high = (float(v) for v in span.split(":"))
-        except ValueError:
-            raise UsageError(f"--vary {text!r}: expected NAME=LOW:HIGH, e.g. hinge_stiffness/front=5e6:2e8") from None
-        ranges[name.strip()] = (low, high)
-    return ranges
-
-
 def run(args) -> int:
     from workbook.design.optimise import optimise
 
@@ -71,7 +53,7 @@ def run(args) -> int:
     if objectives is not None and len(objectives) != 2:
         raise UsageError(f"--pareto {args.pareto!r}: expected two objectives A,B")
     case = load_case(args.case, run=args.run)
-    result = optimise(case, varied(args.vary), objective=args.objective, constraints=args.constraint,
+    result = optimise(case, parse_ranges(args.vary), objective=args.objective, constraints=args.constraint,
                       starts=args.starts, pareto_objectives=objectives, population=args.population,
                       generations=args.generations)
     written = result.write(args.output) if args.output else []

@@ -34,7 +34,7 @@ import sys
 from workbook.cli.loading import load_case
 from workbook.errors import EXIT_FAILED_ROWS, EXIT_OK, InputError, UsageError
 
-__all__ = ["add_arguments", "run_parameter_study", "parse_vary"]
+__all__ = ["add_arguments", "run_parameter_study", "parse_vary", "parse_ranges"]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -121,6 +121,37 @@ def _design_model(case, cases):
     print(f"linear mount prepared in {time.perf_counter() - start:.1f} s: {followed} of {len(cases)} rows "
           "answered by it in NumPy, the others by Exudyn", file=sys.stderr)
     return model if followed else None
+
+
+def parse_ranges(specs: list[str]) -> dict:
+    """``{name: (low, high)}`` of the ``--vary NAME=low:high`` options.
+
+    Raises
+    ------
+    UsageError
+        A malformed option or an unknown parameter, naming it.
+    """
+    from workbook.studies.parametric import parameter
+
+    if not specs:
+        raise UsageError("give at least one --vary NAME=low:high")
+    bounds = {}
+    for spec in specs:
+        name, sep, text = spec.partition("=")
+        name = name.strip()
+        try:
+            parameter(name)
+        except InputError as error:
+            raise UsageError(f"--vary {spec!r}: {error}") from None
+        parts = text.split(":")
+        try:
+            low, high = (float(p) for p in parts) if sep and len(parts) == 2 else (None, None)
+        except ValueError:
+            low = high = None
+        if low is None or high is None or not low < high:
+            raise UsageError(f"--vary {spec!r}: expected NAME=low:high with numbers low < high")
+        bounds[name] = (low, high)
+    return bounds
 
 
 def run_parameter_study(args) -> int:

@@ -21,9 +21,10 @@ from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
-from workbook.errors import InputError, UnwritableCase, UsageError
+from workbook.cli.params import parse_ranges
+from workbook.errors import UnwritableCase
 
-__all__ = ["arguments", "parse_bounds"]
+__all__ = ["arguments"]
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
@@ -42,42 +43,13 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     return run
 
 
-def parse_bounds(specs: list[str]) -> dict:
-    """``{name: (low, high)}`` of the ``--vary NAME=low:high`` options.
-
-    Raises
-    ------
-    UsageError
-        A malformed option or an unknown parameter, naming it.
-    """
-    from workbook.studies.parametric import parameter
-
-    bounds = {}
-    for spec in specs:
-        name, sep, text = spec.partition("=")
-        name = name.strip()
-        try:
-            parameter(name)
-        except InputError as error:
-            raise UsageError(f"--vary {spec!r}: {error}") from None
-        parts = text.split(":")
-        try:
-            low, high = (float(p) for p in parts) if sep and len(parts) == 2 else (None, None)
-        except ValueError:
-            low = high = None
-        if low is None or high is None or not low < high:
-            raise UsageError(f"--vary {spec!r}: expected NAME=low:high with numbers low < high")
-        bounds[name] = (low, high)
-    return bounds
-
-
 def run(args) -> int:
     import pandas as pd
 
     from workbook.cli.rig import read_any_record
     from workbook.rig.updating import update_model
 
-    bounds = parse_bounds(args.vary)
+    bounds = parse_ranges(args.vary)
     case = load_case(args.case, rigid=args.rigid)
     records = [read_any_record(path, args.map) for path in args.record]
     result = update_model(case, records, bounds, periods=args.periods)

@@ -138,17 +138,10 @@ def read_uff_modes(path: str | Path) -> MeasuredModes:
         Not a UFF file, no dataset 55 of analysis type 2 or 3, modes over
         different nodes, or a node without coordinates, naming the dataset.
     """
-    import pyuff
+    from workbook.rig.uff import read_uff_sets
 
     path = Path(path)
-    if not path.is_file():
-        raise RecordError(path, "cannot read: no such file")
-    try:
-        uff = pyuff.UFF(str(path))
-        types = list(uff.get_set_types()) if uff.get_n_sets() else []
-        sets = [(i, uff.read_sets(i)) for i, kind in enumerate(types) if kind in (15, 55)]
-    except Exception as error:  # pyuff raises plain Exception for a file it cannot parse
-        raise RecordError(path, f"not a readable UFF file: {error}") from None
+    sets = read_uff_sets(path, (15, 55))
     points = {int(n): np.array([x, y, z], dtype=float) for _, d in sets if d["type"] == 15
               for n, x, y, z in zip(d["node_nums"], d["x"], d["y"], d["z"], strict=True)}
     modal = [(i, d) for i, d in sets if d["type"] == 55 and int(d.get("analysis_type", 0)) in (NORMAL_MODES, COMPLEX_MODES)]

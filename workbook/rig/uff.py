@@ -37,7 +37,7 @@ from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 from workbook.model.units import si_factor
 from workbook.rig.records import EXCITATION_CHANNEL, RigRecord, check_sampling, parse_header_line
 
-__all__ = ["read_uff_record", "write_uff_record", "UFF_SUFFIXES"]
+__all__ = ["read_uff_record", "read_uff_sets", "write_uff_record", "UFF_SUFFIXES"]
 
 #: File endings of a UFF record.
 UFF_SUFFIXES = (".uff", ".unv")
@@ -49,6 +49,26 @@ _GENERAL, _UNKNOWN = 1, 0
 _ID_LINES = ("id1", "id2", "id3", "id4", "id5")
 _NONE = ("", "NONE")
 
+
+
+def read_uff_sets(path: Path, kinds: tuple[int, ...]) -> list[tuple[int, dict]]:
+    """The datasets of the types *kinds* in the UFF file *path*, with their indices in the file.
+
+    Raises
+    ------
+    RecordError
+        No such file, or a file pyuff cannot read.
+    """
+    import pyuff
+
+    if not path.is_file():
+        raise RecordError(path, "cannot read: no such file")
+    try:
+        uff = pyuff.UFF(str(path))
+        types = list(uff.get_set_types()) if uff.get_n_sets() else []
+        return [(i, uff.read_sets(i)) for i, kind in enumerate(types) if kind in kinds]
+    except Exception as error:  # pyuff raises plain Exception for a file it cannot parse
+        raise RecordError(path, f"not a readable UFF file: {error}") from None
 
 def _direction_text(direction: int) -> str:
     return f"{'+' if direction > 0 else '-'}{'XYZ'[abs(direction) - 1]}" if 1 <= abs(direction) <= 3 else str(direction)
@@ -111,17 +131,8 @@ def read_uff_record(path: str | Path) -> RigRecord:
         or missing, or a missing ID line (run, nominal frequency, a
         transducer's hinges), naming the file and the channel.
     """
-    import pyuff
-
     path = Path(path)
-    if not path.is_file():
-        raise RecordError(path, "cannot read: no such file")
-    try:
-        uff = pyuff.UFF(str(path))
-        types = list(uff.get_set_types()) if uff.get_n_sets() else []
-        datasets = [uff.read_sets(i) for i, kind in enumerate(types) if kind == 58]
-    except Exception as error:  # pyuff raises plain Exception for a file it cannot parse
-        raise RecordError(path, f"not a readable UFF file: {error}") from None
+    datasets = [d for _, d in read_uff_sets(path, (58,))]
     datasets = [d for d in datasets if int(d.get("func_type", -1)) == TIME_RESPONSE]
     if not datasets:
         raise RecordError(path, "no dataset 58 of function type 1 (time response)")
