@@ -156,21 +156,6 @@ def constraint(text: str) -> Constraint:
     raise InputError(f"constraint {text!r}: {expected}, the value positive and LOW < HIGH")
 
 
-def current_value(case: Case, name: str) -> float:
-    """The value the variable *name* has in *case* (a hinge group's first hinge, in the first of its directions)."""
-    from workbook.studies.parametric import ALL_HINGES, HINGE_DIRECTIONS
-
-    base, _, qualifier = name.partition("/")
-    group, _, direction = qualifier.partition("/")
-    if base == "engine_mass":
-        return float(case.engine.mass)
-    if base == "transducer_stiffness":
-        assert case.test_rig is not None     # parameter() refuses it on a case without transducers
-        return float(case.test_rig.stiffness[0])
-    hinge = next(h for h in case.hinges if group in ("", ALL_HINGES) or h.name.startswith(group))
-    return float(hinge.values(base.removeprefix("hinge_"))[HINGE_DIRECTIONS.get(direction, (0,))[0]])
-
-
 @dataclass
 class _Point:
     """One design answered: T with its scaled gradient, and the constraints' rows."""
@@ -586,7 +571,9 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
     mount = mount or LinearMount.prepare(case)
     problem = _Problem(mount, chosen, rules)
-    before_values = {v.name: current_value(mount.case, v.name) for v in chosen}
+    from workbook.studies.parametric import parameter_value
+
+    before_values = {v.name: parameter_value(mount.case, v.name) for v in chosen}
     start = np.array([v.scaled(before_values[v.name]) for v in chosen])
     before = problem.answer(before_values, start, np.ones(len(chosen)))
     runs = [run.name for run in before.answer.result.runs]
