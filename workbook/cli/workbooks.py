@@ -39,7 +39,8 @@ def check_arguments(parser: argparse.ArgumentParser) -> Callable:
             return _report_problems(error)
         case = book.case
         print(f"{book.path.name}: OK - case '{case.name}': {len(case.links)} links, {len(case.hinges)} hinges, "
-              f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values")
+              f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values, "
+              f"{len(case.load_cases)} load cases")
         return EXIT_OK
 
     return check
