@@ -39,7 +39,8 @@ def check_arguments(parser: argparse.ArgumentParser) -> Callable:
             return _report_problems(error)
         case = book.case
         print(f"{book.path.name}: OK - case '{case.name}': {len(case.links)} links, {len(case.hinges)} hinges, "
-              f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values")
+              f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values, "
+              f"{len(case.load_cases)} load cases")
         return EXIT_OK
 
     return check
@@ -130,6 +131,19 @@ def run_workbook(args) -> int:
             pictures.close()
 
 
+def _solved_loads(case):
+    """The table of the case's load cases, solved and printed (None: the case has none)."""
+    if not case.load_cases:
+        return None
+    from workbook.cli.loads import print_load_cases
+    from workbook.excel.loads_sheet import loads_frame
+    from workbook.solve.load_cases import solve_load_cases
+
+    results = solve_load_cases(case)
+    print_load_cases(case, results)
+    return loads_frame(results)
+
+
 def _run_and_write(args, book, selected, progress, pictures) -> int:
     """The runs of :func:`run_workbook`, their results written back and the report."""
     from workbook.errors import SimulationError
@@ -147,6 +161,7 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
         return EXIT_BAD_INPUT if any(failure.bad_input for failure in failures) else EXIT_TROUBLE
     try:
         pole = report_four_pole(book.case) if args.four_pole else None
+        loads = _solved_loads(book.case)
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
@@ -154,7 +169,7 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
         pictures.draw(runs)
     _print_summary(runs)
     try:
-        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened)
+        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened, loads=loads)
     except OSError as error:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)
@@ -162,7 +177,7 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
-            report = write_report(args.report, book, runs, outcome, four_pole=pole, pictures=pictures)
+            report = write_report(args.report, book, runs, outcome, four_pole=pole, pictures=pictures, loads=loads)
         except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE

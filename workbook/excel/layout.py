@@ -22,7 +22,7 @@ from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING,
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
-           "EXCITATIONS", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
+           "EXCITATIONS", "LOAD_CASES", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
            "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES", "MAGNITUDE_LIMITS"]
 
 HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
@@ -241,6 +241,10 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     *_xyz("mesh_bore_axis", "mesh bore axis", DIMENSIONLESS, help="mesh: bore axis direction, mesh frame"),
     _num("loss_factor", "loss factor", help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"),
     _num("modal_damping", "modal damping", help="damping ratio zeta of each elastic mode of the link (empty: 0)"),
+    *(_num(key, key.replace("_", " "), "Pa", unit="MPa", help=f"{what} overriding the preset's (load cases, fatigue)")
+      for key, what in (("yield_strength", "tensile yield strength (0.2 % proof)"),
+                        ("ultimate_strength", "tensile ultimate strength"),
+                        ("endurance_strength", "fully reversed endurance strength"))),
 ))
 
 HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", columns=(
@@ -295,6 +299,24 @@ EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a
     Column("run_up", "run-up", "choice", choices=("rpm", "Hz"),
            help="run-up: the sweep's speeds evenly spaced, tabulated in this unit; the force grows as U w^2 "
                 "(give the unbalance)"),
+))
+
+LOAD_CASES = Table("Load cases", optional=True,
+                   help="limit load cases for mountwb loads and the Result loads sheet of a run (docs/stresses.md); "
+                        "a row holds one extra point force and one moment, more are given in Python or JSON",
+                   columns=(
+    Column("name", "name", "text", required=True, help="unique load case name"),
+    Column("description", "description", "text", help="free text: where the numbers come from"),
+    _num("thrust", "thrust", "N", unit="kN", help="thrust along +x (negative: reverse thrust) (empty: 0)"),
+    *_xyz("thrust_point", "thrust point", "m", help="where the thrust acts (empty: the engine's CG)"),
+    *_xyz("load_factors", "load factor", DIMENSIONLESS,
+          help="load factor in g on every body; empty: 0 in x and y, -1 in z (1 g level flight)"),
+    _num("torque", "torque", "N*m", unit="kN*m", help="engine torque about +x (empty: 0)"),
+    *_xyz("force", "force", "N", help="an extra point force on the engine"),
+    *_xyz("force_point", "force point", "m", help="point of the extra force"),
+    *_xyz("moment", "moment", "N*m", help="an extra moment on the engine"),
+    _num("factor_of_safety", "factor of safety", help="ultimate over limit load, >= 1 (empty: 1.5)"),
+    Column("without_link", "fail-safe link", "text", help="fail-safe: the link removed for this load case"),
 ))
 
 ROTORS = Table("Rotors", optional=True,
@@ -375,4 +397,4 @@ TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes, o
 ))
 
 #: The input tables in sheet order.
-TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, ROTORS, TEST_RIG, CASING, RUNS, TEST_DATA)
+TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, LOAD_CASES, ROTORS, TEST_RIG, CASING, RUNS, TEST_DATA)

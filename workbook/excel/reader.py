@@ -27,6 +27,7 @@ from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import OpenedWorkbook, Record, SheetReader, open_workbook, read_workbook_bytes
 from workbook.model import case as cm
 from workbook.model.casing import DEFAULT_BEARING_STIFFNESS, CasingGeometry, EngineCasing, MountRing
+from workbook.model.load_cases import LoadCase
 
 __all__ = ["CaseBook", "read_workbook"]
 
@@ -68,7 +69,11 @@ class CaseBook:
 # -- items ----------------------------------------------------------------------------------------------------
 
 _GEOMETRY_KEYS = ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")
-_MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density")
+#: Material columns overriding the preset (the strengths are in the Links sheet only).
+_MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density", "yield_strength", "ultimate_strength",
+                  "endurance_strength")
+#: A Load cases row's load factors when their cells are empty: 1 g level flight.
+_LOAD_FACTORS = (0.0, 0.0, -1.0)
 #: Columns of a parametric link's or casing's geometry, which a mesh file replaces (a mesh link's bores take
 #: 'bore radius' too).
 _LINK_SHAPE_KEYS = tuple(key for key in _GEOMETRY_KEYS if key != "bore_radius")
@@ -94,12 +99,13 @@ _FIELD_COLUMNS: dict[str, dict[str, tuple[str, ...]]] = {
                                           f"{key}_{direction.replace(' ', '_')}",)
                   for key in ("stiffness", "damping", "loss_factor") for direction in cm.HINGE_DIRECTIONS},
                "frame": (*L.HINGES.vector_keys("frame_radial_1"), *L.HINGES.vector_keys("frame_axial"))},
+    "Load cases": {"point": L.LOAD_CASES.vector_keys("force_point")},
     "Runs": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "radial_clearance": ("gap",),
              "stiffness": ("hinge_stiffness",), "damping": ("hinge_damping",), "modes": ("fidelity",)},
 }
 #: Item kind in a CaseError of the Case constructor -> its table.
 _ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS,
-                "rotor": L.ROTORS}
+                "rotor": L.ROTORS, "load case": L.LOAD_CASES}
 _ITEM = re.compile(rf"^({'|'.join(_ITEM_TABLES)}) '(.*)'$")
 #: Item of a CaseError about the engine's casing (the Engine casing sheet's one row).
 _CASING_ITEM = "engine casing"
@@ -202,7 +208,7 @@ class _CaseReader(SheetReader):
         if not overrides:
             return base
         return self.build(record, lambda: dataclasses.replace(base, name=f"{base.name} (modified)", **overrides),
-                          _MATERIAL_KEYS)
+                          tuple(overrides))
 
     def link_model(self, record: Record):
         import flexbodies
@@ -296,6 +302,26 @@ class _CaseReader(SheetReader):
                 "moment": lambda: cm.PointMoment(name, vector("moment")),
                 "gravity": lambda: cm.Gravity(name, vector("acceleration"))}[kind]
         return self.build(record, make)
+
+    def load_case(self, record: Record) -> LoadCase | None:
+        """A Load cases row: at most one extra point force and one moment (named 'force' and 'moment')."""
+        get, vector = record.get, record.vector
+        forces: tuple = ()
+        if vector("force") is not None:
+            keys = L.LOAD_CASES.vector_keys("force_point")
+            if not self.require(record, keys, "the point of the extra force"):
+                return None
+            forces = (self.build(record, lambda: cm.PointForce("force", vector("force"), vector("force_point"))),)
+        moments = () if vector("moment") is None else (self.build(record, lambda: cm.PointMoment("moment", vector("moment"))),)
+        if None in forces or None in moments:
+            return None
+        factors = tuple(get(key, default) for key, default in
+                        zip(L.LOAD_CASES.vector_keys("load_factors"), _LOAD_FACTORS, strict=True))
+        given = {key: get(key) for key in ("thrust", "torque", "factor_of_safety", "without_link")
+                 if get(key) is not None}
+        return self.build(record, lambda: LoadCase(get("name"), load_factors=factors, forces=forces, moments=moments,
+                                                   thrust_point=vector("thrust_point"),
+                                                   description=get("description", ""), **given))
 
     def excitations(self, records: list[Record]) -> list:
         """``(record, excitation)`` per excitation: one per row, or one per group
@@ -425,7 +451,7 @@ class _CaseReader(SheetReader):
     # -- the case ----------------------------------------------------------------------------------------
 
     def case(self, tables: dict) -> cm.Case | None:
-        for key in ("Links", "Hinges", "Static loads", "Rotors"):
+        for key in ("Links", "Hinges", "Static loads", "Rotors", L.LOAD_CASES.sheet):
             self.unique(tables[key])
         planes: dict = {}
         for record in tables["Excitations"]:
@@ -439,7 +465,7 @@ class _CaseReader(SheetReader):
         test_rig = [self.test_rig(r) for r in tables["Test rig"] if r.ok]
         items = {key: [(r, make(r) if r.ok else None) for r in tables[key]] for key, make in
                  (("Links", self.link), ("Hinges", self.hinge), ("Static loads", self.static_load),
-                  ("Rotors", self.rotor))}
+                  ("Rotors", self.rotor), (L.LOAD_CASES.sheet, self.load_case))}
         items["Excitations"] = self.excitations(tables["Excitations"])
         first_links: dict[Any, Any] = {}
         for record, link in items["Links"]:
@@ -454,7 +480,7 @@ class _CaseReader(SheetReader):
             return cm.Case(record.get("name"), cast(cm.Engine, engine[0]), built["Links"], built["Hinges"], built["Static loads"],
                            built["Excitations"], analysis=analysis, effects=effects,
                            description=record.get("description", ""), test_rig=test_rig[0] if test_rig else None,
-                           rotors=built["Rotors"])
+                           rotors=built["Rotors"], load_cases=built[L.LOAD_CASES.sheet])
         except cm.CaseError as exc:
             self.case_error(exc, items, tables[L.CASING.sheet])
         return None

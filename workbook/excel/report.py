@@ -17,6 +17,8 @@ repeated on every printed page, every number formatted by its quantity
 - ``Warnings``: every warning of the runs (e.g. a response not steady);
 - ``Plots``: one picture per run (force histories, or T against frequency);
 - ``Model card``: the model card of every run;
+- ``Loads`` (a case with load cases): per load case and link the axial
+  force, stresses and margins of safety (:mod:`workbook.excel.loads_sheet`);
 - ``Metadata``: the input file and its SHA-256 as read, the files written
   and their SHA-256 as they are on disk after the write, versions, date.
 """
@@ -36,10 +38,11 @@ from openpyxl.styles import Alignment, Font, PatternFill
 from openpyxl.utils import get_column_letter
 
 from workbook.answers.isolation import efficiency, level_db
+from workbook.excel import loads_sheet
 from workbook.excel.files import new_file_target, save_atomic, signed, untouched
 from workbook.excel.pictures import draw_pictures
 from workbook.excel.reader import CaseBook
-from workbook.excel.styling import FORMATS, print_setup, style_series, write_text_lines
+from workbook.excel.styling import FORMATS, print_setup, style_series, write_frame, write_text_lines
 from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
 from workbook.model.case import DIRECTIONS
 
@@ -330,7 +333,7 @@ def is_report(path: Path) -> bool:
 
 
 def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
-                 written: WriteOutcome | None = None, *, four_pole=None, pictures=None) -> WriteOutcome:
+                 written: WriteOutcome | None = None, *, four_pole=None, pictures=None, loads=None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
     An existing *path* is replaced only if it is a report this module wrote,
@@ -352,6 +355,8 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     pictures : workbook.excel.pictures.Pictures, optional
         The pictures of *runs*, being drawn (:func:`~workbook.excel.pictures.start_pictures`);
         default: drawn here.
+    loads : pandas.DataFrame, optional
+        The solved load cases (:func:`~workbook.excel.loads_sheet.loads_frame`): a Loads sheet.
 
     Returns
     -------
@@ -369,6 +374,10 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
     _warnings(workbook.create_sheet("Warnings"), runs)
     _plots(workbook.create_sheet("Plots"), runs, draw_pictures(runs) if pictures is None else pictures.result())
     _model_cards(workbook.create_sheet("Model card"), runs)
+    if loads is not None:
+        ws = workbook.create_sheet("Loads")
+        _title(ws, f"{book.case.name}: limit load cases", loads_sheet.NOTE)
+        write_frame(ws, loads, top=4, fill=_HEADER_FILL, quantities=loads_sheet.QUANTITIES)
     if four_pole is not None:
         four_pole_sheet(workbook.create_sheet(FOUR_POLE_SHEET), four_pole)
     _metadata(workbook.create_sheet("Metadata"), book, runs, written)

@@ -19,9 +19,11 @@ __all__ = ["FORMATS", "DIRECTION_COLOURS", "quantity_of", "print_setup", "style_
 #: Number format of each quantity: eta and errors in %, T in four decimals (scientific below 0.01),
 #: levels in dB with one decimal, frequencies in Hz with two, forces in N, dynamic stiffness in N/m
 #: with four digits, phases in degrees with one decimal, plain numbers with five significant digits,
-#: wall times in s with three decimals.
+#: wall times in s with three decimals, stresses in MPa with one, margins of safety and factors with two,
+#: positions in m with four.
 FORMATS = {"eta": '0.00" %"', "T": "[<0.01]0.000E+00;0.0000", "dB": "0.0", "Hz": "0.00", "N": "0.000",
-           "error": '0.0" %"', "zeta": '0.00" %"', "N/m": "0.000E+00", "deg": "0.0", "number": "0.0000E+00", "s": "0.000"}
+           "error": '0.0" %"', "zeta": '0.00" %"', "N/m": "0.000E+00", "deg": "0.0", "number": "0.0000E+00", "s": "0.000",
+           "MPa": "0.0", "margin": "0.00", "m": "0.0000"}
 #: Line and marker colour of each direction in the charts, as in the pictures (matplotlib's first three).
 DIRECTION_COLOURS = {"x": "1F77B4", "y": "FF7F0E", "z": "2CA02C"}
 #: Dash of the lines of the first, second, ... curve group of a chart.

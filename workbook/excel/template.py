@@ -20,12 +20,14 @@ from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.datavalidation import DataValidation
 
 import workbook.excel.layout as L
+from flexbodies.materials import STRENGTH_FIELDS
 from workbook.errors import UnwritableCase
 from workbook.excel.files import new_file_target, save_atomic
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.styling import print_setup
 from workbook.model import case as cm
 from workbook.model.casing import DEFAULT_CORE_SPIN_HZ
+from workbook.model.load_cases import LoadCase, reference_load_cases
 from workbook.model.units import si_factor
 
 __all__ = ["case_rows", "case_workbook", "template_workbook", "reference_workbook", "write_workbook",
@@ -72,6 +74,9 @@ _INSTRUCTIONS = (
     "a mode count, or a cut-off such as '2000 Hz'.",
     "Rotors and Test rig (optional, empty: none): spinning rotors whose gyroscopic moments act on the engine, "
     "and the rig's force transducers under the pylon pins; 'gyroscopics' and 'rig sensors' in Case switch them off.",
+    "Load cases (optional): limit loads (thrust, load factors in g, torque, a point force and a moment, factor of "
+    "safety, a fail-safe link); a run then writes 'Result loads': link forces, stresses and margins of safety.",
+    "Links: yield, ultimate and endurance strength columns override the material preset's.",
     "Test data: measured force amplitudes (pylon sum or a hinge, per direction); "
     "the results show error = (sim - test) / test x 100 %.",
     "Check a workbook:  mountwb check CASE.xlsx     "
@@ -100,7 +105,8 @@ def _row_for_link(link: cm.Link) -> dict:
                 ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")})
     base = flexbodies.material(model.material.name.split(" ")[0])
     row["material"] = base.name
-    row.update({key: getattr(model.material, key) for key in ("youngs_modulus", "poisson_ratio", "density")
+    row.update({key: getattr(model.material, key) for key in ("youngs_modulus", "poisson_ratio", "density",
+                                                               *STRENGTH_FIELDS)
                 if getattr(model.material, key) != getattr(base, key)})
     if link.bore_axis is not None:
         row.update(_vector("bore_axis", link.bore_axis))
@@ -153,6 +159,23 @@ def _row_for_load(load: cm.StaticLoad) -> dict:
     if isinstance(load, cm.PointMoment):
         return {"name": load.name, "type": "moment", **_vector("moment", load.moment)}
     return {"name": load.name, "type": "gravity", **_vector("acceleration", load.acceleration)}
+
+
+def _row_for_load_case(load_case: LoadCase) -> dict:
+    """A Load cases row: its extra point force and moment, at most one of each, are named by the sheet."""
+    if len(load_case.forces) > 1 or len(load_case.moments) > 1:
+        raise UnwritableCase(f"load case {load_case.name!r}: a Load cases row holds one extra force and one moment; "
+                             "a load case with more is given in Python or JSON")
+    row = {"name": load_case.name, "description": load_case.description or None, "thrust": load_case.thrust or None,
+           **_vector("load_factors", load_case.load_factors), "torque": load_case.torque or None,
+           "factor_of_safety": load_case.factor_of_safety, "without_link": load_case.without_link}
+    if load_case.thrust_point is not None:
+        row.update(_vector("thrust_point", load_case.thrust_point))
+    for force in load_case.forces:
+        row.update(**_vector("force", force.force), **_vector("force_point", force.point))
+    for moment in load_case.moments:
+        row.update(_vector("moment", moment.moment))
+    return row
 
 
 def _row_for_rotor(rotor: cm.Rotor) -> dict:
@@ -232,6 +255,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.HINGES.sheet: hinges,
         L.STATIC_LOADS.sheet: [_row_for_load(load) for load in case.static_loads],
         L.EXCITATIONS.sheet: [row for e in case.excitations for row in _rows_for_excitation(e)],
+        L.LOAD_CASES.sheet: [_row_for_load_case(load_case) for load_case in case.load_cases],
         L.ROTORS.sheet: [_row_for_rotor(rotor) for rotor in case.rotors],
         L.TEST_RIG.sheet: _rows_for_test_rig(case.test_rig),
         L.CASING.sheet: _rows_for_casing(case.engine.casing),
@@ -332,10 +356,11 @@ def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPo
 
 
 def template_workbook() -> Workbook:
-    """The case template: the reference mount as example rows, with example runs."""
+    """The case template: the reference mount as example rows, with example runs and the reference load cases."""
     from workbook.model.reference import reference_case
 
-    return case_workbook(reference_case(sweep=True), TEMPLATE_RUNS)
+    return case_workbook(dataclasses.replace(reference_case(sweep=True), load_cases=reference_load_cases()),
+                         TEMPLATE_RUNS)
 
 
 def reference_workbook() -> Workbook:

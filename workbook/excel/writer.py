@@ -1,7 +1,9 @@
 """Write run results back into the case workbook, safely.
 
 Result sheets are named ``Result efficiency``, ``Result hinges``, ``Result
-sweep`` and ``Result model card``; each carries, in a hidden cell, a marker
+sweep``, ``Result model card`` and, for a case with load cases, ``Result
+loads`` (:mod:`workbook.excel.loads_sheet`: rewritten whole when the load
+cases were solved, kept as it was otherwise); each carries, in a hidden cell, a marker
 naming the sheet it was written as. A later run rewrites a sheet only when
 its name is one of these and its marker names that same sheet, and only the
 rows of the runs it computed: the rows of the workbook's other runs stay as
@@ -45,6 +47,7 @@ from openpyxl.styles import Font, PatternFill
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
 from workbook.answers.results import PYLON_SUM, MountResult
+from workbook.excel import loads_sheet
 from workbook.excel.files import (
     ChangedOnDisk,
     held,
@@ -223,13 +226,15 @@ _NOTES = {
 }
 
 
+#: Title of the load cases' result sheet.
+LOADS_SHEET = _sheet_title("loads")
 #: Every sheet title a write may create (and so may replace).
-RESULT_SHEETS = tuple(_sheet_title(name) for name in (*_NOTES, "model card"))
+RESULT_SHEETS = (*(_sheet_title(name) for name in (*_NOTES, "model card")), LOADS_SHEET)
 
 
-def result_sheet_names(frames: dict) -> list[str]:
-    """Titles of the result sheets a write creates."""
-    return [_sheet_title(name) for name in frames] + [_sheet_title("model card")]
+def result_sheet_names(frames: dict, loads=None) -> list[str]:
+    """Titles of the result sheets a write creates (with *loads*, a loads table: its sheet too)."""
+    return [_sheet_title(name) for name in frames] + [_sheet_title("model card")] + ([LOADS_SHEET] if loads is not None else [])
 
 
 def _merged(earlier: list[tuple], fresh: list[tuple], computed: set[str]) -> list:
@@ -279,20 +284,24 @@ def _kept_note(earlier: list[tuple], computed: set[str]) -> str:
     return f"; the results of {', '.join(repr(run) for run in kept)} are from an earlier run" if kept else ""
 
 
-def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, frames: dict | None = None) -> list[str]:
+def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, frames: dict | None = None,
+                      loads=None) -> list[str]:
     """Add the result sheets of *runs* to an openpyxl *workbook*.
 
     The result sheets a write made before are rewritten: the rows and model
     cards of the runs just computed are replaced, those of every other run
     are kept as they were (the sheet's note names them). *frames* are
     ``result_frames(runs, tests)`` when the caller has them already.
+    *loads* (:func:`~workbook.excel.loads_sheet.loads_frame`) replaces the
+    loads sheet whole; without it an earlier loads sheet is kept.
 
     Returns
     -------
     list of str
         The sheet titles written.
     """
-    earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)}
+    earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)
+               and (loads is not None or ws.title != LOADS_SHEET)}
     computed = {run.spec.name for run in runs}
     frames = result_frames(runs, tests) if frames is None else frames
     tables = {}
@@ -321,7 +330,13 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
     ws.cell(1, 1, stamp + _kept_note(cards, computed)).font = Font(italic=True)
     print_setup(ws)
     _mark(ws)
-    return [*tables, ws.title]
+    if loads is None:
+        return [*tables, ws.title]
+    ws = workbook.create_sheet(LOADS_SHEET)
+    ws.cell(1, 1, f"{loads_sheet.NOTE}. {stamp}").font = Font(italic=True)
+    write_frame(ws, loads, top=2, fill=_HEADER_FILL, quantities=loads_sheet.QUANTITIES)
+    _mark(ws)
+    return [*tables, _sheet_title("model card"), ws.title]
 
 
 def _conflicts(workbook, titles: list[str]) -> list[str]:
@@ -379,7 +394,7 @@ def _cached_formula_values(path: Path, workbook, values=None) -> dict[int, dict[
 
 
 def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = (), *,
-                  opened=None) -> WriteOutcome:
+                  opened=None, loads=None) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
     Parameters
@@ -393,6 +408,8 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     opened : OpenedWorkbook, optional
         The workbook as read (``CaseBook.opened``): its sheets are written into
         without loading the file again, while the file is unchanged.
+    loads : pandas.DataFrame, optional
+        The solved load cases (:func:`~workbook.excel.loads_sheet.loads_frame`): the loads sheet.
 
     Returns
     -------
@@ -401,12 +418,12 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
     frames = result_frames(runs, tests)
-    titles = result_sheet_names(frames)
+    titles = result_sheet_names(frames, loads)
     with held(path):
         reason, workbook, values = _reason_not_to_overwrite(path, sha256, titles, opened)
         if reason is None:
             log.info("building the new %s with the results", path.name)
-            add_result_sheets(workbook, runs, tests, stamp, frames)
+            add_result_sheets(workbook, runs, tests, stamp, frames, loads)
             data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook, values))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
@@ -417,7 +434,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
                 reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
-    add_result_sheets(separate, runs, tests, stamp, frames)
+    add_result_sheets(separate, runs, tests, stamp, frames, loads)
     target = save_atomic(separate, name_beside(path, "results"))
     log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)
