@@ -393,7 +393,15 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
     pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
                                initializer=_worker_init, initargs=(started, design_model))
     processes = set()
-    broken = {}
+    broken: dict = {}
+    pids: dict = {}
+
+    def read_started():
+        # read as rows finish: a worker blocks on a full pipe (about 2000 rows of notes) until it is read
+        while not started.empty():
+            index, pid = started.get()
+            pids[index] = pid
+
     try:
         futures = {pool.submit(_reported_row, index, case): index for index, case in pending.items()}
         processes.update(set(multiprocessing.active_children()) - before)  # to read their exit codes later
@@ -403,16 +411,14 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
                 done(future.result())
             except BrokenProcessPool:
                 broken[futures[future]] = pending[futures[future]]
+            read_started()
     except BaseException:
         processes.update(set(multiprocessing.active_children()) - before)
         pool.shutdown(wait=False, cancel_futures=True)
         stop_workers(processes)
         raise
     pool.shutdown(wait=True)
-    pids = {}
-    while not started.empty():
-        index, pid = started.get()
-        pids[index] = pid
+    read_started()
     exitcodes = {process.pid: process.exitcode for process in processes}
     lost = {i: case for i, case in broken.items() if i in pids}
     deaths = {i: _death(exitcodes.get(pids[i])) for i in lost}
