@@ -120,7 +120,7 @@ def test_dask_cluster_equals_local(base, rows, serial, tmp_path):
 
     case_file = tmp_path / "case.json"
     case_file.write_text(to_json(base))
-    argv = ["study", "params", str(case_file), "--output", str(tmp_path / "out")]
+    argv = ["study", "params", str(case_file), "--output", str(tmp_path / "out"), "--exudyn"]  # as the serial rows
     argv += [f"--vary=hinge_stiffness={','.join(map(str, STIFFNESS))}", f"--vary=removed_link={','.join(REMOVED)}"]
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
         assert main(argv + ["--dask", cluster.scheduler_address]) == EXIT_FAILED_ROWS  # stiffness 0, link removed

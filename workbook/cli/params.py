@@ -17,7 +17,7 @@ Rows that change only what a design evaluation follows (hinge springs and
 loss factors, transducer springs, engine mass properties, excitation
 amplitudes) are answered by the case's linear mount, prepared once
 (:class:`workbook.LinearMount`), in NumPy; the others, and every row with
-``--exudyn`` or ``--dask``, by the Exudyn pipeline. The table's ``path``
+``--exudyn``, by the Exudyn pipeline (local processes and Dask workers alike). The table's ``path``
 column says which.
 
 The table file is kept up to date as rows finish, so an interrupted study
@@ -34,20 +34,29 @@ import sys
 from workbook.cli.loading import load_case
 from workbook.errors import EXIT_FAILED_ROWS, EXIT_OK, InputError, UsageError
 
-__all__ = ["add_arguments", "run_parameter_study", "parse_vary", "parse_ranges"]
+__all__ = ["add_arguments", "add_run_arguments", "run_parameter_study", "parse_vary", "parse_ranges",
+           "linear_mount_for"]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Add the options of ``study params`` to its parser."""
     from workbook.studies.parametric import PARAMETERS
-    from workbook.studies.sensitivity import TABLE_FORMATS
 
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=SPEC",
                        help=f"parameter ({', '.join(PARAMETERS)}; a hinge parameter also as NAME/GROUP[/DIRECTION], "
                             "e.g. hinge_stiffness/front/axial) and its values: a,b,c or low:high:points "
                             "(with --lhs: low:high); SI units")
     parser.add_argument("--lhs", type=int, metavar="N", help="N Latin-hypercube samples over the --vary bounds")
-    parser.add_argument("--seed", type=int, default=0, help="Latin-hypercube seed (0)")
+    add_run_arguments(parser, "Latin-hypercube seed (0)")
+    parser.add_argument("--resume", action="store_true",
+                        help="keep the rows the table in --output already holds and run only the missing ones")
+
+
+def add_run_arguments(parser: argparse.ArgumentParser, seed_help: str) -> None:
+    """Add the options of a study's rows (seed, workers, Dask, table format, rigid links, Exudyn) to *parser*."""
+    from workbook.studies.sensitivity import TABLE_FORMATS
+
+    parser.add_argument("--seed", type=int, default=0, help=seed_help)
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
                        help="local processes (default: every core; 1: serial)")
     parser.add_argument("--dask", metavar="ADDRESS", help="run on the Dask scheduler at ADDRESS instead")
@@ -57,8 +66,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="answer every row through Exudyn (default: the rows that change only hinge and "
                              "transducer springs, engine mass properties or excitation amplitudes are answered "
                              "by the case's linear mount in NumPy, equal to 1e-6)")
-    parser.add_argument("--resume", action="store_true",
-                        help="keep the rows the table in --output already holds and run only the missing ones")
 
 
 def _value(text: str, numeric: bool):
@@ -105,7 +112,7 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
     return latin_hypercube(bounds, lhs, seed) if lhs is not None else grid(values)
 
 
-def _design_model(case, cases):
+def linear_mount_for(case, cases):
     """The linear mount of *case* when it follows at least one row's case (said on stderr), else None."""
     import time
 
@@ -154,6 +161,37 @@ def parse_ranges(specs: list[str]) -> dict:
     return bounds
 
 
+def run_table(args, case, table, resume: str) -> list:
+    """Run the rows of *table* (a :class:`workbook.studies.sensitivity.StudyTable`) as *args* ask, the file
+    kept up to date, a progress line on stderr; *resume*: how to go on after an interrupt.
+
+    Returns
+    -------
+    list of RowOutcome
+
+    Raises
+    ------
+    KeyboardInterrupt
+        Ctrl-C or SIGTERM, with the number of finished rows kept in the table and *resume* as its message.
+    """
+    from workbook.studies.parallel import run_rows
+    from workbook.studies.parametric import study_cases
+    from workbook.studies.progress import StudyProgress
+
+    rows = table.rows
+    cases = study_cases(case, rows)
+    design_model = None if args.exudyn else linear_mount_for(case, cases)
+    try:
+        with StudyProgress(len(rows), table.kept, stream=sys.stderr) as progress:
+            outcomes = run_rows(cases, workers=args.workers, dask=args.dask, finished=table.outcomes,
+                                record=table.add, progress=progress.update, design_model=design_model)
+            table.flush()
+    except KeyboardInterrupt as interrupt:
+        table.flush()
+        raise type(interrupt)(f"{table.kept} of {len(rows)} rows finished and kept in {table.path}; {resume}") from None
+    return outcomes
+
+
 def run_parameter_study(args) -> int:
     """Run ``study params``; print the table, a summary line and the files written.
 
@@ -171,9 +209,7 @@ def run_parameter_study(args) -> int:
 
     matplotlib.use("Agg")
 
-    from workbook.studies.parallel import NUMPY_PATH, run_rows
-    from workbook.studies.parametric import study_cases
-    from workbook.studies.progress import StudyProgress
+    from workbook.studies.parallel import NUMPY_PATH
     from workbook.studies.sensitivity import StudyTable, new_study_table, read_finished, table_path, write_study
 
     rows = parse_vary(args.vary, args.lhs, args.seed)
@@ -184,19 +220,7 @@ def run_parameter_study(args) -> int:
     where = f"Dask scheduler {args.dask}" if args.dask else f"{args.workers} local process(es)"
     kept = f" ({len(finished)} already in {path})" if args.resume else ""
     print(f"{case.name}: {len(rows)} study rows{kept} on {where}", file=sys.stderr)
-    cases = study_cases(case, rows)
-    design_model = None
-    if not args.exudyn and not args.dask:
-        design_model = _design_model(case, cases)
-    try:
-        with StudyProgress(len(rows), len(finished), stream=sys.stderr) as progress:
-            outcomes = run_rows(cases, workers=args.workers, dask=args.dask, finished=finished,
-                                record=table.add, progress=progress.update, design_model=design_model)
-            table.flush()
-    except KeyboardInterrupt as interrupt:
-        table.flush()
-        raise type(interrupt)(f"{table.kept} of {len(rows)} rows finished and kept in {path}; "
-                              f"--resume runs the rest") from None
+    outcomes = run_table(args, case, table, "--resume runs the rest")
     frame = table.frame()
     print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}"))
     failed = [outcome for outcome in outcomes if outcome.status != "ok"]

@@ -1,4 +1,4 @@
-"""``mountwb study accuracy|params [CASE]``: studies of one case.
+"""``mountwb study accuracy|params|uq [CASE]``: studies of one case.
 
 - ``mountwb study accuracy [CASE] [--run R] [--repeats N] [--output DIR]``:
   runs the case through the accuracy ladder of
@@ -7,6 +7,8 @@
   of the same name exist).
 - ``mountwb study params [CASE] --vary NAME=SPEC ...``: a parameter study
   (:mod:`workbook.cli.params`).
+- ``mountwb study uq [CASE] --param NAME=DIST ... --samples N [--sobol]``: the
+  uncertainty of T and eta, Monte Carlo and Sobol' indices (:mod:`workbook.cli.uq`).
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import argparse
 import sys
 from typing import Callable
 
-from workbook.cli import params
+from workbook.cli import params, uq
 from workbook.cli.loading import load_case
 from workbook.errors import UsageError
 
@@ -41,6 +43,12 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     _case_arguments(study_params)
     params.add_arguments(study_params)
     study_params.set_defaults(study=params.run_parameter_study)
+    study_uq = kinds.add_parser("uq", help="uncertainty of T and eta: Monte Carlo percentiles and Sobol' indices",
+                                description="sample parameters from distributions; statistics of T and eta, a "
+                                            "histogram/CDF plot and, with --sobol, Sobol' indices (SALib)")
+    _case_arguments(study_uq)
+    uq.add_arguments(study_uq)
+    study_uq.set_defaults(study=uq.run_uq_study)
     return lambda args: args.study(args)
 
 

@@ -173,7 +173,7 @@ def prepare_design_model(base: Case):
         return str(error)
 
 
-def run_row(index: int, case: Case) -> RowOutcome:
+def run_row(index: int, case: Case, design_model: LinearMount | None = None) -> RowOutcome:
     """Run every excitation of one row's case; never raises but for an interrupt.
 
     A row the study's prepared linear mount follows (its springs, engine
@@ -185,6 +185,9 @@ def run_row(index: int, case: Case) -> RowOutcome:
     index : int
         Row number.
     case : Case
+    design_model : LinearMount, optional
+        The study's prepared linear mount (default: this process's, set for
+        the study's rows here or in a worker process).
 
     Returns
     -------
@@ -201,12 +204,13 @@ def run_row(index: int, case: Case) -> RowOutcome:
 
     start = time.perf_counter()
     path = EXUDYN_PATH
+    model = _design_model if design_model is None else design_model
     try:
         with threadpool_limits(limits=1):
             result = None
-            if _design_model is not None:
+            if model is not None:
                 try:
-                    result, path = _design_model.evaluate(case).result, NUMPY_PATH
+                    result, path = model.evaluate(case).result, NUMPY_PATH
                 except OutsideDesignModel:      # a change the prepared mount does not follow
                     pass
             if result is None:
@@ -251,8 +255,8 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         Local processes: rows per worker in one chunk of rows (a fresh pool each chunk).
     design_model : LinearMount, optional
         The base case's prepared linear mount (:func:`prepare_design_model`):
-        the rows it follows are answered by it, here and in local processes
-        (a Dask cluster runs every row through Exudyn).
+        the rows it follows are answered by it, here, in local processes and
+        on a Dask cluster (sent to each worker once).
 
     Returns
     -------
@@ -282,7 +286,7 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         else:
             pending[index] = item
     if dask is not None:
-        _run_dask(pending, dask, done)
+        _run_dask(pending, dask, done, design_model)
     elif workers <= SERIAL or len(pending) <= 1:
         with _signals_seen() as seen, _using(design_model):
             for index, case in pending.items():
@@ -389,7 +393,15 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
     pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
                                initializer=_worker_init, initargs=(started, design_model))
     processes = set()
-    broken = {}
+    broken: dict = {}
+    pids: dict = {}
+
+    def read_started():
+        # read as rows finish: a worker blocks on a full pipe (about 2000 rows of notes) until it is read
+        while not started.empty():
+            index, pid = started.get()
+            pids[index] = pid
+
     try:
         futures = {pool.submit(_reported_row, index, case): index for index, case in pending.items()}
         processes.update(set(multiprocessing.active_children()) - before)  # to read their exit codes later
@@ -399,16 +411,14 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
                 done(future.result())
             except BrokenProcessPool:
                 broken[futures[future]] = pending[futures[future]]
+            read_started()
     except BaseException:
         processes.update(set(multiprocessing.active_children()) - before)
         pool.shutdown(wait=False, cancel_futures=True)
         stop_workers(processes)
         raise
     pool.shutdown(wait=True)
-    pids = {}
-    while not started.empty():
-        index, pid = started.get()
-        pids[index] = pid
+    read_started()
     exitcodes = {process.pid: process.exitcode for process in processes}
     lost = {i: case for i, case in broken.items() if i in pids}
     deaths = {i: _death(exitcodes.get(pids[i])) for i in lost}
@@ -438,7 +448,7 @@ def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker:
                                                  f"also when the row was retried alone"))
 
 
-def _run_dask(pending: dict, address: str, done: Callable) -> None:
+def _run_dask(pending: dict, address: str, done: Callable, design_model: LinearMount | None) -> None:
     from distributed import Client
     from distributed import as_completed as dask_completed
 
@@ -446,7 +456,9 @@ def _run_dask(pending: dict, address: str, done: Callable) -> None:
     with Client(address) as client:
         if cache:  # the workers load the reductions made here (a shared folder on a real cluster)
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
-        futures = client.map(run_row, list(pending), list(pending.values()), pure=False)
+        # the prepared mount goes to every worker once; each task gets it by reference
+        model = None if design_model is None else client.scatter(design_model, broadcast=True)
+        futures = client.map(run_row, list(pending), list(pending.values()), design_model=model, pure=False)
         rows = {future.key: index for future, index in zip(futures, pending, strict=True)}
         for future in dask_completed(futures):
             try:

@@ -128,10 +128,10 @@ def table_path(folder: str | Path, table_format: TableFormat = "csv", stem: str 
     return Path(folder) / f"{stem}.{table_format}"
 
 
-def new_study_table(folder: str | Path, table_format: TableFormat = "csv") -> Path:
-    """The table file of a new study in *folder*: ``parameter-study``, or ``parameter-study-2``... when a file of
-    an earlier study (its table, sheet or plot) is there, which is kept."""
-    return table_path(folder, table_format, free_stem(folder, STUDY_STEM, (f".{table_format}", ".xlsx", ".png")))
+def new_study_table(folder: str | Path, table_format: TableFormat = "csv", stem: str = STUDY_STEM) -> Path:
+    """The table file of a new study in *folder*: ``<stem>`` (``parameter-study``), or ``<stem>-2``... when a
+    file of an earlier study (its table, sheet or plot) is there, which is kept."""
+    return table_path(folder, table_format, free_stem(folder, stem, (f".{table_format}", ".xlsx", ".png")))
 
 
 def _write_table(frame, path: Path) -> None:
@@ -254,9 +254,10 @@ def read_finished(path: str | Path, rows: tuple) -> dict[int, RowOutcome]:
     return finished
 
 
-def _study_workbook(frame, parameters: list[str]):
+def _study_workbook(frame, parameters: list[str], title: str, sheets: dict):
     """The study table as a workbook that prints readably: each parameter headed by its words and
-    unit (``hinge stiffness N/m``), every number formatted by its quantity, the header on every page."""
+    unit (``hinge stiffness N/m``), every number formatted by its quantity, the header on every page;
+    then a sheet per table of *sheets* (title: frame)."""
     from openpyxl import Workbook
 
     from workbook.excel.styling import write_frame
@@ -264,13 +265,16 @@ def _study_workbook(frame, parameters: list[str]):
     headers = {name: f"{name.replace('_', ' ')} {parameter(name).unit}" for name in parameters
                if parameter(name).numeric}
     workbook = Workbook()
-    workbook.active.title = "Parameter study"
+    workbook.active.title = title
     write_frame(workbook.active, frame.rename(columns=headers),
                 quantities={header: "number" for header in headers.values()})
+    for name, table in sheets.items():
+        write_frame(workbook.create_sheet(name), table)
     return workbook
 
 
-def write_study(frame, parameters: list[str], table: str | Path) -> list[Path]:
+def write_study(frame, parameters: list[str], table: str | Path, *, title: str = "Parameter study",
+                sheets: dict | None = None, figure=None) -> list[Path]:
     """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot, each all at once.
 
     Parameters
@@ -279,6 +283,12 @@ def write_study(frame, parameters: list[str], table: str | Path) -> list[Path]:
     parameters : list of str
     table : str or Path
         The table file (:func:`table_path`); the sheet and the plot go beside it under its name.
+    title : str
+        Title of the table's sheet.
+    sheets : dict of str to pandas.DataFrame, optional
+        More sheets of the workbook, by title.
+    figure : matplotlib.figure.Figure, optional
+        The plot to write (closed after), instead of :func:`plot_sensitivity`'s.
 
     Returns
     -------
@@ -289,9 +299,9 @@ def write_study(frame, parameters: list[str], table: str | Path) -> list[Path]:
     _write_table(frame, table)
     sheet = table.with_suffix(".xlsx")
     with replacing(sheet, suffix=".xlsx.tmp") as temporary:
-        _study_workbook(frame, parameters).save(temporary)
+        _study_workbook(frame, parameters, title, sheets or {}).save(temporary)
     plot = table.with_suffix(".png")
-    figure = plot_sensitivity(frame, parameters)
+    figure = plot_sensitivity(frame, parameters) if figure is None else figure
     save_figure(figure, plot, dpi=120)
     import matplotlib.pyplot as plt
 
