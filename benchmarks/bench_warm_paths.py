@@ -20,17 +20,34 @@ that a change of the machine's load hits both alike. Python caches the
 compiled modules of both trees in a temporary folder (``PYTHONPYCACHEPREFIX``),
 as an installed package has them, and a first run of each command fills it.
 
-Measured on the shared 2-core machine of the project (load average 0.3 to
-1.7 from other work while it ran, not the idle machine of the targets),
-``OPENBLAS_NUM_THREADS=1``, with ``python benchmarks/bench_warm_paths.py
---before 6ec551f`` (6ec551f: the code before these changes), medians of 5
-(cold: 3)::
+Measured on the shared 2-core machine of the project, ``OPENBLAS_NUM_THREADS=1``.
+With ``python benchmarks/bench_warm_paths.py --before 6ec551f`` (6ec551f:
+the code before the warm-path changes; load average 0.3 to 1.7 from other
+work), medians of 5 (cold: 3)::
 
     | what                                                    | before  | now    | target |
     | warm `mountwb run`                                      | 1.45 s  | 1.00 s | 1 s    |
     | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.69 s  | 2.60 s | 2 s    |
     | cold `mountwb run` (empty cache)                        | 10.62 s | 9.85 s | 6 s    |
     | unneeded packages the warm run imports                  | meshio, pandas, skfem | none | none |
+
+The cold path since (issue 25, item 5), with ``--before 95f7844 --repeats 3
+--cold-repeats 5`` (95f7844: before the residual mass shared by a link's
+decisions and the nested-dissection ordering; load average 3.3 to 4 from
+other work, so every time is longer than on the quieter machine above)::
+
+    | what                                                    | before  | now     | target |
+    | warm `mountwb run`                                      | 1.11 s  | 1.23 s  | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 3.37 s  | 3.62 s  | 2 s    |
+    | cold `mountwb run` (empty cache)                        | 18.90 s | 16.63 s | 6 s    |
+
+The warm paths do not run the changed code (their difference is the load's).
+The cold run stays above 6 s: it waits for the thrust rod (47k DOF), reduced
+alone in one worker while the other reduces the front and rear links. Of the
+thrust rod's 10.9 s (load about 3): 1.7 s factorisation, 2.7 s in the 64
+single solves of three Lanczos runs (fixed-interface modes, 30 solves, the
+fewest of the ``ncv`` tried; free-free, 21; mounted, 13), 1.7 s assembly,
+1.2 s meshing, 1.5 s geometric stiffness, 0.55 s stress operator and shapes.
 
 Run from the repository's root::
 

@@ -20,7 +20,7 @@ import scipy.sparse as sp
 from .eigen import factorize, lowest_modes
 from .errors import LinkModelError
 
-__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "fixed_interface_set", "kept_count",
+__all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "elastic_coefficients", "fixed_interface_set", "kept_count",
            "ModeBudgetExceeded", "MODE_BUDGET", "estimated_mode_count"]
 
 #: Frequencies below this fraction of the first elastic one count as rigid-body modes.
@@ -216,6 +216,35 @@ def craig_bampton(stiffness, mass, boundary, *, count: int | None = None, cutoff
     return CraigBamptonBasis(np.hstack([vectors, fixed]), boundary, freqs[:keep])
 
 
+def elastic_coefficients(cb: CraigBamptonBasis, stiffness, mass):
+    """The elastic modes of a free-floating Craig-Bampton basis as combinations of its vectors.
+
+    Parameters
+    ----------
+    cb : CraigBamptonBasis
+    stiffness, mass : scipy.sparse matrix
+        The coupled matrices the basis was made from.
+
+    Returns
+    -------
+    coefficients : ndarray, shape (n_basis, n_elastic)
+        The elastic modes are ``cb.vectors @ coefficients``, mass-normalised.
+    frequencies_hz : ndarray, shape (n_elastic,)
+        Free-free frequencies of the reduced body, Hz.
+    """
+    K_r = cb.project(stiffness)
+    M_r = cb.project(mass)
+    lam, X = sla.eigh(K_r, M_r)
+    freqs = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
+    n_rigid = int(np.sum(freqs < _RIGID_FRACTION * freqs[-1]))
+    if n_rigid != 6:
+        raise LinkModelError(
+            f"expected 6 rigid-body modes in the free link, found {n_rigid}: "
+            "the interfaces do not see the body as one free solid"
+        )
+    return X[:, 6:], freqs[6:]
+
+
 def elastic_modes(cb: CraigBamptonBasis, stiffness, mass):
     """Orthonormalise a free-floating Craig-Bampton basis and drop its rigid-body modes.
 
@@ -232,14 +261,5 @@ def elastic_modes(cb: CraigBamptonBasis, stiffness, mass):
     frequencies_hz : ndarray, shape (n_elastic,)
         Free-free frequencies of the reduced body, Hz.
     """
-    K_r = cb.project(stiffness)
-    M_r = cb.project(mass)
-    lam, X = sla.eigh(K_r, M_r)
-    freqs = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
-    n_rigid = int(np.sum(freqs < _RIGID_FRACTION * freqs[-1]))
-    if n_rigid != 6:
-        raise LinkModelError(
-            f"expected 6 rigid-body modes in the free link, found {n_rigid}: "
-            "the interfaces do not see the body as one free solid"
-        )
-    return cb.vectors @ X[:, 6:], freqs[6:]
+    coefficients, freqs = elastic_coefficients(cb, stiffness, mass)
+    return cb.vectors @ coefficients, freqs

@@ -2,7 +2,11 @@
 
 One factorisation per shift, with a fill-reducing ordering, reused for every
 solve and handed to ARPACK as its shift-invert operator (scipy's default
-COLAMD ordering gives several times more fill on elasticity matrices).
+COLAMD ordering gives several times more fill on elasticity matrices). The
+ordering is METIS's nested dissection of the matrix's graph, one vertex per
+node (the DOF of a node share their pattern). On the reference links it gives
+the fill of SuperLU's minimum-degree ordering (within 2 %), but ordering and
+factorisation take 0.45 to 0.75 of its time and a solve 0.7 to 0.8.
 """
 from __future__ import annotations
 
@@ -10,24 +14,69 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["factorize", "natural_frequencies", "free_dofs", "lowest_modes", "start_vector"]
+__all__ = ["factorize", "nested_dissection", "natural_frequencies", "free_dofs", "lowest_modes", "start_vector"]
 
 
 #: Relative residual below which a solve is not refined.
 _ROUND_OFF = 1e-13
 
 
+def _supervariables(pattern: sp.csr_matrix) -> np.ndarray:
+    """The group of each row: consecutive rows of one column pattern (a node's DOF) share one."""
+    n = pattern.shape[0]
+    rows = np.repeat(np.arange(n), np.diff(pattern.indptr))
+    weight = np.random.default_rng(0).random(n)
+    signature = np.stack([np.diff(pattern.indptr), np.bincount(rows, weight[pattern.indices], minlength=n)])
+    new = np.ones(n, dtype=bool)
+    new[1:] = (signature[:, 1:] != signature[:, :-1]).any(axis=0)
+    return np.cumsum(new) - 1
+
+
+def nested_dissection(matrix: sp.spmatrix) -> np.ndarray:
+    """A fill-reducing symmetric ordering of a sparse square matrix: METIS's nested dissection.
+
+    Parameters
+    ----------
+    matrix : scipy.sparse matrix, shape (n, n)
+        Its pattern is symmetrised.
+
+    Returns
+    -------
+    ndarray of int, shape (n,)
+        ``matrix[order][:, order]`` is the matrix to factorise.
+    """
+    import pymetis
+
+    pattern = sp.csr_matrix(matrix, copy=True)
+    pattern.data = np.ones_like(pattern.data)
+    pattern = (pattern + pattern.T).tocsr()
+    group = _supervariables(pattern)
+    members = sp.csr_matrix((np.ones(len(group)), (group, np.arange(len(group)))))
+    graph = (members @ pattern @ members.T).tocsr()
+    graph.setdiag(0)
+    graph.eliminate_zeros()
+    order, _ = pymetis.nested_dissection(adjacency=pymetis.CSRAdjacency(graph.indptr, graph.indices),
+                                         vweights=np.diff(members.indptr))
+    return members[np.asarray(order)].indices
+
+
 class _Factor:
-    """A sparse LU factorisation that solves one or many right-hand sides."""
+    """A sparse LU factorisation, in a nested-dissection order, that solves one or many right-hand sides."""
 
     def __init__(self, matrix: sp.spmatrix):
         self.shape = matrix.shape
         self._matrix = sp.csc_matrix(matrix)
+        self._order = nested_dissection(self._matrix)
         self._lu = spla.splu(
-            self._matrix,
-            permc_spec="MMD_AT_PLUS_A",
+            self._matrix[self._order][:, self._order].tocsc(),
+            permc_spec="NATURAL",
             options={"SymmetricMode": True},
         )
+
+    def _solved(self, rhs: np.ndarray) -> np.ndarray:
+        x = np.empty_like(rhs)
+        x[self._order] = self._lu.solve(np.ascontiguousarray(rhs[self._order]))
+        return x
 
     def solve(self, rhs: np.ndarray) -> np.ndarray:
         """Solve for a vector or for each column of a matrix, with one refinement step.
@@ -39,18 +88,18 @@ class _Factor:
         of a loop over them).
         """
         rhs = np.asarray(rhs, dtype=float)
-        x = self._lu.solve(rhs)
+        x = self._solved(rhs)
         residual = rhs - self._matrix @ x
         if rhs.ndim == 1:
-            return x if np.linalg.norm(residual) <= _ROUND_OFF * np.linalg.norm(rhs) else x + self._lu.solve(residual)
+            return x if np.linalg.norm(residual) <= _ROUND_OFF * np.linalg.norm(rhs) else x + self._solved(residual)
         refine = np.linalg.norm(residual, axis=0) > _ROUND_OFF * np.linalg.norm(rhs, axis=0)
         if refine.any():
-            x[:, refine] += self._lu.solve(np.ascontiguousarray(residual[:, refine]))
+            x[:, refine] += self._solved(residual[:, refine])
         return x
 
     def solve_plain(self, rhs: np.ndarray) -> np.ndarray:
         """Solve for one vector, without refinement (what an eigen-solver's operator needs)."""
-        return self._lu.solve(np.ascontiguousarray(rhs, dtype=float))
+        return self._solved(np.asarray(rhs, dtype=float))
 
     def as_operator(self) -> spla.LinearOperator:
         return spla.LinearOperator(self.shape, matvec=self.solve_plain, dtype=float)

@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .assembly import FEModel
-from .craig_bampton import CraigBamptonBasis, elastic_modes, fixed_interface_set, kept_count
+from .craig_bampton import CraigBamptonBasis, elastic_coefficients, fixed_interface_set, kept_count
 from .frequencies import free_free_frequencies, mounted_frequencies
 from .interfaces import InterfaceCoupling, couple_interfaces, rigid_motion_rows
 from .interior import InteriorSolver
@@ -26,7 +26,7 @@ from .selection import ModeDecision
 from .stress import NodalStress
 
 __all__ = ["CoupledModel", "couple", "reference_frequencies", "reduce_coupled", "reduce_for_decisions",
-           "residual_mass"]
+           "InertiaFlexibility"]
 
 
 @dataclass(frozen=True)
@@ -66,13 +66,16 @@ def reference_frequencies(coupled: CoupledModel, count: int = 6) -> dict:
 
 
 def _padded(matrix: sp.spmatrix, extra: int) -> sp.csr_matrix:
-    """A square matrix with ``extra`` zero rows and columns appended."""
-    return sp.block_diag((matrix, sp.csr_matrix((extra, extra))), format="csr")
+    """A square matrix with ``extra`` zero rows and columns appended (its CSR arrays, the row pointer
+    extended)."""
+    matrix = sp.csr_matrix(matrix)
+    n = matrix.shape[0] + extra
+    indptr = np.concatenate([matrix.indptr, np.full(extra, matrix.indptr[-1])])
+    return sp.csr_matrix((matrix.data, matrix.indices, indptr), shape=(n, n))
 
 
-def residual_mass(coupled: CoupledModel, solver: InteriorSolver, cb: CraigBamptonBasis,
-                  modes_q: np.ndarray) -> np.ndarray:
-    """The omitted fixed-interface modes' residual mass in the body's coordinates.
+class InertiaFlexibility:
+    """The held interior's flexibility seen through the inertia loads of a Craig-Bampton basis.
 
     A motion ``u = W x`` of the body (``x``: its frame's translation, m, and
     rotation, rad, in the body frame, then its elastic modal coordinates)
@@ -84,29 +87,57 @@ def residual_mass(coupled: CoupledModel, solver: InteriorSolver, cb: CraigBampto
         R = f^T (K_ii^-1 - Phi_k Omega_k^-2 Phi_k^T) f,
 
     the residual flexibility of the omitted modes (``K_ii^-1`` less the kept
-    modes' part) seen through ``f``: no omitted mode is computed.
+    modes' part) seen through ``f``: no omitted mode is computed. Every
+    motion of a basis made of the static modes and the lowest fixed-interface
+    modes of *cb* is ``W = V C`` (``V``: *cb*'s vectors), so one block solve
+    with the loads ``(M V)_i`` serves :meth:`residual_mass` of each such basis.
 
-    Returns
-    -------
-    ndarray, shape (6 + n_modes, 6 + n_modes)
-        R, kg s^2 (per unit coordinate).
+    Parameters
+    ----------
+    coupled : CoupledModel
+    solver : InteriorSolver
+        The factorisation *cb* was made with.
+    cb : CraigBamptonBasis
+        The largest basis served.
     """
-    coupling = coupled.coupling
-    carry = np.zeros((len(solver.masters), 6))        # master DOF of a rigid motion about the frame origin
-    for interface, dofs in enumerate(coupling.master_dofs):
-        carry[dofs[:3] - solver.masters[0]] = rigid_motion_rows(coupling.centres[interface:interface + 1])[0]
-        carry[dofs[3:] - solver.masters[0], 3:] = np.eye(3)
-    motion = np.hstack([solver.static_modes() @ carry, modes_q])
-    force = (coupled.mass @ motion)[solver.interior]
-    fixed = cb.vectors[solver.interior, cb.n_static:]
-    omega_sq = (2 * np.pi * np.asarray(cb.fixed_interface_hz)) ** 2
-    projected = fixed.T @ force
-    residual = force.T @ solver.factor.solve(force) - projected.T @ (projected / omega_sq[:, None])
-    return 0.5 * (residual + residual.T)
+
+    def __init__(self, coupled: CoupledModel, solver: InteriorSolver, cb: CraigBamptonBasis):
+        coupling = coupled.coupling
+        #: Static-mode coefficients of a rigid motion about the frame origin, shape (n_static, 6).
+        self.carry = np.zeros((cb.n_static, 6))
+        for interface, dofs in enumerate(coupling.master_dofs):
+            self.carry[dofs[:3] - solver.masters[0]] = rigid_motion_rows(coupling.centres[interface:interface + 1])[0]
+            self.carry[dofs[3:] - solver.masters[0], 3:] = np.eye(3)
+        loads = (coupled.mass @ cb.vectors)[solver.interior]
+        self.flexibility = loads.T @ solver.factor.solve(loads)
+        self.participation = cb.vectors[solver.interior, cb.n_static:].T @ loads
+        self.omega_sq = (2 * np.pi * np.asarray(cb.fixed_interface_hz)) ** 2
+
+    def residual_mass(self, n_fixed: int, coefficients: np.ndarray) -> np.ndarray:
+        """R of the basis of the static modes and the lowest ``n_fixed`` fixed-interface modes.
+
+        Parameters
+        ----------
+        n_fixed : int
+        coefficients : ndarray, shape (n_static + n_fixed, n_modes)
+            The body's elastic modes in that basis
+            (:func:`~flexbodies.craig_bampton.elastic_coefficients`).
+
+        Returns
+        -------
+        ndarray, shape (6 + n_modes, 6 + n_modes)
+            R, kg s^2 (per unit coordinate).
+        """
+        size = len(self.carry) + n_fixed
+        motion = np.hstack([np.vstack([self.carry, np.zeros((n_fixed, 6))]), coefficients])
+        projected = self.participation[:n_fixed, :size] @ motion
+        residual = (motion.T @ self.flexibility[:size, :size] @ motion
+                    - projected.T @ (projected / self.omega_sq[:n_fixed, None]))
+        return 0.5 * (residual + residual.T)
 
 
 def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeDecision, frequencies: dict,
-                   info: dict, solver: InteriorSolver | None = None) -> ReducedLink:
+                   info: dict, flexibility: InertiaFlexibility | None = None) -> ReducedLink:
     """The reduced link of a Craig-Bampton basis: elastic modes, node-wise basis, floating-frame invariants.
 
     Parameters
@@ -120,9 +151,9 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     info : dict
         JSON-able facts about the inputs, stored with the link; reduction
         timings and sizes are added.
-    solver : InteriorSolver, optional
-        The factorisation ``cb`` was made with: the link then keeps its
-        :func:`residual_mass`.
+    flexibility : InertiaFlexibility, optional
+        Of ``cb`` or a larger basis of the same factorisation: the link then
+        keeps its residual mass (:meth:`InertiaFlexibility.residual_mass`).
 
     Returns
     -------
@@ -130,7 +161,8 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     """
     start = time.perf_counter()
     coupling = coupled.coupling
-    modes_q, reduced_hz = elastic_modes(cb, coupled.stiffness, coupled.mass)
+    coefficients, reduced_hz = elastic_coefficients(cb, coupled.stiffness, coupled.mass)
+    modes_q = cb.vectors @ coefficients
     fe = coupled.fe_model
     n_fe = len(fe.nodes)
     n_if = len(coupling.names)
@@ -138,7 +170,8 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     mode_basis = np.vstack([coupling.transform @ modes_q, modes_q[masters_t.ravel()]])
     nodes = np.vstack([fe.nodes, coupling.centres])
     invariants = ffrf_invariants(nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if), mode_basis)
-    residual = np.zeros((0, 0)) if solver is None else residual_mass(coupled, solver, cb, modes_q)
+    residual = (np.zeros((0, 0)) if flexibility is None
+                else flexibility.residual_mass(len(cb.fixed_interface_hz), coefficients))
     stress_modes = np.zeros((0, 6, 0))
     if coupled.stress is not None:
         stress_start = time.perf_counter()
@@ -174,7 +207,8 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     The fixed-interface modes are nested (the lowest ``k`` of one solve), so
     one eigen-solve up to the highest need of all decisions serves each of
     them, truncated to what it keeps; the same factorisation gives the
-    static modes.
+    static modes, and one block solve the residual mass of each
+    (:class:`InertiaFlexibility`).
 
     Parameters
     ----------
@@ -204,12 +238,15 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
         )
         if need_count > len(fixed_hz):
             fixed_hz, fixed = solver.fixed_interface_modes(need_count)
-    static = solver.static_modes()
+    keeps = [kept_count(fixed_hz, decision.count, decision.cutoff_hz) for decision in decisions]
+    largest = CraigBamptonBasis(np.hstack([solver.static_modes(), fixed[:, :max(keeps)]]), solver.masters,
+                                fixed_hz[:max(keeps)])
+    flexibility = InertiaFlexibility(coupled, solver, largest)
     shared = time.perf_counter() - start
     links = []
-    for decision, info in zip(decisions, infos, strict=True):
-        keep = kept_count(fixed_hz, decision.count, decision.cutoff_hz)
-        cb = CraigBamptonBasis(np.hstack([static, fixed[:, :keep]]), solver.masters, fixed_hz[:keep])
+    for decision, keep, info in zip(decisions, keeps, infos, strict=True):
+        cb = CraigBamptonBasis(largest.vectors[:, :largest.n_static + keep], solver.masters, fixed_hz[:keep])
         links.append(reduce_coupled(coupled, cb, decision, frequencies,
-                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared}, solver))
+                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared},
+                                    flexibility))
     return links
