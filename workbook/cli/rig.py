@@ -77,12 +77,19 @@ def simulate_run(case: Case, run: str, *, histories: bool = False) -> Excitation
     """
     from workbook.solve.pipeline import run_case, run_excitation
 
+    excitation = _excitation(case, run)
+    if histories:
+        return run_excitation(case, excitation)[0]
+    return run_case(dataclasses.replace(case, excitations=(excitation,))).runs[0]
+
+
+def _excitation(case: Case, run: str):
+    """The single-frequency excitation named *run* of *case* (UsageError naming those it has)."""
     excitations = {e.name: e for e in case.single_frequency_excitations()}
     if run not in excitations:
-        raise UsageError(f"case {case.name!r} has no excitation {run!r}; it has {', '.join(excitations)}")
-    if histories:
-        return run_excitation(case, excitations[run])[0]
-    return run_case(dataclasses.replace(case, excitations=(excitations[run],))).runs[0]
+        raise UsageError(f"case {case.name!r} has no excitation {run!r}; it has {', '.join(excitations)} "
+                         "(--run NAME)")
+    return excitations[run]
 
 
 def simulated_transmissibility(case: Case, run: str, low_hz: float, high_hz: float, points: int):
@@ -112,11 +119,7 @@ def simulated_transmissibility(case: Case, run: str, low_hz: float, high_hz: flo
     from workbook.model.case import Sweep
     from workbook.solve.sweep import run_sweep
 
-    excitations = {e.name: e for e in case.single_frequency_excitations()}
-    if run not in excitations:
-        raise UsageError(f"case {case.name!r} has no excitation {run!r} to sweep; it has {', '.join(excitations)} "
-                         "(--run NAME)")
-    sweep = Sweep.band(f"{run} sweep", excitations[run], max(low_hz, 0.1), high_hz, points, "linear")
+    sweep = Sweep.band(f"{run} sweep", _excitation(case, run), max(low_hz, 0.1), high_hz, points, "linear")
     answer = run_sweep(dataclasses.replace(case, excitations=(sweep,)), sweep)
     return answer.frequencies, answer.transmissibility()
 
