@@ -17,16 +17,21 @@ from typing import Callable
 from workbook.cli.loading import load_case
 from workbook.errors import UsageError
 
-__all__ = ["arguments", "chosen_load_cases", "print_load_cases"]
+__all__ = ["arguments", "add_load_case_arguments", "chosen_load_cases", "print_load_cases"]
 
 
-def arguments(parser: argparse.ArgumentParser) -> Callable:
+def add_load_case_arguments(parser: argparse.ArgumentParser) -> None:
+    """The options ``mountwb loads`` and ``mountwb stress`` share: the case, its row, the load cases, JSON."""
     parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     parser.add_argument("--run", metavar="R", help="case workbook: take the case of this row of the Runs sheet")
     parser.add_argument("--load-case", dest="load_case", metavar="NAME", action="append",
                         help="solve only this load case (repeatable)")
-    parser.add_argument("--rigid", action="store_true", help="make every link rigid (forces only, no stresses)")
     parser.add_argument("--json", action="store_true", help="print everything as JSON (SI units) instead of tables")
+
+
+def arguments(parser: argparse.ArgumentParser) -> Callable:
+    add_load_case_arguments(parser)
+    parser.add_argument("--rigid", action="store_true", help="make every link rigid (forces only, no stresses)")
     return run
 
 

@@ -24,12 +24,10 @@ VTU_MODES = 6
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
-    parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
-    parser.add_argument("--run", metavar="R", help="case workbook: take the case of this row of the Runs sheet")
-    parser.add_argument("--load-case", dest="load_case", metavar="NAME", action="append",
-                        help="solve only this load case (repeatable)")
+    from workbook.cli.loads import add_load_case_arguments
+
+    add_load_case_arguments(parser)
     parser.add_argument("--vtu", metavar="DIR", help="write each link's mesh with its stress fields as DIR/<link>.vtu")
-    parser.add_argument("--json", action="store_true", help="print everything as JSON (SI units) instead of tables")
     return run
 
 
