@@ -244,8 +244,13 @@ class LinearMount:
             or is excited on an undamped resonance.
         """
         start = time.perf_counter()
+        return self.answer(case, self.solve_items(case), start)
+
+    def answer(self, case: Case, solutions: list["ItemSolution"], start: float) -> DesignAnswer:
+        """The answers of the design *case* from its solved items (:meth:`solve_items`), begun at *start*
+        (``time.perf_counter()``)."""
         runs, static, engine = [], {}, {}
-        for item, solution in zip(case.excitations, self.solve_items(case), strict=True):
+        for item, solution in zip(case.excitations, solutions, strict=True):
             static[item.name] = dict(zip(self.channels, solution.state.forces, strict=True))
             engine[item.name] = solution.engine_static
             for excitation in points_of(item):

@@ -151,7 +151,7 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     case = design_case(mount, values)
     solutions = mount.solve_items(case)
     changes = [_parameter_change(mount, values, name) for name in values]
-    answer = mount.evaluate(case)
+    answer = mount.answer(case, solutions, start)
     runs, t, hinges = _answers(answer, mount.channels)
     gradient = np.zeros(t.shape + (len(values),))
     hinge_gradient = np.zeros(hinges.shape + (len(values),))
