@@ -113,7 +113,7 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
 
 
 def linear_mount_for(case, cases):
-    """The linear mount of *case* when it follows at least one row's case (said on stderr), else None."""
+    """The linear mount of *case* when it follows a row's case (said on stderr), else None."""
     import time
 
     from workbook.model.case import Case
@@ -124,10 +124,14 @@ def linear_mount_for(case, cases):
     if isinstance(model, str):
         print(f"every row through Exudyn: {model}", file=sys.stderr)
         return None
-    followed = sum(isinstance(row, Case) and model.follows(row) for row in cases)
-    print(f"linear mount prepared in {time.perf_counter() - start:.1f} s: {followed} of {len(cases)} rows "
-          "answered by it in NumPy, the others by Exudyn", file=sys.stderr)
-    return model if followed else None
+    # the first row it follows is enough to use it (each row is checked again where it runs)
+    if not any(isinstance(row, Case) and model.follows(row) for row in cases):
+        print(f"every row through Exudyn: the linear mount of {case.name!r} follows none of the rows",
+              file=sys.stderr)
+        return None
+    print(f"linear mount prepared in {time.perf_counter() - start:.1f} s: the rows it follows are answered by it "
+          "in NumPy, the others by Exudyn (the table's path column)", file=sys.stderr)
+    return model
 
 
 def parse_ranges(specs: list[str]) -> dict:
