@@ -17,12 +17,12 @@ result = wb.run_case(case)
 # %%
 # Isolation efficiency eta = (1 - T) x 100 % of the pylon force, per direction:
 
-print(result.table("efficiency").round(2))
+print(result.to_pandas("efficiency").round(2))
 
 # %%
 # The same answers as transmissibility levels, 20 log10 T (dB):
 
-print(result.table("db").round(1))
+print(result.to_pandas("db").round(1))
 
 # %%
 # The model card of a run says how it was solved and what the scene held

@@ -19,12 +19,12 @@ answer = wb.run_sweep(wb.reference_case(), sweep)
 # The mounted modes in the band: the engine's six rigid-body modes on its
 # links, and any link mode below 300 Hz.
 
-print(answer.modes_frame()[["kind", "frequency Hz", "damping ratio %", "engine share %"]].round(2))
+print(answer.modes.to_pandas()[["kind", "frequency Hz", "damping ratio %", "engine share %"]].round(2))
 
 # %%
 # T of the pylon force per direction, every fifth frequency:
 
-print(answer.curves_frame().iloc[::5].round(5))
+print(answer.to_pandas().iloc[::5].round(5))
 
 # %%
 # The curves, log-log, with the modes marked (mounted modes dashed, link modes

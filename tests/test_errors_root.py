@@ -48,7 +48,7 @@ PLAIN_RAISES = {
     ("flexbodies/interior.py", "InteriorSolver.__init__"): "coordinates the package ordered",
     # arguments of a Python function that only calling code gives (the command line never passes a bad one)
     ("workbook/answers/results.py", "MountResult.run"): "a run name asked for in Python",
-    ("workbook/answers/results.py", "MountResult._table_rows"): "a quantity asked for in Python (MountResult.table, table_text)",
+    ("workbook/answers/results.py", "MountResult._table_rows"): "a quantity asked for in Python (MountResult.to_pandas, to_text)",
     ("workbook/answers/text_table.py", "text_table"): "rows and columns the package built",
     ("workbook/excel/pictures.py", "Pictures.result"): "the package's own calls out of order (draw before result)",
     ("workbook/answers/results.py", "MountResult.plot_time_histories"): "a plot asked for in Python",

@@ -184,7 +184,7 @@ def test_bad_input_is_named():
 
 
 def test_table_and_plot(sdof):
-    table = sdof.table()
+    table = sdof.to_pandas()
     assert list(table.index) == list(FREQUENCIES)
     assert table.shape[1] == 2 * 3 * len(QUANTITIES)
     assert table["|K21 y| N/m"].to_numpy() == pytest.approx(np.abs(sdof.direction_values("K21")[:, 1]))

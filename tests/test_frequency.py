@@ -158,13 +158,13 @@ def test_sweep_tabulates_modes_and_plots(reference, tmp_path):
 
     sweep = Sweep.band("sweep", reference.excitations[1], 2.0, 300.0, 200)
     answer = run_sweep(reference, sweep)
-    modes = answer.modes_frame()
+    modes = answer.modes.to_pandas()
     mounted = modes[modes.kind == "mounted"]
     assert len(mounted) == 6
     assert (mounted["damping ratio %"] > 0).all()
     # the thrust rods' first bending modes (about 100 Hz) are link modes in band
     assert (modes.kind == "link").any()
-    curves = answer.curves_frame(locations=(PYLON_SUM, "front-up-left"))
+    curves = answer.to_pandas(locations=(PYLON_SUM, "front-up-left"))
     assert curves.shape == (200, 6)
     # isolation above the mounted modes: T falls well below 1 at the top of the band
     assert curves.iloc[-1][["T pylon sum y", "T pylon sum z"]].max() < 0.1

@@ -27,7 +27,7 @@ def result(reference):
 
 
 def test_mount_isolates_both_rotors(result):
-    table = result.table("efficiency")
+    table = result.to_pandas("efficiency")
     assert list(table.index) == ["LP rotor", "HP rotor"]
     for run in result.runs:
         assert run.steady, run.warnings
@@ -84,7 +84,7 @@ def test_static_modes_match_twenty_fixed_interface_modes_where_the_rule_holds(re
 
 
 def test_result_tabulates_and_serialises(result):
-    frame = result.to_frame()
+    frame = result.to_pandas("all")
     assert len(frame) == 2 * (16 + 1) * 3
     pylon = frame[(frame.location == PYLON_SUM) & (frame.run == "HP rotor")].set_index("direction")
     run = result.run("HP rotor")
@@ -95,7 +95,7 @@ def test_result_tabulates_and_serialises(result):
     card = data["runs"][1]["model_card"]
     assert card["total_dof"] == sum(body["dof"] for body in card["bodies"])
     assert {e["name"]: e["on"] for e in card["effects"]}["hinge clearance"] is False
-    assert result.static_frame().loc[PYLON_SUM, "Fx N"] == pytest.approx(23_000.0, rel=1e-6)
+    assert result.preloads[result.run().name].to_pandas().loc[PYLON_SUM, "Fx N"] == pytest.approx(23_000.0, rel=1e-6)
 
 
 def test_result_plots_itself(result):

@@ -220,7 +220,7 @@ def test_pairing_recovers_the_case_modes_from_a_perturbed_shuffled_test_set(refe
     test = MeasuredModes(frequencies[order] * factors, np.full(6, 0.02), (simulated + noise)[order], dofs, points, "t")
     pairing = pair_modes(read_uff_modes(write_uff_modes(tmp_path / "test.uff", test)), frequencies, simulated)
     assert pairing.pairs == [(i, int(order[i])) for i in range(6)]
-    table = pairing.frame()
+    table = pairing.to_pandas()
     # UFF 55 holds the frequencies to 6 digits
     np.testing.assert_allclose(table["error %"], 100 * (1 / factors - 1), atol=1e-3)
     assert table["MAC"].min() > 0.98

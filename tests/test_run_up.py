@@ -23,7 +23,7 @@ def sdof_run_up():
 
 
 def test_single_dof_run_up_follows_u_omega_squared_times_the_closed_form(sdof_run_up):
-    frame = sdof_run_up.frame()
+    frame = sdof_run_up.to_pandas()
     speeds = frame.index.to_numpy()
     omega = 2 * math.pi * speeds / 60
     ratio = speeds / 60 / NATURAL_HZ
@@ -37,12 +37,19 @@ def test_single_dof_run_up_follows_u_omega_squared_times_the_closed_form(sdof_ru
     np.testing.assert_allclose(frame["frequency Hz"], speeds / 60, rtol=1e-12)
 
 
+def test_former_run_up_table_names_warn_and_give_the_same_tables(sdof_run_up):
+    with pytest.warns(DeprecationWarning, match=r"RunUpAnswer.frame\(\) is now to_pandas"):
+        assert sdof_run_up.frame().equals(sdof_run_up.to_pandas())
+    with pytest.warns(DeprecationWarning, match="modes_frame"):
+        assert sdof_run_up.modes_frame().equals(sdof_run_up.modes.to_pandas())
+
+
 def test_the_mounted_modes_are_marked_at_their_speed(sdof_run_up, tmp_path):
     marked = sdof_run_up.mode_speeds()
     # the translations in y and z at f_n = 10 Hz = 600 rpm lie in the range
     translations = [speed for _, kind, speed in marked if abs(speed - 60 * NATURAL_HZ) < 1e-3 * 60 * NATURAL_HZ]
     assert len(translations) >= 2 and all(kind == "mounted" for _, kind, _ in marked)
-    damping = sdof_run_up.modes_frame()["damping ratio %"]
+    damping = sdof_run_up.modes.to_pandas()["damping ratio %"]
     assert np.isclose(damping, 100 * ZETA, rtol=1e-3).sum() >= 2
     figure = sdof_run_up.plot()
     path = tmp_path / "run-up.png"
@@ -63,7 +70,7 @@ def test_run_up_gives_the_single_runs_at_the_rotor_speeds(coarse_reference):
     single_case = dataclasses.replace(coarse_reference, excitations=singles,
                                       analysis=dataclasses.replace(coarse_reference.analysis, method="frequency"))
     result = run_case(single_case)
-    frame = answer.frame()
+    frame = answer.to_pandas()
     for name, row in (("at LP", 0), ("at HP", -1)):
         expected = result.run(name).transmissibility
         got = frame[["T x", "T y", "T z"]].to_numpy()[row]
@@ -131,7 +138,7 @@ def test_a_workbook_run_up_row_runs_from_the_command_line(coarse_reference, tmp_
     csv = tmp_path / "run-up.csv"
     assert main(["run-up", str(path), "--csv", str(csv)]) == 0
     table = pd.read_csv(csv, index_col=0)
-    expected = run_up(case, item).frame()
+    expected = run_up(case, item).to_pandas()
     np.testing.assert_allclose(table.index, [600.0, 2400.0, 4200.0, 6000.0])
     np.testing.assert_allclose(table.to_numpy(), expected.to_numpy(), rtol=1e-9)
     assert "LP run-up" in capsys.readouterr().out

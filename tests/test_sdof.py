@@ -15,6 +15,7 @@ import math
 import numpy as np
 import pytest
 
+from workbook.answers.results import PYLON_SUM
 from workbook.model.case import ENGINE, PYLON, AnalysisSettings, Case, Engine, Hinge, RotatingForce
 from workbook.solve.pipeline import run_case
 
@@ -69,10 +70,26 @@ def test_hinges_share_the_pylon_force_equally(result):
 
 
 def test_efficiency_and_level_follow_from_transmissibility(result):
-    table = result.table("efficiency")
+    table = result.to_pandas("efficiency")
     run = result.run("r = 3")
     assert table.loc["r = 3", "eta % z"] == pytest.approx((1 - run.transmissibility[2]) * 100)
-    assert result.table("db").loc["r = 3", "dB z"] == pytest.approx(20 * math.log10(run.transmissibility[2]))
+    assert result.to_pandas("db").loc["r = 3", "dB z"] == pytest.approx(20 * math.log10(run.transmissibility[2]))
+
+
+def test_former_table_names_warn_and_give_the_same_tables(result):
+    """The names of version 0.1 (table, table_text, to_frame, static_frame) still answer, with a warning."""
+    with pytest.warns(DeprecationWarning, match=r"MountResult.table\(\) is now to_pandas"):
+        old = result.table("db")
+    assert old.equals(result.to_pandas("db"))
+    with pytest.warns(DeprecationWarning, match="to_frame"):
+        assert result.to_frame().equals(result.to_pandas("all"))
+    with pytest.warns(DeprecationWarning, match="table_text"):
+        assert result.table_text("db") == result.to_text("db")
+    with pytest.warns(DeprecationWarning, match="static_frame"):
+        assert result.static_frame("r = 3").equals(result.preloads["r = 3"].to_pandas())
+    long = result.to_pandas("all")
+    pylon = long[(long["run"] == "r = 3") & (long["location"] == PYLON_SUM)].set_index("direction")
+    assert pylon.loc["z", "dB"] == pytest.approx(result.to_pandas("db").loc["r = 3", "dB z"])
 
 
 def test_clearance_gap_adds_to_the_static_sag():

@@ -8,7 +8,7 @@ reads::
     import workbook as wb
 
     result = wb.run_case(wb.reference_case())
-    print(result.table())
+    print(result.to_pandas())
 
 Each name is imported on first use (PEP 562), so ``import workbook`` is
 fast and a name's heavy dependencies (Exudyn, scikit-fem, openpyxl) load

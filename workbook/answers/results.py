@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from workbook._renamed import renamed
 from workbook.answers.isolation import efficiency, level_db, transmissibility
 from workbook.model.case import DIRECTIONS
 
@@ -150,39 +151,44 @@ class MountResult:
                 return run
         raise KeyError(f"no run {name!r}; runs: {', '.join(r.name for r in self.runs)}")
 
-    def table(self, quantity: str = "efficiency"):
-        """The three-way table of the pylon force, one row per run.
+    def to_pandas(self, quantity: str = "efficiency"):
+        """The answers as a table.
 
         Parameters
         ----------
-        quantity : {"efficiency", "transmissibility", "db", "amplitude"}
-            Isolation efficiency (%), T, 20 log10 T (dB) or amplitude (N).
+        quantity : {"efficiency", "transmissibility", "db", "amplitude", "all"}
+            Isolation efficiency (%), T, 20 log10 T (dB) or amplitude (N) of
+            the pylon force: one row per run, columns frequency (Hz) and x,
+            y, z. ``"all"``: every answer in long form, one row per run,
+            location (hinge or pylon sum) and direction, with amplitude (N),
+            T, eta (%) and dB.
 
         Returns
         -------
         pandas.DataFrame
-            Index: run name; columns: frequency (Hz) and x, y, z.
         """
         import pandas as pd
 
+        if quantity == "all":
+            return self._long_frame()
         rows, columns = self._table_rows(quantity)
         return pd.DataFrame.from_dict(rows, orient="index", columns=columns).rename_axis("run")
 
     def _table_rows(self, quantity: str) -> tuple[dict[str, list[float]], list[str]]:
-        """The rows (run name -> frequency and x, y, z) and the columns of :meth:`table`."""
+        """The rows (run name -> frequency and x, y, z) and the columns of :meth:`to_pandas`."""
         values = {"efficiency": lambda r: r.efficiency, "transmissibility": lambda r: r.transmissibility,
                   "db": lambda r: level_db(r.transmissibility), "amplitude": lambda r: r.pylon_amplitude}
         if quantity not in values:
-            raise ValueError(f"quantity must be one of {', '.join(values)}, got {quantity!r}")
+            raise ValueError(f"quantity must be one of {', '.join(values)}, all, got {quantity!r}")
         units = {"efficiency": "eta %", "transmissibility": "T", "db": "dB", "amplitude": "N"}
         rows = {run.name: [run.frequency_hz, *values[quantity](run)] for run in self.runs}
         columns = ["frequency Hz"] + [f"{units[quantity]} {d}" for d in DIRECTIONS]
         return rows, columns
 
-    def table_text(self, quantity: str = "efficiency", *, frequency: bool = True,
-                   float_format=lambda v: f"{v:8.2f}") -> str:
-        """:meth:`table` as text, as ``table(quantity).to_string(float_format=float_format)`` gives it,
-        without importing pandas for a table of finite numbers.
+    def to_text(self, quantity: str = "efficiency", *, frequency: bool = True,
+                float_format=lambda v: f"{v:8.2f}") -> str:
+        """:meth:`to_pandas` as text, as ``to_pandas(quantity).to_string(float_format=float_format)``
+        gives it, without importing pandas for a table of finite numbers.
 
         Parameters
         ----------
@@ -200,12 +206,11 @@ class MountResult:
         text = text_table("run", rows, columns, float_format) if len(rows) == len(self.runs) else None
         if text is not None:
             return text
-        table = self.table(quantity)
+        table = self.to_pandas(quantity)
         return (table if frequency else table.drop(columns="frequency Hz")).to_string(float_format=float_format)
 
-    def to_frame(self):
-        """Every answer in long form: one row per run, location (hinge or
-        pylon sum) and direction, with amplitude (N), T, eta (%) and dB."""
+    def _long_frame(self):
+        """Every answer in long form (``to_pandas("all")``)."""
         import pandas as pd
 
         rows = []
@@ -219,14 +224,11 @@ class MountResult:
         return pd.DataFrame(rows, columns=["run", "frequency Hz", "location", "pylon side", "direction",
                                            "amplitude N", "T", "eta %", "dB"])
 
-    def static_frame(self, run: str | None = None):
-        """Static (preload) hinge forces of a run, N; pylon sum last."""
-        import pandas as pd
-
-        preload = self.preloads[self.run(run).name]
-        forces = {**preload.hinge_forces, PYLON_SUM: preload.pylon_force}
-        return pd.DataFrame.from_dict({k: list(v) for k, v in forces.items()}, orient="index",
-                                      columns=[f"F{d} N" for d in DIRECTIONS]).rename_axis("hinge")
+    table = renamed("table", "to_pandas(quantity)", lambda self, *a, **k: self.to_pandas(*a, **k))
+    table_text = renamed("table_text", "to_text(quantity)", lambda self, *a, **k: self.to_text(*a, **k))
+    to_frame = renamed("to_frame", 'to_pandas("all")', lambda self: self.to_pandas("all"))
+    static_frame = renamed("static_frame", "preloads[run].to_pandas()",
+                           lambda self, run=None: self.preloads[self.run(run).name].to_pandas())
 
     def to_dict(self) -> dict[str, Any]:
         """The answers as JSON-ready data (no time histories)."""

@@ -97,7 +97,7 @@ def run(args) -> int:
     # where each file went goes to stderr with --json, so that stdout stays one JSON document
     with contextlib.redirect_stdout(sys.stderr) if args.json else contextlib.nullcontext():
         if args.csv:
-            write_output(args.csv, "branches table", "campbell", lambda target: save_csv(diagram.to_frame(), target,
+            write_output(args.csv, "branches table", "campbell", lambda target: save_csv(diagram.to_pandas(), target,
                                                                                         index=False))
         if figure is not None:
             write_output(args.plot, "plot", "campbell", lambda target: save_figure(figure, target, dpi=120))

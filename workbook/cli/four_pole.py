@@ -57,7 +57,7 @@ def run(args) -> int:
     pylon = _pylon(args, frequencies)
     case = load_case(args.case, rigid=args.rigid)
     pole = four_pole(case, frequencies)
-    table = pole.table()
+    table = pole.to_pandas()
     # the force shape of each excitation at one point (imbalances of several planes have none)
     rigid = {x.name: pole.transmissibility(excitation_phasor(x), x.point_forces()[0][0])
              for x in case.single_frequency_excitations() if len(x.point_forces()) == 1}

@@ -225,7 +225,7 @@ def run_parameter_study(args) -> int:
     kept = f" ({len(finished)} already in {path})" if args.resume else ""
     print(f"{case.name}: {len(rows)} study rows{kept} on {where}", file=sys.stderr)
     outcomes = run_table(args, case, table, "--resume runs the rest")
-    frame = table.frame()
+    frame = table.to_pandas()
     print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}"))
     failed = [outcome for outcome in outcomes if outcome.status != "ok"]
     for outcome in failed:

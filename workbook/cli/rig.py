@@ -400,7 +400,7 @@ def _modes(args) -> int:
         shapes = modal.shapes_at_points(np.array([m.engine_shape for m in simulated]), np.array(case.engine.center_of_mass),
                                         test.points, test.dofs)
     pairing = modal.pair_modes(test, np.array([m.frequency_hz for m in simulated]), shapes)
-    table = pairing.frame()
+    table = pairing.to_pandas()
     table["sim motion"] = [simulated[j - 1].description for j in table["sim mode"]]
     if args.json:
         print(json.dumps({"test": test.source, "pairs": json.loads(table.reset_index().to_json(orient="records")),

@@ -157,9 +157,9 @@ def _print_answers(case, result) -> None:
     from workbook.answers.warning_groups import warning_lines
 
     print(f"{case.name}: pylon isolation efficiency eta = (1 - T) x 100 % (T: pylon force / excitation)\n")
-    print(result.table_text("efficiency"))
+    print(result.to_text("efficiency"))
     print("\n20 log10 T (dB):")
-    print(result.table_text("db", frequency=False))
+    print(result.to_text("db", frequency=False))
     for line in warning_lines(result.runs):
         print("\n" + line)
     for card in result.model_cards.values():

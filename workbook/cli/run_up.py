@@ -106,15 +106,15 @@ def run(args) -> int:
     for answer in answers:
         print(f"{case.name}: run-up {answer.sweep.name}, force U w^2 per plane; pylon force amplitude and "
               f"T = |F_pylon| / |F| per direction\n")
-        print(answer.frame().to_string(float_format=lambda v: f"{v:10.4g}"))
+        print(answer.to_pandas().to_string(float_format=lambda v: f"{v:10.4g}"))
         print("\nmodes (marked on the plot at the speed equal to their frequency):")
-        print(answer.modes_frame().to_string(float_format=lambda v: f"{v:8.2f}"))
+        print(answer.modes.to_pandas().to_string(float_format=lambda v: f"{v:8.2f}"))
         for line in warning_lines(answer.result.runs):
             print("\n" + line)
         if curves is not None:
             print("\n" + curves[answers.index(answer)].to_text())
     if args.csv:
-        write_output(args.csv, "table", "run-up", lambda target: save_csv(answers[0].frame(), target))
+        write_output(args.csv, "table", "run-up", lambda target: save_csv(answers[0].to_pandas(), target))
     if figure is not None:
         write_output(args.plot, "plot", "run-up", lambda target: save_figure(figure, target, dpi=120))
     if hinge_figure is not None:

@@ -270,7 +270,7 @@ def four_pole_sheet(ws, pole) -> None:
     :class:`~workbook.solve.four_pole.FourPole`): magnitude (N/m) and
     phase (deg) of K11, K21 and K22 per direction against frequency, and a
     native log-log chart of the magnitudes."""
-    table = pole.table()
+    table = pole.to_pandas()
     _title(ws, f"{pole.case_name}: four-pole parameters of the mount",
            "K11, K22: driving-point dynamic stiffness at the engine and at the pylon pins; K21: blocked transfer "
            "dynamic stiffness (both other terminals blocked)")

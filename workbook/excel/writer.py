@@ -121,7 +121,7 @@ def _long_frame(runs: list[RunResult], tests: tuple) -> pd.DataFrame:
     """Every answer, one row per run, point, location and direction, with the test comparison."""
     frames = []
     for run in runs:
-        frame = run.result.to_frame().rename(columns={"run": "point"})
+        frame = run.result.to_pandas("all").rename(columns={"run": "point"})
         frame.insert(0, "run", run.spec.name)
         frames.append(frame)
     frame = pd.concat(frames, ignore_index=True)

@@ -252,7 +252,7 @@ class ModePairing:
     mac: np.ndarray | None
     pairs: list
 
-    def frame(self):
+    def to_pandas(self):
         """The frequency error table: one row per paired test mode.
 
         Returns

@@ -164,7 +164,7 @@ class CampbellDiagram:
         values = self.whirl[branch, self.speeds_rpm > 0] if (self.speeds_rpm > 0).any() else self.whirl[branch]
         return WHIRL[int(np.sign(np.sum(values))) if np.abs(np.mean(values)) >= 0.5 else 0]
 
-    def to_frame(self):
+    def to_pandas(self):
         """The branches as a long table: branch, speed rpm, frequency Hz, zeta %, whirl, motion."""
         import pandas as pd
 

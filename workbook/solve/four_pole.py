@@ -61,6 +61,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from workbook._renamed import renamed
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
 from workbook.scene.bearing import hinge_matrix
@@ -367,7 +368,7 @@ class FourPole:
             loss[:, d] = 20 * np.log10(np.abs(bolted) / np.abs(mounted))
         return loss
 
-    def table(self):
+    def to_pandas(self):
         """Magnitude (N/m) and phase (deg) of K11, K21 and K22 per direction.
 
         Returns
@@ -384,6 +385,8 @@ class FourPole:
                 columns[f"|{quantity} {axis}| N/m"] = np.abs(values[:, d])
                 columns[f"{quantity} {axis} deg"] = np.degrees(np.angle(values[:, d]))
         return pd.DataFrame(columns, index=pd.Index(self.frequencies_hz, name="frequency Hz"))
+
+    table = renamed("table", "to_pandas()", lambda self: self.to_pandas())
 
     def plot(self):
         """Magnitudes of K11, K21 and K22 per direction against frequency (log-log).

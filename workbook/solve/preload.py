@@ -40,8 +40,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from workbook.answers.isolation import pylon_sum
+from workbook.answers.results import PYLON_SUM
 from workbook.errors import EquilibriumError, MechanismError, UnstablePreloadError, interruption
-from workbook.model.case import ENGINE, Gravity, PointForce, PointMoment
+from workbook.model.case import DIRECTIONS, ENGINE, Gravity, PointForce, PointMoment
 from workbook.scene.build import Scene, marker_bodies
 from workbook.solve.guards import solver_output
 from workbook.solve.modes import Mode, free_motions, linearize, modes_of, unstable_modes
@@ -98,6 +99,20 @@ class Preload:
     relative_mismatch: float
     solved: bool
     stiffening: object = None
+
+    def to_pandas(self):
+        """The static force of each channel, N, one row per channel; pylon sum last.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: channel (hinge or transducer); columns ``Fx N``, ``Fy N``, ``Fz N``.
+        """
+        import pandas as pd
+
+        forces = {**self.hinge_forces, PYLON_SUM: self.pylon_force}
+        return pd.DataFrame.from_dict({k: list(v) for k, v in forces.items()}, orient="index",
+                                      columns=[f"F{d} N" for d in DIRECTIONS]).rename_axis("hinge")
 
 
 def applied_static_force(scene: Scene) -> np.ndarray:

@@ -16,6 +16,7 @@ from typing import cast
 
 import numpy as np
 
+from workbook._renamed import renamed
 from workbook.answers.results import PYLON_SUM
 from workbook.model.case import DIRECTIONS, SPEED_UNITS, Case, RunUp
 from workbook.solve.sweep import SweepAnswer, run_sweep
@@ -41,7 +42,7 @@ class RunUpAnswer(SweepAnswer):
         """Force amplitude per direction of the pylon sum or of a hinge, N, shape (speeds, 3)."""
         return np.array([run.amplitudes()[location] for run in self.result.runs])
 
-    def frame(self, location: str = PYLON_SUM):
+    def to_pandas(self, location: str = PYLON_SUM):
         """One row per speed: frequency (Hz), excitation force (N), the force
         amplitude (N) and T per direction of the pylon sum or a hinge.
 
@@ -59,8 +60,10 @@ class RunUpAnswer(SweepAnswer):
         columns.update({f"T {axis}": transmissibility[:, i] for i, axis in enumerate(DIRECTIONS)})
         return pd.DataFrame(columns, index=pd.Index(self.speeds, name=f"speed {self.speed_unit}"))
 
+    frame = renamed("frame", "to_pandas(location)", lambda self, *a, **k: self.to_pandas(*a, **k))
+
     def mode_speeds(self) -> list[tuple[int, str, float]]:
-        """``(number, kind, speed)`` of each mode of :meth:`modes_frame` whose
+        """``(number, kind, speed)`` of each mode of :attr:`modes` whose
         frequency lies in the speed range (speed in :attr:`speed_unit`)."""
         low, high = self.frequencies[0], self.frequencies[-1]
         return [(number, kind, mode.frequency_hz / SPEED_UNITS[self.speed_unit])
@@ -70,7 +73,7 @@ class RunUpAnswer(SweepAnswer):
         """Force amplitude and T per direction against speed, modes marked.
 
         Mounted modes are dashed lines, link modes dotted, numbered as in
-        :meth:`modes_frame`.
+        ``modes.to_pandas()``.
 
         Returns
         -------

@@ -15,12 +15,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from workbook._renamed import renamed
 from workbook.answers.isolation import transmissibility
 from workbook.answers.results import PYLON_SUM, MountResult
 from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.solve.method import FREQUENCY, MethodChoice
 from workbook.solve.pipeline import prepare, solve_frequencies
-from workbook.solve.sweep_grid import add_grid_warnings, modes_in_band
+from workbook.solve.sweep_grid import ModesInBand, add_grid_warnings, modes_in_band
 
 __all__ = ["SweepAnswer", "run_sweep", "modes_in_band"]
 
@@ -34,13 +35,14 @@ class SweepAnswer:
     sweep : Sweep
     result : MountResult
         One run per sweep frequency.
-    modes : list of (str, Mode)
-        See :func:`modes_in_band`.
+    modes : ModesInBand
+        The mounted modes and the link modes in band (:func:`modes_in_band`);
+        ``modes.to_pandas()`` tabulates them.
     """
 
     sweep: Sweep
     result: MountResult
-    modes: list
+    modes: ModesInBand
 
     @property
     def frequencies(self) -> np.ndarray:
@@ -51,24 +53,7 @@ class SweepAnswer:
         """T per direction of the pylon sum or of a hinge, shape (frequencies, 3)."""
         return np.array([transmissibility(run.amplitudes()[location], run.excitation_amplitude) for run in self.result.runs])
 
-    def modes_frame(self):
-        """The modes in band: frequency (Hz), damping ratio (%), kind, engine
-        share of the kinetic energy (%) and the motion.
-
-        Returns
-        -------
-        pandas.DataFrame
-        """
-        import pandas as pd
-
-        rows = [(kind, mode.frequency_hz, 100 * mode.damping_ratio, 100 * mode.engine_share, mode.description)
-                for kind, mode in self.modes]
-        frame = pd.DataFrame(rows, columns=["kind", "frequency Hz", "damping ratio %", "engine share %",
-                                           "motion"])
-        frame.index = pd.RangeIndex(1, len(frame) + 1, name="mode")
-        return frame
-
-    def curves_frame(self, locations=(PYLON_SUM,)):
+    def to_pandas(self, locations=(PYLON_SUM,)):
         """T per frequency, location and direction, one column per (location, direction).
 
         Returns
@@ -82,11 +67,14 @@ class SweepAnswer:
                    for location in locations for i, axis in enumerate(DIRECTIONS)}
         return pd.DataFrame(columns, index=pd.Index(self.frequencies, name="frequency Hz"))
 
+    curves_frame = renamed("curves_frame", "to_pandas(locations)", lambda self, *a, **k: self.to_pandas(*a, **k))
+    modes_frame = renamed("modes_frame", "modes.to_pandas()", lambda self: self.modes.to_pandas())
+
     def plot(self, locations=(PYLON_SUM,)):
         """Transmissibility per direction against frequency (log-log), modes marked.
 
         Mounted modes are dashed lines, link modes dotted, numbered as in
-        :meth:`modes_frame`.
+        :meth:`ModesInBand.to_pandas <workbook.solve.sweep_grid.ModesInBand.to_pandas>` of :attr:`modes`.
 
         Returns
         -------

@@ -13,7 +13,7 @@ import numpy as np
 from workbook.model.case import SPEED_UNITS, RunUp, Sweep
 from workbook.solve.modes import ENGINE_SHARE, FREE_FREQUENCY_HZ, Mode
 
-__all__ = ["modes_in_band", "grid_warnings", "add_grid_warnings", "PEAK_SHORTFALL", "ADVISED_SPACING"]
+__all__ = ["ModesInBand", "modes_in_band", "grid_warnings", "add_grid_warnings", "PEAK_SHORTFALL", "ADVISED_SPACING"]
 
 
 #: A grid whose nearest point to a mode in its range sees less than this
@@ -24,16 +24,39 @@ PEAK_SHORTFALL = 0.9
 ADVISED_SPACING = 0.25
 
 
-def modes_in_band(modes: list[Mode], stop_hz: float) -> list[tuple[str, Mode]]:
+class ModesInBand(list):
+    """The modes of a sweep's band: a list of ``(kind, Mode)``, numbered from 1
+    in tables and plots; kind is ``"mounted"`` or ``"link"``."""
+
+    def to_pandas(self):
+        """Frequency (Hz), damping ratio (%), kind, engine share of the
+        kinetic energy (%) and the motion of each mode.
+
+        Returns
+        -------
+        pandas.DataFrame
+            Index: mode number (from 1).
+        """
+        import pandas as pd
+
+        rows = [(kind, mode.frequency_hz, 100 * mode.damping_ratio, 100 * mode.engine_share, mode.description)
+                for kind, mode in self]
+        frame = pd.DataFrame(rows, columns=["kind", "frequency Hz", "damping ratio %", "engine share %",
+                                           "motion"])
+        frame.index = pd.RangeIndex(1, len(frame) + 1, name="mode")
+        return frame
+
+
+def modes_in_band(modes: list[Mode], stop_hz: float) -> ModesInBand:
     """The mounted modes and the link modes up to *stop_hz*, labelled.
 
     Returns
     -------
-    list of (str, Mode)
+    ModesInBand
         ``("mounted", mode)`` for every mounted mode (whatever its frequency)
         and ``("link", mode)`` for link modes from 0 to *stop_hz*, ascending.
     """
-    chosen = []
+    chosen = ModesInBand()
     for mode in modes:
         if mode.frequency_hz < FREE_FREQUENCY_HZ:
             continue
@@ -60,7 +83,7 @@ def grid_warnings(frequencies_hz, modes: list[tuple[str, Mode]], unit: str = "Hz
     frequencies_hz : array_like
         The grid, Hz, ascending.
     modes : list of (str, Mode)
-        :func:`modes_in_band`, numbered from 1 as in :meth:`SweepAnswer.modes_frame`.
+        :func:`modes_in_band`, numbered from 1 as in :meth:`ModesInBand.to_pandas`.
     unit : {"Hz", "rpm"}
         Unit the grid is given in (a run-up's speed unit), for the advice.
 

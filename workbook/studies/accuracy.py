@@ -38,6 +38,7 @@ import numpy as np
 
 from flexbodies.atomic import replacing
 from flexbodies.selection import MODE_MARGIN
+from workbook._renamed import renamed
 from workbook.answers.saving import free_stem, save_figure, save_text
 from workbook.errors import InputError
 from workbook.model.case import DIRECTIONS, Case, ModeCutoff, SingleFrequencyExcitation
@@ -207,7 +208,7 @@ class AccuracyStudy:
         """Largest |error| over excitations and directions, %."""
         return float(max(np.abs(e).max() for e in self.errors(result).values()))
 
-    def frame(self):
+    def to_pandas(self):
         """One row per rung: method, links, DOF, wall time (s), error of
         T_x, T_y, T_z per excitation (%), worst |error| (%).
 
@@ -226,6 +227,8 @@ class AccuracyStudy:
             row["worst |error| %"] = self.worst_error(result)
             rows.append(row)
         return pd.DataFrame(rows).set_index("rung")
+
+    frame = renamed("frame", "to_pandas()", lambda self: self.to_pandas())
 
     def _result(self, label: str) -> RungResult | None:
         return next((r for r in self.results if r.rung.label == label), None)
@@ -259,7 +262,7 @@ class AccuracyStudy:
 
     def to_markdown(self) -> str:
         """The table as GitHub markdown, with the reference values and the study's rules."""
-        frame = self.frame()
+        frame = self.to_pandas()
         errors = [c for c in frame.columns if c.endswith("error %") and not c.startswith("worst")]
         header = ["rung", "DOF", "wall time (s)"] + [c.replace(" error %", " err %") for c in errors] + \
                  ["worst (%)"]
@@ -335,7 +338,7 @@ class AccuracyStudy:
         save_figure(figure, paths[1], dpi=130)
         plt.close(figure)
         with replacing(paths[2], suffix=".xlsx.tmp") as temporary:
-            self.frame().to_excel(temporary, sheet_name="accuracy study", engine="openpyxl")
+            self.to_pandas().to_excel(temporary, sheet_name="accuracy study", engine="openpyxl")
         return paths
 
 

@@ -174,10 +174,10 @@ class StudyTable:
         if self.kept == len(self.outcomes):
             return
         count = len(self.outcomes)
-        _write_table(self.frame(), self.path)
+        _write_table(self.to_pandas(), self.path)
         self.kept, self._written_at = count, time.monotonic()
 
-    def frame(self):
+    def to_pandas(self):
         """The table of the rows finished so far, in row order."""
         return study_frame(self.rows, [self.outcomes[i] for i in sorted(self.outcomes)])
 
