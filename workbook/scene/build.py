@@ -537,9 +537,6 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
         nothing has been solved.
     """
     import exudyn as exu
-    from exudyn.advancedUtilities import CreateSymbolicUserFunction
-
-    from flexbodies import add_link_to_exudyn
 
     eii = exu.itemInterface
     if reduced is None:
@@ -558,91 +555,14 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
     hinge_loss, link_loss = loss_factors(case)
     loss_hz = None if exact_loss_factors or excitation is None or not (hinge_loss or link_loss) \
         else excitation.frequency
-
-    def viscous(loss_factor: float, stiffness: float) -> float:
-        """The equivalent viscous damping built for a loss factor (0 when none is built)."""
-        return 0.0 if loss_hz is None else equivalent_viscous_damping(loss_factor, stiffness, loss_hz)
-
-    links = {}
-    for link in case.links:
-        link_damping = case.effects.link_damping
-        optional = {} if link.spin_frequency_hz is None else {"spin_frequency_hz": link.spin_frequency_hz}
-        links[link.name] = add_link_to_exudyn(
-            mbs, reduced[link.name], link.end_a, link.end_b,
-            flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
-            stiffness_damping=(link.stiffness_damping if link_damping else 0.0) + viscous(link_loss.get(link.name, 0.0), 1.0),
-            mass_damping=link.mass_damping if link_damping else 0.0,
-            modal_damping_ratio=link.modal_damping if link_damping else 0.0, name=exudyn_name("link", link.name), **optional)
-
+    links = _add_links(mbs, case, reduced, link_loss, loss_hz)
     transducers = _add_transducers(mbs, case, ground) if case.rig_sensors_built else {}
-
-    def marker(body_name: str, position) -> int:
-        if body_name == PYLON:
-            if transducers:
-                return next(items.markers[1] for items in transducers.values()
-                            if _same_point(items.position, position))
-            return mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=ground, localPosition=list(position)))
-        if body_name == ENGINE and casing is not None:
-            return casing.eye_marker(position)
-        if body_name == ENGINE:
-            local = np.subtract(position, case.engine.center_of_mass)
-            return mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=engine.body, localPosition=list(local)))
-        eye = case.link_map[body_name].eye_at(position)
-        return links[body_name].marker_a if eye == "a" else links[body_name].marker_b
-
-    clearance_functions = {}
-    hinges = {}
-    for hinge in case.hinges:
-        first, second = marker_bodies(hinge)
-        markers = (marker(first, hinge.position), marker(second, hinge.position))
-        clearance = case.effects.clearance and hinge.radial_clearance > 0
-        stiffness = hinge.values("stiffness")
-        if clearance:
-            stiffness[:] = hinge.gap_contact_stiffness
-        etas = hinge.values("loss_factor") if hinge.name in hinge_loss else np.zeros(3)
-        damping = hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)
-        if not clearance:      # the clearance law damps its loss factor on its own tangent stiffness
-            damping = damping + [viscous(eta, k) for eta, k in zip(etas, stiffness, strict=True)]
-        connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-            name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
-            damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
-        law = None
-        if clearance:
-            key = (hinge.radial_clearance, tuple(viscous(eta, 1.0) for eta in etas))
-            if key not in clearance_functions:
-                clearance_functions[key] = exudyn_clearance_function(*key)
-            law = CreateSymbolicUserFunction(mbs, clearance_functions[key], "springForceUserFunction", connector)
-            mbs.SetObjectParameter(connector, "springForceUserFunction", law)
-        elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
-            bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),
-                                              hinge_matrix(case, hinge, "damping", damping))
-            law = CreateSymbolicUserFunction(mbs, bearing, "springForceUserFunction", connector)
-            mbs.SetObjectParameter(connector, "springForceUserFunction", law)
-        sensor = mbs.AddSensor(eii.SensorObject(
-            name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,
-            outputVariableType=exu.OutputVariableType.Force))
-        hinges[hinge.name] = HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
-
+    pins = _Pins(mbs, case, ground, engine, casing, links, transducers)
+    hinges = {hinge.name: _add_hinge(mbs, case, hinge, pins, hinge.name in hinge_loss, loss_hz)
+              for hinge in case.hinges}
     static_loads = _add_static_loads(mbs, case, engine, links, casing) if case.effects.preload else {}
     gyroscopics = _add_gyroscopics(mbs, case, engine) if gyroscopics_built(case) else None
-
-    excitation_items = None
-    if excitation is not None:
-        force_markers, loads, functions = [], [], []
-        parts = ExcitationSignal.at_points(excitation, case.analysis.ramp_periods)
-        for k, (position, part) in enumerate(parts, start=1):
-            force_markers.append(mbs.AddMarker(eii.MarkerBodyPosition(
-                bodyNumber=engine.body, localPosition=list(np.subtract(position, case.engine.center_of_mass)))))
-            label = excitation.name if len(parts) == 1 else f"{excitation.name} {k}"
-            loads.append(mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", label),
-                                                         markerNumber=force_markers[-1], loadVector=[0.0] * 3)))
-            functions.append(CreateSymbolicUserFunction(mbs, part.exudyn_user_function(), "loadVectorUserFunction",
-                                                        loads[-1]))
-            mbs.SetLoadParameter(loads[-1], "loadVectorUserFunction", functions[-1])
-        resultant = None if isinstance(excitation, Simultaneous) else ExcitationSignal.of(excitation,
-                                                                                         case.analysis.ramp_periods)
-        excitation_items = ExcitationItems(excitation.name, tuple(force_markers), tuple(loads), resultant,
-                                           tuple(functions), excitation)
+    excitation_items = None if excitation is None else _add_excitation(mbs, case, engine, excitation)
 
     mbs.Assemble()
     link_mass = sum(link.mass for link in links.values())
@@ -652,6 +572,124 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
     log.info("scene of %r: %d bodies, %d hinges, %d transducers, %d ODE2 coordinates", case.name,
              1 + len(links) + (casing is not None), len(hinges), len(transducers), mbs.systemData.ODE2Size())
     return scene
+
+
+def _viscous(loss_hz: float | None, loss_factor: float, stiffness: float) -> float:
+    """The equivalent viscous damping built for a loss factor at *loss_hz*, N s/m (0 when none is built)."""
+    return 0.0 if loss_hz is None else equivalent_viscous_damping(loss_factor, stiffness, loss_hz)
+
+
+def _add_links(mbs, case: Case, reduced: dict, link_loss: dict[str, float], loss_hz: float | None) -> dict:
+    """Add every link of *case* as a reduced body (flexible or rigid); their items by link name."""
+    from flexbodies import add_link_to_exudyn
+
+    links = {}
+    damped = case.effects.link_damping
+    for link in case.links:
+        optional = {} if link.spin_frequency_hz is None else {"spin_frequency_hz": link.spin_frequency_hz}
+        links[link.name] = add_link_to_exudyn(
+            mbs, reduced[link.name], link.end_a, link.end_b,
+            flexible=case.link_is_flexible(link.name), bore_axis=link.bore_axis,
+            stiffness_damping=(link.stiffness_damping if damped else 0.0)
+            + _viscous(loss_hz, link_loss.get(link.name, 0.0), 1.0),
+            mass_damping=link.mass_damping if damped else 0.0,
+            modal_damping_ratio=link.modal_damping if damped else 0.0, name=exudyn_name("link", link.name),
+            **optional)
+    return links
+
+
+@dataclass
+class _Pins:
+    """The bodies a hinge can join, to find (or add) the marker of a pin."""
+
+    mbs: Any
+    case: Case
+    ground: int
+    engine: EngineItems
+    casing: Any
+    links: dict
+    transducers: dict
+
+    def marker(self, body_name: str, position) -> int:
+        """The marker of body *body_name* at pin *position* (m)."""
+        import exudyn as exu
+
+        eii = exu.itemInterface
+        if body_name == PYLON:
+            if self.transducers:
+                return next(items.markers[1] for items in self.transducers.values()
+                            if _same_point(items.position, position))
+            return self.mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=self.ground, localPosition=list(position)))
+        if body_name == ENGINE and self.casing is not None:
+            return self.casing.eye_marker(position)
+        if body_name == ENGINE:
+            local = np.subtract(position, self.case.engine.center_of_mass)
+            return self.mbs.AddMarker(eii.MarkerBodyPosition(bodyNumber=self.engine.body, localPosition=list(local)))
+        eye = self.case.link_map[body_name].eye_at(position)
+        return self.links[body_name].marker_a if eye == "a" else self.links[body_name].marker_b
+
+
+def _add_hinge(mbs, case: Case, hinge: Hinge, pins: _Pins, lossy: bool, loss_hz: float | None) -> HingeItems:
+    """Add *hinge* as a Cartesian spring-damper with its law and force sensor.
+
+    *lossy*: the hinge's loss factors are built (as viscous damping at
+    *loss_hz*, or by the clearance law on its tangent stiffness).
+    """
+    import exudyn as exu
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    eii = exu.itemInterface
+    first, second = marker_bodies(hinge)
+    markers = (pins.marker(first, hinge.position), pins.marker(second, hinge.position))
+    clearance = case.effects.clearance and hinge.radial_clearance > 0
+    stiffness = hinge.values("stiffness")
+    if clearance:
+        stiffness[:] = hinge.gap_contact_stiffness
+    etas = hinge.values("loss_factor") if lossy else np.zeros(3)
+    damping = hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)
+    if not clearance:      # the clearance law damps its loss factor on its own tangent stiffness
+        damping = damping + [_viscous(loss_hz, eta, k) for eta, k in zip(etas, stiffness, strict=True)]
+    connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
+        name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
+        damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
+    law = None
+    if clearance:
+        spring_force = exudyn_clearance_function(hinge.radial_clearance, [_viscous(loss_hz, eta, 1.0) for eta in etas])
+        law = CreateSymbolicUserFunction(mbs, spring_force, "springForceUserFunction", connector)
+        mbs.SetObjectParameter(connector, "springForceUserFunction", law)
+    elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
+        bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),
+                                          hinge_matrix(case, hinge, "damping", damping))
+        law = CreateSymbolicUserFunction(mbs, bearing, "springForceUserFunction", connector)
+        mbs.SetObjectParameter(connector, "springForceUserFunction", law)
+    sensor = mbs.AddSensor(eii.SensorObject(
+        name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,
+        outputVariableType=exu.OutputVariableType.Force))
+    return HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
+
+
+def _add_excitation(mbs, case: Case, engine: EngineItems,
+                    excitation: SingleFrequencyExcitation | Simultaneous) -> ExcitationItems:
+    """Add the excitation's forces on the engine (one load per plane), each with its user function."""
+    import exudyn as exu
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+
+    eii = exu.itemInterface
+    force_markers, loads, functions = [], [], []
+    parts = ExcitationSignal.at_points(excitation, case.analysis.ramp_periods)
+    for k, (position, part) in enumerate(parts, start=1):
+        force_markers.append(mbs.AddMarker(eii.MarkerBodyPosition(
+            bodyNumber=engine.body, localPosition=list(np.subtract(position, case.engine.center_of_mass)))))
+        label = excitation.name if len(parts) == 1 else f"{excitation.name} {k}"
+        loads.append(mbs.AddLoad(eii.LoadForceVector(name=exudyn_name("excitation", label),
+                                                     markerNumber=force_markers[-1], loadVector=[0.0] * 3)))
+        functions.append(CreateSymbolicUserFunction(mbs, part.exudyn_user_function(), "loadVectorUserFunction",
+                                                    loads[-1]))
+        mbs.SetLoadParameter(loads[-1], "loadVectorUserFunction", functions[-1])
+    resultant = None if isinstance(excitation, Simultaneous) else ExcitationSignal.of(excitation,
+                                                                                     case.analysis.ramp_periods)
+    return ExcitationItems(excitation.name, tuple(force_markers), tuple(loads), resultant, tuple(functions),
+                           excitation)
 
 
 def _same_point(a, b) -> bool:
