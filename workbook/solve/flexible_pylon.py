@@ -3,9 +3,8 @@
 The mount's four-pole set at the excitation's frequency
 (:func:`workbook.solve.four_pole.condense`, formed from the harmonic model
 of the preloaded scene with the pins on rigid ground) is closed by the
-pylon, exactly in the frequency domain:
-
-the case's :class:`~workbook.model.pylon.PylonModel` gives at the pins
+pylon, exactly in the frequency domain. The case's
+:class:`~workbook.model.pylon.PylonModel` gives at the pins
 (:meth:`~workbook.model.pylon.PylonModel.pins_at`) either
 
 - a point dynamic stiffness ``Z_p(f)`` per pin (an impedance table):
