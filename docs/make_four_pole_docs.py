@@ -25,14 +25,18 @@ matplotlib.use("Agg")
 from generated_sections import rewrite_sections  # noqa: E402
 
 from flexbodies import TITANIUM  # noqa: E402
-from workbook.model.pylon_beam import BoxBeamPylon  # noqa: E402
+from workbook.model.pylon_beam import (
+    BoxBeamPylon,  # noqa: E402
+    beam_model,  # noqa: E402
+)
 from workbook.model.pylon_impedance import read_impedance_csv  # noqa: E402
 from workbook.model.reference import HP_ROTOR, LP_ROTOR, reference_case  # noqa: E402
 from workbook.solve.four_pole import REPORT_GRID, frequency_grid  # noqa: E402
-from workbook.solve.four_pole_set import four_pole  # noqa: E402
 from workbook.solve.harmonic import excitation_phasor  # noqa: E402
-from workbook.solve.pipeline import run_case  # noqa: E402
-from workbook.solve.pylon_beam import beam_model  # noqa: E402
+from workbook.solve.pipeline import (
+    four_pole,  # noqa: E402
+    run_case,  # noqa: E402
+)
 
 DOCS = Path(__file__).resolve().parent
 DOCUMENT = "four-pole.md"
@@ -79,7 +83,7 @@ def sections(figure_path: Path | None = None) -> dict[str, str]:
     """Every generated section of docs/four-pole.md, by name; the figure is written to *figure_path* if given."""
     case = reference_case()
     rigid = run_case(case)
-    table = run_case(dataclasses.replace(case, pylon_impedance=read_impedance_csv(IMPEDANCE_TABLE)))
+    table = run_case(dataclasses.replace(case, pylon=read_impedance_csv(IMPEDANCE_TABLE)))
     impedance = _rows(lambda r: rigid.run(r.name).efficiency, lambda r: table.run(r.name).efficiency, ".2f",
                       "| run | eta x, y, z on the rigid pylon (%) | eta x, y, z on the example pylon (%) |")
 
@@ -95,7 +99,7 @@ def sections(figure_path: Path | None = None) -> dict[str, str]:
         "T from the rigid pylon is " + ", ".join(_sci(d, 1) for d in stiff) + " for "
         + ", ".join(_sci(s, 0) for s in STIFF_PYLONS) + " N/m per pin (falling as 1 / Z_p).")
 
-    beam = run_case(dataclasses.replace(case, pylon_beam=EXAMPLE_BEAM))
+    beam = run_case(dataclasses.replace(case, pylon=EXAMPLE_BEAM))
     model = beam_model(EXAMPLE_BEAM, [position for position, _ in case.pylon_pins()])
     clamped = np.sqrt(sla.eigh(model.stiffness, model.mass, eigvals_only=True)[:3]) / (2 * np.pi)
     beam_modes = ("Its first modes alone, clamped at the root with the pins' fittings as stations: "

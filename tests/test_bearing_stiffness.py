@@ -131,8 +131,8 @@ def test_four_pole_set_of_anisotropic_lossy_hinges_gives_the_rig_run():
     pylon impedance, gives the rig run's pylon force (the identity of
     tests/test_four_pole.py, now through the hinges' own 3x3 terminal terms)."""
     from workbook.model.case import ForceTransducers
-    from workbook.solve.four_pole_set import four_pole
     from workbook.solve.harmonic import excitation_phasor
+    from workbook.solve.pipeline import four_pole
 
     rig = ForceTransducers(stiffness=(2e6, 3e6, 4e6), mass=2.5, damping=(50.0, 80.0, 20.0))
     frequencies = (4.0, 11.0, 30.0)

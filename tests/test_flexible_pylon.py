@@ -68,7 +68,7 @@ def test_soft_pylon_is_two_springs_in_series(tmp_path):
     case = _sdof()
     frequencies = [ratio * NATURAL_HZ for ratio in RATIOS]
     table = _write(tmp_path / "pylon.csv", _rows([1.0, *frequencies, 100.0], _pins(case), _pylon))
-    result = run_case(dataclasses.replace(case, pylon_impedance=read_impedance_csv(table)))
+    result = run_case(dataclasses.replace(case, pylon=read_impedance_csv(table)))
     for ratio, frequency in zip(RATIOS, frequencies, strict=True):
         w = 2 * math.pi * frequency
         hinge = STIFFNESS + 1j * w * DAMPING
@@ -89,7 +89,7 @@ def test_between_table_frequencies_real_and_imaginary_parts_are_linear(tmp_path)
     mass-spring law."""
     case = _sdof((1.1,))
     table = read_impedance_csv(_write(tmp_path / "pylon.csv", _rows([5.0, 15.0], _pins(case), _pylon)))
-    run = run_case(dataclasses.replace(case, pylon_impedance=table)).runs[0]
+    run = run_case(dataclasses.replace(case, pylon=table)).runs[0]
     w = 2 * math.pi * 11.0
     hinge = STIFFNESS + 1j * w * DAMPING
     pylon = 0.4 * _pylon(5.0)[0, 0] + 0.6 * _pylon(15.0)[0, 0]
@@ -114,7 +114,7 @@ def test_a_rigid_pylon_is_the_limit_of_a_stiff_one(coarse_reference):
     for stiffness in (1e12, 1e16):
         impedance = PylonImpedance.from_array("stiff", grid, pins, np.broadcast_to(stiffness * np.eye(3),
                                                                                    (2, len(pins), 3, 3)))
-        stiff = run_case(dataclasses.replace(case, pylon_impedance=impedance))
+        stiff = run_case(dataclasses.replace(case, pylon=impedance))
         errors.append(max(np.abs(stiff.run(r.name).transmissibility / r.transmissibility - 1).max()
                           for r in rigid.runs))
     assert errors[1] < 1e-6
@@ -124,7 +124,7 @@ def test_a_rigid_pylon_is_the_limit_of_a_stiff_one(coarse_reference):
 def test_the_table_travels_with_a_json_case(tmp_path):
     case = _sdof()
     table = read_impedance_csv(_write(tmp_path / "pylon.csv", _rows([1.0, 40.0], _pins(case), _pylon)))
-    with_table = dataclasses.replace(case, pylon_impedance=table)
+    with_table = dataclasses.replace(case, pylon=table)
     assert from_json(to_json(with_table)) == with_table
 
 
@@ -137,7 +137,7 @@ def test_the_workbook_sheet_is_the_csv_table(tmp_path):
     for row in rows:
         sheet.append(row)
     wb.save(book)
-    from_sheet = read_workbook(book).case.pylon_impedance
+    from_sheet = read_workbook(book).case.pylon
     from_csv = read_impedance_csv(_write(tmp_path / "pylon.csv", rows))
     np.testing.assert_allclose(from_sheet.values, from_csv.values, rtol=1e-15)
     np.testing.assert_allclose(from_csv.values[1, 0], _pylon(300.0) * 1e6, rtol=1e-12)
@@ -155,7 +155,7 @@ def _table_problem(tmp_path, edit):
     edit(rows)
     path = _write(tmp_path / "bad.csv", rows)
     with pytest.raises((TableError, CaseError)) as error:
-        dataclasses.replace(case, pylon_impedance=read_impedance_csv(path))
+        dataclasses.replace(case, pylon=read_impedance_csv(path))
     return str(error.value)
 
 

@@ -19,10 +19,9 @@ from workbook.cli.main import main
 from workbook.errors import EXIT_BAD_INPUT, EXIT_TROUBLE, CaseError, FourPoleError
 from workbook.model.case import ENGINE, PYLON, ForceTransducers, HarmonicForce, Hinge, Link
 from workbook.solve.four_pole import QUANTITIES, frequency_grid
-from workbook.solve.four_pole_set import four_pole
 from workbook.solve.harmonic import excitation_phasor
 from workbook.solve.method import FREQUENCY, MethodChoice
-from workbook.solve.pipeline import run_case
+from workbook.solve.pipeline import four_pole, run_case
 
 FREQUENCIES = (3.0, 10.5, 40.0)
 IN_FREQUENCY = MethodChoice(FREQUENCY, "four-pole identity check")

@@ -10,7 +10,7 @@ from workbook.errors import EXIT_BAD_INPUT
 from workbook.excel.reader import read_workbook
 from workbook.excel.report import FOUR_POLE_SHEET
 from workbook.solve.four_pole import REPORT_GRID, frequency_grid
-from workbook.solve.four_pole_set import four_pole
+from workbook.solve.pipeline import four_pole
 
 
 def _sheet_table(ws):

@@ -22,11 +22,9 @@ from workbook.cli.main import main
 from workbook.errors import EXIT_BAD_INPUT, CaseError
 from workbook.model.case import AnalysisSettings, HarmonicForce
 from workbook.model.codec import from_json, to_json
-from workbook.model.pylon_beam import BoxBeamPylon
+from workbook.model.pylon_beam import BoxBeamPylon, beam_model
 from workbook.model.pylon_impedance import PylonImpedance
-from workbook.solve.four_pole_set import four_pole
-from workbook.solve.pipeline import run_case
-from workbook.solve.pylon_beam import beam_model
+from workbook.solve.pipeline import four_pole, run_case
 
 ALUMINIUM = Material("aluminium", youngs_modulus=70e9, poisson_ratio=0.33, density=2800.0)
 FREQUENCIES = (3.0, 10.5, 25.0)
@@ -96,12 +94,12 @@ def _vertical_case(beam_length=3.0, **changes):
     beam = BoxBeamPylon(root=(cg[0], cg[1], cg[2] + beam_length), tip=cg, width=0.05, height=0.05, wall=0.002,
                         material=ALUMINIUM, loss_factor=0.05, up=(1.0, 0.0, 0.0), elements=60, **changes)
     return dataclasses.replace(base, excitations=excitations, analysis=AnalysisSettings(method="auto"),
-                               pylon_beam=beam)
+                               pylon=beam)
 
 
 def test_an_axially_loaded_beam_pylon_is_the_rod_in_series():
     case = _vertical_case()
-    beam = case.pylon_beam
+    beam = case.pylon
     result = run_case(case)
     area, density = beam.section().area, ALUMINIUM.density
     modulus = ALUMINIUM.youngs_modulus * (1 + 1j * beam.loss_factor)
@@ -121,9 +119,9 @@ def test_an_axially_loaded_beam_pylon_is_the_rod_in_series():
 
 
 def test_a_stiff_beam_is_the_rigid_pylon():
-    stiff = dataclasses.replace(_vertical_case(), pylon_beam=dataclasses.replace(
-        _vertical_case().pylon_beam, material=dataclasses.replace(ALUMINIUM, youngs_modulus=1e22)))
-    rigid = run_case(dataclasses.replace(stiff, pylon_beam=None))
+    stiff = dataclasses.replace(_vertical_case(), pylon=dataclasses.replace(
+        _vertical_case().pylon, material=dataclasses.replace(ALUMINIUM, youngs_modulus=1e22)))
+    rigid = run_case(dataclasses.replace(stiff, pylon=None))
     on_beam = run_case(stiff)
     for run in rigid.runs:
         np.testing.assert_allclose(on_beam.run(run.name).transmissibility[2], run.transmissibility[2], rtol=1e-6)
@@ -132,15 +130,15 @@ def test_a_stiff_beam_is_the_rigid_pylon():
 def test_bad_beams_and_the_time_domain_are_refused(tmp_path, capsys):
     case = _vertical_case()
     with pytest.raises(CaseError, match="reaches the foot of the pin"):
-        run_case(dataclasses.replace(case, pylon_beam=dataclasses.replace(
-            case.pylon_beam, tip=tuple(np.add(case.engine.center_of_mass, (0.0, 0.0, 0.5))))))
+        run_case(dataclasses.replace(case, pylon=dataclasses.replace(
+            case.pylon, tip=tuple(np.add(case.engine.center_of_mass, (0.0, 0.0, 0.5))))))
     with pytest.raises(CaseError, match="wall"):
         _beam(wall=0.2)
     with pytest.raises(CaseError, match="not along the beam axis"):
         _beam(up=(1.0, 0.0, 0.0))
     table = PylonImpedance.from_array("table", [1.0, 50.0], ["hinge 0", "hinge 1", "hinge 2", "hinge 3"],
                                       np.ones((2, 4, 3, 3)) * 1e6)
-    with pytest.raises(CaseError, match="one pylon model"):
+    with pytest.raises(CaseError, match="one pylon model"), pytest.warns(DeprecationWarning, match="Case.pylon"):
         dataclasses.replace(case, pylon_impedance=table)
     assert from_json(to_json(case)) == case
     path = tmp_path / "case.json"

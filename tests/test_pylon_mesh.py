@@ -19,9 +19,8 @@ from workbook.errors import EXIT_BAD_INPUT, CaseError
 from workbook.model.case import AnalysisSettings, HarmonicForce
 from workbook.model.codec import from_json, to_json
 from workbook.model.pylon_beam import BoxBeamPylon
-from workbook.model.pylon_mesh import MeshPylon
+from workbook.model.pylon_mesh import MINIMUM_MODES, MeshPylon, mesh_pylon_model
 from workbook.solve.pipeline import run_case
-from workbook.solve.pylon_mesh import MINIMUM_MODES, mesh_pylon_model
 
 STEEL_BAR = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
 #: The bar: 1 m from its clamped root to the pin bore, a 50 mm square, 40 mm beyond the bore.
@@ -109,13 +108,13 @@ def _plate_case(tmp_path, modulus=70e9):
     excitations = tuple(HarmonicForce(f"{f:g} Hz", point=cg, direction=(0.3, 0.2, 1.0), amplitude=1000.0,
                                       frequency_hz=f) for f in (3.0, 10.5, 25.0))
     return dataclasses.replace(base, excitations=excitations, analysis=AnalysisSettings(method="auto"),
-                               pylon_mesh=pylon)
+                               pylon=pylon)
 
 
 @pytest.mark.slow
 def test_a_stiff_mesh_is_the_rigid_pylon_and_a_soft_one_is_not(tmp_path):
     stiff = _plate_case(tmp_path, modulus=7e16)
-    rigid = run_case(dataclasses.replace(stiff, pylon_mesh=None))
+    rigid = run_case(dataclasses.replace(stiff, pylon=None))
     on_stiff = run_case(stiff)
     soft = run_case(_plate_case(tmp_path, modulus=2e8))
     for run in rigid.runs:
@@ -129,21 +128,21 @@ def test_a_mesh_pylon_round_trips_through_json_and_bad_ones_are_refused(tmp_path
     case = _plate_case(tmp_path)
     assert from_json(to_json(case)) == case
     with pytest.raises(CaseError, match="bore_radius"):
-        dataclasses.replace(case.pylon_mesh, bore_radius=-1.0)
+        dataclasses.replace(case.pylon, bore_radius=-1.0)
     with pytest.raises(CaseError, match="root_normal"):
-        dataclasses.replace(case.pylon_mesh, root_normal=(0.0, 0.0, 0.0))
+        dataclasses.replace(case.pylon, root_normal=(0.0, 0.0, 0.0))
     pins = [position for position, _ in case.pylon_pins()]
     with pytest.raises(CaseError, match="root_point"):
-        mesh_pylon_model(dataclasses.replace(case.pylon_mesh, root_point=(0.0, 0.0, 5.0)), pins, 30.0)
+        mesh_pylon_model(dataclasses.replace(case.pylon, root_point=(0.0, 0.0, 5.0)), pins, 30.0)
     with pytest.raises(CaseError, match="every pylon pin"):
-        mesh_pylon_model(dataclasses.replace(case.pylon_mesh, bore_radius=0.02), pins, 30.0)
+        mesh_pylon_model(dataclasses.replace(case.pylon, bore_radius=0.02), pins, 30.0)
     beam = BoxBeamPylon(root=(0.0, 0.0, 3.0), tip=case.engine.center_of_mass, width=0.05, height=0.05, wall=0.002,
                         material=STEEL_BAR, up=(1.0, 0.0, 0.0))
-    with pytest.raises(CaseError, match="one pylon model"):
+    with pytest.raises(CaseError, match="one pylon model"), pytest.warns(DeprecationWarning, match="Case.pylon"):
         dataclasses.replace(case, pylon_beam=beam)
     # from the command line: a mesh file that does not exist, exit 2 and the file named
-    data = json.loads(to_json(dataclasses.replace(case, pylon_mesh=dataclasses.replace(
-        case.pylon_mesh, path=str(tmp_path / "no-such.msh")))))
+    data = json.loads(to_json(dataclasses.replace(case, pylon=dataclasses.replace(
+        case.pylon, path=str(tmp_path / "no-such.msh")))))
     (tmp_path / "case.json").write_text(json.dumps(data))
     assert main(["run", str(tmp_path / "case.json")]) == EXIT_BAD_INPUT
     err = capsys.readouterr().err

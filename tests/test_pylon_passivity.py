@@ -75,7 +75,7 @@ def test_the_passive_pylon_still_answers():
     frequency = 1.1 * NATURAL_HZ
     table = PylonImpedance.from_array("passive", [frequency], _pins(case),
                                       np.broadcast_to(_pylon(PYLON_DAMPING)(frequency), (1, 4, 3, 3)))
-    run = run_case(dataclasses.replace(case, pylon_impedance=table)).runs[0]
+    run = run_case(dataclasses.replace(case, pylon=table)).runs[0]
     w = 2 * math.pi * frequency
     hinge, pylon = STIFFNESS + 1j * w * DAMPING, _pylon(PYLON_DAMPING)(frequency)[0, 0]
     series = hinge * pylon / (hinge + pylon)

@@ -51,7 +51,7 @@ def engine():
 
 def _run(engine, step_hz):
     table = _table(np.round(np.arange(10.0, 60.0 + step_hz / 2, step_hz), 6), engine)
-    return run_case(dataclasses.replace(engine, pylon_impedance=table)).runs[0]
+    return run_case(dataclasses.replace(engine, pylon=table)).runs[0]
 
 
 def test_rows_10_hz_apart_across_the_resonance_are_warned(engine):

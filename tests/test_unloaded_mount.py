@@ -19,10 +19,9 @@ from workbook.errors import EquilibriumError
 from workbook.model.case import HarmonicForce
 from workbook.model.reference import ENGINE_CG, reference_case
 from workbook.scene.build import build_scene
-from workbook.solve.four_pole_set import four_pole
 from workbook.solve.harmonic import excitation_phasor
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice
-from workbook.solve.pipeline import run_case
+from workbook.solve.pipeline import four_pole, run_case
 from workbook.solve.preload import check_equilibrium, geometry_roundoff_force, solve_preload
 
 #: 1 N lateral shaking at 59 Hz on the engine's centre of gravity.

@@ -47,8 +47,8 @@ def run(args) -> int:
 
     from workbook.model.case import DIRECTIONS
     from workbook.solve.four_pole import QUANTITIES, frequency_grid
-    from workbook.solve.four_pole_set import four_pole
     from workbook.solve.harmonic import excitation_phasor
+    from workbook.solve.pipeline import four_pole
 
     for option, path, suffix in (("--csv", args.csv, ".csv"), ("--plot", args.plot, ".png"),
                                  ("--xlsx", args.xlsx, ".xlsx")):

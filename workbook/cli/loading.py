@@ -67,7 +67,8 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
         Analysis method (None: as the case says).
     pylon_impedance : str or None
         A CSV table of the pylon's point dynamic stiffness per pin
-        (:mod:`workbook.model.pylon_impedance`; None: as the case says).
+        (:mod:`workbook.model.pylon_impedance`), the case's pylon in place
+        of its own (None: as the case says).
 
     Raises
     ------
@@ -91,7 +92,7 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
     if method is not None:
         case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method=method))
     if pylon_impedance is not None:
-        case = dataclasses.replace(case, pylon_impedance=read_impedance_csv(pylon_impedance))
+        case = dataclasses.replace(case, pylon=read_impedance_csv(pylon_impedance))
     return case.with_rigid_links() if rigid else case
 
 

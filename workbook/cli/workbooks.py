@@ -150,7 +150,7 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     from workbook.excel.execute import run_book
     from workbook.excel.report import write_report
     from workbook.excel.writer import write_results
-    from workbook.solve.four_pole_set import report_four_pole
+    from workbook.solve.pipeline import report_four_pole
 
     runs, failures = run_book(book, selected, progress=progress)
     for failure in failures:

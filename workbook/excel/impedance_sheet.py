@@ -43,6 +43,6 @@ def with_impedance_sheet(case: Case, path: Path, values) -> Case:
         return case
     impedance = impedance_from_rows(values[titles[0]].iter_rows(values_only=True), path.name, SHEET)
     try:
-        return dataclasses.replace(case, pylon_impedance=impedance)
+        return dataclasses.replace(case, pylon=impedance)
     except CaseError as error:
         raise WorkbookError([Problem(path.name, SHEET, None, "pin", error.value, error.expected)]) from None

@@ -597,16 +597,18 @@ class _CaseReader(SheetReader):
                 self.record_problem(record, ("excitation",), record.get("excitation"),
                                     f"{error.expected} (run '{record.get('name')}')")
                 return False
-        impedance = run_case.pylon_impedance
-        if impedance is None:
+        pylon = run_case.pylon
+        covered = None if pylon is None else pylon.covered_hz()
+        if pylon is None or covered is None:
             return True
         try:
-            impedance.check_covers([x.frequency for x in run_case.single_frequency_excitations()])
+            pylon.check_covers([x.frequency for x in run_case.single_frequency_excitations()])
         except cm.CaseError as error:
+            low, high = covered
             self.record_problem(record, ("excitation",), record.get("excitation"),
-                                f"an excitation within the pylon impedance table: run '{record.get('name')}' "
-                                f"excites {error.value}, the table ({impedance.source}) covers "
-                                f"{impedance.frequencies_hz[0]:g} to {impedance.frequencies_hz[-1]:g} Hz (it is "
+                                f"an excitation within the {pylon.noun} table: run '{record.get('name')}' "
+                                f"excites {error.value}, the table ({pylon.label}) covers "
+                                f"{low:g} to {high:g} Hz (it is "
                                 "not extrapolated: extend the table or narrow the excitation's frequencies)")
             return False
         return True

@@ -30,8 +30,10 @@ from workbook.model import fields
 from workbook.model.casing import CASING, EngineCasing
 from workbook.model.fields import MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
 from workbook.model.load_cases import LoadCase
+from workbook.model.pylon import PylonModel
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
+from workbook.model.pylon_legacy import accept_legacy_pylons, legacy_pylon
 from workbook.model.pylon_mesh import MeshPylon
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
@@ -1175,16 +1177,14 @@ class Case:
     rotors : tuple of Rotor
         Spinning rotors whose gyroscopic moments act on the engine (their
         mass and inertia are part of ``engine``).
-    pylon_impedance : PylonImpedance or None
-        The pylon's point dynamic stiffness at its pins against frequency
-        (None: a rigid pylon); frequency domain only.
-    pylon_beam : BoxBeamPylon or None
-        The pylon as a clamped box beam carrying the pins (None: a rigid
-        pylon); frequency domain only, not with a pylon impedance.
-    pylon_mesh : MeshPylon or None
-        The pylon as a user's solid mesh, clamped on its root plane and
-        carrying the pins on its bores (None: a rigid pylon); frequency
-        domain only, the case's one pylon model.
+    pylon : PylonModel or None
+        The flexible pylon carrying the pins (None: a rigid pylon),
+        frequency domain only: a :class:`PylonImpedance` (point dynamic
+        stiffness at the pins against frequency), a :class:`BoxBeamPylon`
+        (a clamped box beam) or a :class:`MeshPylon` (a user's solid mesh
+        clamped on its root plane). The keywords ``pylon_impedance``,
+        ``pylon_beam`` and ``pylon_mesh`` of earlier versions are
+        deprecated aliases.
     load_cases : tuple of LoadCase
         Named static limit load cases for the links' strength
         (:mod:`workbook.model.load_cases`, solved by
@@ -1202,9 +1202,7 @@ class Case:
     description: str = ""
     test_rig: ForceTransducers | None = None
     rotors: tuple[Rotor, ...] = ()
-    pylon_impedance: PylonImpedance | None = None
-    pylon_beam: BoxBeamPylon | None = None
-    pylon_mesh: MeshPylon | None = None
+    pylon: PylonModel | None = None
     load_cases: tuple[LoadCase, ...] = ()
 
     def __post_init__(self):
@@ -1226,22 +1224,10 @@ class Case:
                     raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
             _set(self, name, items)
         owners = self._check_names(groups)
-        if self.pylon_impedance is not None:
-            if not isinstance(self.pylon_impedance, PylonImpedance):
-                raise CaseError("case", "pylon_impedance", self.pylon_impedance, "a PylonImpedance or None")
-            self.pylon_impedance.pin_order(self.pylon_pins())
-        if self.pylon_beam is not None:
-            if not isinstance(self.pylon_beam, BoxBeamPylon):
-                raise CaseError("case", "pylon_beam", self.pylon_beam, "a BoxBeamPylon or None")
-            if self.pylon_impedance is not None:
-                raise CaseError("case", "pylon_beam", self.pylon_beam.name,
-                                "no pylon beam when a pylon impedance is given (one pylon model)")
-        if self.pylon_mesh is not None:
-            if not isinstance(self.pylon_mesh, MeshPylon):
-                raise CaseError("case", "pylon_mesh", self.pylon_mesh, "a MeshPylon or None")
-            if self.pylon_impedance is not None or self.pylon_beam is not None:
-                raise CaseError("case", "pylon_mesh", self.pylon_mesh.name,
-                                "no pylon mesh when a pylon impedance or a pylon beam is given (one pylon model)")
+        if self.pylon is not None:
+            if not isinstance(self.pylon, PylonModel):
+                raise CaseError("case", "pylon", self.pylon, "a PylonImpedance, BoxBeamPylon, MeshPylon or None")
+            self.pylon.check(self.pylon_pins())
         links = self.link_map
         for load_case in self.load_cases:
             load_case.check(links)
@@ -1318,7 +1304,22 @@ class Case:
     @property
     def flexible_pylon(self) -> bool:
         """True if the case gives a flexible pylon (an impedance table, a box beam or a mesh)."""
-        return any(model is not None for model in (self.pylon_impedance, self.pylon_beam, self.pylon_mesh))
+        return self.pylon is not None
+
+    @property
+    def pylon_impedance(self) -> PylonImpedance | None:
+        """Deprecated: ``pylon`` when it is a :class:`PylonImpedance`, else None."""
+        return legacy_pylon(self.pylon, "pylon_impedance")
+
+    @property
+    def pylon_beam(self) -> BoxBeamPylon | None:
+        """Deprecated: ``pylon`` when it is a :class:`BoxBeamPylon`, else None."""
+        return legacy_pylon(self.pylon, "pylon_beam")
+
+    @property
+    def pylon_mesh(self) -> MeshPylon | None:
+        """Deprecated: ``pylon`` when it is a :class:`MeshPylon`, else None."""
+        return legacy_pylon(self.pylon, "pylon_mesh")
 
     @property
     def pylon_hinges(self) -> tuple[Hinge, ...]:
@@ -1356,3 +1357,7 @@ class Case:
     def with_rigid_links(self) -> "Case":
         """The case with every link rigid."""
         return dataclasses.replace(self, effects=dataclasses.replace(self.effects, flexible_links=False))
+
+
+
+Case.__init__ = accept_legacy_pylons(Case.__init__)  # type: ignore[method-assign]

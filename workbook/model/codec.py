@@ -4,7 +4,8 @@ Every dataclass becomes a dictionary of its fields plus ``"type"`` (the class
 name), tuples become lists; decoding reverses that, turning every list back
 into a tuple (the case model stores sequences as tuples). Only the classes
 registered here are decoded, so a case file cannot construct arbitrary
-objects.
+objects. A case's pylon model is written as ``"pylon"``; the per-kind pylon
+fields of earlier versions' files are still read.
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ from workbook.model.casing import CasingGeometry, EngineCasing, MountRing
 from workbook.model.load_cases import LoadCase
 from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
+from workbook.model.pylon_legacy import LEGACY_PYLON_FIELDS
 from workbook.model.pylon_mesh import MeshPylon
 
 __all__ = ["to_dict", "from_dict", "to_json", "from_json"]
@@ -73,6 +75,8 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
         if kind not in classes:
             raise CaseFileError(f"unknown item type {kind!r}; expected one of {', '.join(sorted(classes))}")
         cls = classes[kind]
+        if cls is _case.Case:
+            data = _one_pylon(data)
         known = {f.name for f in dataclasses.fields(cls)}
         unknown = set(data) - known - {"type"}
         if unknown:
@@ -90,6 +94,20 @@ def from_dict(data: Any, _classes: dict[str, type] | None = None) -> Any:
             # a value of the wrong kind (a list where a number belongs, ...)
             raise CaseFileError(f"{kind}: a field holds a value of the wrong kind ({error})") from None
     return data
+
+
+def _one_pylon(data: dict) -> dict:
+    """A case's data with the pylon fields of earlier versions (``pylon_impedance``, ``pylon_beam``,
+    ``pylon_mesh``, at most one of them not null) read as its ``pylon``."""
+    given = {key: data[key] for key in LEGACY_PYLON_FIELDS if key in data}
+    if not given:
+        return data
+    models = {key: value for key, value in {**given, "pylon": data.get("pylon")}.items() if value is not None}
+    if len(models) > 1:
+        raise CaseFileError(f"Case: pylon models in {sorted(models)}; expected one pylon model (field 'pylon')")
+    upgraded = {key: value for key, value in data.items() if key not in given}
+    upgraded["pylon"] = next(iter(models.values()), None)
+    return upgraded
 
 
 def to_json(obj: Any, **kwargs) -> str:

@@ -30,10 +30,12 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
 from workbook.errors import CaseError, Problem, TableError, UnitProblem
+from workbook.model.pylon import Pin, PinDynamics, PylonModel
 from workbook.model.units import si_factor
 
 __all__ = ["PylonImpedance", "read_impedance_csv", "impedance_from_rows", "STIFFNESS_COLUMNS", "FORMAT_HEADER"]
@@ -56,8 +58,8 @@ def _nested(array: np.ndarray) -> tuple:
 
 
 @dataclass(frozen=True)
-class PylonImpedance:
-    """Point dynamic stiffness of the pylon at each pin against frequency.
+class PylonImpedance(PylonModel):
+    """Point dynamic stiffness of the pylon at each pin against frequency (a :class:`~workbook.model.pylon.PylonModel`).
 
     Parameters
     ----------
@@ -77,6 +79,13 @@ class PylonImpedance:
         Values of the wrong shape, or a row that is not passive
         (:data:`PASSIVITY_TOLERANCE`).
     """
+
+    effect: ClassVar[str] = "flexible pylon (point dynamic stiffness)"
+    noun: ClassVar[str] = "pylon impedance"
+    legacy_field: ClassVar[str] = "pylon_impedance"
+    time_domain_what: ClassVar[str] = "frequency-dependent pylon impedance"
+    time_domain_note: ClassVar[str] = ("a dynamic stiffness tabulated against frequency has no time-domain model "
+                                       "here")
 
     source: str
     frequencies_hz: tuple
@@ -146,7 +155,7 @@ class PylonImpedance:
         """``Z_p`` at the table frequencies, complex, shape (f, p, 3, 3), N/m."""
         return np.asarray(self.real) + 1j * np.asarray(self.imag)
 
-    def pin_order(self, case_pins: Sequence[tuple[object, Sequence[str]]]) -> list[int]:
+    def pin_order(self, case_pins: Sequence[Pin]) -> list[int]:
         """The table's pin of each of *case_pins* (``Case.pylon_pins()``).
 
         Raises
@@ -185,24 +194,25 @@ class PylonImpedance:
                    for c in range(flat.shape[1])]
         return np.array(columns).T.reshape(len(wanted), *values.shape[1:])
 
-    def check_covers(self, frequencies_hz) -> None:
-        """Refuse *frequencies_hz* (Hz) unless the table's range holds every one of them.
+    @property
+    def label(self) -> str:
+        """Its source (file, sheet)."""
+        return self.source
 
-        Raises
-        ------
-        workbook.errors.CaseError
-            Naming the frequencies asked for (one, or the lowest to the
-            highest) and the table's range; the table is not extrapolated.
-        """
-        wanted = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
-        table = np.asarray(self.frequencies_hz)
-        outside = wanted[(wanted < table[0] * (1 - 1e-12)) | (wanted > table[-1] * (1 + 1e-12))]
-        if outside.size:
-            asked = f"{wanted[0]:g} Hz" if wanted.size == 1 else f"{wanted.min():g} to {wanted.max():g} Hz"
-            raise CaseError(f"pylon impedance {self.source}", "frequency", asked,
-                            f"frequencies the table covers, {table[0]:g} to {table[-1]:g} Hz ({outside.size} of "
-                            f"{wanted.size} outside; the table is not extrapolated: extend it or narrow the "
-                            "excitation's frequencies)")
+    def covered_hz(self) -> tuple[float, float]:
+        """The table's lowest and highest frequency, Hz (it is not extrapolated)."""
+        return self.frequencies_hz[0], self.frequencies_hz[-1]
+
+    def check(self, pins: Sequence[Pin]) -> None:
+        """Refuse a pin of the case without rows (:meth:`pin_order`)."""
+        self.pin_order(pins)
+
+    def pins_at(self, pins: Sequence[Pin], frequencies_hz: Sequence[float], highest_hz: float) -> PinDynamics:
+        """``Z_p`` at *pins* and *frequencies_hz*, interpolated (:meth:`at`), with its interpolation warnings."""
+        order = self.pin_order(pins)
+        return PinDynamics(self.at(frequencies_hz, order), None,
+                           f"{self.describe()}; real and imaginary parts interpolated linearly in frequency",
+                           self.interpolation_warnings(frequencies_hz, order))
 
     def interpolation_warnings(self, frequencies_hz, order: Sequence[int]) -> list[list[str]]:
         """Warnings for the frequencies the table's rows cannot resolve.

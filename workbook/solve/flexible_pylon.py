@@ -3,15 +3,15 @@
 The mount's four-pole set at the excitation's frequency
 (:func:`workbook.solve.four_pole.condense`, formed from the harmonic model
 of the preloaded scene with the pins on rigid ground) is closed by the
-pylon, exactly in the frequency domain:
+pylon, exactly in the frequency domain. The case's
+:class:`~workbook.model.pylon.PylonModel` gives at the pins
+(:meth:`~workbook.model.pylon.PylonModel.pins_at`) either
 
-- a :class:`~workbook.model.pylon_impedance.PylonImpedance` ``Z_p(f)`` per
-  pin: ``(Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f``,
-  ``x2 = -(K22 + Z_p)^-1 K21 x1``, the pylon loaded with ``Z_p x2``;
-- a :class:`~workbook.model.pylon_beam.BoxBeamPylon` or a
-  :class:`~workbook.model.pylon_mesh.MeshPylon`: its compliance ``G`` at the
-  pins, coupled through the beam (:mod:`workbook.solve.pylon_beam`) or the
-  reduced mesh (:mod:`workbook.solve.pylon_mesh`):
+- a point dynamic stiffness ``Z_p(f)`` per pin (an impedance table):
+  ``(Z_e + K11 - K12 (K22 + Z_p)^-1 K21) x1 = B f``,
+  ``x2 = -(K22 + Z_p)^-1 K21 x1``, the pylon loaded with ``Z_p x2``; or
+- its compliance ``G`` at the pins, coupled through the structure (the box
+  beam, the reduced mesh):
   ``(Z_e + K11 - K12 G (I + K22 G)^-1 K21) x1 = B f``, the pylon loaded with
   ``-(I + K22 G)^-1 K21 x1``.
 
@@ -36,12 +36,11 @@ from workbook.answers.model_card import EffectEntry, ModelCard, model_card
 from workbook.answers.results import ExcitationResult
 from workbook.errors import CaseError
 from workbook.model.case import Case, SingleFrequencyExcitation
+from workbook.model.pylon import PinDynamics
 from workbook.solve.four_pole import condense
 from workbook.solve.harmonic import point_phasors
 from workbook.solve.method import MethodChoice
 from workbook.solve.modes import mounted_modes
-from workbook.solve.pylon_beam import beam_model
-from workbook.solve.pylon_mesh import mesh_pylon_model
 from workbook.solve.stages import link_warnings
 
 __all__ = ["PylonAt", "refuse_time_domain", "pylon_at", "solve_on_pylon"]
@@ -53,31 +52,29 @@ class PylonAt:
 
     Attributes
     ----------
-    stiffness : ndarray or None, complex, shape (n, p, 3, 3)
-        Point dynamic stiffness per pin (an impedance table), N/m.
-    compliance : ndarray or None, complex, shape (n, 3 p, 3 p)
-        Compliance at the pins, coupled between them (a box beam), m/N.
+    dynamics : PinDynamics
+        Its stiffness or compliance at the pins per excitation, and warnings.
     effect : EffectEntry
         The model-card entry.
     seconds : float
         Wall time of forming it, s.
-    warnings : list of list of str
-        Per excitation, what the pylon model cannot resolve there (an
-        impedance table too coarse across a resonance).
     """
 
-    stiffness: np.ndarray | None
-    compliance: np.ndarray | None
+    dynamics: PinDynamics
     effect: EffectEntry
     seconds: float
-    warnings: list | None = None
 
     def closure(self, j: int) -> dict:
         """The keyword arguments of :meth:`~workbook.solve.four_pole.FourPole.respond` at excitation *j*."""
-        if self.stiffness is not None:
-            return {"pylon": self.stiffness[j][None]}
-        assert self.compliance is not None
-        return {"compliance": self.compliance[j][None]}
+        if self.dynamics.stiffness is not None:
+            return {"pylon": self.dynamics.stiffness[j][None]}
+        assert self.dynamics.compliance is not None
+        return {"compliance": self.dynamics.compliance[j][None]}
+
+    def warnings(self, j: int) -> list[str]:
+        """What the pylon model cannot resolve at excitation *j* (an impedance table too coarse across a
+        resonance)."""
+        return self.dynamics.warnings[j] if self.dynamics.warnings else []
 
 
 def refuse_time_domain(case: Case, reason: str) -> None:
@@ -86,24 +83,10 @@ def refuse_time_domain(case: Case, reason: str) -> None:
     Raises
     ------
     workbook.errors.CaseError
-        The case gives a pylon impedance or a pylon beam.
+        The case gives a flexible pylon (``Case.pylon``).
     """
-    if case.pylon_impedance is not None:
-        raise CaseError(f"case {case.name!r}", "pylon_impedance", case.pylon_impedance.source,
-                        f"no frequency-dependent pylon impedance in the time domain ({reason}): a dynamic "
-                        f"stiffness tabulated against frequency has no time-domain model here; run the "
-                        f"frequency domain (method 'auto' or 'frequency', no hinge clearance) or remove the "
-                        f"pylon impedance")
-    if case.pylon_beam is not None:
-        raise CaseError(f"case {case.name!r}", "pylon_beam", case.pylon_beam.name,
-                        f"no pylon beam in the time domain ({reason}): the box beam is built as the pylon's "
-                        f"compliance in the frequency domain; run the frequency domain (method 'auto' or "
-                        f"'frequency', no hinge clearance) or remove the pylon beam")
-    if case.pylon_mesh is not None:
-        raise CaseError(f"case {case.name!r}", "pylon_mesh", case.pylon_mesh.name,
-                        f"no pylon mesh in the time domain ({reason}): the mesh is reduced to the pylon's "
-                        f"compliance in the frequency domain; run the frequency domain (method 'auto' or "
-                        f"'frequency', no hinge clearance) or remove the pylon mesh")
+    if case.pylon is not None:
+        raise CaseError(f"case {case.name!r}", "pylon", case.pylon.label, case.pylon.time_domain_refusal(reason))
 
 
 def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> PylonAt:
@@ -112,38 +95,16 @@ def pylon_at(case: Case, points: tuple[SingleFrequencyExcitation, ...]) -> Pylon
     Raises
     ------
     workbook.errors.CaseError
-        An excitation frequency outside the impedance table; a pin beyond
-        the beam's ends.
+        Input the pylon model cannot answer (:meth:`~workbook.model.pylon.PylonModel.pins_at`):
+        an excitation frequency outside the impedance table, a pin beyond the beam's ends, a mesh
+        that cannot be read.
     """
     start = time.perf_counter()
-    frequencies = [x.frequency for x in points]
-    pins = case.pylon_pins()
-    if case.pylon_impedance is not None:
-        impedance = case.pylon_impedance
-        order = impedance.pin_order(pins)
-        stiffness = impedance.at(frequencies, order)
-        effect = EffectEntry("flexible pylon (point dynamic stiffness)", True,
-                             f"{impedance.describe()}; real and imaginary parts interpolated linearly in frequency")
-        return PylonAt(stiffness, None, effect, time.perf_counter() - start,
-                       impedance.interpolation_warnings(frequencies, order))
-    if case.pylon_mesh is not None:
-        highest = max(x.frequency for x in case.single_frequency_excitations())  # one reduction serves every run
-        structure, facts = mesh_pylon_model(case.pylon_mesh, [position for position, _ in pins], highest)
-        modes = (f"{facts['modes']} fixed-interface modes up to {facts['highest_mode_hz']:.0f} Hz"
-                 if facts["modes"] else "static modes only")
-        effect = EffectEntry("flexible pylon (mesh)", True,
-                             f"{case.pylon_mesh.describe()}; {facts['fe_dof']} FE DOF reduced to "
-                             f"{facts['reduced_dof']} (Craig-Bampton on the pins, {modes}) in "
-                             f"{facts['seconds']:.2f} s, compliance at the pins")
-        return PylonAt(None, structure.compliance(frequencies), effect, time.perf_counter() - start)
-    beam = case.pylon_beam
-    assert beam is not None
-    model = beam_model(beam, [position for position, _ in pins])
-    compliance = model.compliance(frequencies)
-    effect = EffectEntry("flexible pylon (box beam)", True,
-                         f"{beam.describe()}; {len(model.stations) - 1} Euler-Bernoulli elements, "
-                         f"{model.stiffness.shape[0]} DOF, pins on rigid offsets, compliance at the pins")
-    return PylonAt(None, compliance, effect, time.perf_counter() - start)
+    pylon = case.pylon
+    assert pylon is not None
+    highest = max(x.frequency for x in (*case.single_frequency_excitations(), *points))  # one reduction serves every run
+    dynamics = pylon.pins_at(case.pylon_pins(), [x.frequency for x in points], highest)
+    return PylonAt(dynamics, EffectEntry(pylon.effect, True, dynamics.detail), time.perf_counter() - start)
 
 
 def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.ndarray,
@@ -164,7 +125,7 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
     Parameters
     ----------
     case : Case
-        With a pylon impedance or a pylon beam.
+        With a flexible pylon (``Case.pylon``).
     prepared : PreparedScene
         The scene of ``mount_case(case)`` prepared with its harmonic model.
     points : tuple of RotatingForce, HarmonicForce or Imbalance
@@ -195,7 +156,7 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
         seconds = time.perf_counter() - start
         result = _result(excitation, pole.pins, pin_forces, case.analysis.steady_tolerance)
         result.warnings.extend(link_warnings(case, prepared.scene.reduced))
-        result.warnings.extend(pylon.warnings[j] if pylon.warnings else [])
+        result.warnings.extend(pylon.warnings(j))
         timings = dict(prepared.timings, **{"pylon": pylon.seconds, "harmonic solve on the pylon": seconds})
         solver = {"analysis": "frequency domain on a flexible pylon: the mount's four-pole set (6 engine + "
                               f"{3 * len(pole.pins)} pin coordinates) closed by the pylon",

@@ -18,6 +18,10 @@ Stages 1-4 are :func:`prepare`. In the frequency domain a single excitation
 and a whole sweep each cost one :func:`prepare`; in the time domain every
 sweep frequency is its own run (its links reduced for the sweep's highest
 frequency so that every point uses the same link models).
+
+The four-pole set of a case (:func:`four_pole`) is its mount's scene
+prepared by the same stages, then condensed onto the engine and the pylon
+pins (:func:`workbook.solve.four_pole.condense`).
 """
 from __future__ import annotations
 
@@ -27,11 +31,11 @@ import time
 
 from workbook.answers.model_card import ModelCard, model_card
 from workbook.answers.results import ExcitationResult, MountResult
-from workbook.model.case import Case, Simultaneous, SingleFrequencyExcitation, Sweep
+from workbook.model.case import Case, HarmonicForce, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_law import linearised_gap_warnings
 from workbook.solve.flexible_pylon import pylon_at, refuse_time_domain, solve_on_pylon
-from workbook.solve.four_pole import mount_case
+from workbook.solve.four_pole import REPORT_GRID, FourPole, checked_frequencies, condense, frequency_grid, mount_case
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
@@ -46,7 +50,7 @@ from workbook.solve.time_domain import TimeHistories, extract, integrate, plan_r
 from workbook.solve.truncation import describe_truncation, truncation_error
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
-           "RESONANCE_BAND"]
+           "four_pole", "report_four_pole", "RESONANCE_BAND"]
 
 log = logging.getLogger(__name__)
 
@@ -330,8 +334,8 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     -------
     MountResult
 
-    A case with a flexible pylon (``Case.pylon_impedance``, ``Case.pylon_mesh`` or
-    ``Case.pylon_beam``) is answered on that pylon
+    A case with a flexible pylon (``Case.pylon``: an impedance table, a box
+    beam or a mesh) is answered on that pylon
     (:mod:`workbook.solve.flexible_pylon`), in the frequency domain only.
     """
     runs, cards, preloads = [], {}, {}
@@ -371,3 +375,38 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
         preloads.update(item_preloads)
     log.info("%s: %d runs", case.name, len(runs))
     return MountResult(case.name, runs, cards, preloads)
+
+
+def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
+    """The four-pole set of the mount of *case* at *frequencies_hz*, about
+    its preloaded equilibrium.
+
+    Parameters
+    ----------
+    case : Case
+        Its links are reduced for the highest frequency. Test-rig
+        transducers are not part of the mount (give them as a pylon
+        impedance).
+    frequencies_hz, points
+        As :func:`~workbook.solve.four_pole.condense` takes them.
+
+    Raises
+    ------
+    workbook.errors.CaseError
+        A hinge with a clearance law, no pylon-side hinge, or no frequency.
+    workbook.errors.SimulationError
+        A mechanism or a failed equilibrium (preload); a singular set
+        (:class:`~workbook.errors.FourPoleError`).
+    """
+    frequencies = checked_frequencies(frequencies_hz)
+    probe = HarmonicForce("four-pole probe", point=case.engine.center_of_mass, direction=(1.0, 0.0, 0.0),
+                          amplitude=1.0, frequency_hz=float(frequencies.max()))
+    prepared = prepare(mount_case(case), probe)
+    with prepared.scene:
+        return condense(prepared.model, case, frequencies, points=points)
+
+
+def report_four_pole(case: Case) -> FourPole:
+    """The four-pole set of *case* on the default grid (:data:`~workbook.solve.four_pole.REPORT_GRID`),
+    for the report workbook's Four-pole sheet."""
+    return four_pole(case, frequency_grid(*REPORT_GRID))
