@@ -24,7 +24,8 @@ case = reference_case().with_rigid_links()
 case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, settle_time=float(sys.argv[1]),
                                                              start="rest"))
 start = time.perf_counter()
-result, card, _ = run_excitation(case, LP_ROTOR)
+result = run_excitation(case, LP_ROTOR)
+card = result.model_card
 print(json.dumps({"steps": card.solver["steps"], "wall": time.perf_counter() - start,
                   "samples": len(result.time), "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
 """

@@ -151,7 +151,7 @@ def _picture_runs():
                                has_histories=False)
 
     def run(name, points):
-        return SimpleNamespace(spec=SimpleNamespace(name=name), result=MountResult("made-up mount", points, {}, {}))
+        return SimpleNamespace(spec=SimpleNamespace(name=name), result=MountResult("made-up mount", points))
 
     sweep = [point(f"sweep @ {f:g} Hz", f, [0.5 / f, 2 / f, 1 / f]) for f in np.geomspace(5, 300, 12)]
     return [run("LP rotor", [point("LP rotor", 59.0, [0.03, 0.001, 0.02])]),

@@ -10,13 +10,17 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from workbook._renamed import renamed
 from workbook.answers.isolation import efficiency, level_db, transmissibility
 from workbook.model.case import DIRECTIONS
+
+if TYPE_CHECKING:
+    from workbook.answers.model_card import ModelCard
+    from workbook.solve.preload import Preload
 
 __all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM"]
 
@@ -89,6 +93,10 @@ class ExcitationResult(PylonAnswers):
         Complex amplitude of each flexible link's modal coordinates, whose
         stress is ``S q`` (:func:`flexbodies.stress.state_stress`):
         frequency-domain answers on a rigid pylon only (else empty).
+    model_card : ModelCard
+        How the run was computed (None only before a solver attaches it).
+    preload : workbook.solve.preload.Preload
+        The preloaded equilibrium the run starts from (None as the card).
     """
 
     name: str
@@ -108,6 +116,8 @@ class ExcitationResult(PylonAnswers):
     hinge_phasors: dict = field(default_factory=dict, repr=False)
     truncation_error: np.ndarray | None = field(default=None, repr=False)
     link_phasors: dict = field(default_factory=dict, repr=False)
+    model_card: ModelCard | None = field(default=None, repr=False)
+    preload: Preload | None = field(default=None, repr=False)
 
     @property
     def has_histories(self) -> bool:
@@ -125,22 +135,26 @@ class ExcitationResult(PylonAnswers):
 
 @dataclass
 class MountResult:
-    """All runs of a case, with their model cards and preloads.
+    """All runs of a case, each with its model card and preload.
 
     Attributes
     ----------
     case_name : str
     runs : list of ExcitationResult
-    model_cards : dict of str to ModelCard
-        Per run (excitation name).
-    preloads : dict of str to Preload
-        Per run.
     """
 
     case_name: str
     runs: list
-    model_cards: dict
-    preloads: dict
+
+    @property
+    def model_cards(self) -> dict[str, ModelCard]:
+        """The model card of each run, by run name."""
+        return {run.name: run.model_card for run in self.runs if run.model_card is not None}
+
+    @property
+    def preloads(self) -> dict[str, Preload]:
+        """The preload of each run, by run name."""
+        return {run.name: run.preload for run in self.runs if run.preload is not None}
 
     def run(self, name: str | None = None) -> ExcitationResult:
         """The run named *name* (default: the first)."""
@@ -244,9 +258,9 @@ class MountResult:
                 "truncation_error": None if run.truncation_error is None else
                 dict(zip(DIRECTIONS, map(float, run.truncation_error), strict=True)),
                 "steady": run.steady, "steady_change": run.steady_change, "warnings": list(run.warnings),
-                "static_hinge_forces_n": {name: list(map(float, f))
-                                          for name, f in self.preloads[run.name].hinge_forces.items()},
-                "model_card": self.model_cards[run.name].to_dict(),
+                "static_hinge_forces_n": None if run.preload is None else
+                {name: list(map(float, f)) for name, f in run.preload.hinge_forces.items()},
+                "model_card": None if run.model_card is None else run.model_card.to_dict(),
             })
         return {"case": self.case_name, "runs": runs}
 

@@ -79,7 +79,7 @@ def simulate_run(case: Case, run: str, *, histories: bool = False) -> Excitation
 
     excitation = _excitation(case, run)
     if histories:
-        return run_excitation(case, excitation)[0]
+        return run_excitation(case, excitation)
     return run_case(dataclasses.replace(case, excitations=(excitation,))).runs[0]
 
 

@@ -196,13 +196,12 @@ class LinearMount:
             with prepared.scene as scene:
                 if any(items_.clearance for items_ in scene.hinges.values()):
                     raise OutsideDesignModel(case.name, "hinge clearance laws (a nonlinear scene)")
-                _, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen)
+                for run in solve_frequencies(case, prepared, points, chosen):
+                    cards[run.name], preloads[run.name] = run.model_card, run.preload
                 channels, pylon = list(scene.force_channels), list(scene.pylon_channels)
                 items[item.name] = _prepare_item(case, item, scene, prepared, channels,
                                                  [np.asarray(p) for e in points for p, _ in point_phasors(e)],
                                                  time.perf_counter() - start)
-            cards.update(item_cards)
-            preloads.update(item_preloads)
         return cls(case, items, channels, pylon, cards, preloads)
 
     def check(self, case: Case) -> None:
@@ -254,8 +253,10 @@ class LinearMount:
             static[item.name] = dict(zip(self.channels, solution.state.forces, strict=True))
             engine[item.name] = solution.engine_static
             for excitation in points_of(item):
-                runs.append(_answer(case, solution.prepared, solution.model, excitation, self.channels, self.pylon))
-        result = MountResult(case.name, runs, dict(self._cards), dict(self._preloads))
+                run = _answer(case, solution.prepared, solution.model, excitation, self.channels, self.pylon)
+                run.model_card, run.preload = self._cards.get(run.name), self._preloads.get(run.name)
+                runs.append(run)
+        result = MountResult(case.name, runs)
         return DesignAnswer(result, static, time.perf_counter() - start, engine)
 
     def solve_items(self, case: Case) -> list["ItemSolution"]:

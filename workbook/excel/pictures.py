@@ -72,7 +72,7 @@ def _draw(fig, picture: _Picture) -> None:
     fig.subplots_adjust(**_MARGINS)
     ax = fig.add_subplot()
     if single:
-        MountResult(picture.case_name, list(picture.points), {}, {}).draw_efficiency(ax)
+        MountResult(picture.case_name, list(picture.points)).draw_efficiency(ax)
         return
     frequencies = [p.frequency_hz for p in picture.points]
     for i, d in enumerate(DIRECTIONS):

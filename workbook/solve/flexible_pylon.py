@@ -32,7 +32,7 @@ from typing import cast
 
 import numpy as np
 
-from workbook.answers.model_card import EffectEntry, ModelCard, model_card
+from workbook.answers.model_card import EffectEntry, model_card
 from workbook.answers.results import ExcitationResult
 from workbook.errors import CaseError
 from workbook.model.case import Case, SingleFrequencyExcitation
@@ -119,7 +119,7 @@ def _result(excitation: SingleFrequencyExcitation, pins: list, pin_forces: np.nd
 
 
 def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation, ...], pylon: PylonAt,
-                   method: MethodChoice) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict]:
+                   method: MethodChoice) -> list[ExcitationResult]:
     """Frequency-domain answers of *points* on the flexible pylon of *case*.
 
     Parameters
@@ -135,11 +135,10 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
 
     Returns
     -------
-    runs : list of ExcitationResult
+    list of ExcitationResult
         The pylon force is the sum of the pin forces; ``hinge_amplitudes``
-        holds the force on the pylon at each pin (named by its hinges).
-    cards : dict of str to ModelCard
-    preloads : dict of str to Preload
+        holds the force on the pylon at each pin (named by its hinges). Each
+        with its model card and preload.
 
     Raises
     ------
@@ -147,7 +146,7 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
         A singular set (an undamped resonance at an excitation frequency).
     """
     mounted = mounted_modes(prepared.modes)
-    runs, cards, preloads = [], {}, {}
+    runs = []
     for j, excitation in enumerate(points):
         start = time.perf_counter()
         forces = point_phasors(excitation)  # one force, or one per imbalance plane: their responses add
@@ -167,7 +166,6 @@ def solve_on_pylon(case: Case, prepared, points: tuple[SingleFrequencyExcitation
                                         f"mount's four-pole set; the mounted modes listed are those on a rigid "
                                         f"pylon"))
         card.run_name = excitation.name
+        result.model_card, result.preload = card, prepared.preload
         runs.append(result)
-        cards[result.name] = card
-        preloads[result.name] = prepared.preload
-    return runs, cards, preloads
+    return runs

@@ -29,7 +29,7 @@ import dataclasses
 import logging
 import time
 
-from workbook.answers.model_card import ModelCard, model_card
+from workbook.answers.model_card import model_card
 from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, HarmonicForce, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
@@ -154,7 +154,7 @@ def prepare(case: Case, excitation: SingleFrequencyExcitation | Simultaneous, *,
 def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
                    reduce_for: SingleFrequencyExcitation | None = None,
                    progress: ProgressFactory | None = None,
-                   method: MethodChoice | None = None) -> tuple[ExcitationResult, ModelCard, Preload]:
+                   method: MethodChoice | None = None) -> ExcitationResult:
     """Run one single-frequency excitation of *case* in the time domain.
 
     Parameters
@@ -173,9 +173,8 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
 
     Returns
     -------
-    result : ExcitationResult
-    card : ModelCard
-    preload : Preload
+    ExcitationResult
+        With its model card and preload.
 
     Raises
     ------
@@ -184,16 +183,16 @@ def run_excitation(case: Case, excitation: SingleFrequencyExcitation, *,
         an undamped mode, a failed or diverging integration, or an exhausted
         time budget; the message says when and why.
     """
-    results, card, preload = run_in_time(case, excitation, reduce_for=reduce_for, progress=progress, method=method)
-    return results[0], card, preload
+    return run_in_time(case, excitation, reduce_for=reduce_for, progress=progress, method=method)[0]
 
 
 def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous, *,
                 reduce_for: SingleFrequencyExcitation | None = None, progress: ProgressFactory | None = None,
-                method: MethodChoice | None = None) -> tuple[list[ExcitationResult], ModelCard, Preload]:
+                method: MethodChoice | None = None) -> list[ExcitationResult]:
     """One time-domain run of *excitation*: one result, or one per part of a
     :class:`~workbook.model.case.Simultaneous` excitation (all parts in the
-    same run, see :mod:`workbook.solve.simultaneous`); see :func:`run_excitation`."""
+    same run, see :mod:`workbook.solve.simultaneous`, sharing its model card);
+    see :func:`run_excitation`."""
     method = method or MethodChoice(TIME, "asked for directly (run_excitation)")
     refuse_time_domain(case, method.reason)
     start = choose_start(case)
@@ -244,7 +243,9 @@ def run_in_time(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
         f"{histories.extended_periods} periods: the first windows disagreed" if histories.extended_periods
         else "none")
     card.solver["step retries"] = "; ".join(histories.retries) or "none: Newton converged at the planned step"
-    return results, card, prepared.preload
+    for result in results:
+        result.model_card, result.preload = card, prepared.preload
+    return results
 
 
 def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
@@ -268,16 +269,15 @@ def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
 
 def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleFrequencyExcitation, ...],
                       method: MethodChoice, *, progress: ProgressFactory | None = None
-                      ) -> tuple[list[ExcitationResult], dict[str, ModelCard], dict[str, Preload]]:
+                      ) -> list[ExcitationResult]:
     """Frequency-domain answers of the single-frequency excitations *points*
     on a scene prepared with its harmonic model (at the excitation point it
     was prepared with or any other point of the engine).
 
     Returns
     -------
-    runs : list of ExcitationResult
-    cards : dict of str to ModelCard
-    preloads : dict of str to Preload
+    list of ExcitationResult
+        Each with its model card and preload.
     """
     model = prepared.model
     assert model is not None
@@ -285,7 +285,7 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
     solver = _frequency_solver(case, model)
     gaps = [h for h in case.hinges if prepared.scene.hinges[h.name].clearance]
     update, close = progress(f"{points[0].name}: frequencies", len(points)) if progress else (None, None)
-    runs, cards, preloads = [], {}, {}
+    runs = []
     try:
         for done, excitation in enumerate(points, start=1):
             where = run_label(case.name, excitation.name)
@@ -305,15 +305,14 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
             card = model_card(prepared.scene, prepared.preload, mounted, None, timings, method,
                               {**solver, "truncation error": describe_truncation(result.truncation_error)})
             card.run_name = excitation.name
+            result.model_card, result.preload = card, prepared.preload
             runs.append(result)
-            cards[result.name] = card
-            preloads[result.name] = prepared.preload
             if update:
                 update(done)
     finally:
         if close:
             close()
-    return runs, cards, preloads
+    return runs
 
 
 def run_case(case: Case, *, progress: ProgressFactory | None = None,
@@ -338,7 +337,7 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
     beam or a mesh) is answered on that pylon
     (:mod:`workbook.solve.flexible_pylon`), in the frequency domain only.
     """
-    runs, cards, preloads = [], {}, {}
+    runs: list[ExcitationResult] = []
     for item in case.excitations:
         points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
         highest = max(points, key=lambda point: point.frequency)
@@ -347,34 +346,24 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
             pylon = pylon_at(case, points)              # bad pylon input refused before any work
             prepared = prepare(mount_case(case), points[0], reduce_for=highest, progress=progress)
             with prepared.scene:
-                item_runs, item_cards, item_preloads = solve_on_pylon(case, prepared, points, pylon, chosen)
+                item_runs = solve_on_pylon(case, prepared, points, pylon, chosen)
         elif chosen.method == FREQUENCY:
             if isinstance(item, Simultaneous):
                 chosen = dataclasses.replace(chosen, reason=f"{chosen.reason}; {item.name!r} by superposition: "
                                              "each part solved at its own frequency, the response is their sum")
             prepared = prepare(case, points[0], reduce_for=highest, progress=progress)
             with prepared.scene:
-                item_runs, item_cards, item_preloads = solve_frequencies(case, prepared, points, chosen,
-                                                                         progress=progress)
+                item_runs = solve_frequencies(case, prepared, points, chosen, progress=progress)
             if isinstance(item, Sweep):
                 add_grid_warnings(item, item_runs, prepared.modes)
         elif isinstance(item, Simultaneous):
-            item_runs, card, preload = run_in_time(case, item, reduce_for=highest, progress=progress, method=chosen)
-            item_cards = {result.name: card for result in item_runs}
-            item_preloads = {result.name: preload for result in item_runs}
+            item_runs = run_in_time(case, item, reduce_for=highest, progress=progress, method=chosen)
         else:
-            item_runs, item_cards, item_preloads = [], {}, {}
-            for excitation in points:
-                result, card, preload = run_excitation(case, excitation, reduce_for=points[-1], progress=progress,
-                                                       method=chosen)
-                item_runs.append(result)
-                item_cards[result.name] = card
-                item_preloads[result.name] = preload
+            item_runs = [run_excitation(case, excitation, reduce_for=points[-1], progress=progress, method=chosen)
+                         for excitation in points]
         runs += item_runs
-        cards.update(item_cards)
-        preloads.update(item_preloads)
     log.info("%s: %d runs", case.name, len(runs))
-    return MountResult(case.name, runs, cards, preloads)
+    return MountResult(case.name, runs)
 
 
 def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:

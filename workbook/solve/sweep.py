@@ -124,7 +124,7 @@ def run_sweep(case: Case, sweep: Sweep, *, reduced=None) -> SweepAnswer:
     method = MethodChoice(FREQUENCY, "a sweep runs in the frequency domain: one linearisation serves "
                                        "every frequency")
     with prepared.scene:
-        runs, cards, preloads = solve_frequencies(case, prepared, points, method)
+        runs = solve_frequencies(case, prepared, points, method)
     add_grid_warnings(sweep, runs, prepared.modes)
-    return SweepAnswer(sweep, MountResult(case.name, runs, cards, preloads),
+    return SweepAnswer(sweep, MountResult(case.name, runs),
                        modes_in_band(prepared.modes, sweep.frequencies_hz[-1]))

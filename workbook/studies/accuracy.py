@@ -152,11 +152,11 @@ def _solve(case: Case, excitation: SingleFrequencyExcitation, method: Method):
         prepared = prepare(case, excitation)
         choice = MethodChoice(FREQUENCY, "accuracy study rung")
         with prepared.scene:
-            runs, cards, _ = solve_frequencies(case, prepared, (excitation,), choice)
+            (run,) = solve_frequencies(case, prepared, (excitation,), choice)
     else:
-        run, card, _ = run_excitation(case, excitation)
-        runs, cards = [run], {run.name: card}
-    return runs[0].transmissibility, cards[runs[0].name].total_dof
+        run = run_excitation(case, excitation)
+    assert run.model_card is not None      # a solver's result carries its card
+    return run.transmissibility, run.model_card.total_dof
 
 
 def run_rung(case: Case, rung: Rung, repeats: int = 3) -> RungResult:
