@@ -1359,5 +1359,4 @@ class Case:
         return dataclasses.replace(self, effects=dataclasses.replace(self.effects, flexible_links=False))
 
 
-
 Case.__init__ = accept_legacy_pylons(Case.__init__)  # type: ignore[method-assign]

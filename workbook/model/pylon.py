@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.errors import CaseError
 
@@ -171,6 +170,8 @@ class PylonStructure:
 
     def compliance(self, frequencies_hz) -> np.ndarray:
         """``G`` at each frequency, complex, shape (f, 3 p, 3 p), m/N."""
+        import scipy.linalg as sla
+
         result = []
         for frequency in np.atleast_1d(np.asarray(frequencies_hz, dtype=float)):
             omega = 2 * np.pi * frequency

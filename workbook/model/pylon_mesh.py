@@ -36,7 +36,6 @@ from pathlib import Path
 from typing import ClassVar
 
 import numpy as np
-import scipy.sparse as sp
 
 from flexbodies.materials import Material
 from workbook.errors import CaseError
@@ -146,6 +145,8 @@ def _skew(r: np.ndarray) -> np.ndarray:
 
 def _root_coordinates(pylon: MeshPylon, nodes: np.ndarray, coupling, bore_nodes: set) -> np.ndarray:
     """Coupled coordinates of the root plane's nodes (the clamped ones)."""
+    import scipy.sparse as sp
+
     item = f"pylon mesh {pylon.name!r}"
     normal = np.asarray(pylon.root_normal) / np.linalg.norm(pylon.root_normal)
     on_root = np.flatnonzero(np.abs((nodes - np.asarray(pylon.root_point)) @ normal) <= pylon.root_tolerance)
