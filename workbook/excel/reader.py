@@ -561,10 +561,9 @@ class _CaseReader(SheetReader):
         spectrum = _SPECTRUM_ITEM.match(exc.item)
         if spectrum:
             rows = [record for record, _ in items[L.SPEED_SPECTRUM.sheet] if record.get("excitation") == spectrum.group(1)]
-            band = re.match(r"bands\[(\d+)\]$", exc.field)
+            band = re.match(r"bands\[(\d+)\]\.?(.*)$", exc.field)
             record = rows[int(band.group(1))] if band else rows[0]
-            keys = ("excitation",) if exc.field == "excitation" else ("speed_hz", "to_hz") if band and exc.value is not None \
-                else ("hours",)
+            keys = (band.group(2) or "hours",) if band else ("excitation",)
             self.record_problem(record, keys, record.typed(keys, exc.value), exc.expected)
             return
         match = _ITEM.match(exc.item)

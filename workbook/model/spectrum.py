@@ -114,7 +114,7 @@ class SpeedSpectrum:
         Raises
         ------
         CaseError
-            Naming the spectrum and the band (``bands[k]``).
+            Naming the spectrum, the band and its end (``bands[k].speed_hz``).
         """
         from workbook.model.case import Simultaneous, Sweep
 
@@ -129,9 +129,10 @@ class SpeedSpectrum:
             return
         low, high = excitation.frequencies_hz[0], excitation.frequencies_hz[-1]
         for k, band in enumerate(self.bands):
-            for speed in (band.speed_hz, band.to_hz):
+            for end in ("speed_hz", "to_hz"):
+                speed = getattr(band, end)
                 if speed is not None and not low * (1 - _RANGE_SLACK) <= speed <= high * (1 + _RANGE_SLACK):
-                    raise CaseError(item, f"bands[{k}]", speed,
+                    raise CaseError(item, f"bands[{k}].{end}", speed,
                                     f"a speed within the speeds of {excitation.name!r}, {low:g} to {high:g} Hz")
 
     def template(self, excitations):
@@ -154,7 +155,8 @@ def check_speed_spectra(case) -> None:
     ------
     CaseError
         A spectrum naming no rotor excitation of the case or a speed outside
-        its sweep (``speed spectrum '<excitation>'``, field ``bands[k]``), or,
+        its sweep (``speed spectrum '<excitation>'``, field ``bands[k].speed_hz``
+        or ``.to_hz``), or,
         when the case has spectra, a flexible link whose material lacks the
         endurance or ultimate strength or an S-N parameter
         (``link '<name>'``, field ``material.<field>``).
