@@ -97,6 +97,9 @@ def test_the_written_fatigue_sheets_hold_the_numbers_of_mountwb_stress(tmp_path,
     harmonic = {(e["excitation"], link): f for e in fatigue["excitations"] for link, f in e["links"].items()}
     spectra = {(s["excitation"], link): d for s in fatigue["spectra"] for link, d in s["links"].items()}
     assert [s["excitation"] for s in fatigue["spectra"]] == ["LP rotor", "HP rotor"]
+    card = [line for (line,) in load_workbook(path)["Result model card"].iter_rows(max_col=1, values_only=True) if line]
+    assert any("[on ] limit load cases: 1 for the links' static margins" in line for line in card)
+    assert any("[off] link fatigue: no flexible link" in line for line in card)       # the run's links are rigid
     if SOFFICE is not None:
         save_in_libreoffice(path, tmp_path / "scratch")
     for book, title, top in ((load_workbook(path), "Result fatigue", 2), (load_workbook(report), "Fatigue", 4)):
