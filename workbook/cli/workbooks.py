@@ -40,7 +40,7 @@ def check_arguments(parser: argparse.ArgumentParser) -> Callable:
         case = book.case
         print(f"{book.path.name}: OK - case '{case.name}': {len(case.links)} links, {len(case.hinges)} hinges, "
               f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values, "
-              f"{len(case.load_cases)} load cases")
+              f"{len(case.load_cases)} load cases, {len(case.speed_spectra)} speed spectra")
         return EXIT_OK
 
     return check

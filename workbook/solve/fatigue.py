@@ -317,8 +317,9 @@ def miner_damage(equivalents, cycles, material) -> np.ndarray:
     ndarray, shape (n,)
     """
     total = np.zeros(np.shape(equivalents[0]))
-    for equivalent, n in zip(equivalents, cycles, strict=True):
-        total += n / cycles_to_failure(equivalent, material)
+    with np.errstate(divide="ignore"):    # N = 0 (a static failure): infinite damage
+        for equivalent, n in zip(equivalents, cycles, strict=True):
+            total += n / cycles_to_failure(equivalent, material)
     return total
 
 
