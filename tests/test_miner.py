@@ -2,6 +2,7 @@
 the S-N curve and the sum by hand, the presets' S-N lines, bad spectra, and the reference mount's
 sums against the node stresses of its own harmonic answers."""
 import dataclasses
+import json
 import math
 
 import numpy as np
@@ -9,7 +10,8 @@ import pytest
 
 from flexbodies.materials import STEEL, TITANIUM, Material
 from flexbodies.stress import alternating_von_mises, signed_von_mises
-from workbook.errors import CaseError
+from workbook.cli.main import main
+from workbook.errors import EXIT_BAD_INPUT, CaseError
 from workbook.model.codec import from_json, to_json
 from workbook.model.spectrum import SpeedBand, SpeedSpectrum, check_speed_spectra
 from workbook.scene.build import reduce_links
@@ -66,6 +68,20 @@ def test_bad_spectra_are_refused_naming_the_band(coarse_reference):
     with pytest.raises(CaseError, match=f"link '{link.name}', field 'material.fatigue_exponent'"):
         check_speed_spectra(case)
     assert from_json(to_json(case)).speed_spectra == case.speed_spectra
+
+
+def test_the_stress_command_names_a_missing_fatigue_exponent_when_a_spectrum_is_given(coarse_reference, tmp_path,
+                                                                                      capsys):
+    path = tmp_path / "case.json"
+    spectrum = SpeedSpectrum("LP rotor", (SpeedBand(10.0, 50.0),))
+    data = json.loads(to_json(dataclasses.replace(coarse_reference, speed_spectra=(spectrum,))))
+    data["links"][0]["model"]["material"]["fatigue_exponent"] = None
+    path.write_text(json.dumps(data))
+    assert main(["stress", str(path)]) == EXIT_BAD_INPUT
+    message = capsys.readouterr().err
+    assert "material.fatigue_exponent" in message and "Miner" in message
+    path.write_text(to_json(coarse_reference))               # without a spectrum no S-N curve is needed
+    assert from_json(path.read_text()).speed_spectra == ()
 
 
 @pytest.mark.slow
