@@ -1,50 +1,122 @@
-"""Regenerate the fatigue table of docs/stresses.md.
+"""Regenerate the load-case, fatigue and Miner tables of docs/stresses.md and the strength table of the README.
 
-The reference mount (default link meshes) under its LP and HP rotor
-imbalances in the frequency domain, on the preload of its static loads (1 g
-and the cruise thrust): per rotor the lowest fatigue factors over the links
-(:func:`workbook.solve.fatigue.solve_fatigue`). Replaces the section between
-the ``<!-- generated: fatigue -->`` markers. Run from anywhere (under a
-minute once the links are cached)::
+The reference mount (default link meshes): its limit load cases
+(:func:`workbook.model.load_cases.reference_load_cases`, lowest margins per
+load case, :func:`workbook.solve.load_cases.solve_load_cases`); its LP and
+HP rotor imbalances in the frequency domain on the preload of its static
+loads (1 g and the cruise thrust), per rotor the lowest fatigue factors over
+the links; and the Miner sums of its speed spectra
+(:func:`workbook.model.spectrum.reference_speed_spectra`), all by
+:func:`workbook.solve.fatigue.solve_fatigue`. Replaces the sections between
+the ``<!-- generated: ... -->`` markers. Run from anywhere (a few minutes
+once the links are cached)::
 
     OPENBLAS_NUM_THREADS=1 python docs/make_stress_docs.py
 """
 from __future__ import annotations
 
+import dataclasses
+import functools
 from pathlib import Path
 
 from generated_sections import rewrite_sections
 
+from workbook.model.load_cases import reference_load_cases
 from workbook.model.reference import reference_case
+from workbook.model.spectrum import reference_speed_spectra
 from workbook.solve.fatigue import solve_fatigue
+from workbook.solve.load_cases import solve_load_cases
 
 DOCS = Path(__file__).resolve().parent
 DOCUMENT = "stresses.md"
+#: The README's generated sections (the rest of the sections are the document's).
+README = DOCS.parent / "README.md"
+README_SECTIONS = ("strength",)
 
 
-def sections() -> dict[str, str]:
-    """The generated sections of the page by name."""
-    case = reference_case()
-    result = solve_fatigue(case)
+@functools.lru_cache(maxsize=1)
+def _solved():
+    case = dataclasses.replace(reference_case(), speed_spectra=reference_speed_spectra())
+    return case, solve_load_cases(case, reference_load_cases()), solve_fatigue(case)
+
+
+def _lowest_margins(results) -> list[str]:
+    rows = ["| load case | lowest MS_y | lowest MS_u | link, where |", "|---|---|---|---|"]
+    for result in results:
+        stressed = [s for s in result.links.values() if s.yield_margin is not None]
+        worst = min(stressed, key=lambda s: s.ultimate_margin)
+        rows.append(f"| {result.load_case.name} | {min(s.yield_margin for s in stressed):.3g} "
+                    f"| {worst.ultimate_margin:.3g} | {worst.link}, {worst.von_mises_region} |")
+    return rows
+
+
+def _load_cases(results) -> str:
+    nominal = [abs(s.nominal_stress) for r in results for s in r.links.values() if s.nominal_stress is not None]
+    worst = min(results, key=lambda r: min(s.ultimate_margin for s in r.links.values() if s.ultimate_margin is not None))
+    worst_nominal = [abs(s.nominal_stress) for s in worst.links.values() if s.nominal_stress is not None]
+    return "\n".join(_lowest_margins(results) + [
+        "", f"Factor of safety {results[0].load_case.factor_of_safety:g}. The reference links are sized for stiffness, "
+        f"not strength: at most {max(nominal) / 1e6:.0f} MPa nominal shank stress in any load case, "
+        f"{min(worst_nominal) / 1e6:.0f} to {max(worst_nominal) / 1e6:.0f} MPa in the links of the worst "
+        f"({worst.load_case.name})."])
+
+
+def _fatigue_rows(result, per_rotor: int) -> list[str]:
     rows = ["| rotor | link | peak sigma_a (MPa) | sigma_a, sigma_m at the critical node (MPa) | Goodman | Gerber | where |",
             "|---|---|---|---|---|---|---|"]
     for answer in result.excitations:
-        for name, f in sorted(answer.links.items(), key=lambda item: item[1].goodman)[:3]:
+        for name, f in sorted(answer.links.items(), key=lambda item: item[1].goodman)[:per_rotor]:
             rows.append(f"| {answer.excitation} ({answer.frequency_hz:g} Hz) | {name} | {f.peak_alternating / 1e6:.4f} "
                         f"| {f.alternating / 1e6:.4f}, {f.mean / 1e6:.2f} | {f.goodman:.1f} | {f.gerber:.1f} "
                         f"| {f.region} |")
+    return rows
+
+
+def _fatigue(case, result) -> str:
     peak = max(f.peak_alternating for answer in result.excitations for f in answer.links.values())
     materials = sorted({link.model.material.name for link in case.links})
-    rows.append("")
-    rows.append(f"The three lowest Goodman factors per rotor ({', '.join(materials)} links). The largest "
-                f"alternating stress anywhere is {peak / 1e6:.3f} MPa: the imbalance forces "
-                "are small against the links' sizing, and the factors are set by the mean stress of the preload "
-                "(about 1/(sigma_m / S_u)).")
-    return {"fatigue": "\n".join(rows)}
+    return "\n".join(_fatigue_rows(result, 3) + [
+        "", f"The three lowest Goodman factors per rotor ({', '.join(materials)} links). The largest "
+        f"alternating stress anywhere is {peak / 1e6:.3f} MPa: the imbalance forces "
+        "are small against the links' sizing, and the factors are set by the mean stress of the preload "
+        "(about 1/(sigma_m / S_u))."])
+
+
+def _miner(result) -> str:
+    rows = ["| rotor | hours | speeds solved (Hz) | largest sigma_ar (MPa), link, at (Hz) | largest Miner D |",
+            "|---|---|---|---|---|"]
+    for answer in result.spectra:
+        speeds = [f for f, _, _ in answer.speeds]
+        worst = max(answer.links.values(), key=lambda d: d.equivalent)
+        rows.append(f"| {answer.spectrum.excitation} | {answer.spectrum.hours:g} | {len(speeds)}, "
+                    f"{min(speeds):g} to {max(speeds):g} | {worst.equivalent / 1e6:.4f}, {worst.link}, "
+                    f"{worst.speed_hz:g} | {max(d.damage for d in answer.links.values()):g} |")
+    return "\n".join(rows)
+
+
+def _readme(case, loads, fatigue) -> str:
+    return "\n".join(
+        ["Limit load cases (`reference_load_cases()`), lowest margins of safety over the links:", "",
+         *_lowest_margins(loads), "",
+         "Fatigue factors on the preload (1 g, cruise thrust) at the LP and HP rotor speeds, the lowest per rotor:",
+         "", *_fatigue_rows(fatigue, 1), "",
+         "Miner sums over the illustrative speed spectra (`reference_speed_spectra()`, "
+         + ", ".join(f"{a.spectrum.excitation} {a.spectrum.hours:g} h" for a in fatigue.spectra) + "): largest D "
+         + ", ".join(f"{max(d.damage for d in a.links.values()):g}" for a in fatigue.spectra)
+         + " (every stress below the endurance strength)."])
+
+
+def sections() -> dict[str, str]:
+    """The generated sections by name: those of the page and those of the README (:data:`README_SECTIONS`)."""
+    case, loads, fatigue = _solved()
+    return {"load-cases": _load_cases(loads), "fatigue": _fatigue(case, fatigue), "miner": _miner(fatigue),
+            "strength": _readme(case, loads, fatigue)}
 
 
 def main() -> None:
-    print(rewrite_sections(DOCS / DOCUMENT, sections()))
+    generated = sections()
+    print(rewrite_sections(DOCS / DOCUMENT, {k: v for k, v in generated.items() if k not in README_SECTIONS}))
+    print(rewrite_sections(README, {k: generated[k] for k in README_SECTIONS}))
 
 
 if __name__ == "__main__":

@@ -7,10 +7,12 @@ from dataclasses import dataclass
 
 from .errors import LinkModelError
 
-__all__ = ["Material", "STEEL", "TITANIUM", "material", "STRENGTH_FIELDS"]
+__all__ = ["Material", "STEEL", "TITANIUM", "material", "STRENGTH_FIELDS", "FATIGUE_FIELDS", "sn_line_exponent"]
 
+#: The S-N curve's fields of a :class:`Material`: the knee's cycles and the Basquin exponent.
+FATIGUE_FIELDS = ("endurance_cycles", "fatigue_exponent")
 #: Fields of a :class:`Material` no reduction depends on (left out of a link's fingerprint).
-STRENGTH_FIELDS = ("yield_strength", "ultimate_strength", "endurance_strength")
+STRENGTH_FIELDS = ("yield_strength", "ultimate_strength", "endurance_strength", *FATIGUE_FIELDS)
 
 
 @dataclass(frozen=True)
@@ -38,6 +40,15 @@ class Material:
         10^7 cycles or more, in Pa, for the fatigue safety factors
         (:mod:`workbook.solve.fatigue`); None: not known. At most the
         ultimate strength.
+    endurance_cycles : float or None
+        Cycles N_e at the knee of the S-N curve, where the endurance
+        strength is reached (None: not known).
+    fatigue_exponent : float or None
+        Basquin exponent b < 0 of the finite-life S-N curve
+        ``sigma_a = S_e (N / N_e)^b`` for ``N < N_e`` (Basquin's
+        ``sigma_f' (2N)^b`` with ``sigma_f' = S_e (2 N_e)^-b``); None: not
+        known. Both are needed for a Miner damage sum
+        (:mod:`workbook.solve.fatigue`).
 
     Raises
     ------
@@ -52,11 +63,13 @@ class Material:
     yield_strength: float | None = None
     ultimate_strength: float | None = None
     endurance_strength: float | None = None
+    endurance_cycles: float | None = None
+    fatigue_exponent: float | None = None
 
     def __post_init__(self):
         _check_positive(self.name, "Young's modulus", self.youngs_modulus, "Pa")
         _check_positive(self.name, "density", self.density, "kg/m^3")
-        for what in STRENGTH_FIELDS:
+        for what in ("yield_strength", "ultimate_strength", "endurance_strength", "endurance_cycles"):
             if getattr(self, what) is not None:
                 _check_positive(self.name, what.replace("_", " "), getattr(self, what), "Pa")
         if (self.yield_strength is not None and self.ultimate_strength is not None
@@ -67,6 +80,10 @@ class Material:
                 and self.endurance_strength > self.ultimate_strength):
             raise LinkModelError(f"material {self.name!r}: the endurance strength ({self.endurance_strength!r} Pa) "
                                  f"is above the ultimate strength ({self.ultimate_strength!r} Pa)")
+        b = self.fatigue_exponent
+        if b is not None and not (isinstance(b, (int, float)) and math.isfinite(b) and -1.0 < b < 0.0):
+            raise LinkModelError(f"material {self.name!r}: the fatigue exponent (Basquin b) must lie between -1 and 0, "
+                                 f"got {b!r}")
         nu = self.poisson_ratio
         if not (math.isfinite(nu) and -1.0 < nu < 0.5):
             raise LinkModelError(
@@ -95,8 +112,29 @@ def _check_positive(name: str, what: str, value: float, unit: str) -> None:
         raise LinkModelError(f"material {name!r}: {what} must be a positive number in {unit}, got {value!r}")
 
 
+def sn_line_exponent(ultimate: float, endurance: float, endurance_cycles: float, fraction: float = 0.9) -> float:
+    """Basquin exponent b of the S-N line from ``fraction S_u`` at 10^3 cycles to ``S_e`` at *endurance_cycles*.
+
+    Shigley's construction (Budynas and Nisbett, *Shigley's Mechanical
+    Engineering Design*, 10th ed., eqs. 6-13 and 6-14, with the fatigue
+    strength fraction f = 0.9 of S_u below 490 MPa):
+    ``b = -log10(f S_u / S_e) / log10(N_e / 10^3)``.
+
+    Parameters
+    ----------
+    ultimate, endurance : float
+        Ultimate strength S_u and endurance strength S_e, Pa.
+    endurance_cycles : float
+        Cycles N_e at the knee.
+    fraction : float
+        f, the fatigue strength at 10^3 cycles over S_u.
+    """
+    return -math.log10(fraction * ultimate / endurance) / math.log10(endurance_cycles / 1e3)
+
+
 STEEL = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0,
-                 yield_strength=355e6, ultimate_strength=470e6, endurance_strength=235e6)
+                 yield_strength=355e6, ultimate_strength=470e6, endurance_strength=235e6,
+                 endurance_cycles=1e6, fatigue_exponent=sn_line_exponent(470e6, 235e6, 1e6))
 """Structural steel: E = 210 GPa, nu = 0.3, rho = 7850 kg/m^3; the strengths
 are the minimum values of grade S355 (EN 10025-2:2019, table 7): yield
 strength R_eH = 355 MPa (nominal thickness up to 16 mm) and tensile strength
@@ -104,10 +142,14 @@ R_m = 470 MPa (the lower end of 470 to 630 MPa, thickness 3 to 100 mm). The
 endurance strength, 235 MPa, is the rotating-beam estimate
 S_e' = 0.5 R_m for steels with R_m up to 1400 MPa (Budynas and Nisbett,
 *Shigley's Mechanical Engineering Design*, 10th ed., eq. 6-8), with no
-surface, size or reliability factors."""
+surface, size or reliability factors. The S-N curve is Shigley's line from
+0.9 R_m at 10^3 cycles to the endurance strength at N_e = 10^6 cycles (the
+knee of steels there, eqs. 6-13 and 6-14; :func:`sn_line_exponent`):
+Basquin exponent b = -log10(1.8) / 3 = -0.0851."""
 
 TITANIUM = Material("titanium", youngs_modulus=114e9, poisson_ratio=0.34, density=4430.0,
-                    yield_strength=828e6, ultimate_strength=895e6, endurance_strength=510e6)
+                    yield_strength=828e6, ultimate_strength=895e6, endurance_strength=510e6,
+                    endurance_cycles=1e7, fatigue_exponent=sn_line_exponent(895e6, 510e6, 1e7))
 """Titanium alloy Ti-6Al-4V: E = 114 GPa, nu = 0.34, rho = 4430 kg/m^3; the
 strengths are the minimum values of ASTM B265 grade 5 (annealed sheet and
 plate): yield strength (0.2 % offset) 828 MPa, tensile strength 895 MPa. The
@@ -115,7 +157,10 @@ endurance strength, 510 MPa, is the unnotched (K_t = 1) fatigue strength at
 10^7 cycles of annealed Ti-6Al-4V in ASM's property data (ASM Aerospace
 Specification Metals data sheet "Titanium Ti-6Al-4V (Grade 5), Annealed";
 240 MPa with a K_t = 3.3 notch; the stress ratio is not stated there and is
-taken as fully reversed), a typical, not a minimum value."""
+taken as fully reversed), a typical, not a minimum value. The S-N curve is
+Shigley's line (:func:`sn_line_exponent`) from 0.9 R_m at 10^3 cycles to the
+endurance strength at N_e = 10^7 cycles, the cycles of ASM's value: Basquin
+exponent b = -log10(0.9 x 895 / 510) / 4 = -0.0496."""
 
 _PRESETS = {m.name: m for m in (STEEL, TITANIUM)}
 

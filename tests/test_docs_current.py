@@ -46,9 +46,12 @@ def test_four_pole_doc_is_current(cache_dir):
 
 
 @pytest.mark.slow
-def test_stress_doc_is_current(cache_dir):
+def test_stress_doc_and_readme_are_current(cache_dir):
     script = importlib.import_module("make_stress_docs")
-    failures = _differences(script.DOCUMENT, "make_stress_docs.py", script.sections())
+    generated = script.sections()
+    readme = {name: generated.pop(name) for name in script.README_SECTIONS}
+    failures = (_differences(script.DOCUMENT, "make_stress_docs.py", generated)
+                + _differences("../README.md", "make_stress_docs.py", readme))
     assert not failures, "\n\n".join(failures)
 
 

@@ -18,7 +18,7 @@ from workbook.solve.preload import solve_preload
 EFFECTS = {"link flexibility", "static preload", "hinge damping", "hinge loss factor",
            "hinge properties per direction", "link damping", "link modal damping", "link material loss factor", "hinge clearance",
            "flexible engine", "link spin restraints", "gyroscopic rotor", "test-rig force-sensor compliance",
-           "link stress stiffening",
+           "link stress stiffening", "limit load cases", "link fatigue",
            "time domain", "frequency domain", "imbalance planes", "simultaneous excitations"}
 
 
@@ -119,4 +119,5 @@ def test_the_model_card_lists_every_effect_with_its_reason(rigid):
     assert not entries["link flexibility"].on and "rigid" in entries["link flexibility"].detail
     assert not entries["link stress stiffening"].on and entries["link stress stiffening"].detail == "no flexible link"
     assert not entries["flexible engine"].on and "rigid body" in entries["flexible engine"].detail
+    assert (entries["limit load cases"].detail, entries["link fatigue"].detail) == ("none given", "no flexible link")
     assert all(e.detail for e in card.effects)

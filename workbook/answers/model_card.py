@@ -247,6 +247,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
         _rig_sensors(scene),
         _stress_stiffening(preload),
         *_imbalance_planes(scene),
+        *_strength(case, flexible),
     ]
     time_detail = "implicit generalized-alpha; amplitude by DFT of the last window"
     frequency_detail = "harmonic solution of the scene linearised about the preload"
@@ -351,6 +352,34 @@ def _rig_sensors(scene) -> EffectEntry:
     damping = "" if not any(rig.damping) else f", d = ({', '.join(f'{d:.3g}' for d in rig.damping)}) N s/m"
     return EffectEntry(name, True, f"{len(scene.transducers)} transducers, k = ({stiffness}) N/m in x, y, z"
                        f"{damping}, m = {rig.mass:g} kg on pins {pins}; their forces make the pylon force")
+
+
+def _strength(case, flexible: list) -> list[EffectEntry]:
+    """The links' strength settings: the limit load cases, the fatigue materials and the speed spectra."""
+    cases = case.load_cases
+    entries = [EffectEntry("limit load cases", bool(cases),
+                           f"{len(cases)} for the links' static margins, solved apart from the runs: "
+                           + "; ".join(f"{c.name} (FS {c.factor_of_safety:g}"
+                                       + (f", without {c.without_link}" if c.without_link else "") + ")" for c in cases)
+                           if cases else "none given")]
+    materials = {case.link_map[name].model.material for name in flexible}
+
+    def curve(m) -> str:
+        strengths = ", ".join(f"{label} {value / 1e6:g} MPa" for label, value in
+                              (("S_e", m.endurance_strength), ("S_u", m.ultimate_strength)) if value is not None)
+        sn = (f", S-N knee N_e {m.endurance_cycles:g}, b {m.fatigue_exponent:.4g}"
+              if m.endurance_cycles is not None and m.fatigue_exponent is not None else ", no S-N curve")
+        return f"{m.name}: {strengths or 'no strengths'}{sn}"
+
+    spectra = case.speed_spectra
+    entries.append(EffectEntry(
+        "link fatigue", bool(materials),
+        "Goodman and Gerber factors of the flexible links (mountwb stress, Result fatigue); "
+        + "; ".join(curve(m) for m in sorted(materials, key=lambda m: m.name))
+        + ("; Miner sums over the speed spectra of " + ", ".join(
+            f"{s.excitation} ({s.hours:g} h in {len(s.bands)} band(s))" for s in spectra) if spectra
+           else "; no speed spectrum: no Miner sum") if materials else "no flexible link"))
+    return entries
 
 
 def _stress_stiffening(preload) -> EffectEntry:

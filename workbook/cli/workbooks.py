@@ -40,7 +40,7 @@ def check_arguments(parser: argparse.ArgumentParser) -> Callable:
         case = book.case
         print(f"{book.path.name}: OK - case '{case.name}': {len(case.links)} links, {len(case.hinges)} hinges, "
               f"{len(case.excitations)} excitations, {len(book.runs)} runs, {len(book.tests)} test values, "
-              f"{len(case.load_cases)} load cases")
+              f"{len(case.load_cases)} load cases, {len(case.speed_spectra)} speed spectra")
         return EXIT_OK
 
     return check
@@ -144,6 +144,22 @@ def _solved_loads(case):
     return loads_frame(results)
 
 
+def _solved_fatigue(case):
+    """The table of the links' fatigue, solved (None: the case asks for no strength answers, having neither load
+    cases nor speed spectra, or has no flexible link or a flexible pylon)."""
+    if not (case.load_cases or case.speed_spectra) or case.flexible_pylon \
+            or not any(case.link_is_flexible(link.name) for link in case.links):
+        return None
+    from workbook.excel.fatigue_sheet import fatigue_frame
+    from workbook.solve.fatigue import solve_fatigue
+
+    result = solve_fatigue(case)
+    for name, life in result.life_hours().items():
+        print(f"{name}: Miner life under the speed spectra "
+              + (f"{life:.4g} h" if life < float("inf") else "infinite (no stress above the endurance strength)"))
+    return fatigue_frame(result)
+
+
 def _run_and_write(args, book, selected, progress, pictures) -> int:
     """The runs of :func:`run_workbook`, their results written back and the report."""
     from workbook.errors import SimulationError
@@ -162,6 +178,7 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     try:
         pole = report_four_pole(book.case) if args.four_pole else None
         loads = _solved_loads(book.case)
+        fatigue = _solved_fatigue(book.case)
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
@@ -169,7 +186,8 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
         pictures.draw(runs)
     _print_summary(runs)
     try:
-        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened, loads=loads)
+        outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened, loads=loads,
+                                fatigue=fatigue)
     except OSError as error:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)
@@ -177,7 +195,8 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     print_written(book.path.name, "results", outcome.path, outcome.reason)
     if args.report:
         try:
-            report = write_report(args.report, book, runs, outcome, four_pole=pole, pictures=pictures, loads=loads)
+            report = write_report(args.report, book, runs, outcome, four_pole=pole, pictures=pictures, loads=loads,
+                                  fatigue=fatigue)
         except OSError as error:
             print(f"mountwb run: no report: {error}", file=sys.stderr)
             return EXIT_TROUBLE

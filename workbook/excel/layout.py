@@ -22,7 +22,7 @@ from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING,
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
-           "EXCITATIONS", "LOAD_CASES", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
+           "EXCITATIONS", "LOAD_CASES", "SPEED_SPECTRUM", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
            "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES", "MAGNITUDE_LIMITS"]
 
 HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
@@ -38,7 +38,7 @@ AXES = {axis: tuple(float(axis == other) for other in DIRECTIONS) for axis in DI
 #: typing or unit mistake (1e300 N/m, a length in metres typed in millimetres twice) that the
 #: solver would meet only as a failed run; the limits are orders of magnitude beyond any mount.
 MAGNITUDE_LIMITS = {"m": 1e3, "kg": 1e7, "N": 1e10, "N/m": 1e14, "N*s/m": 1e10, "Hz": 1e6, "s": 1e6,
-                    "kg*m^2": 1e8, "Pa": 1e14, "kg/m^3": 1e6, "m/s^2": 1e5, "N*m": 1e11, "kg*m": 1e4}
+                    "kg*m^2": 1e8, "Pa": 1e14, "kg/m^3": 1e6, "m/s^2": 1e5, "N*m": 1e11, "kg*m": 1e4, "h": 1e7}
 
 #: Column kinds: how a cell is read.
 KINDS = ("number", "integer", "text", "choice", "yesno", "modes", "fidelity", "unit")
@@ -245,6 +245,10 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
       for key, what in (("yield_strength", "tensile yield strength (0.2 % proof)"),
                         ("ultimate_strength", "tensile ultimate strength"),
                         ("endurance_strength", "fully reversed endurance strength"))),
+    _num("endurance_cycles", "endurance cycles",
+         help="cycles at the S-N curve's knee, where the endurance strength is reached, overriding the preset's"),
+    _num("fatigue_exponent", "fatigue exponent",
+         help="Basquin exponent b < 0 of the S-N curve sigma_a = S_e (N/N_e)^b, overriding the preset's"),
 ))
 
 HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", columns=(
@@ -317,6 +321,17 @@ LOAD_CASES = Table("Load cases", optional=True,
     *_xyz("moment", "moment", "N*m", help="an extra moment on the engine"),
     _num("factor_of_safety", "factor of safety", help="ultimate over limit load, >= 1 (empty: 1.5)"),
     Column("without_link", "fail-safe link", "text", help="fail-safe: the link removed for this load case"),
+))
+
+SPEED_SPECTRUM = Table("Speed spectrum", optional=True,
+                       help="hours each rotor excitation runs at each speed, for the links' Miner damage sums in "
+                            "the Result fatigue sheet (docs/stresses.md); one row per speed or band of speeds",
+                       columns=(
+    Column("excitation", "excitation", "text", required=True,
+           help="a rotor excitation (rows of the same excitation make its spectrum)"),
+    _num("speed_hz", "speed", "Hz", unit="rpm", required=True, help="the speed, or the band's lower end (Hz accepted)"),
+    _num("to_hz", "to speed", "Hz", unit="rpm", help="the band's upper end (empty: one speed)"),
+    _num("hours", "hours", "h", required=True, help="time at the speed or in the band, >= 0"),
 ))
 
 ROTORS = Table("Rotors", optional=True,
@@ -397,4 +412,4 @@ TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes, o
 ))
 
 #: The input tables in sheet order.
-TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, LOAD_CASES, ROTORS, TEST_RIG, CASING, RUNS, TEST_DATA)
+TABLES = (CASE, ENGINE, LINKS, HINGES, STATIC_LOADS, EXCITATIONS, LOAD_CASES, SPEED_SPECTRUM, ROTORS, TEST_RIG, CASING, RUNS, TEST_DATA)

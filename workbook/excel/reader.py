@@ -28,6 +28,7 @@ from workbook.excel.sheets import OpenedWorkbook, Record, SheetReader, open_work
 from workbook.model import case as cm
 from workbook.model.casing import DEFAULT_BEARING_STIFFNESS, CasingGeometry, EngineCasing, MountRing
 from workbook.model.load_cases import LoadCase
+from workbook.model.spectrum import SpeedBand, SpeedSpectrum, check_speed_spectra
 
 __all__ = ["CaseBook", "read_workbook"]
 
@@ -70,8 +71,8 @@ class CaseBook:
 
 _GEOMETRY_KEYS = ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")
 #: Material columns overriding the preset (the strengths are in the Links sheet only).
-_MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density", "yield_strength", "ultimate_strength",
-                  "endurance_strength")
+_STRENGTH_KEYS = ("yield_strength", "ultimate_strength", "endurance_strength", "endurance_cycles", "fatigue_exponent")
+_MATERIAL_KEYS = ("youngs_modulus", "poisson_ratio", "density", *_STRENGTH_KEYS)
 #: A Load cases row's load factors when their cells are empty: 1 g level flight.
 _LOAD_FACTORS = (0.0, 0.0, -1.0)
 #: Columns of a parametric link's or casing's geometry, which a mesh file replaces (a mesh link's bores take
@@ -100,6 +101,7 @@ _FIELD_COLUMNS: dict[str, dict[str, tuple[str, ...]]] = {
                   for key in ("stiffness", "damping", "loss_factor") for direction in cm.HINGE_DIRECTIONS},
                "frame": (*L.HINGES.vector_keys("frame_radial_1"), *L.HINGES.vector_keys("frame_axial"))},
     "Load cases": {"point": L.LOAD_CASES.vector_keys("force_point")},
+    "Links": {f"material.{key}": (key,) for key in _STRENGTH_KEYS},
     "Runs": {"frequency_hz": ("frequency",), "rpm": ("frequency",), "radial_clearance": ("gap",),
              "stiffness": ("hinge_stiffness",), "damping": ("hinge_damping",), "modes": ("fidelity",)},
 }
@@ -107,6 +109,7 @@ _FIELD_COLUMNS: dict[str, dict[str, tuple[str, ...]]] = {
 _ITEM_TABLES = {"link": L.LINKS, "hinge": L.HINGES, "static load": L.STATIC_LOADS, "excitation": L.EXCITATIONS,
                 "rotor": L.ROTORS, "load case": L.LOAD_CASES}
 _ITEM = re.compile(rf"^({'|'.join(_ITEM_TABLES)}) '(.*)'$")
+_SPECTRUM_ITEM = re.compile(r"^speed spectrum '(.*)'$")
 #: Item of a CaseError about the engine's casing (the Engine casing sheet's one row).
 _CASING_ITEM = "engine casing"
 
@@ -323,6 +326,19 @@ class _CaseReader(SheetReader):
                                                    thrust_point=vector("thrust_point"),
                                                    description=get("description", ""), **given))
 
+    def speed_band(self, record: Record) -> SpeedBand | None:
+        """A Speed spectrum row: hours at a speed, or in a band of speeds."""
+        get = record.get
+        return self.build(record, lambda: SpeedBand(get("hours"), get("speed_hz"), get("to_hz")))
+
+    def speed_spectra(self, bands: list) -> tuple:
+        """The ``(record, band)`` pairs of the Speed spectrum sheet as one spectrum per excitation."""
+        groups: dict[str, list] = {}
+        for record, band in bands:
+            groups.setdefault(record.get("excitation"), []).append((record, band))
+        return tuple(self.build(pairs[0][0], lambda name=name, pairs=pairs: SpeedSpectrum(
+            name, tuple(band for _, band in pairs)), ("hours",)) for name, pairs in groups.items())
+
     def excitations(self, records: list[Record]) -> list:
         """``(record, excitation)`` per excitation: one per row, or one per group
         of ``imbalance plane`` rows of the same name (at its first row)."""
@@ -467,6 +483,8 @@ class _CaseReader(SheetReader):
                  (("Links", self.link), ("Hinges", self.hinge), ("Static loads", self.static_load),
                   ("Rotors", self.rotor), (L.LOAD_CASES.sheet, self.load_case))}
         items["Excitations"] = self.excitations(tables["Excitations"])
+        items[L.SPEED_SPECTRUM.sheet] = [(r, self.speed_band(r) if r.ok else None)
+                                         for r in tables[L.SPEED_SPECTRUM.sheet]]
         first_links: dict[Any, Any] = {}
         for record, link in items["Links"]:
             first_links.setdefault(record.get("name"), link)
@@ -476,11 +494,16 @@ class _CaseReader(SheetReader):
             return None
         (analysis, effects), record = settings[0], tables["Case"][0]
         built: dict[str, tuple[Any, ...]] = {key: tuple(item for _, item in pairs) for key, pairs in items.items()}
+        spectra = self.speed_spectra(items[L.SPEED_SPECTRUM.sheet])
+        if None in spectra:
+            return None
         try:
-            return cm.Case(record.get("name"), cast(cm.Engine, engine[0]), built["Links"], built["Hinges"], built["Static loads"],
+            case = cm.Case(record.get("name"), cast(cm.Engine, engine[0]), built["Links"], built["Hinges"], built["Static loads"],
                            built["Excitations"], analysis=analysis, effects=effects,
                            description=record.get("description", ""), test_rig=test_rig[0] if test_rig else None,
-                           rotors=built["Rotors"], load_cases=built[L.LOAD_CASES.sheet])
+                           rotors=built["Rotors"], load_cases=built[L.LOAD_CASES.sheet], speed_spectra=spectra)
+            check_speed_spectra(case)
+            return case
         except cm.CaseError as exc:
             self.case_error(exc, items, tables[L.CASING.sheet])
         return None
@@ -534,6 +557,14 @@ class _CaseReader(SheetReader):
         if exc.item == _CASING_ITEM and casing:
             keys = _field_keys(L.CASING, exc.field)
             self.record_problem(casing[0], keys, casing[0].typed(keys, exc.value), exc.expected)
+            return
+        spectrum = _SPECTRUM_ITEM.match(exc.item)
+        if spectrum:
+            rows = [record for record, _ in items[L.SPEED_SPECTRUM.sheet] if record.get("excitation") == spectrum.group(1)]
+            band = re.match(r"bands\[(\d+)\]\.?(.*)$", exc.field)
+            record = rows[int(band.group(1))] if band else rows[0]
+            keys = (band.group(2) or "hours",) if band else ("excitation",)
+            self.record_problem(record, keys, record.typed(keys, exc.value), exc.expected)
             return
         match = _ITEM.match(exc.item)
         if match:

@@ -19,6 +19,9 @@ repeated on every printed page, every number formatted by its quantity
 - ``Model card``: the model card of every run;
 - ``Loads`` (a case with load cases): per load case and link the axial
   force, stresses and margins of safety (:mod:`workbook.excel.loads_sheet`);
+- ``Fatigue`` (a case asking for the links' strength): per excitation and
+  link the alternating and mean stress, Goodman and Gerber factors, and per
+  speed spectrum the Miner sum and life (:mod:`workbook.excel.fatigue_sheet`);
 - ``Metadata``: the input file and its SHA-256 as read, the files written
   and their SHA-256 as they are on disk after the write, versions, date.
 """
@@ -38,7 +41,7 @@ from openpyxl.styles import Alignment, Font, PatternFill
 from openpyxl.utils import get_column_letter
 
 from workbook.answers.isolation import efficiency, level_db
-from workbook.excel import loads_sheet
+from workbook.excel import fatigue_sheet, loads_sheet
 from workbook.excel.files import new_file_target, save_atomic, signed, untouched
 from workbook.excel.pictures import draw_pictures
 from workbook.excel.reader import CaseBook
@@ -333,7 +336,8 @@ def is_report(path: Path) -> bool:
 
 
 def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
-                 written: WriteOutcome | None = None, *, four_pole=None, pictures=None, loads=None) -> WriteOutcome:
+                 written: WriteOutcome | None = None, *, four_pole=None, pictures=None, loads=None,
+                 fatigue=None) -> WriteOutcome:
     """Write the report workbook of *runs* to *path* (atomically), or beside it.
 
     An existing *path* is replaced only if it is a report this module wrote,
@@ -357,6 +361,8 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
         default: drawn here.
     loads : pandas.DataFrame, optional
         The solved load cases (:func:`~workbook.excel.loads_sheet.loads_frame`): a Loads sheet.
+    fatigue : pandas.DataFrame, optional
+        The links' fatigue (:func:`~workbook.excel.fatigue_sheet.fatigue_frame`): a Fatigue sheet.
 
     Returns
     -------
@@ -378,6 +384,10 @@ def write_report(path: str | Path, book: CaseBook, runs: list[RunResult],
         ws = workbook.create_sheet("Loads")
         _title(ws, f"{book.case.name}: limit load cases", loads_sheet.NOTE)
         write_frame(ws, loads, top=4, fill=_HEADER_FILL, quantities=loads_sheet.QUANTITIES)
+    if fatigue is not None:
+        ws = workbook.create_sheet("Fatigue")
+        _title(ws, f"{book.case.name}: link fatigue", fatigue_sheet.NOTE)
+        write_frame(ws, fatigue, top=4, fill=_HEADER_FILL, quantities=fatigue_sheet.QUANTITIES)
     if four_pole is not None:
         four_pole_sheet(workbook.create_sheet(FOUR_POLE_SHEET), four_pole)
     _metadata(workbook.create_sheet("Metadata"), book, runs, written)

@@ -129,4 +129,5 @@ def case_for_run(case: Case, run: RunSpec) -> Case:
                         if getattr(run, name) is not None}
     analysis = dataclasses.replace(case.analysis, **analysis_changes) if analysis_changes else case.analysis
     return dataclasses.replace(case, name=f"{case.name} / {run.name}", links=links, hinges=hinges,
-                               excitations=(excitation,), effects=effects, analysis=analysis)
+                               excitations=(excitation,), effects=effects, analysis=analysis,
+                               speed_spectra=tuple(s for s in case.speed_spectra if s.excitation == excitation.name))

@@ -256,6 +256,8 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.STATIC_LOADS.sheet: [_row_for_load(load) for load in case.static_loads],
         L.EXCITATIONS.sheet: [row for e in case.excitations for row in _rows_for_excitation(e)],
         L.LOAD_CASES.sheet: [_row_for_load_case(load_case) for load_case in case.load_cases],
+        L.SPEED_SPECTRUM.sheet: [{"excitation": spectrum.excitation, "speed_hz": band.speed_hz, "to_hz": band.to_hz,
+                                  "hours": band.hours} for spectrum in case.speed_spectra for band in spectrum.bands],
         L.ROTORS.sheet: [_row_for_rotor(rotor) for rotor in case.rotors],
         L.TEST_RIG.sheet: _rows_for_test_rig(case.test_rig),
         L.CASING.sheet: _rows_for_casing(case.engine.casing),
@@ -356,11 +358,13 @@ def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPo
 
 
 def template_workbook() -> Workbook:
-    """The case template: the reference mount as example rows, with example runs and the reference load cases."""
+    """The case template: the reference mount as example rows, with example runs, the reference load cases and
+    speed spectra."""
     from workbook.model.reference import reference_case
+    from workbook.model.spectrum import reference_speed_spectra
 
-    return case_workbook(dataclasses.replace(reference_case(sweep=True), load_cases=reference_load_cases()),
-                         TEMPLATE_RUNS)
+    return case_workbook(dataclasses.replace(reference_case(sweep=True), load_cases=reference_load_cases(),
+                                             speed_spectra=reference_speed_spectra()), TEMPLATE_RUNS)
 
 
 def reference_workbook() -> Workbook:

@@ -3,7 +3,8 @@
 Result sheets are named ``Result efficiency``, ``Result hinges``, ``Result
 sweep``, ``Result model card`` and, for a case with load cases, ``Result
 loads`` (:mod:`workbook.excel.loads_sheet`: rewritten whole when the load
-cases were solved, kept as it was otherwise); each carries, in a hidden cell, a marker
+cases were solved, kept as it was otherwise), and ``Result fatigue``
+(:mod:`workbook.excel.fatigue_sheet`, the same way); each carries, in a hidden cell, a marker
 naming the sheet it was written as. A later run rewrites a sheet only when
 its name is one of these and its marker names that same sheet, and only the
 rows of the runs it computed: the rows of the workbook's other runs stay as
@@ -47,7 +48,7 @@ from openpyxl.styles import Font, PatternFill
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
 from workbook.answers.results import PYLON_SUM, MountResult
-from workbook.excel import loads_sheet
+from workbook.excel import fatigue_sheet, loads_sheet
 from workbook.excel.files import (
     ChangedOnDisk,
     held,
@@ -228,13 +229,16 @@ _NOTES = {
 
 #: Title of the load cases' result sheet.
 LOADS_SHEET = _sheet_title("loads")
+#: Title of the links' fatigue result sheet.
+FATIGUE_SHEET = _sheet_title("fatigue")
 #: Every sheet title a write may create (and so may replace).
-RESULT_SHEETS = (*(_sheet_title(name) for name in (*_NOTES, "model card")), LOADS_SHEET)
+RESULT_SHEETS = (*(_sheet_title(name) for name in (*_NOTES, "model card")), LOADS_SHEET, FATIGUE_SHEET)
 
 
-def result_sheet_names(frames: dict, loads=None) -> list[str]:
-    """Titles of the result sheets a write creates (with *loads*, a loads table: its sheet too)."""
-    return [_sheet_title(name) for name in frames] + [_sheet_title("model card")] + ([LOADS_SHEET] if loads is not None else [])
+def result_sheet_names(frames: dict, loads=None, fatigue=None) -> list[str]:
+    """Titles of the result sheets a write creates (with *loads* or *fatigue*, a table: its sheet too)."""
+    return ([_sheet_title(name) for name in frames] + [_sheet_title("model card")]
+            + [title for title, table in ((LOADS_SHEET, loads), (FATIGUE_SHEET, fatigue)) if table is not None])
 
 
 def _merged(earlier: list[tuple], fresh: list[tuple], computed: set[str]) -> list:
@@ -285,7 +289,7 @@ def _kept_note(earlier: list[tuple], computed: set[str]) -> str:
 
 
 def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, frames: dict | None = None,
-                      loads=None) -> list[str]:
+                      loads=None, fatigue=None) -> list[str]:
     """Add the result sheets of *runs* to an openpyxl *workbook*.
 
     The result sheets a write made before are rewritten: the rows and model
@@ -293,15 +297,17 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
     are kept as they were (the sheet's note names them). *frames* are
     ``result_frames(runs, tests)`` when the caller has them already.
     *loads* (:func:`~workbook.excel.loads_sheet.loads_frame`) replaces the
-    loads sheet whole; without it an earlier loads sheet is kept.
+    loads sheet whole; without it an earlier loads sheet is kept; *fatigue*
+    (:func:`~workbook.excel.fatigue_sheet.fatigue_frame`) likewise the fatigue sheet.
 
     Returns
     -------
     list of str
         The sheet titles written.
     """
+    whole = {LOADS_SHEET: (loads, loads_sheet), FATIGUE_SHEET: (fatigue, fatigue_sheet)}
     earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)
-               and (loads is not None or ws.title != LOADS_SHEET)}
+               and (ws.title not in whole or whole[ws.title][0] is not None)}
     computed = {run.spec.name for run in runs}
     frames = result_frames(runs, tests) if frames is None else frames
     tables = {}
@@ -330,13 +336,15 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
     ws.cell(1, 1, stamp + _kept_note(cards, computed)).font = Font(italic=True)
     print_setup(ws)
     _mark(ws)
-    if loads is None:
-        return [*tables, ws.title]
-    ws = workbook.create_sheet(LOADS_SHEET)
-    ws.cell(1, 1, f"{loads_sheet.NOTE}. {stamp}").font = Font(italic=True)
-    write_frame(ws, loads, top=2, fill=_HEADER_FILL, quantities=loads_sheet.QUANTITIES)
-    _mark(ws)
-    return [*tables, _sheet_title("model card"), ws.title]
+    written = [*tables, ws.title]
+    for title, (table, module) in whole.items():
+        if table is not None:
+            ws = workbook.create_sheet(title)
+            ws.cell(1, 1, f"{module.NOTE}. {stamp}").font = Font(italic=True)
+            write_frame(ws, table, top=2, fill=_HEADER_FILL, quantities=module.QUANTITIES)
+            _mark(ws)
+            written.append(title)
+    return written
 
 
 def _conflicts(workbook, titles: list[str]) -> list[str]:
@@ -394,7 +402,7 @@ def _cached_formula_values(path: Path, workbook, values=None) -> dict[int, dict[
 
 
 def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = (), *,
-                  opened=None, loads=None) -> WriteOutcome:
+                  opened=None, loads=None, fatigue=None) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
     Parameters
@@ -410,6 +418,8 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         without loading the file again, while the file is unchanged.
     loads : pandas.DataFrame, optional
         The solved load cases (:func:`~workbook.excel.loads_sheet.loads_frame`): the loads sheet.
+    fatigue : pandas.DataFrame, optional
+        The links' fatigue (:func:`~workbook.excel.fatigue_sheet.fatigue_frame`): the fatigue sheet.
 
     Returns
     -------
@@ -418,12 +428,12 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
     frames = result_frames(runs, tests)
-    titles = result_sheet_names(frames, loads)
+    titles = result_sheet_names(frames, loads, fatigue)
     with held(path):
         reason, workbook, values = _reason_not_to_overwrite(path, sha256, titles, opened)
         if reason is None:
             log.info("building the new %s with the results", path.name)
-            add_result_sheets(workbook, runs, tests, stamp, frames, loads)
+            add_result_sheets(workbook, runs, tests, stamp, frames, loads, fatigue)
             data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook, values))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
@@ -434,7 +444,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
                 reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
-    add_result_sheets(separate, runs, tests, stamp, frames, loads)
+    add_result_sheets(separate, runs, tests, stamp, frames, loads, fatigue)
     target = save_atomic(separate, name_beside(path, "results"))
     log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)

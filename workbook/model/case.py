@@ -35,6 +35,7 @@ from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_legacy import accept_legacy_pylons, legacy_pylon
 from workbook.model.pylon_mesh import MeshPylon
+from workbook.model.spectrum import SpeedSpectrum
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
@@ -1189,6 +1190,11 @@ class Case:
         Named static limit load cases for the links' strength
         (:mod:`workbook.model.load_cases`, solved by
         :mod:`workbook.solve.load_cases`); the runs do not use them.
+    speed_spectra : tuple of SpeedSpectrum
+        The hours each rotor excitation runs at each speed, for the links'
+        Miner damage sums (:mod:`workbook.model.spectrum`, solved by
+        :mod:`workbook.solve.fatigue`); one per excitation; the runs do not
+        use them.
     """
 
     name: str
@@ -1204,6 +1210,7 @@ class Case:
     rotors: tuple[Rotor, ...] = ()
     pylon: PylonModel | None = None
     load_cases: tuple[LoadCase, ...] = ()
+    speed_spectra: tuple[SpeedSpectrum, ...] = ()
 
     def __post_init__(self):
         fields.nonempty_name("case", self.name)
@@ -1224,6 +1231,16 @@ class Case:
                     raise CaseError("case", name, item, " or ".join(k.__name__ for k in kinds))
             _set(self, name, items)
         owners = self._check_names(groups)
+        spectra = tuple(self.speed_spectra)
+        seen: set = set()
+        for spectrum in spectra:
+            if not isinstance(spectrum, SpeedSpectrum):
+                raise CaseError("case", "speed_spectra", spectrum, "a SpeedSpectrum")
+            if spectrum.excitation in seen:
+                raise CaseError(f"speed spectrum {spectrum.excitation!r}", "excitation", spectrum.excitation,
+                                "one speed spectrum per excitation")
+            seen.add(spectrum.excitation)
+        _set(self, "speed_spectra", spectra)
         if self.pylon is not None:
             if not isinstance(self.pylon, PylonModel):
                 raise CaseError("case", "pylon", self.pylon, "a PylonImpedance, BoxBeamPylon, MeshPylon or None")

@@ -21,6 +21,7 @@ from workbook.model.pylon_beam import BoxBeamPylon
 from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_legacy import LEGACY_PYLON_FIELDS
 from workbook.model.pylon_mesh import MeshPylon
+from workbook.model.spectrum import SpeedBand, SpeedSpectrum
 
 __all__ = ["to_dict", "from_dict", "to_json", "from_json"]
 
@@ -35,6 +36,7 @@ def _registry() -> dict[str, type]:
                _case.ImbalancePlane, _case.Imbalance, _case.RunUp, _case.Simultaneous,
                _case.Sweep, _case.Rotor, _case.ForceTransducers, _case.AnalysisSettings, _case.Effects,
                PylonImpedance, BoxBeamPylon, MeshPylon, EngineCasing, CasingGeometry, MountRing, LoadCase,
+               SpeedSpectrum, SpeedBand,
                flexbodies.LinkModel,
                flexbodies.LinkGeometry, flexbodies.Material, flexbodies.MeshSource, BoreSpec]
     return {cls.__name__: cls for cls in classes}

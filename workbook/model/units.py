@@ -56,7 +56,7 @@ def _parse(text: str):
 
 
 #: The SI unit texts of the sheets' columns: a unit cell holding its column's own SI unit needs no conversion.
-_SI_UNITS = frozenset(("1/s", "Hz", "N", "N*m", "N*s/m", "N/m", "Pa", "deg", "kg", "kg*m", "kg*m^2", "kg/m^3", "m",
+_SI_UNITS = frozenset(("1/s", "Hz", "N", "h", "N*m", "N*s/m", "N/m", "Pa", "deg", "kg", "kg*m", "kg*m^2", "kg/m^3", "m",
                        "m/s^2", "s"))
 
 #: (unit text, SI unit) -> the factor pint gives, for the units engineers type most (the template's among

@@ -27,8 +27,27 @@ with its node, its stresses and its Gerber factor, and the peak alternating
 stress. Every single-frequency excitation is answered alone: each point of a
 sweep (a speed of a run-up) and each part of a simultaneous excitation, by
 the harmonic model of :mod:`workbook.solve.harmonic` (for a case with hinge
-clearance, linearised about the preload). A Miner damage sum over a speed
-spectrum is not computed.
+clearance, linearised about the preload).
+
+A speed spectrum of a rotor (:class:`~workbook.model.spectrum.SpeedSpectrum`:
+hours at each speed) gives each link's Miner damage sum ``D = sum n_i / N_i``
+over its speeds, each speed one harmonic solve of the rotor's excitation:
+
+- at every node the Goodman-equivalent fully reversed stress
+  ``sigma_ar = sigma_a / (1 - sigma_m / S_u)`` (``sigma_a`` for a
+  compressive mean; infinite, a static failure, for ``sigma_m >= S_u``);
+- the cycles ``n_i = f_i x 3600 x hours_i`` (one per revolution, f in Hz);
+- the cycles to failure of the material's S-N curve,
+  ``N = N_e (sigma_ar / S_e)^(1/b)`` (Basquin through the knee
+  ``(N_e, S_e)``); a stress at or below the endurance strength does no
+  damage (``N`` infinite: Miner's rule with an endurance limit);
+- ``D`` the largest node sum over the link, the life ``spectrum hours / D``
+  (infinite for ``D = 0``).
+
+Several rotors' damages add per flight hour: the link's life under all its
+spectra is ``1 / sum(D_r / hours_r)`` (the rotors' stresses are counted
+apart, as if they did not superpose). The case's gyroscopic rotors keep
+their speed.
 """
 from __future__ import annotations
 
@@ -40,9 +59,11 @@ import numpy as np
 from flexbodies.stress import REGIONS, alternating_von_mises, gerber_factor, goodman_factor, link_regions, signed_von_mises, state_stress
 from workbook.errors import CaseError
 from workbook.model.case import Case, Simultaneous, Sweep
+from workbook.model.spectrum import SECONDS_PER_HOUR, SpeedSpectrum, check_speed_spectra
 from workbook.solve.load_cases import link_coordinates
 
-__all__ = ["LinkFatigue", "ExcitationFatigue", "FatigueResult", "link_fatigue", "solve_fatigue"]
+__all__ = ["LinkFatigue", "ExcitationFatigue", "LinkDamage", "SpectrumDamage", "FatigueResult", "link_fatigue",
+           "equivalent_alternating", "cycles_to_failure", "miner_damage", "solve_fatigue"]
 
 
 @dataclass(frozen=True)
@@ -98,6 +119,55 @@ class ExcitationFatigue:
 
 
 @dataclass(frozen=True)
+class LinkDamage:
+    """The Miner damage sum of one link over one speed spectrum.
+
+    Attributes
+    ----------
+    link : str
+    damage : float
+        The largest Miner sum ``D`` over the link's nodes, dimensionless.
+    life_hours : float
+        Spectrum hours over ``D``, h (inf: no damage).
+    equivalent : float
+        The largest Goodman-equivalent alternating stress over the nodes and
+        speeds, Pa.
+    speed_hz : float
+        The speed of that stress, Hz.
+    region : str
+        Where the node of the largest damage is (of the largest equivalent
+        stress when nothing is damaged).
+    point : tuple of 3 floats
+        That node, global coordinates of the undeformed link, m.
+    """
+
+    link: str
+    damage: float
+    life_hours: float
+    equivalent: float
+    speed_hz: float
+    region: str
+    point: tuple
+
+
+@dataclass(frozen=True)
+class SpectrumDamage:
+    """The damage of every flexible link over one rotor's speed spectrum.
+
+    Attributes
+    ----------
+    spectrum : SpeedSpectrum
+    speeds : tuple of (float, float, float)
+        ``(speed Hz, hours, cycles)`` of each speed solved.
+    links : dict of str to LinkDamage
+    """
+
+    spectrum: SpeedSpectrum
+    speeds: tuple
+    links: dict
+
+
+@dataclass(frozen=True)
 class FatigueResult:
     """What :func:`solve_fatigue` gives.
 
@@ -113,6 +183,8 @@ class FatigueResult:
         excitations, s.
     reduced : dict of str to flexbodies.ReducedLink
         The flexible links of that run (their meshes and stress shapes).
+    spectra : list of SpectrumDamage
+        The Miner sums of the case's speed spectra.
     """
 
     case: str
@@ -120,15 +192,30 @@ class FatigueResult:
     mean_stress: dict = field(repr=False)
     stress_seconds: float
     reduced: dict = field(repr=False)
+    spectra: list = field(default_factory=list)
+
+    def life_hours(self) -> dict:
+        """Each link's life under all the spectra, ``1 / sum(D_r / hours_r)``, h (inf: no damage)."""
+        rate: dict = {}
+        for answer in self.spectra:
+            for name, damage in answer.links.items():
+                rate[name] = rate.get(name, 0.0) + damage.damage / answer.spectrum.hours
+        with np.errstate(divide="ignore"):
+            return {name: float(np.divide(1.0, value)) for name, value in rate.items()}
 
     def to_dict(self) -> dict:
-        """JSON-ready, SI units (without the stress fields)."""
+        """JSON-ready, SI units but hours (without the stress fields)."""
         import dataclasses
 
         return {"case": self.case, "stress_seconds": self.stress_seconds,
                 "excitations": [{"excitation": e.excitation, "frequency_hz": e.frequency_hz,
                                  "links": {name: dataclasses.asdict(f) for name, f in e.links.items()}}
-                                for e in self.excitations]}
+                                for e in self.excitations],
+                "spectra": [{"excitation": d.spectrum.excitation, "hours": d.spectrum.hours,
+                             "speeds": [{"speed_hz": f, "hours": h, "cycles": n} for f, h, n in d.speeds],
+                             "links": {name: dataclasses.asdict(x) for name, x in d.links.items()}}
+                            for d in self.spectra],
+                "life_hours": self.life_hours()}
 
 
 def _strengths(case: Case) -> None:
@@ -174,8 +261,117 @@ def link_fatigue(link, reduced, mean_coordinates, amplitude: np.ndarray, rotatio
                        float(goodman[i]), float(gerber.min()), REGIONS[regions[i]], tuple(float(x) for x in point))
 
 
+def equivalent_alternating(alternating, mean, ultimate: float) -> np.ndarray:
+    """Goodman-equivalent fully reversed stress ``sigma_a / (1 - sigma_m / S_u)``.
+
+    A compressive mean is taken as zero (``sigma_a``, as :func:`flexbodies.stress.goodman_factor`
+    does); a mean at or beyond the ultimate strength gives inf (a static failure).
+
+    Parameters
+    ----------
+    alternating, mean : array_like
+        Equivalent alternating and signed mean stress, Pa.
+    ultimate : float
+        Ultimate strength S_u, Pa.
+
+    Returns
+    -------
+    ndarray, Pa
+    """
+    remaining = 1.0 - np.maximum(np.asarray(mean, float), 0.0) / ultimate
+    alternating = np.asarray(alternating, float)
+    with np.errstate(divide="ignore"):
+        return np.where(remaining > 0.0, alternating / np.where(remaining > 0.0, remaining, 1.0), np.inf)
+
+
+def cycles_to_failure(equivalent, material) -> np.ndarray:
+    """Cycles to failure ``N_e (sigma_ar / S_e)^(1/b)`` of the material's S-N curve; inf at or below ``S_e``.
+
+    Parameters
+    ----------
+    equivalent : array_like
+        Fully reversed stress amplitude, Pa.
+    material : flexbodies.Material
+        With endurance strength, endurance cycles and fatigue exponent.
+    """
+    ratio = np.asarray(equivalent, float) / material.endurance_strength
+    above = ratio > 1.0
+    with np.errstate(over="ignore", divide="ignore"):
+        return np.where(above, material.endurance_cycles * np.where(above, ratio, 2.0) ** (1.0 / material.fatigue_exponent),
+                        np.inf)
+
+
+def miner_damage(equivalents, cycles, material) -> np.ndarray:
+    """Miner's sum ``sum_i n_i / N_i`` at each node.
+
+    Parameters
+    ----------
+    equivalents : sequence of array_like, shape (n,)
+        Goodman-equivalent stress at the nodes at each speed, Pa.
+    cycles : sequence of float
+        The cycles n_i at each speed.
+    material : flexbodies.Material
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    total = np.zeros(np.shape(equivalents[0]))
+    with np.errstate(divide="ignore"):    # N = 0 (a static failure): infinite damage
+        for equivalent, n in zip(equivalents, cycles, strict=True):
+            total += n / cycles_to_failure(equivalent, material)
+    return total
+
+
+def _solved(case: Case, points: tuple, reduced: dict | None):
+    """Yield ``(point, scene, means, result)`` per single-frequency *points*, on one prepared scene."""
+    from workbook.solve.pipeline import prepare
+
+    highest = max(points, key=lambda point: point.frequency)
+    prepared = prepare(case, points[0], reduce_for=highest, reduced=reduced)
+    scene, model = prepared.scene, prepared.model
+    assert model is not None
+    with scene:
+        means = link_coordinates(scene)
+        for point in points:
+            yield point, scene, means, model.result(point, case.analysis.steady_tolerance)
+
+
+def _spectrum_damage(case: Case, spectrum: SpeedSpectrum, reduced: dict | None) -> SpectrumDamage:
+    """The Miner sums of every flexible link over *spectrum* (see the module)."""
+    speeds = spectrum.points()
+    cycles = [f * SECONDS_PER_HOUR * hours for f, hours in speeds]
+    points = tuple(spectrum.at(case.excitations, f) for f, _ in speeds)
+    equivalents: dict = {}
+    found: dict = {}
+    for _, scene, means, result in _solved(case, points, reduced):
+        for name in (name for name in case.link_map if name in means):
+            link, body = case.link_map[name], scene.reduced[name]
+            if name not in found:
+                found[name] = (signed_von_mises(state_stress(body, means[name])), link_regions(body),
+                               scene.links[name].rotation, body)
+            alternating = alternating_von_mises(state_stress(body, result.link_phasors[name]))
+            equivalents.setdefault(name, []).append(
+                equivalent_alternating(alternating, found[name][0], link.model.material.ultimate_strength))
+    links = {}
+    for name, stresses in equivalents.items():
+        link = case.link_map[name]
+        _, regions, rotation, body = found[name]
+        damage = miner_damage(stresses, cycles, link.model.material)
+        peaks = np.array([s.max() for s in stresses])
+        k = int(np.argmax(peaks))
+        i = int(np.argmax(damage)) if damage.max() > 0 else int(np.argmax(stresses[k]))
+        total = float(damage.max())
+        point = np.asarray(link.end_a) + rotation @ body.nodes[i]
+        with np.errstate(divide="ignore"):
+            life = float(np.divide(spectrum.hours, total))
+        links[name] = LinkDamage(name, total, life, float(peaks[k]), speeds[k][0], REGIONS[regions[i]],
+                                 tuple(float(x) for x in point))
+    return SpectrumDamage(spectrum, tuple((f, h, n) for (f, h), n in zip(speeds, cycles, strict=True)), links)
+
+
 def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
-    """Dynamic stresses and fatigue factors of every single-frequency excitation of *case* (see the module).
+    """Dynamic stresses, fatigue factors and Miner sums of *case* (see the module).
 
     Parameters
     ----------
@@ -193,13 +389,14 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
     ------
     CaseError
         A flexible link's material without an endurance or ultimate
-        strength, or a flexible pylon.
+        strength (or, with speed spectra, an S-N parameter), a spectrum the
+        case cannot answer (:func:`~workbook.model.spectrum.check_speed_spectra`),
+        or a flexible pylon.
     workbook.errors.SimulationError
         A mechanism, a failed preload or an excitation on an undamped mode.
     """
-    from workbook.solve.pipeline import prepare
-
     _strengths(case)
+    check_speed_spectra(case)
     if case.flexible_pylon:
         raise CaseError(f"case {case.name!r}", "pylon", "a flexible pylon",
                         "a rigid pylon: the link stresses are recovered on the mount's own scene")
@@ -209,26 +406,18 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
     seconds = 0.0
     for item in case.excitations:
         points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
-        highest = max(points, key=lambda point: point.frequency)
-        prepared = prepare(case, points[0], reduce_for=highest, reduced=reduced)
-        scene, model = prepared.scene, prepared.model
-        assert model is not None
-        with scene:
-            means = link_coordinates(scene)
-            flexible = [link for link in case.links if link.name in means]
-            for point in points:
-                result = model.result(point, case.analysis.steady_tolerance)
-                start = time.perf_counter()
-                amplitudes, links = {}, {}
-                for link in flexible:
-                    body = scene.reduced[link.name]
-                    amplitudes[link.name] = state_stress(body, result.link_phasors[link.name])
-                    links[link.name] = link_fatigue(link, body, means[link.name], amplitudes[link.name],
-                                                    scene.links[link.name].rotation)
-                seconds += time.perf_counter() - start
-                answers.append(ExcitationFatigue(point.name, point.frequency, links, amplitudes))
+        for point, scene, means, result in _solved(case, points, reduced):
+            start = time.perf_counter()
+            amplitudes, links = {}, {}
+            for name in (name for name in case.link_map if name in means):
+                body = scene.reduced[name]
+                amplitudes[name] = state_stress(body, result.link_phasors[name])
+                links[name] = link_fatigue(case.link_map[name], body, means[name], amplitudes[name],
+                                           scene.links[name].rotation)
+            seconds += time.perf_counter() - start
+            answers.append(ExcitationFatigue(point.name, point.frequency, links, amplitudes))
             if not mean_stress:
                 mean_stress = {name: state_stress(scene.reduced[name], q) for name, q in means.items()}
                 first = {name: scene.reduced[name] for name in means}
-    return FatigueResult(case.name, answers, mean_stress, seconds, first)
-
+    spectra = [_spectrum_damage(case, spectrum, reduced) for spectrum in case.speed_spectra]
+    return FatigueResult(case.name, answers, mean_stress, seconds, first, spectra)
