@@ -110,6 +110,8 @@ def bearing_load(link_mesh, bore, direction, force: float) -> np.ndarray:
     """
     import skfem
 
+    from .meshing import surface_basis
+
     mesh = link_mesh.mesh
     axis = np.asarray(bore.axis, float) / np.linalg.norm(bore.axis)
     push = np.asarray(direction, float)
@@ -119,8 +121,8 @@ def bearing_load(link_mesh, bore, direction, force: float) -> np.ndarray:
     on_bore[bore.nodes] = True
     facets = mesh.boundary_facets()
     facets = facets[on_bore[mesh.facets[:, facets]].all(axis=0)]
-    basis = skfem.FacetBasis(mesh, mesh.elem(), facets=facets, intorder=4)
-    centre = np.asarray(bore.centre, float)
+    basis, origin = surface_basis(mesh, facets)
+    centre = np.asarray(bore.centre, float) - origin
 
     def radial(x):
         rel = np.stack([x[i] - centre[i] for i in range(3)])

@@ -36,7 +36,7 @@ from .errors import LinkModelError
 from .geometry import LinkGeometry, default_element_size
 
 __all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "mesh_pieces", "default_element_size", "gmsh_model",
-           "generate_tet10", "refine_near", "skfem_mesh"]
+           "generate_tet10", "refine_near", "skfem_mesh", "surface_basis"]
 
 logger = logging.getLogger(__name__)
 
@@ -590,12 +590,32 @@ def _no_bore_message(spec, source, tol, dist, centre, axis) -> str:
             "from the axis (check the centre, radius and the mesh's scale)")
 
 
+def surface_basis(mesh, facets: np.ndarray) -> tuple:
+    """A scikit-fem basis on some boundary faces of *mesh*, made about their own middle.
+
+    scikit-fem finds the quadrature points' element coordinates by Newton's
+    method to an absolute tolerance of 1e-12, which round-off defeats for
+    small curved elements a metre from the origin: the basis is made on the
+    mesh moved so that the faces' middle is at the origin.
+
+    Returns
+    -------
+    basis : skfem.FacetBasis
+        On the moved mesh (the same nodes, elements and faces).
+    origin : ndarray, shape (3,)
+        Where the faces' middle is, m: add it to the basis's coordinates.
+    """
+    origin = mesh.doflocs[:, np.unique(mesh.facets[:, facets])].mean(axis=1)
+    moved = mesh.translated(-origin)
+    return skfem.FacetBasis(moved, moved.elem(), facets=facets, intorder=_SURFACE_INTORDER), origin
+
+
 def _bore_from_facets(mesh, name: str, facets: np.ndarray, nominal) -> Bore:
     """Integrate shape functions over the bore faces; fit or adopt centre, axis, radius."""
-    fb = skfem.FacetBasis(mesh, mesh.elem(), facets=facets, intorder=_SURFACE_INTORDER)
+    fb, origin = surface_basis(mesh, facets)
     weights = skfem.asm(_unit_load, fb)
     nodes = np.unique(fb.get_dofs(facets=facets).flatten())
-    x = np.asarray(fb.global_coordinates())  # (3, faces, points)
+    x = np.asarray(fb.global_coordinates()) + origin[:, None, None]  # (3, faces, points)
     dx = fb.dx
     area = dx.sum()
     centroid = np.einsum("ifq,fq->i", x, dx) / area
