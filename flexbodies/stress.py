@@ -324,8 +324,9 @@ def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
     q = np.asarray(modal_coordinates)
     n = shapes.shape[0]
     matrix = shapes.reshape(6 * n, -1)
-    if np.iscomplexobj(q):  # two real products: no complex copy of the shapes
-        return (matrix @ q.real + 1j * (matrix @ q.imag)).reshape(n, 6)
+    if np.iscomplexobj(q):  # one real product of two columns: no complex copy of the shapes, read once
+        parts = matrix @ np.stack([q.real, q.imag], axis=1)
+        return (parts[:, 0] + 1j * parts[:, 1]).reshape(n, 6)
     return (matrix @ q).reshape(n, 6)
 
 

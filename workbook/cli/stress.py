@@ -89,8 +89,9 @@ def print_bore_convergence(study) -> None:
               "meshes: not converged, do not use them as they are")
     nodes = max(max(pair) for pair in study.meshes.values())
     seconds = sum(sum(pair) for pair in study.seconds.values())
-    print(f"  cost: {2 * len(study.meshes)} refined sub-models (up to {nodes} FE nodes), {seconds:.0f} s to mesh, "
-          "assemble and solve when first asked; their peaks are kept in the link cache")
+    print(f"  cost: {2 * len(study.meshes)} refined sub-models of {len(study.meshes)} distinct links (up to {nodes} "
+          f"FE nodes), {seconds:.0f} s to mesh, assemble and solve when first asked; their peaks are kept in the "
+          "link cache and loaded since")
     if study.skipped:
         print(f"  not refined (links from mesh files): {', '.join(study.skipped)}")
 

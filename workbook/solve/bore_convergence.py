@@ -61,10 +61,11 @@ class BoreStudy:
     ----------
     rows : list of BoreConvergence
     meshes : dict of str to tuple of 2 ints
-        FE nodes of each link's two refined meshes.
+        FE nodes of the two refined meshes of each distinct link model, by
+        the names of the links that share it (joined by ", ").
     seconds : dict of str to tuple of 2 floats
-        Time of meshing, assembling and solving each link's two meshes
-        when they were computed (kept in the link cache with the peaks), s.
+        Time of meshing, assembling and solving those two meshes when they
+        were computed (kept in the link cache with the peaks), s.
     skipped : tuple of str
         Links without a parametric geometry (a mesh file is not refined).
     """
@@ -95,6 +96,7 @@ def bore_convergence(case, results) -> BoreStudy:
     from flexbodies.bore_stress import bore_peaks, convergence_sizes
 
     peaks: dict = {}
+    sharing: dict = {}
     skipped = []
     for link in case.links:
         if link.model is None or not link.flexible:
@@ -103,6 +105,7 @@ def bore_convergence(case, results) -> BoreStudy:
             skipped.append(link.name)
             continue
         peaks[link.name] = [bore_peaks(link.model, size) for size in convergence_sizes(link.model)]
+        sharing.setdefault(link.model.key(), []).append(link.name)
     rows = []
     for result in results:
         for name, stress in result.links.items():
@@ -113,5 +116,6 @@ def bore_convergence(case, results) -> BoreStudy:
             rows.append(BoreConvergence(result.load_case.name, name, stress.axial_force, stress.von_mises,
                                         tuple(p.bore_element_size for p in peaks[name]), (coarse, fine), change,
                                         abs(change) <= CONVERGENCE_TOLERANCE))
-    return BoreStudy(rows, {name: tuple(p.nodes for p in found) for name, found in peaks.items()},
-                     {name: tuple(p.seconds for p in found) for name, found in peaks.items()}, tuple(skipped))
+    distinct = {", ".join(names): peaks[names[0]] for names in sharing.values()}
+    return BoreStudy(rows, {names: tuple(p.nodes for p in found) for names, found in distinct.items()},
+                     {names: tuple(p.seconds for p in found) for names, found in distinct.items()}, tuple(skipped))
