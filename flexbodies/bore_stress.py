@@ -78,12 +78,15 @@ class BorePeaks:
 
 
 def convergence_sizes(model) -> tuple[float, float]:
-    """The bore element sizes (m) of a link model's two refined meshes: :data:`BORE_DIVISIONS` per bore circumference."""
+    """The bore element sizes (m) of a link model's two refined meshes: :data:`BORE_DIVISIONS` per bore
+    circumference, at most the link's element size."""
     if model.geometry is None:
         raise LinkModelError("the bore peak needs a parametric link geometry to mesh again; "
                              "a link from a mesh file is not refined")
-    radius = model.geometry.bore_radius
-    coarse, fine = (2 * np.pi * radius / n for n in BORE_DIVISIONS)
+    from .geometry import default_element_size
+
+    size = model.element_size if model.element_size is not None else default_element_size(model.geometry)
+    coarse, fine = (min(2 * np.pi * model.geometry.bore_radius / n, size) for n in BORE_DIVISIONS)
     return coarse, fine
 
 

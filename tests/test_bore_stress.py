@@ -89,10 +89,10 @@ def test_bearing_load_pushes_one_half_of_the_bore_with_the_given_resultant():
 def test_bore_peaks_per_newton_are_kept_in_the_cache(tmp_path):
     geometry = LinkGeometry(length=0.20, eye_outer_radius=0.020, bore_radius=0.010, thickness=0.012,
                             shank_width=0.025, shank_thickness=0.012)
-    model = LinkModel(geometry=geometry, material=STEEL)
+    model = LinkModel(geometry=geometry, material=STEEL, element_size=0.008)    # coarse: the test's time
     sizes = convergence_sizes(model)
-    np.testing.assert_allclose(sizes, [2 * np.pi * 0.010 / n for n in BORE_DIVISIONS])
-    size = 0.0048                                                   # the link's own size: the test's time
+    np.testing.assert_allclose(sizes, [min(2 * np.pi * 0.010 / n, 0.008) for n in BORE_DIVISIONS])
+    size = 0.008
     peaks = bore_peaks(model, size, cache_dir=tmp_path)
     net_section = 2 * (geometry.eye_outer_radius - geometry.bore_radius) * geometry.thickness
     # a pin-loaded eye of d/H = 0.5: a concentration of a few times the net-section stress, the
@@ -102,3 +102,37 @@ def test_bore_peaks_per_newton_are_kept_in_the_cache(tmp_path):
     assert peaks.peak(-2e4) == pytest.approx(2e4 * max(peaks.compression))
     again = bore_peaks(model, size, cache_dir=tmp_path)
     assert again == peaks and len(list(tmp_path.glob("bores-*.json"))) == 1
+
+
+@pytest.mark.slow
+def test_load_case_bore_peaks_follow_the_axial_force_on_both_meshes(cache_dir, monkeypatch):
+    from types import SimpleNamespace
+
+    import flexbodies.bore_stress as bore_stress
+    from workbook.model.case import Link
+    from workbook.model.load_cases import LoadCase
+    from workbook.solve.bore_convergence import CONVERGENCE_TOLERANCE, bore_convergence
+    from workbook.solve.load_cases import LinkStress, LoadCaseResult
+
+    monkeypatch.setattr(bore_stress, "BORE_DIVISIONS", (8, 10))   # a coarse pair: the test's time
+    geometry = LinkGeometry(length=0.20, eye_outer_radius=0.020, bore_radius=0.010, thickness=0.012,
+                            shank_width=0.025, shank_thickness=0.012)
+    model = LinkModel(geometry=geometry, material=STEEL, element_size=0.008)
+    case = SimpleNamespace(links=(Link("bar", (0.0, 0.0, 0.0), (0.20, 0.0, 0.0), model),
+                                  Link("twin", (0.0, 1.0, 0.0), (0.20, 1.0, 0.0), model)))
+    results = [LoadCaseResult(LoadCase(name), {}, np.zeros(3), np.zeros(3), np.zeros(3), np.zeros(3),
+                              {"bar": LinkStress("bar", force, None, None, von_mises=1e6),
+                               "twin": LinkStress("twin", -force, None, None, von_mises=1e6)}, 0.0)
+               for name, force in (("pull", 2e4), ("light", 5e2))]
+    study = bore_convergence(case, results)
+    assert [(row.load_case, row.link) for row in study.rows] == [("pull", "bar"), ("pull", "twin"),
+                                                                  ("light", "bar"), ("light", "twin")]
+    assert list(study.meshes) == ["bar, twin"]                     # one model, meshed once per size
+    pair = [bore_peaks(model, size, cache_dir=cache_dir) for size in convergence_sizes(model)]
+    for row in study.rows:
+        np.testing.assert_allclose(row.peaks, [p.peak(row.axial_force) for p in pair])
+        assert row.change == pytest.approx(row.peaks[1] / row.peaks[0] - 1)
+        assert row.converged == (abs(row.change) <= CONVERGENCE_TOLERANCE)
+    # the same relative change at any force of one sign: the peak is linear in it
+    assert study.rows[0].change == pytest.approx(study.rows[2].change)
+    assert study.rows[1].peaks[0] < study.rows[0].peaks[0]        # compression bears on the other half
