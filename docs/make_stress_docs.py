@@ -8,8 +8,12 @@ loads (1 g and the cruise thrust), per rotor the lowest fatigue factors over
 the links; and the Miner sums of its speed spectra
 (:func:`workbook.model.spectrum.reference_speed_spectra`), all by
 :func:`workbook.solve.fatigue.solve_fatigue`. Replaces the sections between
-the ``<!-- generated: ... -->`` markers. Run from anywhere (a few minutes
-once the links are cached)::
+the ``<!-- generated: ... -->`` markers. Then the bore peaks of its
+reference load cases on the two meshes refined at the bores
+(:func:`workbook.solve.bore_convergence.bore_convergence`): per distinct link
+the peak per net-section stress, per load case the highest bore peak. Run
+from anywhere (a few minutes once the links and their refined meshes are
+cached)::
 
     OPENBLAS_NUM_THREADS=1 python docs/make_stress_docs.py
 """
@@ -21,9 +25,11 @@ from pathlib import Path
 
 from generated_sections import rewrite_sections
 
+from flexbodies.bore_stress import BORE_DIVISIONS, bore_peaks, convergence_sizes
 from workbook.model.load_cases import reference_load_cases
 from workbook.model.reference import reference_case
 from workbook.model.spectrum import reference_speed_spectra
+from workbook.solve.bore_convergence import CONVERGENCE_TOLERANCE, bore_convergence
 from workbook.solve.fatigue import solve_fatigue
 from workbook.solve.load_cases import solve_load_cases
 
@@ -40,21 +46,25 @@ def _solved():
     return case, solve_load_cases(case, reference_load_cases()), solve_fatigue(case)
 
 
-def _lowest_margins(results) -> list[str]:
-    rows = ["| load case | lowest MS_y | lowest MS_u | link, where |", "|---|---|---|---|"]
+def _lowest_margins(results, bores) -> list[str]:
+    rows = ["| load case | lowest MS_y | lowest MS_u | link, where | at the bores (pin load, sub-model): "
+            "lowest MS_y, MS_u, link |", "|---|---|---|---|---|"]
     for result in results:
         stressed = [s for s in result.links.values() if s.yield_margin is not None]
         worst = min(stressed, key=lambda s: s.ultimate_margin)
+        at_bores = [r for r in bores.rows if r.load_case == result.load_case.name and r.ultimate_margin is not None]
+        bore = min(at_bores, key=lambda r: r.ultimate_margin)
         rows.append(f"| {result.load_case.name} | {min(s.yield_margin for s in stressed):.3g} "
-                    f"| {worst.ultimate_margin:.3g} | {worst.link}, {worst.von_mises_region} |")
+                    f"| {worst.ultimate_margin:.3g} | {worst.link}, {worst.von_mises_region} "
+                    f"| {min(r.yield_margin for r in at_bores):.3g}, {bore.ultimate_margin:.3g}, {bore.link} |")
     return rows
 
 
-def _load_cases(results) -> str:
+def _load_cases(results, bores) -> str:
     nominal = [abs(s.nominal_stress) for r in results for s in r.links.values() if s.nominal_stress is not None]
     worst = min(results, key=lambda r: min(s.ultimate_margin for s in r.links.values() if s.ultimate_margin is not None))
     worst_nominal = [abs(s.nominal_stress) for s in worst.links.values() if s.nominal_stress is not None]
-    return "\n".join(_lowest_margins(results) + [
+    return "\n".join(_lowest_margins(results, bores) + [
         "", f"Factor of safety {results[0].load_case.factor_of_safety:g}. The reference links are sized for stiffness, "
         f"not strength: at most {max(nominal) / 1e6:.0f} MPa nominal shank stress in any load case, "
         f"{min(worst_nominal) / 1e6:.0f} to {max(worst_nominal) / 1e6:.0f} MPa in the links of the worst "
@@ -94,10 +104,12 @@ def _miner(result) -> str:
     return "\n".join(rows)
 
 
-def _readme(case, loads, fatigue) -> str:
+def _readme(case, loads, bores, fatigue) -> str:
     return "\n".join(
-        ["Limit load cases (`reference_load_cases()`), lowest margins of safety over the links:", "",
-         *_lowest_margins(loads), "",
+        ["Limit load cases (`reference_load_cases()`), lowest margins of safety over the links: of the reduced "
+         "links' own peaks (bores tied rigidly) and of the bore peaks under the pins' bearing load "
+         "(`docs/stresses.md`):", "",
+         *_lowest_margins(loads, bores), "",
          "Fatigue factors on the preload (1 g, cruise thrust) at the LP and HP rotor speeds, the lowest per rotor:",
          "", *_fatigue_rows(fatigue, 1), "",
          "Miner sums over the illustrative speed spectra (`reference_speed_spectra()`, "
@@ -109,8 +121,38 @@ def _readme(case, loads, fatigue) -> str:
 def sections() -> dict[str, str]:
     """The generated sections by name: those of the page and those of the README (:data:`README_SECTIONS`)."""
     case, loads, fatigue = _solved()
-    return {"load-cases": _load_cases(loads), "fatigue": _fatigue(case, fatigue), "miner": _miner(fatigue),
-            "strength": _readme(case, loads, fatigue)}
+    bores = bore_convergence(case, loads)
+    return {"load-cases": _load_cases(loads, bores), "fatigue": _fatigue(case, fatigue), "miner": _miner(fatigue),
+            "strength": _readme(case, loads, bores, fatigue), "bore-convergence": _bore_section(case, bores)}
+
+
+def _bore_section(case, study) -> str:
+    coarse, fine = BORE_DIVISIONS
+    rows = [f"| links | d/H | FE nodes ({coarse}, {fine} per bore) | K_tn tension, {coarse} / {fine} | change "
+            f"| K_tn compression, {coarse} / {fine} | change |", "|---|---|---|---|---|---|---|"]
+    models: dict = {}
+    for link in case.links:
+        models.setdefault(link.model.key(), (link.model, []))[1].append(link.name)
+    for model, names in models.values():
+        g = model.geometry
+        net = 2 * (g.eye_outer_radius - g.bore_radius) * g.thickness
+        pair = [bore_peaks(model, size) for size in convergence_sizes(model)]
+        tension = [max(p.tension) * net for p in pair]
+        compression = [max(p.compression) * net for p in pair]
+        rows.append(f"| {', '.join(names)} | {g.bore_radius / g.eye_outer_radius:.2f} "
+                    f"| {pair[0].nodes}, {pair[1].nodes} | {tension[0]:.3f} / {tension[1]:.3f} "
+                    f"| {tension[1] / tension[0] - 1:+.2%} | {compression[0]:.3f} / {compression[1]:.3f} "
+                    f"| {compression[1] / compression[0] - 1:+.2%} |")
+    rows += ["", "The highest bore peak of each reference load case:", "",
+             "| load case | link | N (kN) | reduced link's peak (MPa) | bore peak, "
+             f"{coarse} / {fine} per bore (MPa) | change | converged (<= {CONVERGENCE_TOLERANCE:.0%}) |",
+             "|---|---|---|---|---|---|---|"]
+    for load_case in dict.fromkeys(row.load_case for row in study.rows):
+        row = max((r for r in study.rows if r.load_case == load_case), key=lambda r: r.peaks[1])
+        rows.append(f"| {row.load_case} | {row.link} | {row.axial_force / 1e3:.1f} | {row.reduced_peak / 1e6:.1f} "
+                    f"| {row.peaks[0] / 1e6:.1f} / {row.peaks[1] / 1e6:.1f} | {row.change:+.2%} "
+                    f"| {'yes' if row.converged else 'no'} |")
+    return "\n".join(rows)
 
 
 def main() -> None:

@@ -36,7 +36,7 @@ from .errors import LinkModelError
 from .geometry import LinkGeometry, default_element_size
 
 __all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "mesh_pieces", "default_element_size", "gmsh_model",
-           "generate_tet10", "skfem_mesh"]
+           "generate_tet10", "refine_near", "skfem_mesh", "surface_basis"]
 
 logger = logging.getLogger(__name__)
 
@@ -161,7 +161,8 @@ class LinkMesh:
         )
 
 
-def mesh_link(geometry: LinkGeometry, element_size: float | None = None) -> LinkMesh:
+def mesh_link(geometry: LinkGeometry, element_size: float | None = None,
+              bore_element_size: float | None = None) -> LinkMesh:
     """Mesh a parametric link with quadratic tetrahedra (gmsh, OpenCASCADE).
 
     The mesh is deterministic: the same input gives the same nodes and
@@ -175,6 +176,10 @@ def mesh_link(geometry: LinkGeometry, element_size: float | None = None) -> Link
     element_size : float, optional
         Largest element edge length in m. Bores get at least 16 elements
         around their circumference. Default :func:`default_element_size`.
+    bore_element_size : float, optional
+        A finer element edge at the bore surfaces, m, growing linearly to
+        ``element_size`` at one bore radius from them (the local refinement
+        of a stress request, :mod:`flexbodies.bore_stress`). Default: none.
 
     Returns
     -------
@@ -185,16 +190,23 @@ def mesh_link(geometry: LinkGeometry, element_size: float | None = None) -> Link
     size = default_element_size(geometry) if element_size is None else float(element_size)
     if not (math.isfinite(size) and size > 0):
         raise LinkModelError(f"element size must be a positive length in m, got {element_size!r}")
+    fine = None if bore_element_size is None else float(bore_element_size)
+    if fine is not None and not (math.isfinite(fine) and 0 < fine <= size):
+        raise LinkModelError(f"bore element size must be a positive length in m up to the element size "
+                             f"{size:.4g} m, got {bore_element_size!r}")
+    g = geometry
     with gmsh_model("link"):
         _build_link_solid(geometry)
+        if fine is not None:
+            refine_near(_bore_surfaces(g), fine, size, g.bore_radius)
         points, cells = generate_tet10(size)
     mesh, _ = skfem_mesh("tetra10", points, cells)
-    g = geometry
     specs = (
         BoreSpec("A", centre=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), radius=g.bore_radius),
         BoreSpec("B", centre=(g.length, 0.0, 0.0), axis=(0.0, 0.0, 1.0), radius=g.bore_radius),
     )
-    link = LinkMesh.from_skfem(mesh, specs, source=f"gmsh link mesh, element size {size * 1e3:.4g} mm")
+    refined = "" if fine is None else f", {fine * 1e3:.4g} mm at the bores"
+    link = LinkMesh.from_skfem(mesh, specs, source=f"gmsh link mesh, element size {size * 1e3:.4g} mm{refined}")
     logger.info("meshed link: %s", link.describe())
     return link
 
@@ -327,6 +339,36 @@ def _build_link_solid(g: LinkGeometry) -> None:
              for x in (0.0, g.length)]
     occ.cut(solid, holes)
     occ.synchronize()
+
+
+def _bore_surfaces(g: LinkGeometry) -> list[int]:
+    """The gmsh surface tags of the two bores of a built link solid."""
+    import gmsh
+
+    pad = 1e-6 * g.length
+    found = []
+    for x in (0.0, g.length):
+        box = (x - g.bore_radius - pad, -g.bore_radius - pad, -g.thickness / 2 - pad,
+               x + g.bore_radius + pad, g.bore_radius + pad, g.thickness / 2 + pad)
+        found += [tag for dim, tag in gmsh.model.getEntitiesInBoundingBox(*box, dim=2)]
+    return found
+
+
+def refine_near(surfaces: list[int], fine: float, size: float, distance: float) -> None:
+    """Ask gmsh for elements of edge *fine* (m) on *surfaces*, growing linearly to *size* (m) at *distance* (m)."""
+    import gmsh
+
+    field = gmsh.model.mesh.field
+    near = field.add("Distance")
+    field.setNumbers(near, "SurfacesList", surfaces)
+    field.setNumber(near, "Sampling", 100)
+    ramp = field.add("Threshold")
+    field.setNumber(ramp, "InField", near)
+    field.setNumber(ramp, "SizeMin", fine)
+    field.setNumber(ramp, "SizeMax", size)
+    field.setNumber(ramp, "DistMin", 0.0)
+    field.setNumber(ramp, "DistMax", distance)
+    field.setAsBackgroundMesh(ramp)
 
 
 def generate_tet10(size: float, curvature_points: int = 16) -> tuple[np.ndarray, np.ndarray]:
@@ -548,12 +590,32 @@ def _no_bore_message(spec, source, tol, dist, centre, axis) -> str:
             "from the axis (check the centre, radius and the mesh's scale)")
 
 
+def surface_basis(mesh, facets: np.ndarray) -> tuple:
+    """A scikit-fem basis on some boundary faces of *mesh*, made about their own middle.
+
+    scikit-fem finds the quadrature points' element coordinates by Newton's
+    method to an absolute tolerance of 1e-12, which round-off defeats for
+    small curved elements a metre from the origin: the basis is made on the
+    mesh moved so that the faces' middle is at the origin.
+
+    Returns
+    -------
+    basis : skfem.FacetBasis
+        On the moved mesh (the same nodes, elements and faces).
+    origin : ndarray, shape (3,)
+        Where the faces' middle is, m: add it to the basis's coordinates.
+    """
+    origin = mesh.doflocs[:, np.unique(mesh.facets[:, facets])].mean(axis=1)
+    moved = mesh.translated(-origin)
+    return skfem.FacetBasis(moved, moved.elem(), facets=facets, intorder=_SURFACE_INTORDER), origin
+
+
 def _bore_from_facets(mesh, name: str, facets: np.ndarray, nominal) -> Bore:
     """Integrate shape functions over the bore faces; fit or adopt centre, axis, radius."""
-    fb = skfem.FacetBasis(mesh, mesh.elem(), facets=facets, intorder=_SURFACE_INTORDER)
+    fb, origin = surface_basis(mesh, facets)
     weights = skfem.asm(_unit_load, fb)
     nodes = np.unique(fb.get_dofs(facets=facets).flatten())
-    x = np.asarray(fb.global_coordinates())  # (3, faces, points)
+    x = np.asarray(fb.global_coordinates()) + origin[:, None, None]  # (3, faces, points)
     dx = fb.dx
     area = dx.sum()
     centroid = np.einsum("ifq,fq->i", x, dx) / area

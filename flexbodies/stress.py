@@ -22,6 +22,7 @@ in Voigt order :data:`VOIGT`, Pa.
 """
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -231,12 +232,30 @@ def gerber_factor(alternating, mean, endurance: float, ultimate: float) -> np.nd
 
 
 def max_principal(stress: np.ndarray) -> np.ndarray:
-    """Largest principal stress of Voigt stress, shape (n, 6) -> (n,), Pa."""
-    s = np.asarray(stress)
-    tensor = np.empty((len(s), 3, 3))
-    for row, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
-        tensor[:, a, b] = tensor[:, b, a] = s[:, row]
-    return np.linalg.eigvalsh(tensor)[:, -1]
+    """Largest principal stress of Voigt stress, shape (n, 6) -> (n,), Pa.
+
+    In closed form (the trigonometric solution of the characteristic cubic
+    of the deviator): the largest eigenvalue is ``p + 2 q cos(phi)`` with
+    ``p`` the mean normal stress, ``q = sqrt(J2 / 3)`` and
+    ``cos(3 phi) = J3 / (2 q^3)``, in a few array operations over all nodes
+    rather than an eigen-solve per node.
+    """
+    s = np.asarray(stress, dtype=float)
+    xx, yy, zz, yz, xz, xy = (s[:, i] for i in range(6))
+    mean = (xx + yy + zz) / 3
+    a, b, c = xx - mean, yy - mean, zz - mean
+    j2 = 0.5 * (a * a + b * b + c * c) + yz * yz + xz * xz + xy * xy
+    j3 = a * b * c + 2 * yz * xz * xy - a * yz * yz - b * xz * xz - c * xy * xy
+    q = np.sqrt(j2 / 3)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cosine = np.where(q > 0, j3 / (2 * q**3), 0.0)
+    phi = np.arccos(np.clip(cosine, -1.0, 1.0)) / 3
+    return mean + 2 * q * np.cos(phi)
+
+
+#: Regions of the links seen in this process, by the key of their inputs (their mesh), most recent last.
+_regions: OrderedDict = OrderedDict()
+_REGIONS_KEPT = 32
 
 
 def link_regions(link: ReducedLink) -> np.ndarray:
@@ -244,12 +263,27 @@ def link_regions(link: ReducedLink) -> np.ndarray:
 
     A node within the eye's outer radius of an eye centre (the bore radius
     times two for a link read from a mesh file) is in that eye, every other
-    node in the shank.
+    node in the shank. Kept per link mesh (the key of the link's inputs), so
+    each stress recovery after the first finds it made; read-only.
 
     Returns
     -------
     ndarray of int, shape (n,)
     """
+    key = link.info.get("input_hash")
+    if key is not None and key in _regions:
+        _regions.move_to_end(key)
+        return _regions[key]
+    regions = _regions_of(link)
+    regions.flags.writeable = False
+    if key is not None:
+        _regions[key] = regions
+        while len(_regions) > _REGIONS_KEPT:
+            _regions.popitem(last=False)
+    return regions
+
+
+def _regions_of(link: ReducedLink) -> np.ndarray:
     n = int(link.master_nodes[0])
     nodes = link.nodes[:n]
     geometry = (link.info.get("inputs") or {}).get("geometry")
@@ -289,7 +323,11 @@ def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
         raise LinkModelError("this reduced body was reduced without its stress shapes")
     q = np.asarray(modal_coordinates)
     n = shapes.shape[0]
-    return (shapes.reshape(6 * n, -1) @ q).reshape(n, 6)
+    matrix = shapes.reshape(6 * n, -1)
+    if np.iscomplexobj(q):  # one real product of two columns: no complex copy of the shapes, read once
+        parts = matrix @ np.stack([q.real, q.imag], axis=1)
+        return (parts[:, 0] + 1j * parts[:, 1]).reshape(n, 6)
+    return (matrix @ q).reshape(n, 6)
 
 
 def write_vtu(path, link: ReducedLink, fields: dict, modes: int = 0):

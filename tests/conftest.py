@@ -24,8 +24,14 @@ SHORT = AnalysisSettings(settle_time_constants=0.5, measured_periods=10)
 
 @pytest.fixture(scope="session", autouse=True)
 def cache_dir(tmp_path_factory):
-    """A reduction cache shared by all tests of one session (never the user's own cache)."""
-    path = tmp_path_factory.mktemp("reduction-cache")
+    """A reduction cache shared by all tests of one session (never the user's own cache).
+
+    Under pytest-xdist the workers of a session share it (the cache locks its
+    entries), so each link is reduced once per session, not once per worker.
+    """
+    base = tmp_path_factory.getbasetemp()
+    path = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "reduction-cache"
+    path.mkdir(exist_ok=True)
     os.environ["MOUNTWB_CACHE"] = str(path)
     return path
 

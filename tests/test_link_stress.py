@@ -108,3 +108,19 @@ def test_strengths_do_not_change_the_reduction_key():
         Material("x", 210e9, 0.3, 7850.0, yield_strength=500e6, ultimate_strength=400e6)
     with pytest.raises(LinkModelError, match="yield strength"):
         Material("x", 210e9, 0.3, 7850.0, yield_strength=-1.0)
+
+
+def test_largest_principal_in_closed_form_equals_the_eigen_solve():
+    rng = np.random.default_rng(3)
+    stress = rng.standard_normal((2000, 6)) * 1e8
+    stress[:3] = [[1e8, 1e8, 1e8, 0, 0, 0], [0, 0, 0, 0, 0, 0], [2e8, -1e8, -1e8, 0, 0, 1e-3]]   # degenerate states
+    tensor = np.empty((len(stress), 3, 3))
+    for row, (a, b) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
+        tensor[:, a, b] = tensor[:, b, a] = stress[:, row]
+    np.testing.assert_allclose(max_principal(stress), np.linalg.eigvalsh(tensor)[:, -1], rtol=0, atol=1e-12 * 1e9)
+
+
+def test_regions_are_made_once_per_link_mesh(reduced):
+    first, second = link_regions(reduced), link_regions(reduced)
+    assert first is second and not first.flags.writeable
+    assert set(np.unique(first)) == {0, 1, 2}

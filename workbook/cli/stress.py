@@ -17,7 +17,7 @@ from typing import Callable
 
 from workbook.cli.loading import load_case
 
-__all__ = ["arguments"]
+__all__ = ["arguments", "print_bore_convergence"]
 
 #: Mode shapes written with each link's VTU file.
 VTU_MODES = 6
@@ -33,6 +33,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 
 def run(args) -> int:
     from workbook.cli.loads import chosen_load_cases, print_load_cases
+    from workbook.solve.bore_convergence import bore_convergence
     from workbook.solve.fatigue import solve_fatigue
     from workbook.solve.load_cases import solve_load_cases
 
@@ -40,13 +41,15 @@ def run(args) -> int:
     chosen = chosen_load_cases(case, args.load_case)
     fatigue = solve_fatigue(case)
     results = solve_load_cases(case, chosen) if chosen else []
+    bores = bore_convergence(case, results)
     if args.vtu:
         write_fields(Path(args.vtu), fatigue)
     if args.json:
         print(json.dumps({"case": case.name, "load_cases": [r.to_dict() for r in results],
-                          "fatigue": fatigue.to_dict()}, indent=1))
+                          "bore_convergence": bores.to_dict(), "fatigue": fatigue.to_dict()}, indent=1))
         return 0
     print_load_cases(case, results)
+    print_bore_convergence(bores)
     print("\nfatigue on the preload (the case's static loads): alternating stress sigma_a = largest von Mises "
           "over the cycle, mean sigma_m = von Mises of the preload stress signed by its hydrostatic part; "
           "Goodman 1/n = sigma_a/S_e + sigma_m/S_u, Gerber n sigma_a/S_e + (n sigma_m/S_u)^2 = 1")
@@ -61,6 +64,38 @@ def run(args) -> int:
     if args.vtu:
         print(f"VTU files: {args.vtu}/<link>.vtu")
     return 0
+
+
+def print_bore_convergence(study) -> None:
+    """The bore peaks of a :class:`~workbook.solve.bore_convergence.BoreStudy` on its two meshes, and their cost."""
+    from flexbodies.bore_stress import BORE_DIVISIONS
+    from workbook.solve.bore_convergence import CONVERGENCE_TOLERANCE
+
+    if not study.rows:
+        return
+    coarse, fine = BORE_DIVISIONS
+    print(f"\nbore peak von Mises under the pin's bearing load (cosine pressure), on meshes of {coarse} and {fine} "
+          f"elements around the bore; the reduced link ties its bores rigidly, its own peak beside; margins of "
+          f"safety of the {fine}/bore peak")
+    print(f"  {'load case':30s} {'link':14s} {'N kN':>8s} {'reduced MPa':>11s} {f'{coarse}/bore MPa':>12s} "
+          f"{f'{fine}/bore MPa':>12s} {'change':>7s} {'MS_y':>6s} {'MS_u':>6s}  converged")
+    for row in study.rows:
+        reduced = "-" if row.reduced_peak is None else f"{row.reduced_peak / 1e6:.1f}"
+        state = "yes" if row.converged else f"NO: change above {CONVERGENCE_TOLERANCE:.0%}"
+        margins = " ".join("     -" if m is None else f"{m:6.2f}" for m in (row.yield_margin, row.ultimate_margin))
+        print(f"  {row.load_case:30s} {row.link:14s} {row.axial_force / 1e3:8.1f} {reduced:>11s} "
+              f"{row.peaks[0] / 1e6:12.1f} {row.peaks[1] / 1e6:12.1f} {row.change:7.1%} {margins}  {state}")
+    bad = [row for row in study.rows if not row.converged]
+    if bad:
+        print(f"  warning: {len(bad)} bore peak(s) changed by more than {CONVERGENCE_TOLERANCE:.0%} between the two "
+              "meshes: not converged, do not use them as they are")
+    nodes = max(max(pair) for pair in study.meshes.values())
+    seconds = sum(sum(pair) for pair in study.seconds.values())
+    print(f"  cost: {2 * len(study.meshes)} refined sub-models of {len(study.meshes)} distinct links (up to {nodes} "
+          f"FE nodes), {seconds:.0f} s to mesh, assemble and solve when first asked; their peaks are kept in the "
+          "link cache and loaded since")
+    if study.skipped:
+        print(f"  not refined (links from mesh files): {', '.join(study.skipped)}")
 
 
 def write_fields(directory: Path, fatigue) -> list[Path]:

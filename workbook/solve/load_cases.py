@@ -32,7 +32,7 @@ from workbook.scene.build import build_scene, reduce_links
 from workbook.solve.preload import link_compression, solve_preload
 from workbook.solve.stress_stiffening import stiffen_links
 
-__all__ = ["LinkStress", "LoadCaseResult", "load_case_scene_case", "link_stress", "link_coordinates",
+__all__ = ["LinkStress", "LoadCaseResult", "load_case_scene_case", "link_stress", "link_coordinates", "margin",
            "solve_load_case", "solve_load_cases"]
 
 
@@ -127,7 +127,8 @@ def load_case_scene_case(case: Case, load_case: LoadCase) -> Case:
                                effects=dataclasses.replace(base.effects, preload=True))
 
 
-def _margin(strength, stress) -> float | None:
+def margin(strength, stress) -> float | None:
+    """The margin of safety ``strength / stress - 1`` (None without a strength or a positive stress)."""
     if strength is None or stress is None or stress <= 0:
         return None
     return float(strength / stress - 1.0)
@@ -172,8 +173,8 @@ def link_stress(link, reduced, modal_coordinates, axial_force: float, rotation, 
     return dataclasses.replace(
         found, von_mises=float(vm[i]), von_mises_region=where(i)[0], von_mises_point=where(i)[1],
         max_principal=float(principal[j]), max_principal_region=where(j)[0], max_principal_point=where(j)[1],
-        yield_margin=_margin(material.yield_strength, float(vm[i])),
-        ultimate_margin=_margin(material.ultimate_strength, factor_of_safety * float(vm[i])))
+        yield_margin=margin(material.yield_strength, float(vm[i])),
+        ultimate_margin=margin(material.ultimate_strength, factor_of_safety * float(vm[i])))
 
 
 def link_coordinates(scene) -> dict:
