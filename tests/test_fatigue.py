@@ -111,8 +111,9 @@ def test_the_stress_command_prints_json_and_writes_vtu(coarse_reference, tmp_pat
 
     path = tmp_path / "case.json"
     path.write_text(to_json(dataclasses.replace(coarse_reference, load_cases=(LoadCase("cruise", thrust=23e3),))))
-    assert main(["stress", str(path), "--vtu", str(tmp_path / "vtu"), "--json"]) == 0
+    assert main(["stress", str(path), "--vtu", str(tmp_path / "vtu"), "--png", str(tmp_path / "png"), "--json"]) == 0
     answer = json.loads(capsys.readouterr().out)
+    assert sorted(p.name for p in (tmp_path / "png").iterdir()) == sorted(f"{x.name}.png" for x in coarse_reference.links)
     assert answer["load_cases"][0]["load_case"] == "cruise"
     lp = answer["fatigue"]["excitations"][0]
     assert lp["excitation"] == "LP rotor" and lp["links"]["rear-middle"]["goodman"] > 1
@@ -122,6 +123,16 @@ def test_the_stress_command_prints_json_and_writes_vtu(coarse_reference, tmp_pat
     assert mesh.point_data["LP rotor alternating von Mises"].max() == pytest.approx(
         lp["links"]["rear-middle"]["peak_alternating"], rel=1e-12)
     assert mesh.point_data["mode 1"].shape == (len(preload), 3)
+
+
+def test_a_link_is_drawn_with_the_peaks_of_its_stress_fields(fatigue):
+    figure = fatigue.plot("rear-middle")
+    titles = [ax.get_title() for ax in figure.axes if ax.get_title()]
+    preload = von_mises(fatigue.mean_stress["rear-middle"]).max()
+    assert titles[0] == f"preload von Mises: peak {preload / 1e6:.3g} MPa"
+    for title, answer in zip(titles[1:], fatigue.excitations, strict=True):
+        peak = answer.links["rear-middle"].peak_alternating
+        assert title.startswith(answer.excitation) and title.endswith(f"peak {peak / 1e6:.3g} MPa")
 
 
 def test_the_stress_command_names_a_missing_endurance_strength(coarse_reference, tmp_path, capsys):

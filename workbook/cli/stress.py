@@ -1,4 +1,4 @@
-"""``mountwb stress [CASE] [--run R] [--load-case NAME] [--vtu DIR] [--json]``.
+"""``mountwb stress [CASE] [--run R] [--load-case NAME] [--vtu DIR] [--png DIR] [--json]``.
 
 Everything the package says of the links' strength: the static margins of
 the limit load cases (the tables of ``mountwb loads``,
@@ -6,7 +6,9 @@ the limit load cases (the tables of ``mountwb loads``,
 dynamic stress on the preload and the fatigue safety factors by Goodman and
 Gerber (:mod:`workbook.solve.fatigue`). ``--vtu DIR`` writes each flexible
 link's surface with its preload stress, the dynamic stress amplitude of each
-excitation and its first mode shapes, one VTU file per link (ParaView).
+excitation and its first mode shapes, one VTU file per link (ParaView);
+``--png DIR`` draws the same stress fields on each link's shape, one PNG per
+link.
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 
     add_load_case_arguments(parser)
     parser.add_argument("--vtu", metavar="DIR", help="write each link's mesh with its stress fields as DIR/<link>.vtu")
+    parser.add_argument("--png", metavar="DIR", help="draw each link's stress fields on its shape as DIR/<link>.png")
     return run
 
 
@@ -44,6 +47,8 @@ def run(args) -> int:
     bores = bore_convergence(case, results)
     if args.vtu:
         write_fields(Path(args.vtu), fatigue)
+    if args.png:
+        draw_fields(Path(args.png), fatigue)
     if args.json:
         print(json.dumps({"case": case.name, "load_cases": [r.to_dict() for r in results],
                           "bore_convergence": bores.to_dict(), "fatigue": fatigue.to_dict()}, indent=1))
@@ -60,10 +65,46 @@ def run(args) -> int:
         for name, f in answer.links.items():
             print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
                   f"{f.goodman:9.3g} {f.gerber:9.3g} {f.region:>6s}")
+    print_miner_sums(fatigue)
     print(f"\nstress recovery and fatigue factors, all links and excitations: {fatigue.stress_seconds:.3f} s")
     if args.vtu:
         print(f"VTU files: {args.vtu}/<link>.vtu")
+    if args.png:
+        print(f"PNG files: {args.png}/<link>.png")
     return 0
+
+
+def print_miner_sums(fatigue) -> None:
+    """The Miner sums of a :class:`~workbook.solve.fatigue.FatigueResult`'s speed spectra and each link's life."""
+    if not fatigue.spectra:
+        return
+    life = fatigue.life_hours()
+    for answer in fatigue.spectra:
+        print(f"\nMiner sum over the speed spectrum of {answer.spectrum.excitation} ({answer.spectrum.hours:g} h, "
+              f"{len(answer.speeds)} speeds; Goodman-equivalent stress sigma_ar, none below the endurance strength)")
+        print(f"  {'link':16s} {'damage D':>10s} {'life h':>10s} {'sigma_ar MPa':>12s} {'at Hz':>8s} {'where':>6s}")
+        for name, d in answer.links.items():
+            print(f"  {name:16s} {d.damage:10.3g} {d.life_hours:10.3g} {d.equivalent / 1e6:12.4f} {d.speed_hz:8.4g} "
+                  f"{d.region:>6s}")
+    print("  life under all spectra: " + ", ".join(f"{name} {hours:.3g} h" for name, hours in life.items()))
+
+
+def draw_fields(directory: Path, fatigue) -> list[Path]:
+    """Draw ``directory/<link>.png`` for each flexible link (:meth:`~workbook.solve.fatigue.FatigueResult.plot`)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workbook.answers.saving import save_figure
+
+    directory.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in fatigue.reduced:
+        figure = fatigue.plot(name)
+        written.append(save_figure(figure, directory / f"{name}.png"))
+        plt.close(figure)
+    return written
 
 
 def print_bore_convergence(study) -> None:

@@ -203,6 +203,41 @@ class FatigueResult:
         with np.errstate(divide="ignore"):
             return {name: float(np.divide(1.0, value)) for name, value in rate.items()}
 
+    def plot(self, link: str):
+        """The stress fields of *link* on its shape: the preload's von Mises
+        stress, then each excitation's alternating von Mises stress, MPa, at
+        the FE nodes seen along the bore axes (link frame: x along the link),
+        the peak starred.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+        """
+        import matplotlib.pyplot as plt
+
+        from flexbodies.stress import alternating_von_mises, von_mises
+
+        reduced = self.reduced[link]
+        fields = {"preload von Mises": von_mises(self.mean_stress[link])}
+        for answer in self.excitations:
+            fields[f"{answer.excitation} ({answer.frequency_hz:g} Hz) alternating von Mises"] = \
+                alternating_von_mises(answer.amplitudes[link])
+        nodes = 1e3 * reduced.nodes[: len(next(iter(fields.values())))]
+        fig, axes = plt.subplots(len(fields), 1, figsize=(9, 2.4 * len(fields)), squeeze=False,
+                                 constrained_layout=True)
+        for ax, (title, values) in zip(axes[:, 0], fields.items(), strict=True):
+            order = np.argsort(values)       # the highest stresses drawn last, on top
+            drawn = ax.scatter(nodes[order, 0], nodes[order, 1], c=values[order] / 1e6, s=4, cmap="viridis")
+            peak = int(np.argmax(values))
+            ax.plot(nodes[peak, 0], nodes[peak, 1], marker="*", color="red", markersize=12)
+            ax.set_title(f"{title}: peak {values[peak] / 1e6:.3g} MPa", fontsize="small")
+            ax.set_aspect("equal")
+            ax.set_ylabel("y mm")
+            fig.colorbar(drawn, ax=ax, label="MPa")
+        axes[-1, 0].set_xlabel("x mm (along the link)")
+        fig.suptitle(f"{self.case}: link {link}")
+        return fig
+
     def to_dict(self) -> dict:
         """JSON-ready, SI units but hours (without the stress fields)."""
         import dataclasses
