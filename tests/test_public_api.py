@@ -26,7 +26,7 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.channel_set", "workbook.design.expansion",
     "workbook.design.kinematics", "workbook.design.sensitivity",
-    "workbook.design.linear_mount", "workbook.design.optimise",
+    "workbook.design.linear_mount", "workbook.design.optimise", "workbook.design.bands", "workbook.design.link_fatigue",
     "workbook.answers", "workbook.answers.amplitude", "workbook.answers.hinge_curves", "workbook.answers.isolation",
     "workbook.answers.link_stiffness",
     "workbook.answers.link_table", "workbook.answers.model_card", "workbook.answers.results",
