@@ -37,7 +37,7 @@ INTERNAL_MODULES = (
     "workbook.cli.params", "workbook.cli.uq",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
     "workbook.excel", "workbook.excel.execute", "workbook.excel.files", "workbook.excel.impedance_sheet",
-    "workbook.excel.layout", "workbook.excel.loads_sheet", "workbook.excel.pictures", "workbook.excel.reader", "workbook.excel.report",
+    "workbook.excel.layout", "workbook.excel.loads_sheet", "workbook.excel.optimise_sheet", "workbook.excel.pictures", "workbook.excel.reader", "workbook.excel.report",
     "workbook.excel.rig_points",
     "workbook.excel.runs", "workbook.excel.sheets", "workbook.excel.styling", "workbook.excel.template",
     "workbook.excel.writer",

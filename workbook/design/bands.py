@@ -16,13 +16,15 @@ fixed (Danskin: the peak's own shift adds nothing to first order).
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg as sla
 
-from workbook.design.linear_mount import ItemSolution
 from workbook.errors import InputError
 from workbook.model.case import SINGLE_FREQUENCY_KINDS, Case, Sweep
+
+if TYPE_CHECKING:     # the linear mount loads the scene's modules: imported where a band is answered
+    from workbook.design.linear_mount import ItemSolution
 
 __all__ = ["BAND_POINTS", "band_text", "band_case", "band_peaks", "with_frequencies"]
 
@@ -78,7 +80,7 @@ def with_frequencies(case: Case, added: dict) -> Case:
     """*case* with the frequencies *added* (sweep name to Hz) put into its sweeps (duplicates dropped)."""
     excitations = []
     for item in case.excitations:
-        if isinstance(item, Sweep) and added.get(item.name):
+        if isinstance(item, Sweep) and item.name in added:
             merged = np.sort(np.concatenate([item.frequencies_hz, added[item.name]]))
             keep = np.append(True, np.diff(merged) > PEAK_TOLERANCE * merged[1:])
             item = dataclasses.replace(item, frequencies_hz=tuple(float(f) for f in merged[keep]))
@@ -88,6 +90,8 @@ def with_frequencies(case: Case, added: dict) -> Case:
 
 def _transmissibility(solution: ItemSolution, excitation, pylon: list) -> np.ndarray:
     """T per direction of one excitation, shape (3,)."""
+    import scipy.linalg as sla
+
     model = solution.model
     omega = 2 * np.pi * excitation.frequency
     motion = sla.solve(model.dynamic(omega), model.load(excitation), check_finite=False)
@@ -109,6 +113,7 @@ def band_peaks(item: Sweep, solution: ItemSolution, pylon: list, grid: np.ndarra
     grid : ndarray, shape (points, 3)
         T at the grid's frequencies.
     """
+    import scipy.linalg as sla
     from scipy.optimize import minimize_scalar
 
     frequencies = np.asarray(item.frequencies_hz)

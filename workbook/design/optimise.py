@@ -45,7 +45,7 @@ from workbook.design.sensitivity import amplitude_change, design_case, design_se
 from workbook.errors import InfeasibleProblem, InputError, SimulationError
 from workbook.model.case import DIRECTIONS, Case, Sweep
 
-__all__ = ["Variable", "Constraint", "constraint", "variable", "optimise", "pareto", "OptimisationResult",
+__all__ = ["Variable", "Constraint", "constraint", "variable", "variable_name", "optimise", "pareto", "OptimisationResult",
            "ParetoFront", "OBJECTIVES", "QUANTITIES", "MARGIN"]
 
 #: Objectives of :func:`optimise`.
@@ -98,6 +98,23 @@ class Variable:
         return self.value(x) * np.log(self.high / self.low) if self.log else self.high - self.low
 
 
+def variable_name(name: str) -> None:
+    """Check that *name* is a study parameter the fast path follows.
+
+    Raises
+    ------
+    InputError
+        An unknown name, or one that needs a new link reduction per design (``section_scale``).
+    """
+    from workbook.studies.parametric import parameter
+
+    parameter(name)
+    if name.partition("/")[0] not in _FAST:
+        raise InputError(f"variable {name!r}: the optimiser varies only what the fast linear mount follows "
+                         f"({', '.join(_FAST)}, per hinge group and direction); {name} needs a new preparation "
+                         "(section_scale: a new link reduction) per design: use 'mountwb study params' for it")
+
+
 def variable(name: str, low: float, high: float) -> Variable:
     """The variable *name* over [low, high].
 
@@ -107,13 +124,7 @@ def variable(name: str, low: float, high: float) -> Variable:
         A parameter the fast path cannot follow (``section_scale`` needs a
         new link reduction per design), an unknown name, or an empty range.
     """
-    from workbook.studies.parametric import parameter
-
-    parameter(name)
-    if name.partition("/")[0] not in _FAST:
-        raise InputError(f"variable {name!r}: the optimiser varies only what the fast linear mount follows "
-                         f"({', '.join(_FAST)}, per hinge group and direction); {name} needs a new preparation "
-                         "(section_scale: a new link reduction) per design: use 'mountwb study params' for it")
+    variable_name(name)
     if not (np.isfinite(low) and np.isfinite(high) and high > low):
         raise InputError(f"variable {name!r}: found the range {low:g}:{high:g}, expected LOW:HIGH with LOW < HIGH")
     if name.partition("/")[0] in _LOG and low < 0:
