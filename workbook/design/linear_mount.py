@@ -108,12 +108,16 @@ class StressedLink:
         With its stress shapes.
     rotation : ndarray, shape (3, 3)
         Link frame to global.
+    component_shapes : ndarray, shape (6 n, modes)
+        The stress shapes with rows (component, node): ``(component_shapes @ Q).reshape(6, -1).T``
+        is the stress of the columns of Q, a Fortran-ordered (n K, 6), quick to read by component.
     """
 
     link: Link
     coordinates: np.ndarray
     reduced: ReducedLink = field(repr=False)
     rotation: np.ndarray = field(repr=False)
+    component_shapes: np.ndarray = field(repr=False)
 
 
 @dataclass
@@ -371,8 +375,10 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
         reduced = scene.reduced.get(link.name)
         if case.link_is_flexible(link.name) and reduced is not None and reduced.stress_modes.size:
             first = scene.mbs.GetNodeODE2Index(scene.links[link.name].nodes[1])
-            stressed[link.name] = StressedLink(link, np.arange(first, first + reduced.stress_modes.shape[2]), reduced,
-                                               np.asarray(scene.links[link.name].rotation))
+            shapes = reduced.stress_modes
+            stressed[link.name] = StressedLink(
+                link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
+                np.ascontiguousarray(shapes.transpose(1, 0, 2)).reshape(-1, shapes.shape[2]))
     return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine, points, warnings,
                  prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed)
 

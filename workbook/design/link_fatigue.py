@@ -102,15 +102,15 @@ def link_fatigue_factors(solution: ItemSolution, d_state: np.ndarray, motions: l
         rows = _coordinates(solution, stressed)
         mean_q = state[stressed.coordinates]
         mean = signed_von_mises(state_stress(stressed.reduced, mean_q))
-        shapes = stressed.reduced.stress_modes
-        amplitudes = shapes.reshape(-1, shapes.shape[2]) @ np.array([motion[rows] for motion, _ in motions]).T
-        nodes = shapes.shape[0]
-        alternating = alternating_von_mises(amplitudes.reshape(nodes, 6, -1).transpose(2, 0, 1).reshape(-1, 6))
-        goodman = goodman_factor(alternating.reshape(-1, nodes), mean[None, :], material.endurance_strength,
-                                 material.ultimate_strength)                      # (excitations, nodes)
-        k, node = np.unravel_index(int(np.argmin(goodman)), goodman.shape)
+        phasors = np.array([motion[rows] for motion, _ in motions]).T                  # (modes, excitations)
+        nodes = stressed.reduced.stress_modes.shape[0]
+        # (6 n, K) with the component slowest: its transpose is a Fortran-ordered (n K, 6), read by column fast
+        amplitudes = (stressed.component_shapes @ phasors).reshape(6, -1).T
+        goodman = goodman_factor(alternating_von_mises(amplitudes).reshape(nodes, -1), mean[:, None],
+                                 material.endurance_strength, material.ultimate_strength)     # (nodes, excitations)
+        node, k = np.unravel_index(int(np.argmin(goodman)), goodman.shape)
         motion, d_motion = motions[k]
         gradient = _factor_change(stressed, int(node), mean_q, d_state[stressed.coordinates], motion[rows],
                                   d_motion[rows])
-        factors.append(FatigueFactor(name, float(goodman[k, node]), gradient, int(k)))
+        factors.append(FatigueFactor(name, float(goodman[node, k]), gradient, int(k)))
     return factors
