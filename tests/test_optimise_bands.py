@@ -152,3 +152,44 @@ def test_fatigue_factors_are_the_pipelines(band_mount, stiffness):
         for name, factor in links.items():
             difference = (sides[0][item][name].goodman - sides[1][item][name].goodman) / (2 * step)
             assert factor.gradient[0] == pytest.approx(difference, rel=1e-3, abs=1e-6 * factor.goodman / stiffness)
+
+
+@pytest.mark.slow
+def test_link_margins_are_the_load_cases(cache_dir):
+    """Under a limit load (pull-up 2.5 g) and a fail-safe one (take-off without rear-middle, 10 mm of engine
+    displacement), the fast path's link margins equal solve_load_cases': to 1e-9 at the prepared design, and
+    at hinges 1.5 times stiffer to the expansion's first-order accuracy in the state's change (3.4 mm there:
+    the peak stresses within 2e-3 of the largest); their derivative is the central difference of the margin."""
+    from workbook.design.link_margins import link_margins, load_case_mounts
+    from workbook.design.sensitivity import design_sensitivity
+    from workbook.model.load_cases import reference_load_cases
+    from workbook.solve.load_cases import solve_load_cases
+
+    chosen = [lc for lc in reference_load_cases() if lc.name in ("pull-up 2.5 g", "take-off, rear-middle failed")]
+    case = dataclasses.replace(reference_case(element_size=COARSE_ELEMENT_SIZE), load_cases=tuple(chosen))
+    mounts = load_case_mounts(case)
+
+    def fast(mount, load_case, stiffness):
+        s = design_sensitivity(mount, {"hinge_stiffness/all": stiffness})
+        return {m.link: m for m in link_margins(s.solutions[0], np.array([d for _, d in s.changes[0]]).T,
+                                                load_case.factor_of_safety)}
+
+    for stiffness in (2e7, 3e7):
+        design = dataclasses.replace(case, hinges=design_case(mounts[0][1], {"hinge_stiffness/all": stiffness}).hinges)
+        for (load_case, mount), result in zip(mounts, solve_load_cases(design), strict=True):
+            found = fast(mount, load_case, stiffness)
+            assert set(found) == {name for name, s in result.links.items() if s.yield_margin is not None}
+            expected = {name: min(result.links[name].yield_margin, result.links[name].ultimate_margin)
+                        for name in found}
+            if stiffness == 2e7:
+                for name, margin in found.items():
+                    assert margin.margin == pytest.approx(expected[name], rel=1e-9), (load_case.name, name)
+                continue
+            # the peak stress per unit strength, 1 / (1 + margin)
+            largest = max(1 / (1 + value) for value in expected.values())
+            for name, margin in found.items():
+                assert 1 / (1 + margin.margin) == pytest.approx(1 / (1 + expected[name]), abs=2e-3 * largest)
+            sides = [fast(mount, load_case, stiffness * (1 + s)) for s in (1e-4, -1e-4)]
+            for name, margin in found.items():
+                difference = (sides[0][name].margin - sides[1][name].margin) / (2e-4 * stiffness)
+                assert margin.gradient[0] == pytest.approx(difference, rel=1e-3, abs=1e-12)

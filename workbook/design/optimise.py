@@ -41,6 +41,7 @@ import scipy.linalg as sla
 from workbook.design.bands import BAND_POINTS, band_case, band_peaks, with_frequencies
 from workbook.design.linear_mount import DesignAnswer, LinearMount, points_of
 from workbook.design.link_fatigue import link_fatigue_factors
+from workbook.design.link_margins import link_margins, load_case_mounts
 from workbook.design.sensitivity import amplitude_change, design_case, design_sensitivity, point_change
 from workbook.errors import InfeasibleProblem, InputError, SimulationError
 from workbook.model.case import DIRECTIONS, Case, Sweep
@@ -56,6 +57,8 @@ QUANTITIES = {"displacement": "m", "sag": "m", "rotation": "rad"}
 MODES_OUTSIDE = "modes_outside"
 #: The fatigue constraint's name: every link's lowest Goodman factor at least the limit.
 FATIGUE = "fatigue"
+#: The static margin constraint's name: every link's margin of safety under every limit load case at least the limit.
+LINK_MARGIN = "margin"
 #: Relative margin inside each stated limit the optimiser aims at, so that its optimum meets the limit.
 MARGIN = 1e-6
 #: A constraint whose normalised slack is below this is reported active.
@@ -145,14 +148,15 @@ class Constraint:
         """As :func:`constraint` reads it."""
         if self.quantity == MODES_OUTSIDE:
             return f"{MODES_OUTSIDE}={self.limit[0]:g}:{self.limit[1]:g}"
-        if self.quantity == FATIGUE:
-            return f"{FATIGUE}>={self.limit:g}"
+        if self.quantity in (FATIGUE, LINK_MARGIN):
+            return f"{self.quantity}>={self.limit:g}"
         return f"{self.quantity}<={self.limit:g}"
 
 
 def constraint(text: str) -> Constraint:
     """Read a constraint: ``displacement<=M``, ``sag<=M``, ``rotation<=RAD``, ``modes_outside=LOW:HIGH`` (Hz)
-    or ``fatigue>=N`` (every link's lowest Goodman factor over every excitation point, bands' peaks included).
+    ``fatigue>=N`` (every link's lowest Goodman factor over every excitation point, bands' peaks included)
+    or ``margin>=M`` (every link's margin of safety under every limit load case of the case).
 
     Raises
     ------
@@ -160,10 +164,10 @@ def constraint(text: str) -> Constraint:
         Naming the text and what is expected.
     """
     expected = (f"expected {', '.join(f'{q}<=VALUE ({u})' for q, u in QUANTITIES.items())} or "
-                f"{MODES_OUTSIDE}=LOW:HIGH (Hz) or {FATIGUE}>=FACTOR")
+                f"{MODES_OUTSIDE}=LOW:HIGH (Hz), {FATIGUE}>=FACTOR or {LINK_MARGIN}>=MARGIN")
     quantity, sign, rest = text.replace(" ", "").partition(">=")
     try:
-        if sign and quantity == FATIGUE and float(rest) > 0:
+        if sign and quantity in (FATIGUE, LINK_MARGIN) and float(rest) > (0 if quantity == FATIGUE else -1):
             return Constraint(quantity, float(rest))
         quantity, sign, rest = text.replace(" ", "").partition("<=")
         if sign and quantity in QUANTITIES and float(rest) > 0:
@@ -250,9 +254,10 @@ class _Problem:
     """The scaled problem, each design answered once (the last one kept)."""
 
     def __init__(self, mount: LinearMount, variables: list[Variable], constraints: list[Constraint],
-                 derivatives: bool = True):
+                 derivatives: bool = True, load_mounts: list | None = None):
         self.mount, self.variables, self.constraints = mount, variables, constraints
         self.derivatives = derivatives
+        self.load_mounts = load_mounts or []       # (LoadCase, LinearMount) of the margin constraints
         self.items = [item.name for item in mount.case.excitations]
         self.evaluations = 0
         self._cache: dict = {}
@@ -330,6 +335,18 @@ class _Problem:
                 measures.append((label, value, rule.text))
                 g.append(slack)
                 dg.append(d_slack * slope if self.derivatives else np.zeros(len(x)))
+        for rule in (rule for rule in self.constraints if rule.quantity == LINK_MARGIN):
+            for load_case, load_mount in self.load_mounts:
+                if self.derivatives:
+                    s = design_sensitivity(load_mount, values)
+                    solution, d_state = s.solutions[0], np.array([d for _, d in s.changes[0]]).T
+                else:
+                    solution = load_mount.solve_items(design_case(load_mount, values))[0]
+                    d_state = np.zeros((len(solution.prepared.expansion.state), 0))
+                for margin in link_margins(solution, d_state, load_case.factor_of_safety):
+                    measures.append((f"link margin ({load_case.name}, {margin.link})", margin.margin, rule.text))
+                    g.append(margin.margin - rule.limit - MARGIN)
+                    dg.append(margin.gradient * slope if self.derivatives else np.zeros(len(x)))
         return _Point(x, values, answer, t, dt, measures, np.array(g), np.array(dg).reshape(len(g), len(x)),
                       rows, peaks)
 
@@ -647,7 +664,8 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
     banded = band_case(case, bands, band_points) if bands else case
     mount = mount or LinearMount.prepare(banded)
-    problem = _Problem(mount, chosen, rules)
+    load_mounts = load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
+    problem = _Problem(mount, chosen, rules, load_mounts=load_mounts)
     from workbook.studies.parametric import parameter_value
 
     before_values = {v.name: parameter_value(mount.case, v.name) for v in chosen}
@@ -750,7 +768,8 @@ def pareto(case: Case, variables: dict, objectives: tuple = ("worst", "displacem
     chosen = [variable(name, *bounds) for name, bounds in variables.items()]
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
     mount = mount or LinearMount.prepare(case)
-    problem = _Problem(mount, chosen, rules, derivatives=False)
+    load_mounts = load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
+    problem = _Problem(mount, chosen, rules, derivatives=False, load_mounts=load_mounts)
 
     rows = len(problem.point(np.full(len(chosen), 0.5)).g)     # constraint rows (a fatigue rule: one per link)
 
