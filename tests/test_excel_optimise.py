@@ -42,6 +42,7 @@ ROWS = [{"kind": "variable", "name": "hinge_stiffness/front", "low": 5e6, "high"
         {"kind": "variable", "name": "hinge_loss_factor/all", "low": 0.01, "high": 0.2},
         {"kind": "constraint", "name": "displacement", "value": 0.002},
         {"kind": "constraint", "name": "fatigue", "value": 2},
+        {"kind": "constraint", "name": "margin", "value": 0},
         {"kind": "constraint", "name": "modes_outside", "low": 50, "high": 70},
         {"kind": "band", "name": "LP rotor", "low": 40, "high": 62},
         {"kind": "objective", "name": "weighted"}, {"kind": "starts", "value": 2}]
@@ -51,7 +52,7 @@ def test_the_sheet_reads_into_the_problem(tmp_path):
     sheet = read_workbook(_with_sheet(copy_reference(tmp_path), ROWS)).optimise
     assert sheet.variables == {"hinge_stiffness/front": (5e6, 2e8), "hinge_loss_factor/all": (0.01, 0.2)}
     assert sheet.constraints == (Constraint("displacement", 0.002), Constraint("fatigue", 2.0),
-                                 Constraint("modes_outside", (50.0, 70.0)))
+                                 Constraint("margin", 0.0), Constraint("modes_outside", (50.0, 70.0)))
     assert sheet.bands == {"LP rotor": (40.0, 62.0)}
     assert (sheet.objective, sheet.starts) == ("weighted", 2)
     assert read_workbook(copy_reference(tmp_path, "plain.xlsx")).optimise is None

@@ -42,8 +42,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="worst: the worst T over runs and directions, dB (default); weighted: the mean of T")
     parser.add_argument("--constraint", action="append", default=[], metavar="C",
                         help="displacement<=M, sag<=M (the engine CG's static displacement under the preload), "
-                             "rotation<=RAD, modes_outside=LOW:HIGH (Hz), or fatigue>=N (every link's lowest "
-                             "Goodman factor); repeatable")
+                             "rotation<=RAD, modes_outside=LOW:HIGH (Hz), fatigue>=N (every link's lowest "
+                             "Goodman factor) or margin>=M (every link's margin of safety under the case's limit "
+                             "load cases); repeatable")
     parser.add_argument("--band", action="append", default=[], metavar="EXCITATION=LOW:HIGH",
                         help="a rotor's speed band, Hz (idle to red line): its T judged over the band "
                              "(e.g. 'LP rotor=40:62'); repeatable")

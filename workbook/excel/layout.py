@@ -404,10 +404,11 @@ OPTIMISE = Table("Optimise", optional=True,
            required=True, help="what the row gives"),
     Column("name", "name", "text",
            help="variable: a study parameter (e.g. hinge_stiffness/front); constraint: displacement, sag, rotation, "
-                "fatigue or modes_outside; band: a rotor excitation; objective: worst or weighted"),
+                "fatigue, margin or modes_outside; band: a rotor excitation; objective: worst or weighted"),
     _num("low", "low", help="variable, band or modes_outside: the range's lower end, SI units (N/m, Hz)"),
     _num("high", "high", help="variable, band or modes_outside: the range's upper end, SI units"),
-    _num("value", "value", help="constraint: its limit (m, rad, or the fatigue factor); starts: SLSQP starts"),
+    _num("value", "value", help="constraint: its limit (m, rad, the fatigue factor or the margin of safety); "
+                                "starts: SLSQP starts"),
 ))
 
 #: The input tables in sheet order.

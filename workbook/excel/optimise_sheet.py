@@ -5,7 +5,8 @@ One row per item (:data:`~workbook.excel.layout.OPTIMISE`), SI units:
 - ``variable``: a study parameter name with its range (low, high);
 - ``constraint``: ``displacement``, ``sag`` or ``rotation`` (value: the
   upper limit, m or rad), ``fatigue`` (value: the lowest Goodman factor
-  allowed) or ``modes_outside`` (low, high: the band, Hz);
+  allowed), ``margin`` (value: the lowest margin of safety under the load
+  cases) or ``modes_outside`` (low, high: the band, Hz);
 - ``band``: a rotor excitation's speed band (low, high, Hz);
 - ``objective``: ``worst`` or ``weighted``; ``starts``: the SLSQP starts.
 
@@ -55,7 +56,7 @@ def _expected(error: InputError) -> str:
 def _constraint_text(name: str, record: Record) -> str:
     if name == "modes_outside":
         return f"{name}={record.get('low')}:{record.get('high')}"
-    return f"{name}{'>=' if name == 'fatigue' else '<='}{record.get('value')}"
+    return f"{name}{'>=' if name in ('fatigue', 'margin') else '<='}{record.get('value')}"
 
 
 def read_optimise_sheet(reader, records: list[Record], case: Case) -> OptimiseSheet | None:
