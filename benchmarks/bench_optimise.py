@@ -50,6 +50,9 @@ def main(starts: int = 2, points: int = 13) -> None:
     for name, value in rows:
         print(f"{name:<44}{value:>14}")
     print("active: " + ("; ".join(active) or "none"))
+    for end in result.starts:
+        print(f"start {end['start']}: worst T {end['objective']:.3f} dB, {end['iterations']} SLSQP iterations, "
+              f"{end['message']}")
     print(table.to_string(float_format=lambda v: f"{v:.5g}"))
     print(f"load: {open('/proc/loadavg').read().split()[0]}")
 

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from workbook.errors import InputError
-from workbook.model.case import SINGLE_FREQUENCY_KINDS, Case, Sweep
+from workbook.model.case import SINGLE_FREQUENCY_KINDS, Case, Imbalance, Sweep
 
 if TYPE_CHECKING:     # the linear mount loads the scene's modules: imported where a band is answered
     from workbook.design.linear_mount import ItemSolution
@@ -88,15 +88,14 @@ def with_frequencies(case: Case, added: dict) -> Case:
     return dataclasses.replace(case, excitations=tuple(excitations))
 
 
-def _transmissibility(solution: ItemSolution, excitation, pylon: list) -> np.ndarray:
-    """T per direction of one excitation, shape (3,)."""
+def _transmissibility(solution: ItemSolution, load: np.ndarray, frequency: float, pylon: list) -> np.ndarray:
+    """T per direction at *frequency* (Hz) of the generalised force *load* per N of excitation, shape (3,)."""
     import scipy.linalg as sla
 
     model = solution.model
-    omega = 2 * np.pi * excitation.frequency
-    motion = sla.solve(model.dynamic(omega), model.load(excitation), check_finite=False)
-    forces = (model.output(omega) @ motion).reshape(-1, 3)
-    return np.abs(forces[pylon].sum(axis=0)) / excitation.force_amplitude
+    omega = 2 * np.pi * frequency
+    motion = sla.solve(model.dynamic(omega), load, check_finite=False)
+    return np.abs((model.output(omega) @ motion).reshape(-1, 3)[pylon].sum(axis=0))
 
 
 def band_peaks(item: Sweep, solution: ItemSolution, pylon: list, grid: np.ndarray) -> np.ndarray:
@@ -125,10 +124,17 @@ def band_peaks(item: Sweep, solution: ItemSolution, pylon: list, grid: np.ndarra
 
     solved: dict = {}
 
+    def load(f: float) -> np.ndarray:
+        """The load per N of excitation at *f*: one direction at every speed for a single force."""
+        excitation = dataclasses.replace(item.template, frequency_hz=f if varying else low, rpm=None)
+        return model.load(excitation) / excitation.force_amplitude
+
+    varying = isinstance(item.template, Imbalance)          # its planes' forces may grow unlike one another
+    fixed = load(low)
+
     def at(f: float) -> np.ndarray:
         if f not in solved:
-            solved[f] = _transmissibility(solution, dataclasses.replace(item.template, frequency_hz=f, rpm=None),
-                                          pylon)
+            solved[f] = _transmissibility(solution, load(f) if varying else fixed, f, pylon)
         return solved[f]
 
     peaks = np.zeros(3)

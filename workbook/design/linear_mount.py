@@ -108,9 +108,11 @@ class StressedLink:
         With its stress shapes.
     rotation : ndarray, shape (3, 3)
         Link frame to global.
-    component_shapes : ndarray, shape (6 n, modes)
-        The stress shapes with rows (component, node): ``(component_shapes @ Q).reshape(6, -1).T``
-        is the stress of the columns of Q, a Fortran-ordered (n K, 6), quick to read by component.
+    component_shapes : ndarray, shape (6, n, modes)
+        The stress shapes component-major: ``(component_shapes[:, nodes] @ Q).reshape(6, -1).T`` is the
+        stress at *nodes* of the columns of Q, a Fortran-ordered (nodes K, 6), quick to read by component.
+    node_norms : ndarray, shape (n,)
+        Each node's spectral norm of its stress shapes (6, modes): ``|S_i q| <= node_norms[i] |q|``, Pa.
     """
 
     link: Link
@@ -118,6 +120,7 @@ class StressedLink:
     reduced: ReducedLink = field(repr=False)
     rotation: np.ndarray = field(repr=False)
     component_shapes: np.ndarray = field(repr=False)
+    node_norms: np.ndarray = field(repr=False)
 
 
 @dataclass
@@ -378,7 +381,7 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
             shapes = reduced.stress_modes
             stressed[link.name] = StressedLink(
                 link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
-                np.ascontiguousarray(shapes.transpose(1, 0, 2)).reshape(-1, shapes.shape[2]))
+                np.ascontiguousarray(shapes.transpose(1, 0, 2)), np.linalg.norm(shapes, ord=2, axis=(1, 2)))
     return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine, points, warnings,
                  prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed)
 

@@ -23,6 +23,9 @@ from workbook.design.linear_mount import ItemSolution, StressedLink
 
 __all__ = ["FatigueFactor", "link_fatigue_factors", "VON_MISES_FORM"]
 
+#: Nodes of the largest bound on their load whose factors are found first; a node whose bound is below the
+#: largest load among them cannot hold the lowest factor, and is left out.
+CANDIDATES = 64
 #: ``a @ VON_MISES_FORM @ b`` is the von Mises bilinear form of two Voigt stresses (its square for a == b), Pa^2.
 VON_MISES_FORM = np.block([[np.full((3, 3), -0.5) + 1.5 * np.eye(3), np.zeros((3, 3))],
                            [np.zeros((3, 3)), 3 * np.eye(3)]])
@@ -46,6 +49,15 @@ class FatigueFactor:
     goodman: float
     gradient: np.ndarray
     excitation: int
+
+
+def _goodman(stressed: StressedLink, nodes: np.ndarray, phasors: np.ndarray, mean: np.ndarray) -> np.ndarray:
+    """The Goodman factors at *nodes* of the link's modal phasors (modes, K) on its signed mean stress (n,),
+    shape (nodes, K)."""
+    material = stressed.link.model.material
+    amplitudes = (stressed.component_shapes[:, nodes] @ phasors).reshape(6, -1).T
+    alternating = alternating_von_mises(amplitudes).reshape(len(nodes), -1)
+    return goodman_factor(alternating, mean[nodes, None], material.endurance_strength, material.ultimate_strength)
 
 
 def _coordinates(solution: ItemSolution, stressed: StressedLink) -> np.ndarray:
@@ -103,14 +115,19 @@ def link_fatigue_factors(solution: ItemSolution, d_state: np.ndarray, motions: l
         mean_q = state[stressed.coordinates]
         mean = signed_von_mises(state_stress(stressed.reduced, mean_q))
         phasors = np.array([motion[rows] for motion, _ in motions]).T                  # (modes, excitations)
-        nodes = stressed.reduced.stress_modes.shape[0]
-        # (6 n, K) with the component slowest: its transpose is a Fortran-ordered (n K, 6), read by column fast
-        amplitudes = (stressed.component_shapes @ phasors).reshape(6, -1).T
-        goodman = goodman_factor(alternating_von_mises(amplitudes).reshape(nodes, -1), mean[:, None],
-                                 material.endurance_strength, material.ultimate_strength)     # (nodes, excitations)
-        node, k = np.unravel_index(int(np.argmin(goodman)), goodman.shape)
+        tensile = np.maximum(mean, 0.0) / material.ultimate_strength
+
+        # the largest load sigma_a / S_e + sigma_m / S_u a node can have: sigma_a <= sqrt(3) |S_i q_hat|
+        bound = (np.sqrt(3) * stressed.node_norms * np.linalg.norm(phasors, axis=0).max()
+                 / material.endurance_strength + tensile)
+        likely = np.argsort(bound)[-min(len(bound), CANDIDATES):]
+        lowest = _goodman(stressed, likely, phasors, mean).min()
+        nodes = np.flatnonzero(bound >= 1 / lowest * (1 - 1e-12))          # only these can reach it
+        factors_at = _goodman(stressed, nodes, phasors, mean)
+        at, k = np.unravel_index(int(np.argmin(factors_at)), factors_at.shape)
+        node = nodes[at]
         motion, d_motion = motions[k]
         gradient = _factor_change(stressed, int(node), mean_q, d_state[stressed.coordinates], motion[rows],
                                   d_motion[rows])
-        factors.append(FatigueFactor(name, float(goodman[node, k]), gradient, int(k)))
+        factors.append(FatigueFactor(name, float(factors_at[at, k]), gradient, int(k)))
     return factors

@@ -155,7 +155,7 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     start = time.perf_counter()
     case = design_case(mount, values)
     solutions = mount.solve_items(case)
-    changes = [_parameter_change(mount, values, name) for name in values]
+    changes = [_parameter_change(mount, values, name, case) for name in values]
     answer = mount.answer(case, solutions, start)
     runs, t, hinges = _answers(answer, mount.channels)
     gradient = np.zeros(t.shape + (len(values),))
@@ -214,13 +214,14 @@ def amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
     return np.divide(np.real(np.conj(phasor) * change), size, out=np.zeros(shape), where=size > 0)
 
 
-def _parameter_change(mount: LinearMount, values: dict, name: str) -> tuple[ChannelSprings, float]:
-    """d(springs)/dp and d(engine mass)/dp: exact forward differences, both being linear in each parameter."""
+def _parameter_change(mount: LinearMount, values: dict, name: str, base: Case) -> tuple[ChannelSprings, float]:
+    """d(springs)/dp and d(engine mass)/dp: exact forward differences from *base* (the design with *values*),
+    both being linear in each parameter."""
     from workbook.design.linear_mount import channel_springs
 
     value = values[name]
     step = 1e-3 * (abs(value) or 1.0)
-    sides = [design_case(mount, {**values, name: value + step}), design_case(mount, values)]
+    sides = [design_case(mount, {**values, name: value + step}), base]
     springs = [channel_springs(case, mount.channels, mount.frames) for case in sides]
     change = ChannelSprings(*((a - b) / step for a, b in zip(dataclasses.astuple(springs[0]),
                                                              dataclasses.astuple(springs[1]), strict=True)))
