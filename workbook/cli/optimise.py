@@ -1,5 +1,5 @@
 """``mountwb optimise [CASE] [--vary NAME=LOW:HIGH ...] [--objective worst|weighted] [--constraint C ...]
-[--band EXCITATION=LOW:HIGH ...] [--starts N] [--pareto [A,B]] [--output DIR] [--json]``.
+[--band EXCITATION=LOW:HIGH ...] [--starts N] [--iterations N] [--pareto [A,B]] [--output DIR] [--json]``.
 
 Without ``--vary`` the problem is the case workbook's Optimise sheet
 (:mod:`workbook.excel.optimise_sheet`), the options' constraints and bands
@@ -53,6 +53,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                              "are found as well")
     parser.add_argument("--starts", type=int, help="SLSQP starts: the case's design, then a Latin "
                         "hypercube (default 3)")
+    parser.add_argument("--iterations", type=int, default=60, metavar="N",
+                        help="SLSQP iterations per start at most (default 60)")
     parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
                         help="also the NSGA-II front of two objectives (default worst,displacement; each worst, "
                              "worst/RUN, displacement, sag or rotation)")
@@ -96,7 +98,7 @@ def run(args) -> int:
     bands = {**sheet.bands, **dict(band_text(text) for text in args.band)}
     objective = args.objective or sheet.objective or "worst"
     result = optimise(case, variables, objective=objective, constraints=[*sheet.constraints, *args.constraint],
-                      starts=args.starts or sheet.starts or 3, pareto_objectives=objectives,
+                      starts=args.starts or sheet.starts or 3, maxiter=args.iterations, pareto_objectives=objectives,
                       population=args.population, generations=args.generations, bands=bands,
                       band_points=args.band_points)
     written = result.write(args.output) if args.output else []
