@@ -57,7 +57,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="SLSQP iterations per start at most (default 60)")
     parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
                         help="also the NSGA-II front of two objectives (default worst,displacement; each worst, "
-                             "worst/RUN, displacement, sag or rotation)")
+                             "worst/EXCITATION, displacement, sag or rotation)")
     parser.add_argument("--population", type=int, default=50, help="--pareto: designs per generation (default 50)")
     parser.add_argument("--generations", type=int, default=20, help="--pareto: generations (default 20)")
     parser.add_argument("--output", metavar="DIR", help="write the optimised case, the table, history and plot here")

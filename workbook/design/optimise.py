@@ -13,8 +13,14 @@ objective and constraints:
   its length, ``sag``: downwards, m), its static rotation (``rotation``: the
   length of its Rxyz angles, rad), and mounted modes outside a band
   (``modes_outside=LOW:HIGH``, Hz: ``((f - c) / h)^2 >= 1`` for the band's
-  centre c and half-width h, the mounted mode nearest the band counting);
-  every variable within its range.
+  centre c and half-width h, the mounted mode nearest the band counting),
+  every link's lowest Goodman fatigue factor over each excitation's points
+  (``fatigue>=N``, :mod:`workbook.design.link_fatigue`) and its margin of
+  safety under each limit load case (``margin>=M``,
+  :mod:`workbook.design.link_margins`); every variable within its range;
+- speed bands (*bands*, :mod:`workbook.design.bands`): a rotor's excitation
+  a sweep over its band, the worst of each band and direction searched
+  between its points, each such peak one more row of the objective.
 
 :func:`optimise` runs SLSQP (SciPy) from several starts (the case's own
 design, then a Latin hypercube) on variables scaled to [0, 1], on a
