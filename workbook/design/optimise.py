@@ -745,7 +745,7 @@ def pareto(case: Case, variables: dict, objectives: tuple = ("worst", "displacem
     Parameters
     ----------
     objectives : (str, str)
-        Each ``worst`` (worst T over runs and directions, dB), ``worst/RUN`` (of one run), or one of
+        Each ``worst`` (worst T over runs and directions, dB), ``worst/EXCITATION`` (of one excitation item, a band's peaks included), or one of
         :data:`QUANTITIES` (the largest over the excitation items).
     constraints
         As :func:`optimise`; ``modes_outside`` ones cost a modal solve each.
