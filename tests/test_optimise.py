@@ -58,7 +58,8 @@ def test_constraint_and_variable_texts():
     assert opt.constraint("sag <= 0.005") == opt.Constraint("sag", 0.005)
     assert opt.constraint("modes_outside=50:70") == opt.Constraint("modes_outside", (50.0, 70.0))
     assert opt.constraint("displacement<=2e-3").text == "displacement<=0.002"
-    for bad in ("sag<0.005", "modes_outside=70:50", "weight<=3", "sag<=-1"):
+    assert opt.constraint("fatigue >= 2").text == "fatigue>=2" and opt.constraint("margin>=0").limit == 0.0
+    for bad in ("sag<0.005", "modes_outside=70:50", "weight<=3", "sag<=-1", "fatigue>=0", "margin>=-1", "fatigue<=2"):
         with pytest.raises(InputError, match="expected"):
             opt.constraint(bad)
     with pytest.raises(InputError, match="new link reduction"):

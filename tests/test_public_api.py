@@ -26,7 +26,8 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.channel_set", "workbook.design.expansion",
     "workbook.design.kinematics", "workbook.design.sensitivity",
-    "workbook.design.linear_mount", "workbook.design.optimise",
+    "workbook.design.linear_mount", "workbook.design.optimise", "workbook.design.bands", "workbook.design.link_fatigue",
+    "workbook.design.link_margins",
     "workbook.answers", "workbook.answers.amplitude", "workbook.answers.hinge_curves", "workbook.answers.isolation",
     "workbook.answers.link_stiffness",
     "workbook.answers.link_table", "workbook.answers.model_card", "workbook.answers.results",
@@ -37,7 +38,7 @@ INTERNAL_MODULES = (
     "workbook.cli.params", "workbook.cli.uq",
     "workbook.cli.rig", "workbook.cli.run", "workbook.cli.run_up", "workbook.cli.study", "workbook.cli.workbooks",
     "workbook.excel", "workbook.excel.execute", "workbook.excel.files", "workbook.excel.impedance_sheet",
-    "workbook.excel.layout", "workbook.excel.loads_sheet",
+    "workbook.excel.layout", "workbook.excel.loads_sheet", "workbook.excel.optimise_sheet",
     "workbook.excel.fatigue_sheet", "workbook.excel.pictures", "workbook.excel.reader", "workbook.excel.report",
     "workbook.excel.rig_points",
     "workbook.excel.runs", "workbook.excel.sheets", "workbook.excel.styling", "workbook.excel.template",

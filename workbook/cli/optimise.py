@@ -1,5 +1,9 @@
-"""``mountwb optimise [CASE] --vary NAME=LOW:HIGH ... [--objective worst|weighted] [--constraint C ...]
-[--starts N] [--pareto [A,B]] [--output DIR] [--json]``.
+"""``mountwb optimise [CASE] [--vary NAME=LOW:HIGH ...] [--objective worst|weighted] [--constraint C ...]
+[--band EXCITATION=LOW:HIGH ...] [--starts N] [--iterations N] [--pareto [A,B]] [--output DIR] [--json]``.
+
+Without ``--vary`` the problem is the case workbook's Optimise sheet
+(:mod:`workbook.excel.optimise_sheet`), the options' constraints and bands
+added to it, their objective and starts replacing its.
 
 Optimises the case's design on the fast linear mount
 (:mod:`workbook.design.optimise`): prints the before/after table (the
@@ -13,11 +17,15 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
-from workbook.cli.loading import load_case
+from workbook.cli.loading import is_workbook, load_case
 from workbook.cli.params import parse_ranges
+from workbook.design.bands import BAND_POINTS, band_text
 from workbook.errors import UsageError
+
+if TYPE_CHECKING:
+    from workbook.excel.optimise_sheet import OptimiseSheet
 
 __all__ = ["arguments"]
 
@@ -25,20 +33,31 @@ __all__ = ["arguments"]
 def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     parser.add_argument("--run", metavar="R", help="case workbook: take the case of this row of the Runs sheet")
-    parser.add_argument("--vary", action="append", metavar="NAME=LOW:HIGH", required=True,
+    parser.add_argument("--vary", action="append", default=[], metavar="NAME=LOW:HIGH",
                         help="a design variable and its range, SI units (a study parameter: hinge_stiffness, "
                              "hinge_loss_factor, hinge_damping, per group and direction as "
-                             "hinge_stiffness/front/axial; transducer_stiffness; engine_mass); repeatable")
-    parser.add_argument("--objective", choices=("worst", "weighted"), default="worst",
+                             "hinge_stiffness/front/axial; transducer_stiffness; engine_mass); repeatable; "
+                             "none: the problem of the case workbook's Optimise sheet")
+    parser.add_argument("--objective", choices=("worst", "weighted"),
                         help="worst: the worst T over runs and directions, dB (default); weighted: the mean of T")
     parser.add_argument("--constraint", action="append", default=[], metavar="C",
                         help="displacement<=M, sag<=M (the engine CG's static displacement under the preload), "
-                             "rotation<=RAD, or modes_outside=LOW:HIGH (Hz); repeatable")
-    parser.add_argument("--starts", type=int, default=3, help="SLSQP starts: the case's design, then a Latin "
+                             "rotation<=RAD, modes_outside=LOW:HIGH (Hz), fatigue>=N (every link's lowest "
+                             "Goodman factor) or margin>=M (every link's margin of safety under the case's limit "
+                             "load cases); repeatable")
+    parser.add_argument("--band", action="append", default=[], metavar="EXCITATION=LOW:HIGH",
+                        help="a rotor's speed band, Hz (idle to red line): its T judged over the band "
+                             "(e.g. 'LP rotor=40:62'); repeatable")
+    parser.add_argument("--band-points", type=int, default=BAND_POINTS,
+                        help=f"speeds per band, evenly spaced (default {BAND_POINTS}); the peaks between them "
+                             "are found as well")
+    parser.add_argument("--starts", type=int, help="SLSQP starts: the case's design, then a Latin "
                         "hypercube (default 3)")
+    parser.add_argument("--iterations", type=int, default=60, metavar="N",
+                        help="SLSQP iterations per start at most (default 60)")
     parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
                         help="also the NSGA-II front of two objectives (default worst,displacement; each worst, "
-                             "worst/RUN, displacement, sag or rotation)")
+                             "worst/EXCITATION, displacement, sag or rotation)")
     parser.add_argument("--population", type=int, default=50, help="--pareto: designs per generation (default 50)")
     parser.add_argument("--generations", type=int, default=20, help="--pareto: generations (default 20)")
     parser.add_argument("--output", metavar="DIR", help="write the optimised case, the table, history and plot here")
@@ -46,20 +65,46 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     return run
 
 
+def _sheet(path: str | None) -> "OptimiseSheet":
+    """The Optimise sheet of the case workbook *path*.
+
+    Raises
+    ------
+    UsageError
+        *path* is no case workbook, or its Optimise sheet gives no variable.
+    """
+    from workbook.excel.reader import read_workbook
+
+    if path is None or not is_workbook(path):
+        raise UsageError("give the design variables as --vary NAME=LOW:HIGH, or a case workbook whose Optimise "
+                         "sheet lists them")
+    sheet = read_workbook(path).optimise
+    if sheet is None or not sheet.variables:
+        raise UsageError(f"{path}: no --vary given and its Optimise sheet lists no variable (a row of kind "
+                         "'variable' with a name, low and high)")
+    return sheet
+
+
 def run(args) -> int:
     from workbook.design.optimise import optimise
+    from workbook.excel.optimise_sheet import OptimiseSheet
 
     objectives = tuple(args.pareto.split(",")) if args.pareto else None
     if objectives is not None and len(objectives) != 2:
         raise UsageError(f"--pareto {args.pareto!r}: expected two objectives A,B")
     case = load_case(args.case, run=args.run)
-    result = optimise(case, parse_ranges(args.vary), objective=args.objective, constraints=args.constraint,
-                      starts=args.starts, pareto_objectives=objectives, population=args.population,
-                      generations=args.generations)
+    sheet = _sheet(args.case) if not args.vary else OptimiseSheet()
+    variables = parse_ranges(args.vary) if args.vary else sheet.variables
+    bands = {**sheet.bands, **dict(band_text(text) for text in args.band)}
+    objective = args.objective or sheet.objective or "worst"
+    result = optimise(case, variables, objective=objective, constraints=[*sheet.constraints, *args.constraint],
+                      starts=args.starts or sheet.starts or 3, maxiter=args.iterations, pareto_objectives=objectives,
+                      population=args.population, generations=args.generations, bands=bands,
+                      band_points=args.band_points)
     written = result.write(args.output) if args.output else []
     if args.json:
         table = result.table.reset_index()
-        print(json.dumps({"case": case.name, "objective": args.objective, "values": result.values,
+        print(json.dumps({"case": case.name, "objective": objective, "values": result.values,
                           "table": table.to_dict(orient="records"), "starts": result.starts,
                           "evaluations": result.evaluations, "seconds": result.seconds,
                           "fast_difference": result.fast_difference, "written": [str(p) for p in written]},

@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.linalg as sla
@@ -38,12 +39,15 @@ from workbook.design.assembly import (
 )
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, UnstablePreloadError
-from workbook.model.case import Case, Engine, Gravity, Simultaneous, SingleFrequencyExcitation, Sweep
+from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.harmonic import point_phasors
 from workbook.solve.stages import link_warnings
 
-__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "channel_frames", "channel_springs"]
+if TYPE_CHECKING:
+    from flexbodies.reduced import ReducedLink
+
+__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_frames", "channel_springs"]
 
 
 def channel_frames(case: Case, channels: list[str]) -> np.ndarray:
@@ -91,6 +95,34 @@ class _FlexibleLink:
     stiffening: object = field(repr=False)   # flexbodies LinkStiffening
 
 
+@dataclass(frozen=True)
+class StressedLink:
+    """A flexible link whose stress the design evaluation recovers: ``sigma = S q`` of its modal coordinates.
+
+    Attributes
+    ----------
+    link : workbook.model.case.Link
+    coordinates : ndarray of int
+        Its modal coordinates among the item's full coordinates.
+    reduced : flexbodies.ReducedLink
+        With its stress shapes.
+    rotation : ndarray, shape (3, 3)
+        Link frame to global.
+    component_shapes : ndarray, shape (6, n, modes)
+        The stress shapes component-major: ``(component_shapes[:, nodes] @ Q).reshape(6, -1).T`` is the
+        stress at *nodes* of the columns of Q, a Fortran-ordered (nodes K, 6), quick to read by component.
+    node_norms : ndarray, shape (n,)
+        Each node's spectral norm of its stress shapes (6, modes): ``|S_i q| <= node_norms[i] |q|``, Pa.
+    """
+
+    link: Link
+    coordinates: np.ndarray
+    reduced: ReducedLink = field(repr=False)
+    rotation: np.ndarray = field(repr=False)
+    component_shapes: np.ndarray = field(repr=False)
+    node_norms: np.ndarray = field(repr=False)
+
+
 @dataclass
 class _Item:
     """One excitation item, prepared."""
@@ -108,6 +140,7 @@ class _Item:
     modes: list
     base_engine: Engine
     prepared_seconds: float
+    stressed: dict = field(default_factory=dict)     # name -> StressedLink, the links with stress shapes
 
 
 @dataclass(frozen=True)
@@ -341,8 +374,17 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
                 raise OutsideDesignModel(case.name, f"link {link.name!r}: modal damping on a stiffened link")
     engine = np.arange(scene.mbs.GetNodeODE2Index(scene.engine.node), scene.mbs.GetNodeODE2Index(scene.engine.node) + 6)
     warnings = link_warnings(case, scene.reduced)
+    stressed = {}
+    for link in case.links:
+        reduced = scene.reduced.get(link.name)
+        if case.link_is_flexible(link.name) and reduced is not None and reduced.stress_modes.size:
+            first = scene.mbs.GetNodeODE2Index(scene.links[link.name].nodes[1])
+            shapes = reduced.stress_modes
+            stressed[link.name] = StressedLink(
+                link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
+                np.ascontiguousarray(shapes.transpose(1, 0, 2)), np.linalg.norm(shapes, ord=2, axis=(1, 2)))
     return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine, points, warnings,
-                 prepared.modes, case.engine, seconds + time.perf_counter() - start)
+                 prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed)
 
 
 @dataclass(frozen=True)

@@ -13,8 +13,14 @@ objective and constraints:
   its length, ``sag``: downwards, m), its static rotation (``rotation``: the
   length of its Rxyz angles, rad), and mounted modes outside a band
   (``modes_outside=LOW:HIGH``, Hz: ``((f - c) / h)^2 >= 1`` for the band's
-  centre c and half-width h, the mounted mode nearest the band counting);
-  every variable within its range.
+  centre c and half-width h, the mounted mode nearest the band counting),
+  every link's lowest Goodman fatigue factor over each excitation's points
+  (``fatigue>=N``, :mod:`workbook.design.link_fatigue`) and its margin of
+  safety under each limit load case (``margin>=M``,
+  :mod:`workbook.design.link_margins`); every variable within its range;
+- speed bands (*bands*, :mod:`workbook.design.bands`): a rotor's excitation
+  a sweep over its band, the worst of each band and direction searched
+  between its points, each such peak one more row of the objective.
 
 :func:`optimise` runs SLSQP (SciPy) from several starts (the case's own
 design, then a Latin hypercube) on variables scaled to [0, 1], on a
@@ -38,12 +44,15 @@ from typing import Any
 import numpy as np
 import scipy.linalg as sla
 
-from workbook.design.linear_mount import DesignAnswer, LinearMount
-from workbook.design.sensitivity import design_case, design_sensitivity
+from workbook.design.bands import BAND_POINTS, band_case, band_peaks, with_frequencies
+from workbook.design.linear_mount import DesignAnswer, LinearMount, points_of
+from workbook.design.link_fatigue import link_fatigue_factors
+from workbook.design.link_margins import link_margins, load_case_mounts
+from workbook.design.sensitivity import amplitude_change, design_case, design_sensitivity, point_change
 from workbook.errors import InfeasibleProblem, InputError, SimulationError
-from workbook.model.case import DIRECTIONS, Case
+from workbook.model.case import DIRECTIONS, Case, Sweep
 
-__all__ = ["Variable", "Constraint", "constraint", "variable", "optimise", "pareto", "OptimisationResult",
+__all__ = ["Variable", "Constraint", "constraint", "variable", "variable_name", "optimise", "pareto", "OptimisationResult",
            "ParetoFront", "OBJECTIVES", "QUANTITIES", "MARGIN"]
 
 #: Objectives of :func:`optimise`.
@@ -52,6 +61,10 @@ OBJECTIVES = ("worst", "weighted")
 QUANTITIES = {"displacement": "m", "sag": "m", "rotation": "rad"}
 #: The band constraint's name.
 MODES_OUTSIDE = "modes_outside"
+#: The fatigue constraint's name: every link's lowest Goodman factor at least the limit.
+FATIGUE = "fatigue"
+#: The static margin constraint's name: every link's margin of safety under every limit load case at least the limit.
+LINK_MARGIN = "margin"
 #: Relative margin inside each stated limit the optimiser aims at, so that its optimum meets the limit.
 MARGIN = 1e-6
 #: A constraint whose normalised slack is below this is reported active.
@@ -94,6 +107,23 @@ class Variable:
         return self.value(x) * np.log(self.high / self.low) if self.log else self.high - self.low
 
 
+def variable_name(name: str) -> None:
+    """Check that *name* is a study parameter the fast path follows.
+
+    Raises
+    ------
+    InputError
+        An unknown name, or one that needs a new link reduction per design (``section_scale``).
+    """
+    from workbook.studies.parametric import parameter
+
+    parameter(name)
+    if name.partition("/")[0] not in _FAST:
+        raise InputError(f"variable {name!r}: the optimiser varies only what the fast linear mount follows "
+                         f"({', '.join(_FAST)}, per hinge group and direction); {name} needs a new preparation "
+                         "(section_scale: a new link reduction) per design: use 'mountwb study params' for it")
+
+
 def variable(name: str, low: float, high: float) -> Variable:
     """The variable *name* over [low, high].
 
@@ -103,13 +133,7 @@ def variable(name: str, low: float, high: float) -> Variable:
         A parameter the fast path cannot follow (``section_scale`` needs a
         new link reduction per design), an unknown name, or an empty range.
     """
-    from workbook.studies.parametric import parameter
-
-    parameter(name)
-    if name.partition("/")[0] not in _FAST:
-        raise InputError(f"variable {name!r}: the optimiser varies only what the fast linear mount follows "
-                         f"({', '.join(_FAST)}, per hinge group and direction); {name} needs a new preparation "
-                         "(section_scale: a new link reduction) per design: use 'mountwb study params' for it")
+    variable_name(name)
     if not (np.isfinite(low) and np.isfinite(high) and high > low):
         raise InputError(f"variable {name!r}: found the range {low:g}:{high:g}, expected LOW:HIGH with LOW < HIGH")
     if name.partition("/")[0] in _LOG and low < 0:
@@ -119,7 +143,8 @@ def variable(name: str, low: float, high: float) -> Variable:
 
 @dataclass(frozen=True)
 class Constraint:
-    """A constraint: ``quantity <= limit``, or mounted modes outside the band ``limit`` (low, high), Hz."""
+    """A constraint: ``quantity <= limit`` (``fatigue >= limit``), or mounted modes outside the band ``limit``
+    (low, high), Hz."""
 
     quantity: str
     limit: Any          # float, or (low, high) for a band
@@ -129,11 +154,15 @@ class Constraint:
         """As :func:`constraint` reads it."""
         if self.quantity == MODES_OUTSIDE:
             return f"{MODES_OUTSIDE}={self.limit[0]:g}:{self.limit[1]:g}"
+        if self.quantity in (FATIGUE, LINK_MARGIN):
+            return f"{self.quantity}>={self.limit:g}"
         return f"{self.quantity}<={self.limit:g}"
 
 
 def constraint(text: str) -> Constraint:
-    """Read a constraint: ``displacement<=M``, ``sag<=M``, ``rotation<=RAD`` or ``modes_outside=LOW:HIGH`` (Hz).
+    """Read a constraint: ``displacement<=M``, ``sag<=M``, ``rotation<=RAD``, ``modes_outside=LOW:HIGH`` (Hz)
+    ``fatigue>=N`` (every link's lowest Goodman factor over every excitation point, bands' peaks included)
+    or ``margin>=M`` (every link's margin of safety under every limit load case of the case).
 
     Raises
     ------
@@ -141,9 +170,12 @@ def constraint(text: str) -> Constraint:
         Naming the text and what is expected.
     """
     expected = (f"expected {', '.join(f'{q}<=VALUE ({u})' for q, u in QUANTITIES.items())} or "
-                f"{MODES_OUTSIDE}=LOW:HIGH (Hz)")
-    quantity, sign, rest = text.replace(" ", "").partition("<=")
+                f"{MODES_OUTSIDE}=LOW:HIGH (Hz), {FATIGUE}>=FACTOR or {LINK_MARGIN}>=MARGIN")
+    quantity, sign, rest = text.replace(" ", "").partition(">=")
     try:
+        if sign and quantity in (FATIGUE, LINK_MARGIN) and float(rest) > (0 if quantity == FATIGUE else -1):
+            return Constraint(quantity, float(rest))
+        quantity, sign, rest = text.replace(" ", "").partition("<=")
         if sign and quantity in QUANTITIES and float(rest) > 0:
             return Constraint(quantity, float(rest))
         quantity, sign, rest = text.replace(" ", "").partition("=")
@@ -168,6 +200,8 @@ class _Point:
     measures: list                  # per constraint row: (label, value, limit text)
     g: np.ndarray                   # normalised slack, >= 0 feasible
     dg: np.ndarray                  # (rows, n)
+    rows: list = field(default_factory=list)     # per row of t: its excitation item
+    peaks: dict = field(default_factory=dict)    # per band (sweep): its peaks' frequencies per direction, Hz
 
 
 def _mounted_modes(solution, changes) -> tuple[np.ndarray, np.ndarray]:
@@ -226,9 +260,10 @@ class _Problem:
     """The scaled problem, each design answered once (the last one kept)."""
 
     def __init__(self, mount: LinearMount, variables: list[Variable], constraints: list[Constraint],
-                 derivatives: bool = True):
+                 derivatives: bool = True, load_mounts: list | None = None):
         self.mount, self.variables, self.constraints = mount, variables, constraints
         self.derivatives = derivatives
+        self.load_mounts = load_mounts or []       # (LoadCase, LinearMount) of the margin constraints
         self.items = [item.name for item in mount.case.excitations]
         self.evaluations = 0
         self._cache: dict = {}
@@ -248,30 +283,78 @@ class _Problem:
     def answer(self, values: dict, x: np.ndarray, slope: np.ndarray) -> _Point:
         """The design with the parameter *values*; derivatives per scaled variable (*slope*: d value / d x)."""
         self.evaluations += 1
+        fatigue = any(rule.quantity == FATIGUE for rule in self.constraints)
+        excitations = self.mount.case.excitations           # a design changes none of them
         if self.derivatives:
             s = design_sensitivity(self.mount, values)
-            answer, t, dt = s.answer, s.transmissibility, s.gradient * slope
-            statics = [(solution.engine_static, np.array([d[solution.prepared.engine] for _, d in changes]
-                                                          ).T.reshape(6, -1))
-                       for solution, changes in zip(s.solutions, s.changes, strict=True)]
-            pairs = list(zip(s.solutions, s.changes, strict=True))
+            answer, solutions, changes, motions = s.answer, s.solutions, s.changes, s.motions
+            t, dt = s.transmissibility, s.gradient * slope
         else:
+            begin = time.perf_counter()
             case = design_case(self.mount, values)
-            answer = self.mount.evaluate(case)
+            solutions = self.mount.solve_items(case)
+            answer = self.mount.answer(case, solutions, begin)
+            changes = [[] for _ in solutions]
             t = np.array([run.transmissibility for run in answer.result.runs])
             dt = np.zeros(t.shape + (len(x),))
-            statics = [(answer.engine_static[item], np.zeros((6, 0))) for item in self.items]
-            pairs = [(solution, []) for solution in self.mount.solve_items(case)] \
-                if any(rule.quantity == MODES_OUTSIDE for rule in self.constraints) else []
-        modes = [_mounted_modes(solution, changes) for solution, changes in pairs]
+            motions = [point_change(solution, [], excitation)[:2] if fatigue else None
+                       for item, solution in zip(excitations, solutions, strict=True)
+                       for excitation in points_of(item)]
+        pylon = [self.mount.channels.index(name) for name in self.mount.pylon]
+        rows = [item.name for item in excitations for _ in points_of(item)]
+        extra_t, extra_dt, peaks = [], [], {}
+        item_motions = []
+        row = 0
+        for item, solution, item_changes in zip(excitations, solutions, changes, strict=True):
+            count = len(points_of(item))
+            item_motions.append(list(motions[row:row + count]))
+            models = [model for model, _ in item_changes]
+            if isinstance(item, Sweep) and count > 1:
+                peaks[item.name] = band_peaks(item, solution, pylon, t[row:row + count])
+                for frequency in peaks[item.name]:
+                    excitation = dataclasses.replace(item.template, frequency_hz=float(frequency), rpm=None)
+                    motion, d_motion, forces, d_forces = point_change(solution, models, excitation)
+                    force, d_force = forces[pylon].sum(axis=0), d_forces[pylon].sum(axis=0)
+                    extra_t.append(np.abs(force) / excitation.force_amplitude)
+                    extra_dt.append(amplitude_change(force[:, None], d_force) / excitation.force_amplitude * slope
+                                    if self.derivatives else np.zeros((3, len(x))))
+                    item_motions[-1].append((motion, d_motion))
+                    rows.append(item.name)
+            row += count
+        if extra_t:
+            t, dt = np.vstack([t, extra_t]), np.concatenate([dt, extra_dt])
+        modes = [_mounted_modes(solution, item_changes) for solution, item_changes in zip(solutions, changes, strict=True)] \
+            if any(rule.quantity == MODES_OUTSIDE for rule in self.constraints) else []
         measures, g, dg = [], [], []
-        for k, (item, (static, d_static)) in enumerate(zip(self.items, statics, strict=True)):
+        for k, (name, solution) in enumerate(zip(self.items, solutions, strict=True)):
+            d_state = np.array([d for _, d in changes[k]]).T.reshape(len(solution.prepared.expansion.state), -1)
+            static, d_static = solution.engine_static, d_state[solution.prepared.engine]
             for rule in self.constraints:
-                label, value, slack, d_slack = _measure(item, rule, static, d_static, modes[k] if modes else None)
+                if rule.quantity == FATIGUE:
+                    for factor in link_fatigue_factors(solution, d_state, item_motions[k]):
+                        measures.append((f"fatigue factor, Goodman ({name}, {factor.link})", factor.goodman,
+                                         rule.text))
+                        g.append((factor.goodman - rule.limit * (1 + MARGIN)) / rule.limit)
+                        dg.append(factor.gradient * slope / rule.limit if self.derivatives else np.zeros(len(x)))
+                    continue
+                label, value, slack, d_slack = _measure(name, rule, static, d_static, modes[k] if modes else None)
                 measures.append((label, value, rule.text))
                 g.append(slack)
                 dg.append(d_slack * slope if self.derivatives else np.zeros(len(x)))
-        return _Point(x, values, answer, t, dt, measures, np.array(g), np.array(dg).reshape(len(g), len(x)))
+        for rule in (rule for rule in self.constraints if rule.quantity == LINK_MARGIN):
+            for load_case, load_mount in self.load_mounts:
+                if self.derivatives:
+                    s = design_sensitivity(load_mount, values)
+                    solution, d_state = s.solutions[0], np.array([d for _, d in s.changes[0]]).T
+                else:
+                    solution = load_mount.solve_items(design_case(load_mount, values))[0]
+                    d_state = np.zeros((len(solution.prepared.expansion.state), 0))
+                for margin in link_margins(solution, d_state, load_case.factor_of_safety):
+                    measures.append((f"link margin ({load_case.name}, {margin.link})", margin.margin, rule.text))
+                    g.append(margin.margin - rule.limit - MARGIN)
+                    dg.append(margin.gradient * slope if self.derivatives else np.zeros(len(x)))
+        return _Point(x, values, answer, t, dt, measures, np.array(g), np.array(dg).reshape(len(g), len(x)),
+                      rows, peaks)
 
     def violation(self, point: _Point) -> float:
         """The largest normalised violation (0: feasible)."""
@@ -489,13 +572,22 @@ def _least_violation(problem: _Problem, x0: np.ndarray) -> np.ndarray:
     return minimize(violation, x0, jac=True, method="L-BFGS-B", bounds=[(0.0, 1.0)] * len(x0)).x
 
 
-def _table(problem: _Problem, kind: str, weights: np.ndarray, before: _Point, after: _Point, runs: list):
+def _worst(rows: list, t: np.ndarray) -> dict:
+    """The worst T per excitation item and direction (over a band's points and peaks)."""
+    items = np.array(rows)
+    return {(item, d): float(t[items == item, k].max()) for item in dict.fromkeys(rows)
+            for k, d in enumerate(DIRECTIONS)}
+
+
+def _table(problem: _Problem, kind: str, weights: np.ndarray, before: _Point, after: _Point, exact: tuple):
+    """Before and after; the T rows (the worst of each excitation item and direction) of *after* from *exact*
+    (rows, T): the pipeline's run of the written optimum."""
     import pandas as pd
 
     rows = [("objective", "worst T (dB)" if kind == "worst" else "weighted mean T",
              _objective_value(kind, weights, before), _objective_value(kind, weights, after), "", "")]
-    for run, t_before, t_after in zip(runs, before.t, after.t, strict=True):
-        rows += [("T", f"{run} {d}", tb, ta, "", "") for d, tb, ta in zip(DIRECTIONS, t_before, t_after, strict=True)]
+    worst_before, worst_after = _worst(before.rows, before.t), _worst(*exact)
+    rows += [("T", f"{item} {d}", value, worst_after[item, d], "", "") for (item, d), value in worst_before.items()]
     for (label, value_before, limit), (_, value_after, _), slack in zip(before.measures, after.measures, after.g,
                                                                          strict=True):
         rows.append(("constraint", label, value_before, value_after, limit, "active" if slack <= ACTIVE else ""))
@@ -517,7 +609,8 @@ def _weights(weights, runs: int) -> np.ndarray:
 
 def optimise(case: Case, variables: dict, objective: str = "worst", constraints=(), starts: int = 4,
              weights=None, seed: int = 0, maxiter: int = 60, pareto_objectives: tuple | None = None,
-             population: int = 50, generations: int = 20, mount: LinearMount | None = None) -> OptimisationResult:
+             population: int = 50, generations: int = 20, mount: LinearMount | None = None, bands: dict | None = None,
+             band_points: int = BAND_POINTS) -> OptimisationResult:
     """The design of *case* within *variables* that minimises *objective* subject to *constraints*.
 
     Parameters
@@ -526,7 +619,8 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     variables : dict of str to (float, float)
         Study parameter name to its range (low, high), SI units.
     objective : {"worst", "weighted"}
-        Worst T over runs and directions (dB), or the weighted mean of T.
+        Worst T over runs and directions (dB), or the weighted mean of T;
+        a sweep's (a band's) runs include its peaks (:func:`~workbook.design.bands.band_peaks`).
     constraints : iterable of Constraint or str
         See :func:`constraint`.
     starts : int
@@ -542,7 +636,12 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     population, generations : int
         Of the front's NSGA-II.
     mount : LinearMount, optional
-        *case* prepared already.
+        *case* prepared already (with *bands*: the case of :func:`~workbook.design.bands.band_case`).
+    bands : dict of str to (float, float), optional
+        Rotor excitation name to its speed band (idle, red line), Hz: the
+        excitation becomes a sweep of *band_points* speeds over it
+        (:func:`~workbook.design.bands.band_case`).
+    band_points : int
 
     Returns
     -------
@@ -569,15 +668,16 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
         raise InputError(f"starts: found {starts}, expected at least 1")
     chosen = [variable(name, *bounds) for name, bounds in variables.items()]
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
-    mount = mount or LinearMount.prepare(case)
-    problem = _Problem(mount, chosen, rules)
+    banded = band_case(case, bands, band_points) if bands else case
+    mount = mount or LinearMount.prepare(banded)
+    load_mounts = load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
+    problem = _Problem(mount, chosen, rules, load_mounts=load_mounts)
     from workbook.studies.parametric import parameter_value
 
     before_values = {v.name: parameter_value(mount.case, v.name) for v in chosen}
     start = np.array([v.scaled(before_values[v.name]) for v in chosen])
     before = problem.answer(before_values, start, np.ones(len(chosen)))
-    runs = [run.name for run in before.answer.result.runs]
-    weight = _weights(weights, len(runs))
+    weight = _weights(weights, len(before.rows))
     positions = [np.clip(start, 0, 1)]
     if starts > 1:
         positions += list(qmc.LatinHypercube(d=len(chosen), seed=seed).random(starts - 1))
@@ -597,15 +697,17 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
         _raise_infeasible(problem, min(ends, key=lambda end: end["violation"]).get("x", positions[0]))
     best = min(feasible, key=lambda end: end["objective"])
     after = problem.point(best["x"])
-    optimum = design_case(mount, after.values)
+    optimum = with_frequencies(design_case(mount, after.values), after.peaks)    # the bands' peaks as speeds
     result = run_case(optimum)
     exact = np.array([run.transmissibility for run in result.runs])
-    fast_difference = float(np.abs(exact - after.t).max())
-    front = pareto(case, variables, pareto_objectives, rules, population, generations, seed, mount) \
+    fast = np.array([run.transmissibility for run in mount.evaluate(optimum).result.runs])
+    fast_difference = float(np.abs(exact - fast).max())
+    front = pareto(mount.case, variables, pareto_objectives, rules, population, generations, seed, mount) \
         if pareto_objectives else None
+    exact_rows = [item.name for item in optimum.excitations for _ in points_of(item)]
     return OptimisationResult(
         optimum, mount.case, chosen, rules, objective, after.values,
-        _table(problem, objective, weight, before, dataclasses.replace(after, t=exact), runs), pd.DataFrame(history, columns=[
+        _table(problem, objective, weight, before, after, (exact_rows, exact)), pd.DataFrame(history, columns=[
             "start", "iteration", "objective", "violation"]),
         [{k: v for k, v in end.items() if k != "x"} for end in ends], result, fast_difference,
         problem.evaluations, time.perf_counter() - begin, front)
@@ -621,15 +723,16 @@ def _raise_infeasible(problem: _Problem, x0: np.ndarray):
                                          in closest.measures], held)
 
 
-def _pareto_measure(name: str, answer: DesignAnswer) -> float:
-    """One front objective of an evaluated design: ``worst`` or ``worst/RUN`` (T, dB), or a displacement quantity."""
+def _pareto_measure(name: str, point: _Point) -> float:
+    """One front objective of an evaluated design: ``worst`` or ``worst/ITEM`` (T, dB, a band's peaks
+    included), or a displacement quantity."""
     if name.partition("/")[0] == "worst":
-        run = name.partition("/")[2]
-        t = [r.transmissibility for r in answer.result.runs if not run or r.name == run]
+        item = name.partition("/")[2]
+        t = point.t[[not item or row == item for row in point.rows]]
         return float(20 * np.log10(max(np.max(t), 1e-12)))
     rule = Constraint(name, 1.0)
     values = []
-    for static in answer.engine_static.values():
+    for static in point.answer.engine_static.values():
         vector = static[3:6] if rule.quantity == "rotation" else static[:3]
         values.append(-vector[2] if rule.quantity == "sag" else float(np.linalg.norm(vector)))
     return max(values)
@@ -642,7 +745,7 @@ def pareto(case: Case, variables: dict, objectives: tuple = ("worst", "displacem
     Parameters
     ----------
     objectives : (str, str)
-        Each ``worst`` (worst T over runs and directions, dB), ``worst/RUN`` (of one run), or one of
+        Each ``worst`` (worst T over runs and directions, dB), ``worst/EXCITATION`` (of one excitation item, a band's peaks included), or one of
         :data:`QUANTITIES` (the largest over the excitation items).
     constraints
         As :func:`optimise`; ``modes_outside`` ones cost a modal solve each.
@@ -671,16 +774,19 @@ def pareto(case: Case, variables: dict, objectives: tuple = ("worst", "displacem
     chosen = [variable(name, *bounds) for name, bounds in variables.items()]
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
     mount = mount or LinearMount.prepare(case)
-    problem = _Problem(mount, chosen, rules, derivatives=False)
+    load_mounts = load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
+    problem = _Problem(mount, chosen, rules, derivatives=False, load_mounts=load_mounts)
+
+    rows = len(problem.point(np.full(len(chosen), 0.5)).g)     # constraint rows (a fatigue rule: one per link)
 
     class Front(ElementwiseProblem):
         def __init__(self):
-            super().__init__(n_var=len(chosen), n_obj=2, n_ieq_constr=len(rules) * len(runs), xl=0.0, xu=1.0)
+            super().__init__(n_var=len(chosen), n_obj=2, n_ieq_constr=rows, xl=0.0, xu=1.0)
 
         def _evaluate(self, x, out, *args, **kwargs):
             point = problem.point(x)
-            out["F"] = [_pareto_measure(name, point.answer) for name in objectives]
-            if rules:
+            out["F"] = [_pareto_measure(name, point) for name in objectives]
+            if rows:
                 out["G"] = -point.g
 
     answer = minimize(Front(), NSGA2(pop_size=population), ("n_gen", generations), seed=seed, verbose=False)

@@ -39,7 +39,8 @@ from workbook.design.assembly import (
 from workbook.design.linear_mount import DesignAnswer, ItemSolution, LinearMount, linear_model, points_of
 from workbook.model.case import DIRECTIONS, Case, Gravity
 
-__all__ = ["DesignSensitivity", "design_sensitivity", "difference_sensitivity", "design_case", "STATE_STEP"]
+__all__ = ["DesignSensitivity", "design_sensitivity", "difference_sensitivity", "design_case", "point_change",
+           "amplitude_change", "STATE_STEP"]
 
 #: Largest coordinate change (m, rad, modal coordinates) of the central difference along the state change.
 STATE_STEP = 1e-6
@@ -77,6 +78,9 @@ class DesignSensitivity:
         (a model of the same form) and of its state ``dq`` (empty for
         differences): what :mod:`workbook.design.optimise` differentiates
         the engine's static displacement and the mounted modes with.
+    motions : list of (ndarray, ndarray)
+        Per run, the projected motion phasor (n,) and its derivative (n, P)
+        (empty for differences).
     """
 
     parameters: list
@@ -92,6 +96,7 @@ class DesignSensitivity:
     seconds: float
     solutions: list = dataclasses.field(default_factory=list)
     changes: list = dataclasses.field(default_factory=list)
+    motions: list = dataclasses.field(default_factory=list)
 
     def to_pandas(self):
         """dT/dp as a table: one row per run and direction, one column per parameter."""
@@ -150,51 +155,73 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     start = time.perf_counter()
     case = design_case(mount, values)
     solutions = mount.solve_items(case)
-    changes = [_parameter_change(mount, values, name) for name in values]
+    changes = [_parameter_change(mount, values, name, case) for name in values]
     answer = mount.answer(case, solutions, start)
     runs, t, hinges = _answers(answer, mount.channels)
     gradient = np.zeros(t.shape + (len(values),))
     hinge_gradient = np.zeros(hinges.shape + (len(values),))
     pylon = [mount.channels.index(name) for name in mount.pylon]
     row = 0
-    item_changes = []
+    item_changes: list = []
+    motions: list = []
     for item, solution in zip(case.excitations, solutions, strict=True):
         item_changes.append([_model_change(case, solution, springs, mass) for springs, mass in changes])
         models = [model for model, _ in item_changes[-1]]
         for excitation in points_of(item):
-            omega = 2 * np.pi * excitation.frequency
-            model = solution.model
-            lu = sla.lu_factor(model.dynamic(omega), check_finite=False)
-            motion = sla.lu_solve(lu, model.load(excitation), check_finite=False)
-            output = model.output(omega)
-            forces = (output @ motion).reshape(-1, 3)
-            pylon_force = forces[pylon].sum(axis=0)
-            for j, change in enumerate(models):
-                d_motion = sla.lu_solve(lu, change.load(excitation) - change.dynamic(omega) @ motion,
-                                        check_finite=False)
-                d_forces = (change.output(omega) @ motion + output @ d_motion).reshape(-1, 3)
-                hinge_gradient[row, :, :, j] = _amplitude_change(forces, d_forces)
-                gradient[row, :, j] = _amplitude_change(pylon_force, d_forces[pylon].sum(axis=0)) \
-                    / excitation.force_amplitude
+            motion, d_motion, forces, d_forces = point_change(solution, models, excitation)
+            motions.append((motion, d_motion))
+            pylon_force, d_pylon = forces[pylon].sum(axis=0), d_forces[pylon].sum(axis=0)
+            hinge_gradient[row] = amplitude_change(forces[..., None], d_forces)
+            gradient[row] = amplitude_change(pylon_force[:, None], d_pylon) / excitation.force_amplitude
             row += 1
     return DesignSensitivity(list(values), np.array(list(values.values()), dtype=float), answer, runs,
                              list(mount.channels), t, gradient, hinges, hinge_gradient, "direct",
-                             time.perf_counter() - start, solutions, item_changes)
+                             time.perf_counter() - start, solutions, item_changes, motions)
 
 
-def _amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
-    """``d|y| = Re(conj(y) dy) / |y|`` (0 where y is 0)."""
-    size = np.abs(phasor)
-    return np.divide(np.real(np.conj(phasor) * change), size, out=np.zeros(size.shape), where=size > 0)
+def point_change(solution: ItemSolution, models: list, excitation) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                                              np.ndarray]:
+    """One single-frequency excitation of a solved item and its derivatives along the model changes *models*.
+
+    Returns
+    -------
+    motion : ndarray, complex, shape (n,)
+        The projected motion phasor.
+    d_motion : ndarray, complex, shape (n, P)
+    forces : ndarray, complex, shape (C, 3)
+        The channel force phasors, N.
+    d_forces : ndarray, complex, shape (C, 3, P)
+    """
+    omega = 2 * np.pi * excitation.frequency
+    model = solution.model
+    lu = sla.lu_factor(model.dynamic(omega), check_finite=False)
+    motion = sla.lu_solve(lu, model.load(excitation), check_finite=False)
+    output = model.output(omega)
+    forces = (output @ motion).reshape(-1, 3)
+    d_motion = np.zeros((len(motion), len(models)), dtype=complex)
+    d_forces = np.zeros(forces.shape + (len(models),), dtype=complex)
+    for j, change in enumerate(models):
+        d_motion[:, j] = sla.lu_solve(lu, change.load(excitation) - change.dynamic(omega) @ motion,
+                                      check_finite=False)
+        d_forces[..., j] = (change.output(omega) @ motion + output @ d_motion[:, j]).reshape(-1, 3)
+    return motion, d_motion, forces, d_forces
 
 
-def _parameter_change(mount: LinearMount, values: dict, name: str) -> tuple[ChannelSprings, float]:
-    """d(springs)/dp and d(engine mass)/dp: exact forward differences, both being linear in each parameter."""
+def amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
+    """``d|y| = Re(conj(y) dy) / |y|`` (0 where y is 0), broadcast (e.g. *phasor* (..., 1), *change* (..., P))."""
+    shape = np.broadcast_shapes(phasor.shape, change.shape)
+    size = np.broadcast_to(np.abs(phasor), shape)
+    return np.divide(np.real(np.conj(phasor) * change), size, out=np.zeros(shape), where=size > 0)
+
+
+def _parameter_change(mount: LinearMount, values: dict, name: str, base: Case) -> tuple[ChannelSprings, float]:
+    """d(springs)/dp and d(engine mass)/dp: exact forward differences from *base* (the design with *values*),
+    both being linear in each parameter."""
     from workbook.design.linear_mount import channel_springs
 
     value = values[name]
     step = 1e-3 * (abs(value) or 1.0)
-    sides = [design_case(mount, {**values, name: value + step}), design_case(mount, values)]
+    sides = [design_case(mount, {**values, name: value + step}), base]
     springs = [channel_springs(case, mount.channels, mount.frames) for case in sides]
     change = ChannelSprings(*((a - b) / step for a, b in zip(dataclasses.astuple(springs[0]),
                                                              dataclasses.astuple(springs[1]), strict=True)))

@@ -22,7 +22,8 @@ from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING,
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
-           "EXCITATIONS", "LOAD_CASES", "SPEED_SPECTRUM", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA", "HEADER_ROW", "UNIT_ROW",
+           "EXCITATIONS", "LOAD_CASES", "SPEED_SPECTRUM", "ROTORS", "TEST_RIG", "CASING", "RUNS", "TEST_DATA",
+           "OPTIMISE", "HEADER_ROW", "UNIT_ROW",
            "FIRST_DATA_ROW", "INSTRUCTIONS_SHEET", "RESULT_PREFIX", "YES", "NO", "AXES", "MAGNITUDE_LIMITS"]
 
 HEADER_ROW, UNIT_ROW, FIRST_DATA_ROW = 1, 2, 3
@@ -409,6 +410,21 @@ TEST_DATA = Table("Test data", optional=True, help="measured force amplitudes, o
                 "pylon T per direction times the run's excitation amplitude"),
     Column("periods", "record periods", "integer", DIMENSIONLESS,
            help="rig record: whole periods per window (empty: the run's measured periods)"),
+))
+
+OPTIMISE = Table("Optimise", optional=True,
+                 help="the design optimisation mountwb optimise CASE.xlsx runs without --vary "
+                      "(docs/optimisation.md); one row per variable, constraint, band, objective or starts",
+                 columns=(
+    Column("kind", "kind", "choice", choices=("variable", "constraint", "band", "objective", "starts"),
+           required=True, help="what the row gives"),
+    Column("name", "name", "text",
+           help="variable: a study parameter (e.g. hinge_stiffness/front); constraint: displacement, sag, rotation, "
+                "fatigue, margin or modes_outside; band: a rotor excitation; objective: worst or weighted"),
+    _num("low", "low", help="variable, band or modes_outside: the range's lower end, SI units (N/m, Hz)"),
+    _num("high", "high", help="variable, band or modes_outside: the range's upper end, SI units"),
+    _num("value", "value", help="constraint: its limit (m, rad, the fatigue factor or the margin of safety); "
+                                "starts: SLSQP starts"),
 ))
 
 #: The input tables in sheet order.

@@ -23,6 +23,7 @@ from workbook.errors import WorkbookError
 from workbook.excel.files import bounded_file_problem
 from workbook.excel.impedance_sheet import SHEET as IMPEDANCE_SHEET
 from workbook.excel.impedance_sheet import with_impedance_sheet
+from workbook.excel.optimise_sheet import OptimiseSheet, read_optimise_sheet
 from workbook.excel.runs import RunSpec, TestPoint, case_for_run
 from workbook.excel.sheets import OpenedWorkbook, Record, SheetReader, open_workbook, read_workbook_bytes
 from workbook.model import case as cm
@@ -53,6 +54,8 @@ class CaseBook:
     opened : OpenedWorkbook or None
         The workbook as read, for :func:`~workbook.excel.writer.write_results` (which then does not
         open the file again).
+    optimise : OptimiseSheet or None
+        The Optimise sheet's problem (None: no such sheet or no rows).
     """
 
     path: Path
@@ -61,6 +64,7 @@ class CaseBook:
     tests: tuple
     sha256: str
     opened: OpenedWorkbook | None = dataclasses.field(default=None, compare=False, repr=False)
+    optimise: OptimiseSheet | None = None
 
     def run_case(self, run: RunSpec) -> cm.Case:
         """The case of one run (see :func:`~workbook.excel.runs.case_for_run`)."""
@@ -725,9 +729,10 @@ def read_workbook(path: str | Path) -> CaseBook:
     sha256 = hashlib.sha256(data).hexdigest()
     formulas, values = open_workbook(path, data)
     reader = _CaseReader(path, formulas, values)
-    tables = {table.sheet: reader.table(table) for table in L.TABLES}
+    tables = {table.sheet: reader.table(table) for table in (*L.TABLES, L.OPTIMISE)}
     reader.sheet_title(IMPEDANCE_SHEET)
-    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), IMPEDANCE_SHEET), (L.INSTRUCTIONS_SHEET,))
+    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), L.OPTIMISE.sheet, IMPEDANCE_SHEET),
+                           (L.INSTRUCTIONS_SHEET,))
     if reader.merged_found:
         raise WorkbookError(reader.problems)
     case = reader.case(tables)
@@ -737,8 +742,9 @@ def read_workbook(path: str | Path) -> CaseBook:
     case = with_impedance_sheet(case, path, values)
     runs = reader.runs(case, tables["Runs"])
     tests = reader.tests(runs, tables["Test data"], case)
+    optimise = read_optimise_sheet(reader, tables[L.OPTIMISE.sheet], case)
     if reader.problems:
         raise WorkbookError(reader.problems)
     log.info("read %s: %d links, %d hinges, %d runs", path.name, len(case.links), len(case.hinges), len(runs))
     return CaseBook(path, case, tuple(run for _, run in runs), tuple(tests), sha256,
-                    OpenedWorkbook(sha256, formulas, values))
+                    OpenedWorkbook(sha256, formulas, values), optimise)
