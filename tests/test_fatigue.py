@@ -53,7 +53,9 @@ def test_harmonic_stress_at_a_low_frequency_equals_the_static_stress(coarse_refe
                                effects=dataclasses.replace(coarse_reference.effects, stress_stiffening="off"))
     excitation = case.excitations[0]
     reduced = reduce_links(case, excitation)
-    point, force = np.array([0.5, 0.1, 0.2]), np.array([300.0, -500.0, 1000.0])
+    # a probe of 100 N: the odd (third-order) part of the geometric nonlinearity, which the central
+    # difference keeps, is then far below 1e-6 (5e-7 at 1000 N, 2e-8 at 100 N)
+    point, force = np.array([0.5, 0.1, 0.2]), np.array([30.0, -50.0, 100.0])
     prepared = prepare(case, excitation, reduced=reduced)
     with prepared.scene as scene:
         model = prepared.model
@@ -70,7 +72,7 @@ def test_harmonic_stress_at_a_low_frequency_equals_the_static_stress(coarse_refe
     peak = max(np.abs(stress).max() for stress in static[0].values())
     for name, stress in harmonic.items():
         difference = (static[0][name] - static[1][name]) / 2
-        assert np.abs(stress.real - difference).max() < 2e-6 * peak, name
+        assert np.abs(stress.real - difference).max() < 1e-6 * peak, name
         assert np.abs(stress.imag).max() < 1e-6 * peak, name
 
 
