@@ -102,3 +102,15 @@ def test_any_pylon_model_closes_the_set_as_an_impedance_table_of_the_same_stiffn
     assert "flexible pylon (springs)" in effects
     with pytest.raises(CaseError, match="no pylon springs in the time domain"):
         run_case(dataclasses.replace(case, pylon=_Springs(stiffness), analysis=AnalysisSettings(method="time")))
+
+
+def test_an_impedance_table_on_the_command_line_is_refused_beside_another_pylon_model(capsys):
+    from workbook.cli.main import main
+    from workbook.errors import EXIT_BAD_INPUT
+
+    table = Path(__file__).parents[1] / "docs" / "pylon-impedance-example.csv"
+    before = OLD_FILE.read_bytes()
+    assert main(["run", str(OLD_FILE), "--pylon-impedance", str(table)]) == EXIT_BAD_INPUT
+    error = capsys.readouterr().err
+    assert "already has a pylon beam" in error and "one pylon model" in error
+    assert OLD_FILE.read_bytes() == before

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 from workbook.errors import CaseError, UsageError
 from workbook.model.case import AnalysisMethod, Case
 from workbook.model.codec import from_json
-from workbook.model.pylon_impedance import read_impedance_csv
+from workbook.model.pylon_impedance import PylonImpedance, read_impedance_csv
 from workbook.model.reference import reference_case
 
 if TYPE_CHECKING:   # the stages module loads the scene builder and SciPy: not for a command's --help
@@ -92,6 +92,10 @@ def load_case(path: str | None = None, *, run: str | None = None, rigid: bool = 
     if method is not None:
         case = dataclasses.replace(case, analysis=dataclasses.replace(case.analysis, method=method))
     if pylon_impedance is not None:
+        if case.pylon is not None and not isinstance(case.pylon, PylonImpedance):
+            raise UsageError(f"--pylon-impedance {pylon_impedance}: the case already has a {case.pylon.noun} "
+                             f"({case.pylon.label}) and a case has one pylon model; leave out --pylon-impedance "
+                             "or take the pylon model out of the case")
         case = dataclasses.replace(case, pylon=read_impedance_csv(pylon_impedance))
     return case.with_rigid_links() if rigid else case
 
