@@ -97,7 +97,7 @@ def sections(nominal, rig, result: UpdateResult, true: dict) -> dict[str, str]:
         f"pylon forces nearly cancel (T y {simulated_y['LP rotor']:.2g} at LP and {simulated_y['HP rotor']:.2g} at "
         "HP), is the most sensitive to the boundary: its error is up to "
         f"{lateral['error before %'].abs().max():.0f} % before and {lateral['error after %'].abs().max():.1f} % "
-        f"after. The fit took {result.evaluations} evaluations with derivatives.")
+        "after.")
     return {"seed pattern parameters": "\n".join(lines), "seed pattern errors": "\n".join(table),
             "seed pattern reading": reading}
 

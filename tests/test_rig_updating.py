@@ -132,17 +132,17 @@ def test_a_record_with_a_larger_uncertainty_weighs_less(mount, exact):
 
 @pytest.mark.slow
 def test_standard_errors_from_the_weights_match_a_monte_carlo_over_the_noise(mount, exact):
-    """30 noise realisations (ln T normal with each record's sigma) fitted: the scatter of the fitted
-    values is the reported standard error within 40 % (the sample SD of 30 normal draws has a relative
-    standard error of 1/sqrt(58) = 13 %: 3 of it), and their mean is the truth within 3 SE/sqrt(30)."""
+    """20 noise realisations (ln T normal with each record's sigma) fitted: the scatter of the fitted
+    values is the reported standard error within 50 % (the sample SD of 20 normal draws has a relative
+    standard error of 1/sqrt(38) = 16 %: 3 of it), and their mean is the truth within 3 SE/sqrt(20)."""
     truth, t = exact
     rng = np.random.default_rng(7)
     fits = [update_to_transmissibility(truth, RUNS, t * np.exp(SIGMA[:, None] * rng.standard_normal(t.shape)), TWO,
                                        uncertainty=[Uncertainty(s) for s in SIGMA], mount=mount, screening=0, starts=1)
-            for _ in range(30)]
+            for _ in range(20)]
     logs = np.log([fit.values for fit in fits])
     predicted = np.median([fit.standard_errors / fit.values for fit in fits], axis=0)
-    np.testing.assert_allclose(np.std(logs, axis=0, ddof=1), predicted, rtol=0.4)
+    np.testing.assert_allclose(np.std(logs, axis=0, ddof=1), predicted, rtol=0.5)
     assert np.all(np.abs(logs.mean(axis=0) - np.log([TRUTH[n] for n in fits[0].parameters]))
                   < 3 * predicted / np.sqrt(len(fits)))
     # from the weights, not the residual: the same for every realisation (up to the Jacobian's change)

@@ -27,9 +27,10 @@ the :data:`CHI_SQUARE_LEVEL` quantile of its distribution is warned of (the
 records scatter more than their uncertainties say, or the model misses). T of a mount isolating by a cancellation of
 its pylon forces is far from linear in the parameters, and the error has
 local minima: the fit first screens :data:`SCREENING` designs of a Latin
-hypercube over the (log) bounds, by their error alone, and then starts
-the solver from the case's values and from the :data:`STARTS` - 1 best
-designs screened, keeping the best solution. The standard error of p is ``p sd(x)`` on a
+hypercube over the (log) bounds, by their error alone, then starts the
+solver from the case's values and from the :data:`STARTS` - 1 best designs
+screened, :data:`PRUNING` evaluations each, and goes on from the best of
+them to convergence. The standard error of p is ``p sd(x)`` on a
 log scale. A parameter is not determined by the data when the condition
 number of the column-scaled ``J^T J`` exceeds :data:`CONDITION_LIMIT`, or its
 correlation with another exceeds :data:`CORRELATION_LIMIT` in magnitude: a
@@ -49,7 +50,7 @@ from workbook.errors import UsageError
 from workbook.model.case import DIRECTIONS, Case
 
 __all__ = ["UpdateResult", "Uncertainty", "update_model", "update_to_transmissibility", "CONDITION_LIMIT",
-           "CORRELATION_LIMIT", "SCREENING", "STARTS", "CHI_SQUARE_LEVEL"]
+           "CORRELATION_LIMIT", "SCREENING", "STARTS", "PRUNING", "CHI_SQUARE_LEVEL"]
 
 log = logging.getLogger(__name__)
 
@@ -61,6 +62,8 @@ CORRELATION_LIMIT = 0.999
 SCREENING = 64
 #: Starts of the solver: the case's values and the best designs screened.
 STARTS = 2
+#: Model evaluations of each start before only the best one goes on.
+PRUNING = 8
 #: Quantile of chi-square above which the residual of weighted data is warned of.
 CHI_SQUARE_LEVEL = 0.999
 
@@ -395,9 +398,13 @@ def update_to_transmissibility(case: Case, runs: list, measured: np.ndarray, var
     errors = [_screened_error(mount, dict(zip(names, values_of(np.array(list(row.values()))), strict=True)),
                               case_runs, rows, measured, weights) for row in screened]
     candidates = [x0] + [np.array(list(screened[i].values())) for i in np.argsort(errors)[:starts - 1]]
-    fits = [least_squares(residual, x, jac=jacobian, bounds=(lower, upper), method="trf",
-                          x_scale="jac", max_nfev=max_evaluations) for x in candidates]
-    fit = min(fits, key=lambda f: f.cost)
+    def solve(x: np.ndarray, evaluations: int):
+        return least_squares(residual, x, jac=jacobian, bounds=(lower, upper), method="trf", x_scale="jac",
+                             max_nfev=evaluations)
+
+    if len(candidates) > 1:      # every start a few steps, then the best one on to convergence
+        candidates = [min((solve(x, PRUNING) for x in candidates), key=lambda f: f.cost).x]
+    fit = solve(candidates[0], max_evaluations)
     after, r, jac = simulated(fit.x), residual(fit.x), jacobian(fit.x)
     values = values_of(fit.x)
     dof = r.size - len(names)
