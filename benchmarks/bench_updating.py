@@ -48,7 +48,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rigid", action="store_true", help="rigid links (default: as the case asks)")
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--seeds", type=int, default=20, help="noisy records per run for the measurement's scatter")
+    parser.add_argument("--seeds", type=int, default=20,
+                        help="noisy records per run for the measurement's scatter (0: no measurement table)")
     args = parser.parse_args()
     base = reference_case()
     nominal = dataclasses.replace(base.with_rigid_links() if args.rigid else base, test_rig=ForceTransducers((1e8,) * 3))
@@ -60,7 +61,8 @@ def main() -> None:
     records = [synthetic_record(run, REFERENCE_TRANSDUCERS, excitation=excitation, sample_rate_hz=rate,
                                 duration=2.0, noise=0.005, seed=seed)
                for seed in (3, 4) for run, excitation in zip(result.runs, truth.excitations, strict=True)]
-    measurement_error(result, truth, rate, nominal.analysis.measured_periods, args.seeds)
+    if args.seeds:
+        measurement_error(result, truth, rate, nominal.analysis.measured_periods, args.seeds)
     start = time.perf_counter()
     mount = LinearMount.prepare(nominal)
     print(f"links {'rigid' if args.rigid else 'as the case asks'}; linear mount prepared in "

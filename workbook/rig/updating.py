@@ -109,9 +109,6 @@ class Uncertainty:
         """The standard deviation of ln T of the measured T *measured*."""
         return np.full(np.shape(measured), self.value) if self.relative else self.value / np.asarray(measured)
 
-    def __str__(self) -> str:
-        return f"{100 * self.value:g}%" if self.relative else f"{self.value:g}"
-
 
 @dataclass(frozen=True)
 class UpdateResult:
