@@ -59,7 +59,10 @@ def test_a_clean_record_of_a_rig_case_measures_its_transducers_t(nominal, rig):
     run, excitation = result.runs[1], nominal.excitations[1]      # HP: the transducers' mass counts most
     record = synthetic_record(run, REFERENCE_TRANSDUCERS, excitation=excitation, sample_rate_hz=4096.0,
                               duration=2.0, noise=0.0, drift=0.0)
-    np.testing.assert_allclose(measure(record, 100).transmissibility, run.transmissibility, rtol=1e-3)
+    # the amplitudes fitted at the (searched) frequency, not read off a DFT of a window of whole samples, whose
+    # image leakage reached 0.2 % in records of the reference mount
+    np.testing.assert_allclose(measure(record, 100).transmissibility, run.transmissibility, rtol=1e-5)
+    np.testing.assert_allclose(measure(record, 7).transmissibility, run.transmissibility, rtol=1e-5)
 
 
 def test_updating_recovers_the_perturbed_parameters_within_two_standard_errors(nominal, mount, rig):
