@@ -361,26 +361,25 @@ def update_to_transmissibility(case: Case, runs: list, measured: np.ndarray, var
     def values_of(x: np.ndarray) -> np.ndarray:
         return np.where(log_scale, np.exp(x), x)
 
-    def simulated(x: np.ndarray) -> np.ndarray:
-        """T per measurement of the design x (the model alone: the residual at a trial step)."""
-        key = ("t", x.tobytes())
-        if key not in answers:
-            answer = mount.evaluate(design_case(mount, dict(zip(names, values_of(x), strict=True)))).result
-            by_name = {run.name: run.transmissibility for run in answer.runs}
-            answers[key] = np.array([by_name[case_runs[row]] for row in rows])
-        return answers[key]
-
-    def jacobian(x: np.ndarray) -> np.ndarray:
-        """d r / d x of the design x (the derivatives: at an accepted step only)."""
-        key = ("j", x.tobytes())
+    def answer(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """T per measurement of the design x and d r / d x (one solve gives both: the solver accepts
+        nearly every step, so computing the derivatives at a rejected one costs less than a second solve
+        of an accepted one)."""
+        key = x.tobytes()
         if key not in answers:
             counter["evaluations"] += 1
             sensitivity = design_sensitivity(mount, dict(zip(names, values_of(x), strict=True)))
             by_run = [sensitivity.runs.index(run) for run in case_runs]
             t = sensitivity.transmissibility[by_run][rows]
             gradient = sensitivity.gradient[by_run][rows] * np.where(log_scale, values_of(x), 1.0)
-            answers[key] = ((gradient / t[..., None]) * weights[..., None]).reshape(-1, len(names))
+            answers[key] = (t, ((gradient / t[..., None]) * weights[..., None]).reshape(-1, len(names)))
         return answers[key]
+
+    def simulated(x: np.ndarray) -> np.ndarray:
+        return answer(x)[0]
+
+    def jacobian(x: np.ndarray) -> np.ndarray:
+        return answer(x)[1]
 
     def residual(x: np.ndarray) -> np.ndarray:
         return (np.log(simulated(x) / measured) * weights).ravel()
@@ -395,6 +394,7 @@ def update_to_transmissibility(case: Case, runs: list, measured: np.ndarray, var
     errors = [_screened_error(mount, dict(zip(names, values_of(np.array(list(row.values()))), strict=True)),
                               case_runs, rows, measured, weights) for row in screened]
     candidates = [x0] + [np.array(list(screened[i].values())) for i in np.argsort(errors)[:starts - 1]]
+
     def solve(x: np.ndarray, evaluations: int):
         return least_squares(residual, x, jac=jacobian, bounds=(lower, upper), method="trf", x_scale="jac",
                              max_nfev=evaluations)
