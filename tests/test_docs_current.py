@@ -88,3 +88,10 @@ def test_a_changed_section_is_named():
     generated = {"balance": section(text, "balance", "reference-mount.md") + " (changed)"}
     failures = _differences("reference-mount.md", "make_reference_docs.py", generated)
     assert len(failures) == 1 and "docs/reference-mount.md, section 'balance'" in failures[0]
+
+
+@pytest.mark.slow
+def test_updating_doc_is_current(cache_dir):
+    script = importlib.import_module("make_updating_docs")
+    failures = _differences(script.DOCUMENT, "make_updating_docs.py", script.sections(*script.study()))
+    assert not failures, "\n\n".join(failures)

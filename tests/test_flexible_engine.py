@@ -254,3 +254,23 @@ def test_a_bad_casing_cell_is_named(tmp_path, edits, named):
         read_workbook(path)
     for words in named:
         assert words in str(error.value)
+
+
+@pytest.mark.slow
+def test_the_reduced_casing_stiffness_is_linear_in_its_modulus():
+    """Two Craig-Bampton reductions of a tube with two bearing planes and four fixed-interface modes,
+    at E and 1.3 E: the reduced stiffness scales by 1.3, the reduced mass and the mode shapes do not
+    change (so the casing's modulus acts on the reduced casing as a factor on its stiffness)."""
+    interfaces = tuple(CasingInterface(f"plane {k}", (x, 0.0, 0.0), "bearing", 0.02) for k, x in enumerate((0.1, 0.4)))
+    reduced = [reduce_casing(CasingModel(interfaces, geometry=CasingGeometry(0.03, 0.012, 0.0, 0.5),
+                                         material=dataclasses.replace(STEEL, youngs_modulus=factor * 210e9),
+                                         element_size=0.02), 4, [1.0], use_cache=False)[0]
+               for factor in (1.0, 1.3)]
+    stiffness, mass = ([np.asarray(r.ffrf[key], dtype=float) for r in reduced]
+                       for key in ("stiffnessMatrixReduced", "massMatrixReduced"))
+    assert stiffness[0].shape[0] >= 4
+    np.testing.assert_allclose(stiffness[1], 1.3 * stiffness[0], rtol=0, atol=1e-10 * np.abs(stiffness[0]).max())
+    np.testing.assert_allclose(mass[1], mass[0], rtol=0, atol=1e-12 * np.abs(mass[0]).max())
+    shapes = [np.asarray(r.mode_basis) for r in reduced]
+    signs = np.sign(np.sum(shapes[0] * shapes[1], axis=0))
+    np.testing.assert_allclose(shapes[1], shapes[0] * signs, rtol=0, atol=1e-8 * np.abs(shapes[0]).max())

@@ -155,7 +155,8 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     start = time.perf_counter()
     case = design_case(mount, values)
     solutions = mount.solve_items(case)
-    changes = [_parameter_change(mount, values, name, case) for name in values]
+    changes = [_parameter_change(mount, values, name, case, solutions[0].springs if solutions else None)
+               for name in values]
     answer = mount.answer(case, solutions, start)
     runs, t, hinges = _answers(answer, mount.channels)
     gradient = np.zeros(t.shape + (len(values),))
@@ -165,7 +166,9 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     item_changes: list = []
     motions: list = []
     for item, solution in zip(case.excitations, solutions, strict=True):
-        item_changes.append([_model_change(case, solution, springs, mass) for springs, mass in changes])
+        states = _state_changes(case, solution, changes)
+        item_changes.append([_model_change(case, solution, springs, mass, state)
+                             for (springs, mass), state in zip(changes, states, strict=True)])
         models = [model for model, _ in item_changes[-1]]
         for excitation in points_of(item):
             motion, d_motion, forces, d_forces = point_change(solution, models, excitation)
@@ -214,61 +217,65 @@ def amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
     return np.divide(np.real(np.conj(phasor) * change), size, out=np.zeros(shape), where=size > 0)
 
 
-def _parameter_change(mount: LinearMount, values: dict, name: str, base: Case) -> tuple[ChannelSprings, float]:
-    """d(springs)/dp and d(engine mass)/dp: exact forward differences from *base* (the design with *values*),
-    both being linear in each parameter."""
+def _parameter_change(mount: LinearMount, values: dict, name: str, case: Case, springs: ChannelSprings | None
+                      ) -> tuple[ChannelSprings, float]:
+    """d(springs)/dp and d(engine mass)/dp: exact forward differences from the design *case* and its
+    *springs* (None: found here), both being linear in each parameter."""
     from workbook.design.linear_mount import channel_springs
 
     value = values[name]
     step = 1e-3 * (abs(value) or 1.0)
-    sides = [design_case(mount, {**values, name: value + step}), base]
-    springs = [channel_springs(case, mount.channels, mount.frames) for case in sides]
-    change = ChannelSprings(*((a - b) / step for a, b in zip(dataclasses.astuple(springs[0]),
-                                                             dataclasses.astuple(springs[1]), strict=True)))
-    return change, (sides[0].engine.mass - sides[1].engine.mass) / step
+    changed = design_case(mount, {**values, name: value + step})
+    base = channel_springs(case, mount.channels, mount.frames) if springs is None else springs
+    change = ChannelSprings(*((a - b) / step for a, b in zip(
+        dataclasses.astuple(channel_springs(changed, mount.channels, mount.frames)), dataclasses.astuple(base),
+        strict=True)))
+    return change, (changed.engine.mass - case.engine.mass) / step
 
 
-def _state_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """d(dq)/dp of the final preload solve and d(tension)/dp of each stiffened link, in pass order."""
+def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Per parameter change ``(springs, mass)``: d(dq)/dp of the final preload solve and d(tension)/dp of
+    each stiffened link, in pass order (each pass's tangent stiffness factorised once for all of them)."""
     prepared, base = solution.prepared, solution.springs
     expansion = prepared.expansion
     channels = expansion.channels
+    names = [link.name for link in case.links]
     gravity = np.zeros(prepared.size)
     if case.effects.preload:
         for load in case.static_loads:
             if isinstance(load, Gravity):
                 gravity[prepared.engine[:3]] += np.asarray(load.acceleration)
-    d_tension = np.zeros(len(prepared.links))
-    d_state = np.zeros(prepared.size)
-    d_forces = None
+    d_tension = [np.zeros(len(prepared.links)) for _ in changes]
+    d_state = [np.zeros(prepared.size) for _ in changes]
+    d_forces: list = [None for _ in changes]
     for dq, tensions, loads in solution.state.passes:
-        if d_forces is not None:
-            names = [link.name for link in case.links]
-            by_link = -np.einsum("lcx,cx->l", prepared.compression, d_forces)
-            d_tension = np.array([by_link[names.index(link.name)] if link.name in tensions else 0.0
-                                  for link in prepared.links])
         at = channels.state(total(expansion, dq))
-        residual = without_normal(expansion, dq, channels.force(at, springs.stiffness)) - mass * gravity
         q = total(expansion, dq)
-        for link, change in zip(prepared.links, d_tension, strict=True):
-            residual[link.modal] += change * (link.geometric @ q[link.modal])
         _, rest_stiffness, _ = rest_matrices(expansion, dq, loads)
         basis = projection(expansion, dq)
-        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, base, at))
-        d_state = basis.expand(np.linalg.solve(stiffness, -basis.rows(residual)))
-        jacobian_force = channels.outputs(at, base.stiffness) @ d_state
-        d_forces = prepared.sign * (np.einsum("cab,cb->ca", springs.stiffness, at.separation)
-                                    + jacobian_force.reshape(-1, 3))
-    return d_state, d_tension
+        factor = sla.lu_factor(basis.both(tangent_stiffness(expansion, dq, rest_stiffness, base, at)),
+                               check_finite=False)
+        jacobian = channels.outputs(at, base.stiffness)
+        for j, (springs, mass) in enumerate(changes):
+            if d_forces[j] is not None:
+                by_link = -np.einsum("lcx,cx->l", prepared.compression, d_forces[j])
+                d_tension[j] = np.array([by_link[names.index(link.name)] if link.name in tensions else 0.0
+                                         for link in prepared.links])
+            residual = without_normal(expansion, dq, channels.force(at, springs.stiffness)) - mass * gravity
+            for link, change in zip(prepared.links, d_tension[j], strict=True):
+                residual[link.modal] += change * (link.geometric @ q[link.modal])
+            d_state[j] = basis.expand(sla.lu_solve(factor, -basis.rows(residual), check_finite=False))
+            d_forces[j] = prepared.sign * (np.einsum("cab,cb->ca", springs.stiffness, at.separation)
+                                           + (jacobian @ d_state[j]).reshape(-1, 3))
+    return list(zip(d_state, d_tension, strict=True))
 
 
-def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float):
+def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float, state_change: tuple):
     """The derivative of the item's linear model (a model of the same form: Z, C and f are linear in it)
-    and of its state ``dq``."""
+    and of its state ``dq``, given the derivative of the state and tensions (:func:`_state_changes`)."""
     prepared, state, model = solution.prepared, solution.state, solution.model
     expansion = prepared.expansion
-    d_state, d_tension = _state_change(case, solution, springs, mass)
+    d_state, d_tension = state_change
     # along the state change: central differences of the whole linear model
     step = STATE_STEP / max(np.abs(d_state).max(), 1e-300)
     sides = [linear_model(case, prepared, solution.springs, dataclasses.replace(state, dq=state.dq + sign * step

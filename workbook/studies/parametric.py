@@ -20,6 +20,8 @@ frequency          Hz     frequency of every single-frequency excitation
 removed_link       text   a link removed with its hinges (``none``: all kept)
 transducer_stiffness N/m  stiffness of every test-rig force transducer, x y z
 engine_mass        kg     the engine's mass (its inertia kept)
+casing_modulus     Pa     Young's modulus of the flexible engine casing's
+                          material (a case with ``Engine.casing``)
 =================  =====  ====================================================
 
 A hinge parameter may name a group of hinges and a direction of the hinge
@@ -106,6 +108,17 @@ def _hinge_values(case: Case, field_name: str, value: float, group: str, directi
     return dataclasses.replace(case, hinges=tuple(hinges))
 
 
+def _casing_modulus(case: Case, modulus: float) -> Case:
+    casing = case.engine.casing
+    if casing is None:
+        raise CaseError("study", "casing_modulus", modulus, "a case with a flexible engine casing (Engine.casing)")
+    if not modulus > 0:
+        raise CaseError("study", "casing_modulus", modulus, "a positive Young's modulus, Pa")
+    material = dataclasses.replace(casing.material, youngs_modulus=float(modulus))
+    return dataclasses.replace(case, engine=dataclasses.replace(case.engine, casing=dataclasses.replace(
+        casing, material=material)))
+
+
 def _transducers(case: Case, stiffness: float) -> Case:
     if case.test_rig is None:
         raise CaseError("study", "transducer_stiffness", stiffness, "a case with test-rig force transducers")
@@ -154,7 +167,7 @@ def parameter(name: str) -> Parameter:
 
 def parameter_value(case: Case, name: str) -> float:
     """The value *case* holds of the numeric parameter *name* (SI units; a hinge parameter, the
-    transducer stiffness or the engine mass).
+    transducer stiffness, the engine mass or the casing's modulus).
 
     Raises
     ------
@@ -164,13 +177,17 @@ def parameter_value(case: Case, name: str) -> float:
     """
     if name == "engine_mass":
         return float(case.engine.mass)
+    if name == "casing_modulus":
+        if case.engine.casing is None:
+            raise CaseError("case", name, None, "a case with a flexible engine casing (Engine.casing)")
+        return float(case.engine.casing.material.youngs_modulus)
     if name == "transducer_stiffness":
         if case.test_rig is None:
             raise CaseError("case", name, None, "a case with test-rig force transducers")
         values = np.asarray(case.test_rig.stiffness, dtype=float)
     elif name in PARAMETERS and name not in _HINGE_FIELDS:
         raise InputError(f"{name!r} has no single value in a case to start from; a hinge parameter, "
-                         "transducer_stiffness or engine_mass has")
+                         "transducer_stiffness, engine_mass or casing_modulus has")
     else:
         base, group, direction = _hinge_target(name)
         axes = list(HINGE_DIRECTIONS.get(direction, (0, 1, 2)))
@@ -247,6 +264,7 @@ PARAMETERS = {p.name: p for p in (
               _transducers),
     Parameter("engine_mass", "kg", "the engine's mass (its inertia kept)",
               lambda case, v: dataclasses.replace(case, engine=dataclasses.replace(case.engine, mass=float(v)))),
+    Parameter("casing_modulus", "Pa", "Young's modulus of the flexible engine casing's material", _casing_modulus),
 )}
 
 
