@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 from workbook.design.linear_mount import LinearMount  # noqa: E402
 from workbook.model.case import ForceTransducers  # noqa: E402
 from workbook.model.reference import reference_case  # noqa: E402
-from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, default_sample_rate, synthetic_record  # noqa: E402
+from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, default_sample_rate, synthetic_record, synthetic_records  # noqa: E402
 from workbook.rig.updating import update_model  # noqa: E402
 from workbook.solve.pipeline import run_case  # noqa: E402
 from workbook.studies.parametric import parameter  # noqa: E402
@@ -57,11 +57,9 @@ def main() -> None:
     for name, value in TRUTH.items():
         truth = parameter(name).apply(truth, value)
     result = run_case(truth)
-    rate = default_sample_rate(e.frequency_hz for e in truth.excitations)
-    records = [synthetic_record(run, REFERENCE_TRANSDUCERS, excitation=excitation, sample_rate_hz=rate,
-                                duration=2.0, noise=0.005, seed=seed)
-               for seed in (3, 4) for run, excitation in zip(result.runs, truth.excitations, strict=True)]
+    records = synthetic_records(truth, result, (3, 4), noise=0.005)
     if args.seeds:
+        rate = default_sample_rate(e.frequency_hz for e in truth.excitations)
         measurement_error(result, truth, rate, nominal.analysis.measured_periods, args.seeds)
     start = time.perf_counter()
     mount = LinearMount.prepare(nominal)

@@ -26,7 +26,7 @@ from generated_sections import rewrite_sections
 
 from workbook.model.case import ForceTransducers
 from workbook.model.reference import reference_case
-from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, default_sample_rate, synthetic_record
+from workbook.rig.synthetic import synthetic_records
 from workbook.rig.updating import UpdateResult, update_model
 from workbook.solve.pipeline import run_case
 from workbook.studies.parametric import parameter, parameter_value
@@ -54,10 +54,7 @@ def study() -> tuple:
     for name, value in RIG.items():
         rig = parameter(name).apply(rig, value)
     answers = run_case(rig)
-    rate = default_sample_rate(e.frequency_hz for e in rig.excitations)
-    records = [synthetic_record(run, REFERENCE_TRANSDUCERS, excitation=excitation, sample_rate_hz=rate,
-                                duration=2.0, noise=NOISE, seed=seed)
-               for seed in SEEDS for run, excitation in zip(answers.runs, rig.excitations, strict=True)]
+    records = synthetic_records(rig, answers, SEEDS, noise=NOISE)
     true = {run.name: run.transmissibility for run in answers.runs}
     return nominal, rig, update_model(nominal, records, BOUNDS), true
 

@@ -17,7 +17,7 @@ from workbook.model.codec import from_json, to_json
 from workbook.model.reference import reference_case
 from workbook.rig.correlation import measure
 from workbook.rig.records import write_record
-from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, default_sample_rate, synthetic_record
+from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, synthetic_record, synthetic_records
 from workbook.rig.updating import Uncertainty, update_model, update_to_transmissibility
 from workbook.studies.parametric import parameter, parameter_value
 
@@ -47,10 +47,7 @@ def rig(nominal):
     for name, value in TRUTH.items():
         truth = parameter(name).apply(truth, value)
     result = run_case(truth)
-    rate = default_sample_rate(e.frequency_hz for e in truth.excitations)
-    records = [synthetic_record(run, REFERENCE_TRANSDUCERS, excitation=excitation, sample_rate_hz=rate,
-                                duration=2.0, noise=NOISE, seed=seed)
-               for seed in (3, 4) for run, excitation in zip(result.runs, truth.excitations, strict=True)]
+    records = synthetic_records(truth, result, (3, 4), noise=NOISE)
     return result, records
 
 

@@ -27,7 +27,7 @@ from workbook.model.case import TRANSDUCER_PREFIX
 from workbook.rig.correlation import MIN_SAMPLES_PER_PERIOD
 from workbook.rig.records import RigRecord
 
-__all__ = ["synthetic_record", "broadband_record", "run_up_record", "default_sample_rate", "REFERENCE_TRANSDUCERS",
+__all__ = ["synthetic_record", "synthetic_records", "broadband_record", "run_up_record", "default_sample_rate", "REFERENCE_TRANSDUCERS",
            "RATE_MARGIN"]
 
 #: A default record samples the highest frequency this many times more
@@ -126,6 +126,37 @@ def synthetic_record(result: ExcitationResult, transducers: dict, *, excitation=
         notes={"made by": f"workbook.rig.synthetic.synthetic_record from a simulation: noise {noise:g} x amplitude, "
                           f"speed drift {drift:g}, seed {seed}",
                "simulated T x y z": " ".join(f"{t:.6g}" for t in result.transmissibility)})
+
+
+def synthetic_records(case, result, seeds, *, transducers: dict | None = None, duration: float = 2.0,
+                      noise: float = 0.005) -> list[RigRecord]:
+    """Noisy records of every run of *result* (the answers of *case*), one per seed and run.
+
+    Sampled at :func:`default_sample_rate` of the case's excitations (every
+    rotor can be compared at it); the other parameters as :func:`synthetic_record`.
+
+    Parameters
+    ----------
+    case : workbook.model.case.Case
+    result : workbook.answers.results.MountResult
+        Frequency-domain answers of *case*, one run per excitation.
+    seeds : iterable of int
+    transducers : dict, optional
+        Default :data:`REFERENCE_TRANSDUCERS`.
+    duration : float
+        s.
+    noise : float
+        Relative to each transducer's largest amplitude.
+
+    Returns
+    -------
+    list of RigRecord
+        Seed by seed, the runs in order.
+    """
+    rate = default_sample_rate(e.frequency_hz for e in case.excitations)
+    return [synthetic_record(run, REFERENCE_TRANSDUCERS if transducers is None else transducers, excitation=excitation,
+                             sample_rate_hz=rate, duration=duration, noise=noise, seed=seed)
+            for seed in seeds for run, excitation in zip(result.runs, case.excitations, strict=True)]
 
 
 def _carrying(pylon_channels, hinges) -> list:
