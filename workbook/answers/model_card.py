@@ -13,6 +13,7 @@ import numpy as np
 
 from workbook.model.case import ENGINE
 from workbook.model.casing import CASING
+from workbook.scene import hinge_laws
 from workbook.scene.build import Scene, loss_factors
 
 __all__ = ["BodyEntry", "EffectEntry", "ModelCard", "model_card"]
@@ -205,9 +206,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
     damped_links = [link.name for link in case.links
                     if link.name in flexible and (link.stiffness_damping > 0 or link.mass_damping > 0)]
     modal_links = [link.name for link in case.links if link.name in flexible and link.modal_damping > 0]
-    gaps = [h for h in case.hinges if h.radial_clearance > 0]
     hinge_damping = [h for h in case.hinges if h.values("damping").max() > 0]
-    anisotropic = [h.name for h in case.hinges if not h.isotropic]
     hinge_loss, link_loss = loss_factors(case)
     loads = ", ".join(load.name for load in case.static_loads)
     entries = [
@@ -222,10 +221,7 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                     else ("switched off" if not effects.hinge_damping else "no hinge has viscous damping")),
         _loss_factor_entry(scene, "hinge loss factor", hinge_loss, effects.hinge_damping, "hinge", "k",
                            len(case.hinges)),
-        EffectEntry("hinge properties per direction", bool(anisotropic),
-                    f"stiffness, damping or loss factor per direction of the hinge frame (radial 1, radial 2, "
-                    f"axial) on {', '.join(anisotropic)}: R^T diag(k) R in global axes (symbolic spring law)"
-                    if anisotropic else "every hinge isotropic (one value in every direction)"),
+        *(EffectEntry(law.name, *entry) for law in hinge_laws.HINGE_LAWS if (entry := law.card_entry(case)) is not None),
         EffectEntry("link damping", effects.link_damping and bool(damped_links),
                     f"Rayleigh damping on {', '.join(damped_links)}" if effects.link_damping and damped_links else
                     ("switched off" if not effects.link_damping else "no flexible link has Rayleigh damping")),
@@ -236,11 +232,6 @@ def _effects(scene, preload, method) -> list[EffectEntry]:
                     ("switched off" if not effects.link_damping else "no flexible link has a modal damping ratio")),
         _loss_factor_entry(scene, "link material loss factor", link_loss, effects.link_damping, "flexible link",
                            "K_red", len(flexible)),
-        EffectEntry("hinge clearance", effects.clearance and bool(gaps),
-                    f"clearance law (symbolic user function) on {', '.join(h.name for h in gaps)}"
-                    if effects.clearance and gaps else
-                    ("switched off: gaps ignored" if not effects.clearance else "no hinge has a gap > 0")
-                    + _ignored_contact(case)),
         _flexible_engine(scene),
         _spin_restraints(scene),
         _gyroscopics(scene),
@@ -276,13 +267,6 @@ def _loss_factor_entry(scene, name: str, lossy: dict, switched_on: bool, kind: s
         how = (f"as the equivalent viscous damping eta {stiffness} / w at {scene.loss_factor_hz:g} Hz (the "
                f"excitation frequency of this run): exact in the steady state at {scene.loss_factor_hz:g} Hz only")
     return EffectEntry(name, True, f"{listing}: {how}")
-
-
-def _ignored_contact(case) -> str:
-    from workbook.scene.build import ignored_contact_stiffness
-
-    ignored = [h.name for h in ignored_contact_stiffness(case)]
-    return f"; contact_stiffness ignored on {', '.join(ignored)} (no gap)" if ignored else ""
 
 
 def _spin_restraints(scene) -> EffectEntry:

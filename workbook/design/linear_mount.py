@@ -227,8 +227,9 @@ class LinearMount:
             highest = max(points, key=lambda point: point.frequency)
             prepared = prepare(case, points[0], reduce_for=highest)
             with prepared.scene as scene:
-                if any(items_.clearance for items_ in scene.hinges.values()):
-                    raise OutsideDesignModel(case.name, "hinge clearance laws (a nonlinear scene)")
+                for items_ in scene.hinges.values():
+                    if items_.nonlinear:
+                        raise OutsideDesignModel(case.name, f"{items_.hinge_law.name} laws (a nonlinear scene)")
                 for run in solve_frequencies(case, prepared, points, chosen):
                     cards[run.name], preloads[run.name] = run.model_card, run.preload
                 channels, pylon = list(scene.force_channels), list(scene.pylon_channels)

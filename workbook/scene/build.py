@@ -54,17 +54,17 @@ from workbook.model.case import (
     transducer_name,
 )
 from workbook.model.casing import CASING
-from workbook.scene.bearing import exudyn_bearing_function, hinge_matrix
+from workbook.scene import hinge_laws
 from workbook.scene.engine_casing import CasingItems, add_flexible_engine
 from workbook.scene.excitation import ExcitationSignal
-from workbook.scene.hinge_law import exudyn_clearance_function
+from workbook.scene.hinge_law_base import HingeLaw
 from workbook.scene.link_workers import LinkJob, reduce_in_workers
 from workbook.scene.mode_budget import mode_budget_error
 from workbook.scene.structural_damping import equivalent_viscous_damping
 
 __all__ = ["Scene", "EngineItems", "HingeItems", "TransducerItems", "ExcitationItems", "build_scene",
            "GyroscopicItems", "gyroscopics_built", "exudyn_gyroscopic_function", "reduce_links", "link_jobs",
-           "exudyn_name", "ignored_contact_stiffness", "loss_factors", "marker_bodies", "net_angular_momentum",
+           "exudyn_name", "loss_factors", "marker_bodies", "net_angular_momentum",
            "scene_warnings", "CANCELLED_MOMENTUM"]
 
 log = logging.getLogger(__name__)
@@ -105,20 +105,23 @@ class HingeItems:
         Pylon-side hinge: its force is part of the pylon force (with the
         rig's transducers built, it acts on a transducer instead, and the
         transducer forces make the pylon force).
-    clearance : bool
-        The clearance law is built (gap > 0 and clearance switched on).
+    hinge_law : HingeLaw
+        The hinge's law (:mod:`workbook.scene.hinge_laws`).
     law : exudyn.symbolic.UserFunction or None
-        The recorded ``springForceUserFunction``, if built: the clearance
-        law, or the per-direction law of an anisotropic hinge
-        (:mod:`workbook.scene.bearing`).
+        The recorded ``springForceUserFunction``, if the law built one.
     """
 
     connector: int
     sensor: int
     markers: tuple
     on_pylon: bool
-    clearance: bool
+    hinge_law: HingeLaw
     law: Any = field(default=None, repr=False)
+
+    @property
+    def nonlinear(self) -> bool:
+        """The hinge's law makes the scene nonlinear."""
+        return self.hinge_law.nonlinear
 
 
 @dataclass(frozen=True)
@@ -332,11 +335,12 @@ class Scene:
 
     @contextmanager
     def gaps_closed(self):
-        """Context in which every clearance law is replaced by its contact
-        stiffness, as if each gap were closed (for the mechanism check: the
-        gaps of an unloaded mount are open, and inside them only the small
-        residual stiffness of :mod:`workbook.scene.hinge_law` acts)."""
-        laws = {items.connector: items.law for items in self.hinges.values() if items.clearance}
+        """Context in which every nonlinear law is replaced by its connector's
+        diagonal spring-damper: each clearance law by its contact stiffness,
+        as if each gap were closed (for the mechanism check: the gaps of an
+        unloaded mount are open, and inside them only the small residual
+        stiffness of :mod:`workbook.scene.hinge_law` acts)."""
+        laws = {items.connector: items.law for items in self.hinges.values() if items.nonlinear}
         for connector in laws:
             self.mbs.SetObjectParameter(connector, "springForceUserFunction", 0)
         try:
@@ -373,21 +377,11 @@ def marker_bodies(hinge: Hinge) -> tuple[str, str]:
     return hinge.bodies if hinge.body_b != PYLON else hinge.bodies[::-1]
 
 
-def ignored_contact_stiffness(case: Case) -> list[Hinge]:
-    """Hinges that give a contact stiffness (other than their stiffness) but
-    no gap: no clearance law is built, so the contact stiffness never acts."""
-    return [h for h in case.hinges if h.contact_stiffness is not None and h.radial_clearance == 0
-            and np.any(h.values("stiffness") != h.contact_stiffness)]
-
-
 def scene_warnings(case: Case) -> list[str]:
-    """What the case gives that the scene does not build, in words: a
-    contact stiffness on a hinge without a gap, and rotors whose spin
-    angular momenta cancel (no gyroscopic moment)."""
-    warnings = [f"hinge {h.name!r}: contact_stiffness {h.contact_stiffness:g} N/m is ignored: the hinge has no gap "
-                f"(radial_clearance 0), so its stiffness "
-                f"{' / '.join(f'{k:g}' for k in h.values('stiffness'))} N/m acts"
-                for h in ignored_contact_stiffness(case)]
+    """What the case gives that the scene does not build, in words: what
+    each hinge law says (a contact stiffness on a hinge without a gap), and
+    rotors whose spin angular momenta cancel (no gyroscopic moment)."""
+    warnings = [warning for law in hinge_laws.HINGE_LAWS for warning in law.warnings(case)]
     if case.rotors and case.effects.gyroscopics and not gyroscopics_built(case):
         warnings.append(f"rotors {', '.join(repr(r.name) for r in case.rotors)}: their spin angular momenta cancel "
                         f"(net {np.linalg.norm(net_angular_momentum(case)):.3g} kg m^2/s), so they exert no "
@@ -633,7 +627,9 @@ def _add_hinge(mbs, case: Case, hinge: Hinge, pins: _Pins, lossy: bool, loss_hz:
     """Add *hinge* as a Cartesian spring-damper with its law and force sensor.
 
     *lossy*: the hinge's loss factors are built (as viscous damping at
-    *loss_hz*, or by the clearance law on its tangent stiffness).
+    *loss_hz*, or as the law damps them, the clearance law on its tangent
+    stiffness). The law is the first of :mod:`workbook.scene.hinge_laws` that
+    applies, else the plain spring-damper.
     """
     import exudyn as exu
     from exudyn.advancedUtilities import CreateSymbolicUserFunction
@@ -641,31 +637,22 @@ def _add_hinge(mbs, case: Case, hinge: Hinge, pins: _Pins, lossy: bool, loss_hz:
     eii = exu.itemInterface
     first, second = marker_bodies(hinge)
     markers = (pins.marker(first, hinge.position), pins.marker(second, hinge.position))
-    clearance = case.effects.clearance and hinge.radial_clearance > 0
-    stiffness = hinge.values("stiffness")
-    if clearance:
-        stiffness[:] = hinge.gap_contact_stiffness
+    hinge_law = hinge_laws.law_of(case, hinge)
     etas = hinge.values("loss_factor") if lossy else np.zeros(3)
-    damping = hinge.values("damping") if case.effects.hinge_damping else np.zeros(3)
-    if not clearance:      # the clearance law damps its loss factor on its own tangent stiffness
-        damping = damping + [_viscous(loss_hz, eta, k) for eta, k in zip(etas, stiffness, strict=True)]
+    built = hinge_law.connector(case, hinge, hinge.values("stiffness"),
+                                hinge.values("damping") if case.effects.hinge_damping else np.zeros(3),
+                                np.array([_viscous(loss_hz, eta, 1.0) for eta in etas]))
     connector = mbs.AddObject(eii.ObjectConnectorCartesianSpringDamper(
-        name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(stiffness),
-        damping=list(damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
+        name=exudyn_name("hinge", hinge.name), markerNumbers=list(markers), stiffness=list(built.stiffness),
+        damping=list(built.damping), visualization=eii.VObjectConnectorCartesianSpringDamper(show=False)))
     law = None
-    if clearance:
-        spring_force = exudyn_clearance_function(hinge.radial_clearance, [_viscous(loss_hz, eta, 1.0) for eta in etas])
-        law = CreateSymbolicUserFunction(mbs, spring_force, "springForceUserFunction", connector)
-        mbs.SetObjectParameter(connector, "springForceUserFunction", law)
-    elif np.ptp(stiffness) > 0 or np.ptp(damping) > 0:
-        bearing = exudyn_bearing_function(hinge_matrix(case, hinge, "stiffness", stiffness),
-                                          hinge_matrix(case, hinge, "damping", damping))
-        law = CreateSymbolicUserFunction(mbs, bearing, "springForceUserFunction", connector)
+    if built.spring_force is not None:
+        law = CreateSymbolicUserFunction(mbs, built.spring_force, "springForceUserFunction", connector)
         mbs.SetObjectParameter(connector, "springForceUserFunction", law)
     sensor = mbs.AddSensor(eii.SensorObject(
         name=exudyn_name("hinge force", hinge.name), objectNumber=connector, storeInternal=True, writeToFile=False,
         outputVariableType=exu.OutputVariableType.Force))
-    return HingeItems(connector, sensor, markers, hinge.on_pylon, clearance, law)
+    return HingeItems(connector, sensor, markers, hinge.on_pylon, hinge_law, law)
 
 
 def _add_excitation(mbs, case: Case, engine: EngineItems,

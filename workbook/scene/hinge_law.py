@@ -18,13 +18,21 @@ a damper that switches on at full strength at impact made the contact force
 jump and Newton fail on rattling gaps. The law is recorded as an Exudyn symbolic
 user function and runs at C++ speed (plain Python user functions were
 measured about 2x slower per run).
+
+:data:`CLEARANCE` is the law as a :class:`~workbook.scene.hinge_law_base.HingeLaw`:
+it takes every hinge with a gap while ``Effects.clearance`` is on.
 """
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
+from workbook.model.case import Case, Hinge
+from workbook.scene.hinge_law_base import Connector, HingeLaw
+
 __all__ = ["RESIDUAL_STIFFNESS_RATIO", "clearance_force", "tangent_stiffness", "exudyn_clearance_function",
-           "linearised_gap_warnings"]
+           "linearised_gap_warnings", "ignored_contact_stiffness", "ClearanceLaw", "CLEARANCE"]
 
 #: Stiffness inside the gap relative to the contact stiffness.
 RESIDUAL_STIFFNESS_RATIO = 1e-4
@@ -172,3 +180,59 @@ def linearised_gap_warnings(hinges, static_forces: dict, dynamic_amplitudes: dic
                             f"force {static:.4g} N, so the contact can lift off and the gap open; the frequency "
                             f"domain assumes it stays closed: use the time domain")
     return warnings
+
+
+def ignored_contact_stiffness(case: Case) -> list[Hinge]:
+    """Hinges that give a contact stiffness (other than their stiffness) but
+    no gap: no clearance law is built, so the contact stiffness never acts."""
+    return [h for h in case.hinges if h.contact_stiffness is not None and h.radial_clearance == 0
+            and np.any(h.values("stiffness") != h.contact_stiffness)]
+
+
+class ClearanceLaw(HingeLaw):
+    """The clearance law (module text) on every hinge with a gap, while ``Effects.clearance`` is on."""
+
+    name = "hinge clearance"
+    nonlinear = True
+    linearised = "the clearance laws are linearised about the preloaded state (gaps frozen as they are there)"
+    time_domain_note = "the time domain resolves the contact"
+
+    def applies(self, case: Case, hinge: Hinge) -> bool:
+        return case.effects.clearance and hinge.radial_clearance > 0
+
+    def connector(self, case: Case, hinge: Hinge, stiffness: np.ndarray, damping: np.ndarray,
+                  loss_time: np.ndarray) -> Connector:
+        """The contact stiffness on the connector; the law damps its loss factor on its own tangent stiffness."""
+        return Connector(np.full(3, hinge.gap_contact_stiffness), damping,
+                         exudyn_clearance_function(hinge.radial_clearance, loss_time))
+
+    def force(self, case: Case, hinge: Hinge, displacement, velocity, loss_time=0.0) -> np.ndarray:
+        return clearance_force(displacement, velocity, hinge.radial_clearance, hinge.gap_contact_stiffness,
+                               float(hinge.values("damping")[0]), loss_time)   # isotropic (Hinge checks)
+
+    def card_entry(self, case: Case) -> tuple[bool, str]:
+        switched = case.effects.clearance
+        gaps = [h.name for h in case.hinges if h.radial_clearance > 0]
+        if switched and gaps:
+            return True, f"clearance law (symbolic user function) on {', '.join(gaps)}"
+        ignored = [h.name for h in ignored_contact_stiffness(case)]
+        return False, (("switched off: gaps ignored" if not switched else "no hinge has a gap > 0")
+                       + (f"; contact_stiffness ignored on {', '.join(ignored)} (no gap)" if ignored else ""))
+
+    def warnings(self, case: Case) -> list[str]:
+        return [f"hinge {h.name!r}: contact_stiffness {h.contact_stiffness:g} N/m is ignored: the hinge has no gap "
+                f"(radial_clearance 0), so its stiffness "
+                f"{' / '.join(f'{k:g}' for k in h.values('stiffness'))} N/m acts"
+                for h in ignored_contact_stiffness(case)]
+
+    def refusal(self, hinge: Hinge) -> tuple[str, Any, str]:
+        return ("radial_clearance", hinge.radial_clearance,
+                "0 for the four-pole parameters of a linear mount (or the clearance effect off)")
+
+    def linearised_warnings(self, hinges: list[Hinge], static_forces: dict,
+                            dynamic_amplitudes: dict) -> list[str]:
+        return linearised_gap_warnings(hinges, static_forces, dynamic_amplitudes)
+
+
+#: The clearance law.
+CLEARANCE = ClearanceLaw()

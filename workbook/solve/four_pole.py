@@ -65,6 +65,7 @@ from workbook._renamed import renamed
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
 from workbook.scene.bearing import hinge_matrix
+from workbook.scene.hinge_laws import nonlinear_hinges
 
 __all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
            "REPORT_GRID"]
@@ -418,17 +419,14 @@ def mount_case(case: Case) -> Case:
     Raises
     ------
     workbook.errors.CaseError
-        A hinge with a clearance law: the four-pole set is that of a linear mount;
+        A hinge with a nonlinear law (a clearance): the four-pole set is that of a linear mount;
         or a flexible engine: its engine-side points are on the rigid engine.
     """
     if case.engine.casing is not None:
         raise CaseError("engine", "casing", "a flexible casing", "None (a rigid engine) for the four-pole parameters "
                         "and a flexible pylon: their engine-side points are those of a rigid engine")
-    if case.effects.clearance:
-        for hinge in case.hinges:
-            if hinge.radial_clearance > 0:
-                raise CaseError(f"hinge {hinge.name!r}", "radial_clearance", hinge.radial_clearance,
-                                "0 for the four-pole parameters of a linear mount (or the clearance effect off)")
+    for law, hinges in nonlinear_hinges(case).items():      # the first refuses
+        raise CaseError(f"hinge {hinges[0].name!r}", *law.refusal(hinges[0]))
     if not case.pylon_hinges:
         raise CaseError("case", "hinges", "no pylon-side hinge", "at least one hinge on the pylon")
     return dataclasses.replace(case, effects=dataclasses.replace(case.effects, rig_sensors=False))

@@ -33,7 +33,7 @@ from workbook.answers.model_card import model_card
 from workbook.answers.results import ExcitationResult, MountResult
 from workbook.model.case import Case, HarmonicForce, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, build_scene, reduce_links
-from workbook.scene.hinge_law import linearised_gap_warnings
+from workbook.scene.hinge_laws import nonlinear_hinges
 from workbook.solve.flexible_pylon import pylon_at, refuse_time_domain, solve_on_pylon
 from workbook.solve.four_pole import REPORT_GRID, FourPole, checked_frequencies, condense, frequency_grid, mount_case
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
@@ -283,7 +283,7 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
     assert model is not None
     mounted = mounted_modes(prepared.modes)
     solver = _frequency_solver(case, model)
-    gaps = [h for h in case.hinges if prepared.scene.hinges[h.name].clearance]
+    laws = nonlinear_hinges(case)
     update, close = progress(f"{points[0].name}: frequencies", len(points)) if progress else (None, None)
     runs = []
     try:
@@ -295,8 +295,9 @@ def solve_frequencies(case: Case, prepared: PreparedScene, points: tuple[SingleF
             with singular_solve_guard(where, excitation.frequency, prepared.modes):
                 result = model.result(excitation, case.analysis.steady_tolerance)
             result.warnings.extend(link_warnings(case, prepared.scene.reduced))
-            result.warnings.extend(linearised_gap_warnings(gaps, prepared.preload.hinge_forces,
-                                                           result.hinge_amplitudes))
+            for law, hinges in laws.items():
+                result.warnings.extend(law.linearised_warnings(hinges, prepared.preload.hinge_forces,
+                                                               result.hinge_amplitudes))
             timings = dict(prepared.timings, **{"harmonic solve": time.perf_counter() - start})
             if model.residual_mass is not None:
                 start = time.perf_counter()

@@ -45,8 +45,8 @@ import numpy as np
 
 from workbook.model.case import Case, Simultaneous, SingleFrequencyExcitation
 from workbook.scene.build import Scene
+from workbook.scene.hinge_laws import linear_note, nonlinear_reason
 from workbook.solve.harmonic import HarmonicModel
-from workbook.solve.method import clearance_hinges
 
 __all__ = ["REST", "STEADY", "StartChoice", "choose_start", "SteadyStart", "steady_start"]
 
@@ -73,17 +73,16 @@ class StartChoice:
 def choose_start(case: Case) -> StartChoice:
     """The start of a time run of *case* from ``case.analysis.start`` (module text)."""
     asked = case.analysis.start
-    gaps = clearance_hinges(case)
-    nonlinear = f"hinge clearance on {', '.join(repr(g) for g in gaps)} makes the scene nonlinear" if gaps else ""
+    nonlinear = nonlinear_reason(case)
     if asked == REST:
         return StartChoice(REST, "the case asks for it (start 'rest')")
     if asked == STEADY:
         return StartChoice(STEADY, "the case asks for it (start 'steady')" + (
             f"; {nonlinear}, so the linearised steady state is only where the integration starts settling"
-            if gaps else ""))
-    if gaps:
+            if nonlinear else ""))
+    if nonlinear:
         return StartChoice(REST, f"auto: {nonlinear}, its linearised steady state is not its periodic solution")
-    return StartChoice(STEADY, "auto: the scene is linear (no hinge clearance), so the harmonic solution of its "
+    return StartChoice(STEADY, f"auto: the scene is linear ({linear_note()}), so the harmonic solution of its "
                        "linearisation is its periodic steady state")
 
 
