@@ -4,7 +4,7 @@ Everything the package says of the links' strength: the static margins of
 the limit load cases (the tables of ``mountwb loads``,
 :mod:`workbook.solve.load_cases`), then per rotor excitation and link the
 dynamic stress on the preload and the fatigue safety factors by Goodman and
-Gerber (:mod:`workbook.solve.fatigue`). ``--vtu DIR`` writes each flexible
+Gerber, and Haigh for a material with a Haigh curve (:mod:`workbook.solve.fatigue`). ``--vtu DIR`` writes each flexible
 link's surface with its preload stress, the dynamic stress amplitude of each
 excitation and its first mode shapes, one VTU file per link (ParaView);
 ``--png DIR`` draws the same stress fields on each link's shape, one PNG per
@@ -19,7 +19,7 @@ from typing import Callable
 
 from workbook.cli.loading import load_case
 
-__all__ = ["arguments", "print_bore_convergence"]
+__all__ = ["arguments", "print_bore_convergence", "print_fatigue_factors"]
 
 #: Mode shapes written with each link's VTU file.
 VTU_MODES = 6
@@ -55,16 +55,7 @@ def run(args) -> int:
         return 0
     print_load_cases(case, results)
     print_bore_convergence(bores)
-    print("\nfatigue on the preload (the case's static loads): alternating stress sigma_a = largest von Mises "
-          "over the cycle, mean sigma_m = von Mises of the preload stress signed by its hydrostatic part; "
-          "Goodman 1/n = sigma_a/S_e + sigma_m/S_u, Gerber n sigma_a/S_e + (n sigma_m/S_u)^2 = 1")
-    for answer in fatigue.excitations:
-        print(f"\n{answer.excitation} ({answer.frequency_hz:g} Hz)")
-        print(f"  {'link':16s} {'peak sigma_a MPa':>16s} {'sigma_a MPa':>11s} {'sigma_m MPa':>11s} "
-              f"{'Goodman':>9s} {'Gerber':>9s} {'at':>6s}")
-        for name, f in answer.links.items():
-            print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
-                  f"{f.goodman:9.3g} {f.gerber:9.3g} {f.region:>6s}")
+    print_fatigue_factors(fatigue)
     print_miner_sums(fatigue)
     print(f"\nstress recovery and fatigue factors, all links and excitations: {fatigue.stress_seconds:.3f} s")
     if args.vtu:
@@ -72,6 +63,27 @@ def run(args) -> int:
     if args.png:
         print(f"PNG files: {args.png}/<link>.png")
     return 0
+
+
+def print_fatigue_factors(fatigue) -> None:
+    """Per excitation and link of a :class:`~workbook.solve.fatigue.FatigueResult` its stresses and fatigue
+    factors (the Haigh column when a link's material has a Haigh curve)."""
+    print("\nfatigue on the preload (the case's static loads): alternating stress sigma_a = largest von Mises "
+          "over the cycle, mean sigma_m = von Mises of the preload stress signed by its hydrostatic part; "
+          "Goodman 1/n = sigma_a/S_e + sigma_m/S_u, Gerber n sigma_a/S_e + (n sigma_m/S_u)^2 = 1")
+    haigh = any(f.haigh is not None for answer in fatigue.excitations for f in answer.links.values())
+    if haigh:
+        print("Haigh: (n sigma_m, n sigma_a) on the material's Haigh curve (the proportional load line; '-' a "
+              "material without one); Gerber and Haigh the lowest over the link's nodes, at its worst node for each")
+    haigh_header = f" {'Haigh':>9s}" if haigh else ""
+    for answer in fatigue.excitations:
+        print(f"\n{answer.excitation} ({answer.frequency_hz:g} Hz)")
+        print(f"  {'link':16s} {'peak sigma_a MPa':>16s} {'sigma_a MPa':>11s} {'sigma_m MPa':>11s} "
+              f"{'Goodman':>9s} {'Gerber':>9s}{haigh_header} {'at':>6s}")
+        for name, f in answer.links.items():
+            column = "" if not haigh else f" {'-':>9s}" if f.haigh is None else f" {f.haigh:9.3g}"
+            print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
+                  f"{f.goodman:9.3g} {f.gerber:9.3g}{column} {f.region:>6s}")
 
 
 def print_miner_sums(fatigue) -> None:

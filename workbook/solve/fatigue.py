@@ -20,11 +20,15 @@ field ``S q_hat``, both one matrix product with the link's stress shapes
 - the fatigue safety factors by the modified Goodman line and the Gerber
   parabola (:func:`flexbodies.stress.goodman_factor`,
   :func:`flexbodies.stress.gerber_factor`), against the material's endurance
-  and ultimate strength; a compressive mean earns no credit.
+  and ultimate strength, and, when the material has a Haigh curve
+  (:attr:`flexbodies.materials.Material.haigh_curve`), the Haigh factor on
+  the proportional load line (:func:`flexbodies.stress.haigh_factor`); a
+  compressive mean earns no credit.
 
 Per link and excitation the lowest Goodman factor over the nodes is reported
-with its node, its stresses and its Gerber factor, and the peak alternating
-stress. Every single-frequency excitation is answered alone: each point of a
+with its node and its stresses, the lowest Gerber and Haigh factors over the
+nodes (at that node or another: each criterion's own worst node), and the
+peak alternating stress. Every single-frequency excitation is answered alone: each point of a
 sweep (a speed of a run-up) and each part of a simultaneous excitation, by
 the harmonic model of :mod:`workbook.solve.harmonic` (for a case with hinge
 clearance, linearised about the preload).
@@ -56,7 +60,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexbodies.stress import REGIONS, alternating_von_mises, gerber_factor, goodman_factor, link_regions, signed_von_mises, state_stress
+from flexbodies.stress import (
+    REGIONS,
+    alternating_von_mises,
+    gerber_factor,
+    goodman_factor,
+    haigh_factor,
+    link_regions,
+    signed_von_mises,
+    state_stress,
+)
 from workbook.errors import CaseError
 from workbook.model.case import Case, Simultaneous, Sweep
 from workbook.model.spectrum import SECONDS_PER_HOUR, SpeedSpectrum, check_speed_spectra
@@ -86,6 +99,9 @@ class LinkFatigue:
         Where that node is: ``"eye A"``, ``"shank"`` or ``"eye B"``.
     point : tuple of 3 floats
         That node, global coordinates of the undeformed link, m.
+    haigh : float or None
+        The lowest Haigh factor over the nodes (at that node or another),
+        None when the link's material has no Haigh curve.
     """
 
     link: str
@@ -96,6 +112,7 @@ class LinkFatigue:
     gerber: float
     region: str
     point: tuple
+    haigh: float | None = None
 
 
 @dataclass(frozen=True)
@@ -289,11 +306,13 @@ def link_fatigue(link, reduced, mean_coordinates, amplitude: np.ndarray, rotatio
     mean = signed_von_mises(state_stress(reduced, mean_coordinates))
     goodman = goodman_factor(alternating, mean, material.endurance_strength, material.ultimate_strength)
     gerber = gerber_factor(alternating, mean, material.endurance_strength, material.ultimate_strength)
+    haigh = None if material.haigh_curve is None else float(haigh_factor(alternating, mean, material.haigh_curve).min())
     i = int(np.argmin(goodman))
     regions = link_regions(reduced)
     point = np.asarray(link.end_a) + rotation @ reduced.nodes[i]
     return LinkFatigue(link.name, float(alternating.max()), float(alternating[i]), float(mean[i]),
-                       float(goodman[i]), float(gerber.min()), REGIONS[regions[i]], tuple(float(x) for x in point))
+                       float(goodman[i]), float(gerber.min()), REGIONS[regions[i]], tuple(float(x) for x in point),
+                       haigh)
 
 
 def equivalent_alternating(alternating, mean, ultimate: float) -> np.ndarray:
