@@ -13,13 +13,14 @@ link.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
 
-__all__ = ["arguments", "print_bore_convergence", "print_fatigue_factors"]
+__all__ = ["arguments", "print_bore_convergence", "print_bore_fatigue", "print_fatigue_factors"]
 
 #: Mode shapes written with each link's VTU file.
 VTU_MODES = 6
@@ -37,6 +38,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 def run(args) -> int:
     from workbook.cli.loads import chosen_load_cases, print_load_cases
     from workbook.solve.bore_convergence import bore_convergence
+    from workbook.solve.bore_fatigue import bore_fatigue
     from workbook.solve.fatigue import solve_fatigue
     from workbook.solve.load_cases import solve_load_cases
 
@@ -45,17 +47,20 @@ def run(args) -> int:
     fatigue = solve_fatigue(case)
     results = solve_load_cases(case, chosen) if chosen else []
     bores = bore_convergence(case, results)
+    at_bores = bore_fatigue(case, fatigue)
     if args.vtu:
         write_fields(Path(args.vtu), fatigue)
     if args.png:
         draw_fields(Path(args.png), fatigue)
     if args.json:
         print(json.dumps({"case": case.name, "load_cases": [r.to_dict() for r in results],
-                          "bore_convergence": bores.to_dict(), "fatigue": fatigue.to_dict()}, indent=1))
+                          "bore_convergence": bores.to_dict(), "fatigue": fatigue.to_dict(),
+                          "bore_fatigue": [dataclasses.asdict(row) for row in at_bores]}, indent=1))
         return 0
     print_load_cases(case, results)
     print_bore_convergence(bores)
     print_fatigue_factors(fatigue)
+    print_bore_fatigue(at_bores)
     print_miner_sums(fatigue)
     print(f"\nstress recovery and fatigue factors, all links and excitations: {fatigue.stress_seconds:.3f} s")
     if args.vtu:
@@ -84,6 +89,20 @@ def print_fatigue_factors(fatigue) -> None:
             column = "" if not haigh else f" {'-':>9s}" if f.haigh is None else f" {f.haigh:9.3g}"
             print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
                   f"{f.goodman:9.3g} {f.gerber:9.3g}{column} {f.region:>6s}")
+
+
+def print_bore_fatigue(rows) -> None:
+    """The bore fatigue factors (:func:`~workbook.solve.bore_fatigue.bore_fatigue`) beside the reduced links'."""
+    if not rows:
+        return
+    print("\nfatigue at the bores (the bore sub-model under the pins' bearing load, a two-force link): "
+          "sigma_m = k(sign N_0) |N_0|, sigma_a = max(k_t, k_c) |N^|, k the sub-model's peak per newton; "
+          "conservative: both peaks at one point, no credit for a compressive preload")
+    print(f"  {'excitation':20s} {'link':16s} {'N_0 kN':>8s} {'|N^| N':>9s} {'sigma_m MPa':>11s} "
+          f"{'sigma_a MPa':>11s} {'Goodman':>9s} {'reduced link':>12s}")
+    for row in rows:
+        print(f"  {row.excitation:20s} {row.link:16s} {row.axial_force / 1e3:8.2f} {row.axial_amplitude:9.3g} "
+              f"{row.mean / 1e6:11.2f} {row.alternating / 1e6:11.4f} {row.goodman:9.3g} {row.reduced_goodman:12.3g}")
 
 
 def print_miner_sums(fatigue) -> None:

@@ -55,6 +55,7 @@ their speed.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
@@ -74,6 +75,7 @@ from workbook.errors import CaseError
 from workbook.model.case import Case, Simultaneous, Sweep
 from workbook.model.spectrum import SECONDS_PER_HOUR, SpeedSpectrum, check_speed_spectra
 from workbook.solve.load_cases import link_coordinates
+from workbook.solve.preload import link_compression
 
 __all__ = ["LinkFatigue", "ExcitationFatigue", "LinkDamage", "SpectrumDamage", "FatigueResult", "link_fatigue",
            "equivalent_alternating", "cycles_to_failure", "miner_damage", "solve_fatigue"]
@@ -102,6 +104,12 @@ class LinkFatigue:
     haigh : float or None
         The lowest Haigh factor over the nodes (at that node or another),
         None when the link's material has no Haigh curve.
+    axial_force : float or None
+        The preload's axial force N_0 of the link, tension positive, N (from
+        the hinge forces at its eyes).
+    axial_amplitude : float or None
+        The amplitude ``|N^|`` of the link's harmonic axial force, N (from the
+        hinge force phasors at its eyes, projected on the link axis).
     """
 
     link: str
@@ -113,6 +121,8 @@ class LinkFatigue:
     region: str
     point: tuple
     haigh: float | None = None
+    axial_force: float | None = None
+    axial_amplitude: float | None = None
 
 
 @dataclass(frozen=True)
@@ -257,8 +267,6 @@ class FatigueResult:
 
     def to_dict(self) -> dict:
         """JSON-ready, SI units but hours (without the stress fields)."""
-        import dataclasses
-
         return {"case": self.case, "stress_seconds": self.stress_seconds,
                 "excitations": [{"excitation": e.excitation, "frequency_hz": e.frequency_hz,
                                  "links": {name: dataclasses.asdict(f) for name, f in e.links.items()}}
@@ -378,7 +386,8 @@ def miner_damage(equivalents, cycles, material) -> np.ndarray:
 
 
 def _solved(case: Case, points: tuple, reduced: dict | None):
-    """Yield ``(point, scene, means, result)`` per single-frequency *points*, on one prepared scene."""
+    """Yield ``(point, scene, means, tension, result)`` per single-frequency *points*, on one prepared scene
+    (*tension*: each link's preload axial force, N)."""
     from workbook.solve.pipeline import prepare
 
     highest = max(points, key=lambda point: point.frequency)
@@ -387,8 +396,9 @@ def _solved(case: Case, points: tuple, reduced: dict | None):
     assert model is not None
     with scene:
         means = link_coordinates(scene)
+        tension = {name: -float(value) for name, value in link_compression(scene, prepared.preload.hinge_forces).items()}
         for point in points:
-            yield point, scene, means, model.result(point, case.analysis.steady_tolerance)
+            yield point, scene, means, tension, model.result(point, case.analysis.steady_tolerance)
 
 
 def _spectrum_damage(case: Case, spectrum: SpeedSpectrum, reduced: dict | None) -> SpectrumDamage:
@@ -398,7 +408,7 @@ def _spectrum_damage(case: Case, spectrum: SpeedSpectrum, reduced: dict | None) 
     points = tuple(spectrum.at(case.excitations, f) for f, _ in speeds)
     equivalents: dict = {}
     found: dict = {}
-    for _, scene, means, result in _solved(case, points, reduced):
+    for _, scene, means, _, result in _solved(case, points, reduced):
         for name in (name for name in case.link_map if name in means):
             link, body = case.link_map[name], scene.reduced[name]
             if name not in found:
@@ -460,14 +470,15 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
     seconds = 0.0
     for item in case.excitations:
         points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
-        for point, scene, means, result in _solved(case, points, reduced):
+        for point, scene, means, tension, result in _solved(case, points, reduced):
             start = time.perf_counter()
             amplitudes, links = {}, {}
+            axial = link_compression(scene, result.hinge_phasors)
             for name in (name for name in case.link_map if name in means):
                 body = scene.reduced[name]
                 amplitudes[name] = state_stress(body, result.link_phasors[name])
-                links[name] = link_fatigue(case.link_map[name], body, means[name], amplitudes[name],
-                                           scene.links[name].rotation)
+                found = link_fatigue(case.link_map[name], body, means[name], amplitudes[name], scene.links[name].rotation)
+                links[name] = dataclasses.replace(found, axial_force=tension[name], axial_amplitude=float(abs(axial[name])))
             seconds += time.perf_counter() - start
             answers.append(ExcitationFatigue(point.name, point.frequency, links, amplitudes))
             if not mean_stress:
