@@ -12,8 +12,9 @@ from workbook.model.case import Link
 from workbook.solve.fatigue import ExcitationFatigue, FatigueResult, LinkFatigue
 
 
-def test_bore_fatigue_against_a_hand_calculation(cache_dir, monkeypatch):
+def test_bore_fatigue_against_a_hand_calculation(cache_dir, monkeypatch, capsys):
     import flexbodies.bore_stress as bore_stress
+    from workbook.cli.stress import print_bore_fatigue
     from workbook.solve.bore_fatigue import bore_fatigue
 
     monkeypatch.setattr(bore_stress, "BORE_DIVISIONS", (8, 10))   # a coarse pair: the test's time
@@ -41,6 +42,10 @@ def test_bore_fatigue_against_a_hand_calculation(cache_dir, monkeypatch):
         assert row.goodman == pytest.approx(1 / (k_t * 300.0 / se + k_mean * 2e4 / su), rel=1e-12)
         assert row.reduced_goodman == links[row.link].goodman
     assert rows[1].goodman > rows[0].goodman                   # the compressive preload loads the bore less
+    print_bore_fatigue(rows)                                   # the table of mountwb stress
+    printed = [line.split() for line in capsys.readouterr().out.splitlines() if line.split()[2:3] in (["bar"], ["twin"])]
+    assert [(words[2], float(words[3]), float(words[-2]), float(words[-1])) for words in printed] == [
+        (row.link, round(row.axial_force / 1e3, 2), float(f"{row.goodman:.3g}"), row.reduced_goodman) for row in rows]
     # nothing axial: nothing loads the bore
     links["bar"] = reduced("bar", 20.0, 0.0, 0.0)
     assert np.isinf(bore_fatigue(case, fatigue)[0].goodman)
