@@ -28,7 +28,10 @@ field ``S q_hat``, both one matrix product with the link's stress shapes
 Per link and excitation the lowest Goodman factor over the nodes is reported
 with its node and its stresses, the lowest Gerber and Haigh factors over the
 nodes (at that node or another: each criterion's own worst node), and the
-peak alternating stress. Every single-frequency excitation is answered alone: each point of a
+peak alternating stress; and the link's axial force, of the preload and the
+amplitude of its phasor (the hinge forces and force phasors at its eyes on
+the link axis, :func:`~workbook.solve.preload.link_compression`), from which
+:mod:`workbook.solve.bore_fatigue` gives the fatigue at the bores. Every single-frequency excitation is answered alone: each point of a
 sweep (a speed of a run-up) and each part of a simultaneous excitation, by
 the harmonic model of :mod:`workbook.solve.harmonic` (for a case with hinge
 clearance, linearised about the preload).
