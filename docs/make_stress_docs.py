@@ -11,7 +11,9 @@ the links; and the Miner sums of its speed spectra
 the ``<!-- generated: ... -->`` markers. Then the bore peaks of its
 reference load cases on the two meshes refined at the bores
 (:func:`workbook.solve.bore_convergence.bore_convergence`): per distinct link
-the peak per net-section stress, per load case the highest bore peak. Run
+the peak per net-section stress, per load case the highest bore peak; and the
+conservative fatigue factors at the bores of the LP and HP imbalances
+(:func:`workbook.solve.bore_fatigue.bore_fatigue`). Run
 from anywhere (a few minutes once the links and their refined meshes are
 cached)::
 
@@ -30,6 +32,7 @@ from workbook.model.load_cases import reference_load_cases
 from workbook.model.reference import reference_case
 from workbook.model.spectrum import reference_speed_spectra
 from workbook.solve.bore_convergence import CONVERGENCE_TOLERANCE, bore_convergence
+from workbook.solve.bore_fatigue import bore_fatigue
 from workbook.solve.fatigue import solve_fatigue
 from workbook.solve.load_cases import solve_load_cases
 
@@ -123,7 +126,28 @@ def sections() -> dict[str, str]:
     case, loads, fatigue = _solved()
     bores = bore_convergence(case, loads)
     return {"load-cases": _load_cases(loads, bores), "fatigue": _fatigue(case, fatigue), "miner": _miner(fatigue),
-            "strength": _readme(case, loads, bores, fatigue), "bore-convergence": _bore_section(case, bores)}
+            "strength": _readme(case, loads, bores, fatigue), "bore-convergence": _bore_section(case, bores),
+            "bore-fatigue": _bore_fatigue(bore_fatigue(case, fatigue))}
+
+
+def _bore_fatigue(rows) -> str:
+    table = ["| rotor | link | N_0 (kN) | N^ amplitude (N) | sigma_m, sigma_a at the bore (MPa) | Goodman at the bore "
+             "| reduced link's Goodman |", "|---|---|---|---|---|---|---|"]
+    for excitation in dict.fromkeys(row.excitation for row in rows):
+        ours = sorted((row for row in rows if row.excitation == excitation), key=lambda row: row.goodman)
+        for row in ours[:3]:
+            table.append(f"| {row.excitation} ({row.frequency_hz:g} Hz) | {row.link} | {row.axial_force / 1e3:.2f} "
+                         f"| {row.axial_amplitude:.3g} | {row.mean / 1e6:.2f}, {row.alternating / 1e6:.4f} "
+                         f"| {row.goodman:.1f} | {row.reduced_goodman:.1f} |")
+    ratio = [row.reduced_goodman / row.goodman for row in rows if row.axial_force > 0.1 * max(r.axial_force for r in rows)]
+    below = sorted({row.link for row in rows if row.reduced_goodman < row.goodman})
+    return "\n".join(table + [
+        "", f"The three lowest bore factors per rotor. Where the link carries a preload (N_0 above a tenth of the "
+        f"largest), the bore factor is {min(ratio):.1f} to {max(ratio):.1f} times lower than the reduced link's: "
+        "the bore peak per newton against the rigidly tied bore's. "
+        + (f"The bore factor leaves out what is not axial: where the link carries little axial preload the reduced "
+           f"link's factor is the lower ({', '.join(below)}); take the lower of the two." if below else
+           "Take the lower of the two factors.")])
 
 
 def _bore_section(case, study) -> str:

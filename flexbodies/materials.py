@@ -11,8 +11,10 @@ __all__ = ["Material", "STEEL", "TITANIUM", "material", "STRENGTH_FIELDS", "FATI
 
 #: The S-N curve's fields of a :class:`Material`: the knee's cycles and the Basquin exponent.
 FATIGUE_FIELDS = ("endurance_cycles", "fatigue_exponent")
-#: Fields of a :class:`Material` no reduction depends on (left out of a link's fingerprint).
+#: The scalar strength fields of a :class:`Material` (one Links-sheet column each).
 STRENGTH_FIELDS = ("yield_strength", "ultimate_strength", "endurance_strength", *FATIGUE_FIELDS)
+#: Fields of a :class:`Material` no reduction depends on (left out of a link's fingerprint).
+_NOT_ELASTIC = (*STRENGTH_FIELDS, "haigh_curve")
 
 
 @dataclass(frozen=True)
@@ -49,6 +51,16 @@ class Material:
         ``sigma_f' (2N)^b`` with ``sigma_f' = S_e (2 N_e)^-b``); None: not
         known. Both are needed for a Miner damage sum
         (:mod:`workbook.solve.fatigue`).
+    haigh_curve : tuple of (float, float) or None
+        The material's Haigh diagram: the allowable ``(mean, alternating)``
+        stress amplitudes, Pa, as a polyline from the alternating axis
+        ``(0, S_a0)`` to the mean axis ``(S_m, 0)`` (e.g. ``(0, S_e)`` to
+        ``(S_u, 0)`` through measured points): means strictly increasing,
+        alternating stresses not increasing and positive but the last, which is
+        zero. It is not extrapolated: a load line meets it between its ends.
+        Compressive means get no credit (the curve's value at zero mean, as
+        the Goodman and Gerber factors do). For the Haigh factor
+        (:func:`flexbodies.stress.haigh_factor`); None: not given.
 
     Raises
     ------
@@ -65,8 +77,11 @@ class Material:
     endurance_strength: float | None = None
     endurance_cycles: float | None = None
     fatigue_exponent: float | None = None
+    haigh_curve: tuple | None = None
 
     def __post_init__(self):
+        if self.haigh_curve is not None:
+            object.__setattr__(self, "haigh_curve", _checked_haigh_curve(self.name, self.haigh_curve))
         _check_positive(self.name, "Young's modulus", self.youngs_modulus, "Pa")
         _check_positive(self.name, "density", self.density, "kg/m^3")
         for what in ("yield_strength", "ultimate_strength", "endurance_strength", "endurance_cycles"):
@@ -103,8 +118,41 @@ class Material:
         return self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
 
     def elastic_inputs(self) -> dict:
-        """The fields a reduction depends on (all but :data:`STRENGTH_FIELDS`), JSON-able."""
-        return {key: value for key, value in dataclasses.asdict(self).items() if key not in STRENGTH_FIELDS}
+        """The fields a reduction depends on (all but the strengths and the Haigh curve), JSON-able."""
+        return {key: value for key, value in dataclasses.asdict(self).items() if key not in _NOT_ELASTIC}
+
+
+def _checked_haigh_curve(name: str, curve) -> tuple:
+    """*curve* as a tuple of ``(mean, alternating)`` float pairs, Pa, or a LinkModelError naming what is wrong."""
+    where = f"material {name!r}: the Haigh curve"
+    try:
+        points = tuple((float(m), float(a)) for m, a in curve)
+    except (TypeError, ValueError):
+        raise LinkModelError(f"{where} must be a sequence of (mean, alternating) stress pairs in Pa, "
+                             f"got {curve!r}") from None
+    if len(points) < 2:
+        raise LinkModelError(f"{where} needs at least two points, from (0, S_a0) to (S_m, 0), got {len(points)}")
+    for k, (m, a) in enumerate(points):
+        if not (math.isfinite(m) and math.isfinite(a)):
+            raise LinkModelError(f"{where}: point {k + 1} {(m, a)!r} is not finite")
+    if points[0][0] != 0.0 or not points[0][1] > 0.0:
+        raise LinkModelError(f"{where} must start on the alternating axis, at (0, S_a0) with S_a0 > 0 Pa, "
+                             f"got {points[0]!r}")
+    if points[-1][1] != 0.0:
+        raise LinkModelError(f"{where} must end on the mean axis, at (S_m, 0) (it is not extrapolated), "
+                             f"got {points[-1]!r}")
+    for k in range(1, len(points)):
+        (m0, a0), (m1, a1) = points[k - 1], points[k]
+        if not m1 > m0:
+            raise LinkModelError(f"{where}: the means must increase strictly, point {k + 1} {points[k]!r} "
+                                 f"follows {points[k - 1]!r}")
+        if a1 > a0:
+            raise LinkModelError(f"{where}: the alternating stresses must not increase, point {k + 1} "
+                                 f"{points[k]!r} follows {points[k - 1]!r}")
+        if k < len(points) - 1 and not a1 > 0.0:
+            raise LinkModelError(f"{where}: only its last point lies on the mean axis, point {k + 1} is "
+                                 f"{points[k]!r}")
+    return points
 
 
 def _check_positive(name: str, what: str, value: float, unit: str) -> None:

@@ -37,7 +37,7 @@ if TYPE_CHECKING:  # meshing loads scikit-fem and gmsh: imported where a link is
 
 __all__ = ["VOIGT", "REGIONS", "NodalStress", "nodal_stress_operator", "von_mises", "max_principal",
            "link_regions", "state_stress", "alternating_von_mises", "signed_von_mises", "goodman_factor",
-           "gerber_factor", "write_vtu"]
+           "gerber_factor", "haigh_factor", "write_vtu"]
 
 #: Stress components, in the order of the stress shapes.
 VOIGT = ("xx", "yy", "zz", "yz", "xz", "xy")
@@ -229,6 +229,41 @@ def gerber_factor(alternating, mean, endurance: float, ultimate: float) -> np.nd
     sm = np.maximum(np.asarray(mean, float), 0.0)
     with np.errstate(divide="ignore"):
         return 2 * endurance / (sa + np.sqrt(sa**2 + (2 * sm * endurance / ultimate) ** 2))
+
+
+def haigh_factor(alternating, mean, curve) -> np.ndarray:
+    """Fatigue safety factor on a Haigh diagram: the factor n with ``(n sigma_m, n sigma_a)`` on the curve.
+
+    The proportional load line (the ray from the origin through the
+    stress point) meets the polyline once, the curve falling from the
+    alternating to the mean axis (:attr:`flexbodies.materials.Material.haigh_curve`):
+    on the segment ``P_k P_k+1`` whose polar angles bracket the ray's,
+    ``n = (P_k x d) / (r x d)`` with ``d = P_k+1 - P_k`` and ``r`` the stress
+    point (``x`` the 2D cross product). A compressive mean is taken as zero
+    (``n = S_a0 / sigma_a``, no credit). The curve ``((0, S_e), (S_u, 0))``
+    gives :func:`goodman_factor`.
+
+    Parameters
+    ----------
+    alternating, mean : array_like
+        Equivalent alternating and (signed) mean stress, Pa.
+    curve : sequence of (float, float)
+        ``(mean, alternating)`` points, Pa, as a :class:`~flexbodies.materials.Material`
+        holds them (checked there).
+
+    Returns
+    -------
+    ndarray
+        The factor n (inf where nothing alternates and the mean is not tensile).
+    """
+    points = np.asarray(curve, dtype=float)
+    sa = np.asarray(alternating, float)
+    sm = np.maximum(np.asarray(mean, float), 0.0)
+    angles = np.arctan2(points[::-1, 1], points[::-1, 0])           # increasing, 0 to pi/2
+    k = len(points) - 2 - np.clip(np.searchsorted(angles, np.arctan2(sa, sm), side="right") - 1, 0, len(points) - 2)
+    start, step = points[k], points[k + 1] - points[k]
+    with np.errstate(divide="ignore"):
+        return (start[..., 0] * step[..., 1] - start[..., 1] * step[..., 0]) / (sm * step[..., 1] - sa * step[..., 0])
 
 
 def max_principal(stress: np.ndarray) -> np.ndarray:

@@ -17,7 +17,7 @@ from workbook.scene.build import build_scene, reduce_links
 from workbook.solve.fatigue import solve_fatigue
 from workbook.solve.load_cases import link_coordinates
 from workbook.solve.pipeline import prepare
-from workbook.solve.preload import solve_preload
+from workbook.solve.preload import link_compression, solve_preload
 
 
 def test_alternating_stress_is_the_largest_von_mises_over_the_cycle():
@@ -48,7 +48,8 @@ def test_fatigue_factors_against_a_hand_calculation():
 @pytest.mark.slow
 def test_harmonic_stress_at_a_low_frequency_equals_the_static_stress(coarse_reference):
     """The quasi-static limit: a force phasor F at 1e-4 Hz against static solves at +-F (central
-    difference: the geometric nonlinearity's even part cancels), without other static loads."""
+    difference: the geometric nonlinearity's even part cancels), without other static loads: the
+    link stresses and the links' axial forces from the hinge forces."""
     case = dataclasses.replace(coarse_reference, static_loads=(),
                                effects=dataclasses.replace(coarse_reference.effects, stress_stiffening="off"))
     excitation = case.excitations[0]
@@ -59,15 +60,22 @@ def test_harmonic_stress_at_a_low_frequency_equals_the_static_stress(coarse_refe
     prepared = prepare(case, excitation, reduced=reduced)
     with prepared.scene as scene:
         model = prepared.model
-        phasors = model.link_phasors(model.motion(1e-4, model.input_matrix(point) @ force.astype(complex)))
+        motion = model.motion(1e-4, model.input_matrix(point) @ force.astype(complex))
+        phasors = model.link_phasors(motion)
         harmonic = {name: state_stress(scene.reduced[name], q) for name, q in phasors.items()}
-    static = []
+        axial = link_compression(scene, model.respond_generalised(1e-4, model.input_matrix(point)
+                                                                   @ force.astype(complex)).hinge_forces)
+    static, compression = [], []
     for sign in (1.0, -1.0):
         loaded = dataclasses.replace(case, excitations=(),
                                      static_loads=(PointForce("probe", tuple(sign * force), tuple(point)),))
         with build_scene(loaded, None, reduced=reduced) as scene:
-            solve_preload(scene)
+            compression.append(link_compression(scene, solve_preload(scene).hinge_forces))
             static.append({name: state_stress(scene.reduced[name], q) for name, q in link_coordinates(scene).items()})
+    # the axial force phasor of the bore fatigue (hinge force phasors on the link axis) likewise
+    largest = max(abs(value) for value in compression[0].values())
+    for name, value in axial.items():
+        assert abs(value - (compression[0][name] - compression[1][name]) / 2) < 1e-6 * largest, name
     assert len(phasors) == len(case.links)
     peak = max(np.abs(stress).max() for stress in static[0].values())
     for name, stress in harmonic.items():

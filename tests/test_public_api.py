@@ -57,7 +57,7 @@ INTERNAL_MODULES = (
     "workbook.scene.hinge_laws", "workbook.scene.link_workers",
     "workbook.scene.mode_budget", "workbook.scene.structural_damping",
     "workbook.solve", "workbook.solve.campbell", "workbook.solve.flexible_pylon", "workbook.solve.four_pole",
-    "workbook.solve.bore_convergence", "workbook.solve.fatigue",
+    "workbook.solve.bore_convergence", "workbook.solve.bore_fatigue", "workbook.solve.fatigue",
     "workbook.solve.guards", "workbook.solve.harmonic", "workbook.solve.load_cases", "workbook.solve.method", "workbook.solve.modes",
     "workbook.solve.pipeline", "workbook.solve.preload",
     "workbook.solve.response_sweep", "workbook.solve.run_up",

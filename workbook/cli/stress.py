@@ -4,7 +4,7 @@ Everything the package says of the links' strength: the static margins of
 the limit load cases (the tables of ``mountwb loads``,
 :mod:`workbook.solve.load_cases`), then per rotor excitation and link the
 dynamic stress on the preload and the fatigue safety factors by Goodman and
-Gerber (:mod:`workbook.solve.fatigue`). ``--vtu DIR`` writes each flexible
+Gerber, and Haigh for a material with a Haigh curve (:mod:`workbook.solve.fatigue`). ``--vtu DIR`` writes each flexible
 link's surface with its preload stress, the dynamic stress amplitude of each
 excitation and its first mode shapes, one VTU file per link (ParaView);
 ``--png DIR`` draws the same stress fields on each link's shape, one PNG per
@@ -13,13 +13,14 @@ link.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
 
-__all__ = ["arguments", "print_bore_convergence"]
+__all__ = ["arguments", "print_bore_convergence", "print_bore_fatigue", "print_fatigue_factors"]
 
 #: Mode shapes written with each link's VTU file.
 VTU_MODES = 6
@@ -37,6 +38,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
 def run(args) -> int:
     from workbook.cli.loads import chosen_load_cases, print_load_cases
     from workbook.solve.bore_convergence import bore_convergence
+    from workbook.solve.bore_fatigue import bore_fatigue
     from workbook.solve.fatigue import solve_fatigue
     from workbook.solve.load_cases import solve_load_cases
 
@@ -45,26 +47,20 @@ def run(args) -> int:
     fatigue = solve_fatigue(case)
     results = solve_load_cases(case, chosen) if chosen else []
     bores = bore_convergence(case, results)
+    at_bores = bore_fatigue(case, fatigue)
     if args.vtu:
         write_fields(Path(args.vtu), fatigue)
     if args.png:
         draw_fields(Path(args.png), fatigue)
     if args.json:
         print(json.dumps({"case": case.name, "load_cases": [r.to_dict() for r in results],
-                          "bore_convergence": bores.to_dict(), "fatigue": fatigue.to_dict()}, indent=1))
+                          "bore_convergence": bores.to_dict(), "fatigue": fatigue.to_dict(),
+                          "bore_fatigue": [dataclasses.asdict(row) for row in at_bores]}, indent=1))
         return 0
     print_load_cases(case, results)
     print_bore_convergence(bores)
-    print("\nfatigue on the preload (the case's static loads): alternating stress sigma_a = largest von Mises "
-          "over the cycle, mean sigma_m = von Mises of the preload stress signed by its hydrostatic part; "
-          "Goodman 1/n = sigma_a/S_e + sigma_m/S_u, Gerber n sigma_a/S_e + (n sigma_m/S_u)^2 = 1")
-    for answer in fatigue.excitations:
-        print(f"\n{answer.excitation} ({answer.frequency_hz:g} Hz)")
-        print(f"  {'link':16s} {'peak sigma_a MPa':>16s} {'sigma_a MPa':>11s} {'sigma_m MPa':>11s} "
-              f"{'Goodman':>9s} {'Gerber':>9s} {'at':>6s}")
-        for name, f in answer.links.items():
-            print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
-                  f"{f.goodman:9.3g} {f.gerber:9.3g} {f.region:>6s}")
+    print_fatigue_factors(fatigue)
+    print_bore_fatigue(at_bores)
     print_miner_sums(fatigue)
     print(f"\nstress recovery and fatigue factors, all links and excitations: {fatigue.stress_seconds:.3f} s")
     if args.vtu:
@@ -72,6 +68,41 @@ def run(args) -> int:
     if args.png:
         print(f"PNG files: {args.png}/<link>.png")
     return 0
+
+
+def print_fatigue_factors(fatigue) -> None:
+    """Per excitation and link of a :class:`~workbook.solve.fatigue.FatigueResult` its stresses and fatigue
+    factors (the Haigh column when a link's material has a Haigh curve)."""
+    print("\nfatigue on the preload (the case's static loads): alternating stress sigma_a = largest von Mises "
+          "over the cycle, mean sigma_m = von Mises of the preload stress signed by its hydrostatic part; "
+          "Goodman 1/n = sigma_a/S_e + sigma_m/S_u, Gerber n sigma_a/S_e + (n sigma_m/S_u)^2 = 1")
+    haigh = any(f.haigh is not None for answer in fatigue.excitations for f in answer.links.values())
+    if haigh:
+        print("Haigh: (n sigma_m, n sigma_a) on the material's Haigh curve (the proportional load line; '-' a "
+              "material without one); Gerber and Haigh the lowest over the link's nodes, at its worst node for each")
+    haigh_header = f" {'Haigh':>9s}" if haigh else ""
+    for answer in fatigue.excitations:
+        print(f"\n{answer.excitation} ({answer.frequency_hz:g} Hz)")
+        print(f"  {'link':16s} {'peak sigma_a MPa':>16s} {'sigma_a MPa':>11s} {'sigma_m MPa':>11s} "
+              f"{'Goodman':>9s} {'Gerber':>9s}{haigh_header} {'at':>6s}")
+        for name, f in answer.links.items():
+            column = "" if not haigh else f" {'-':>9s}" if f.haigh is None else f" {f.haigh:9.3g}"
+            print(f"  {name:16s} {f.peak_alternating / 1e6:16.4f} {f.alternating / 1e6:11.4f} {f.mean / 1e6:11.2f} "
+                  f"{f.goodman:9.3g} {f.gerber:9.3g}{column} {f.region:>6s}")
+
+
+def print_bore_fatigue(rows) -> None:
+    """The bore fatigue factors (:func:`~workbook.solve.bore_fatigue.bore_fatigue`) beside the reduced links'."""
+    if not rows:
+        return
+    print("\nfatigue at the bores (the bore sub-model under the pins' bearing load, a two-force link): "
+          "sigma_m = k(sign N_0) |N_0|, sigma_a = max(k_t, k_c) |N^|, k the sub-model's peak per newton; "
+          "conservative: both peaks at one point, no credit for a compressive preload")
+    print(f"  {'excitation':20s} {'link':16s} {'N_0 kN':>8s} {'|N^| N':>9s} {'sigma_m MPa':>11s} "
+          f"{'sigma_a MPa':>11s} {'Goodman':>9s} {'reduced link':>12s}")
+    for row in rows:
+        print(f"  {row.excitation:20s} {row.link:16s} {row.axial_force / 1e3:8.2f} {row.axial_amplitude:9.3g} "
+              f"{row.mean / 1e6:11.2f} {row.alternating / 1e6:11.4f} {row.goodman:9.3g} {row.reduced_goodman:12.3g}")
 
 
 def print_miner_sums(fatigue) -> None:

@@ -103,6 +103,9 @@ def _row_for_link(link: cm.Link) -> dict:
            "loss_factor": link.loss_factor or None, "modal_damping": link.modal_damping or None}
     row.update({key: getattr(model.geometry, key) for key in
                 ("eye_outer_radius", "bore_radius", "thickness", "shank_width", "shank_thickness")})
+    if model.material.haigh_curve is not None:
+        raise UnwritableCase(f"link {link.name!r}: the Haigh curve of material {model.material.name!r} has no Links "
+                             "column (a case with one is kept as a case file)")
     base = flexbodies.material(model.material.name.split(" ")[0])
     row["material"] = base.name
     row.update({key: getattr(model.material, key) for key in ("youngs_modulus", "poisson_ratio", "density",

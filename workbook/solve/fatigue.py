@@ -20,11 +20,18 @@ field ``S q_hat``, both one matrix product with the link's stress shapes
 - the fatigue safety factors by the modified Goodman line and the Gerber
   parabola (:func:`flexbodies.stress.goodman_factor`,
   :func:`flexbodies.stress.gerber_factor`), against the material's endurance
-  and ultimate strength; a compressive mean earns no credit.
+  and ultimate strength, and, when the material has a Haigh curve
+  (:attr:`flexbodies.materials.Material.haigh_curve`), the Haigh factor on
+  the proportional load line (:func:`flexbodies.stress.haigh_factor`); a
+  compressive mean earns no credit.
 
 Per link and excitation the lowest Goodman factor over the nodes is reported
-with its node, its stresses and its Gerber factor, and the peak alternating
-stress. Every single-frequency excitation is answered alone: each point of a
+with its node and its stresses, the lowest Gerber and Haigh factors over the
+nodes (at that node or another: each criterion's own worst node), and the
+peak alternating stress; and the link's axial force, of the preload and the
+amplitude of its phasor (the hinge forces and force phasors at its eyes on
+the link axis, :func:`~workbook.solve.preload.link_compression`), from which
+:mod:`workbook.solve.bore_fatigue` gives the fatigue at the bores. Every single-frequency excitation is answered alone: each point of a
 sweep (a speed of a run-up) and each part of a simultaneous excitation, by
 the harmonic model of :mod:`workbook.solve.harmonic` (for a case with hinge
 clearance, linearised about the preload).
@@ -51,16 +58,27 @@ their speed.
 """
 from __future__ import annotations
 
+import dataclasses
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexbodies.stress import REGIONS, alternating_von_mises, gerber_factor, goodman_factor, link_regions, signed_von_mises, state_stress
+from flexbodies.stress import (
+    REGIONS,
+    alternating_von_mises,
+    gerber_factor,
+    goodman_factor,
+    haigh_factor,
+    link_regions,
+    signed_von_mises,
+    state_stress,
+)
 from workbook.errors import CaseError
 from workbook.model.case import Case, Simultaneous, Sweep
 from workbook.model.spectrum import SECONDS_PER_HOUR, SpeedSpectrum, check_speed_spectra
 from workbook.solve.load_cases import link_coordinates
+from workbook.solve.preload import link_compression
 
 __all__ = ["LinkFatigue", "ExcitationFatigue", "LinkDamage", "SpectrumDamage", "FatigueResult", "link_fatigue",
            "equivalent_alternating", "cycles_to_failure", "miner_damage", "solve_fatigue"]
@@ -86,6 +104,15 @@ class LinkFatigue:
         Where that node is: ``"eye A"``, ``"shank"`` or ``"eye B"``.
     point : tuple of 3 floats
         That node, global coordinates of the undeformed link, m.
+    haigh : float or None
+        The lowest Haigh factor over the nodes (at that node or another),
+        None when the link's material has no Haigh curve.
+    axial_force : float or None
+        The preload's axial force N_0 of the link, tension positive, N (from
+        the hinge forces at its eyes).
+    axial_amplitude : float or None
+        The amplitude ``|N^|`` of the link's harmonic axial force, N (from the
+        hinge force phasors at its eyes, projected on the link axis).
     """
 
     link: str
@@ -96,6 +123,9 @@ class LinkFatigue:
     gerber: float
     region: str
     point: tuple
+    haigh: float | None = None
+    axial_force: float | None = None
+    axial_amplitude: float | None = None
 
 
 @dataclass(frozen=True)
@@ -240,8 +270,6 @@ class FatigueResult:
 
     def to_dict(self) -> dict:
         """JSON-ready, SI units but hours (without the stress fields)."""
-        import dataclasses
-
         return {"case": self.case, "stress_seconds": self.stress_seconds,
                 "excitations": [{"excitation": e.excitation, "frequency_hz": e.frequency_hz,
                                  "links": {name: dataclasses.asdict(f) for name, f in e.links.items()}}
@@ -289,11 +317,13 @@ def link_fatigue(link, reduced, mean_coordinates, amplitude: np.ndarray, rotatio
     mean = signed_von_mises(state_stress(reduced, mean_coordinates))
     goodman = goodman_factor(alternating, mean, material.endurance_strength, material.ultimate_strength)
     gerber = gerber_factor(alternating, mean, material.endurance_strength, material.ultimate_strength)
+    haigh = None if material.haigh_curve is None else float(haigh_factor(alternating, mean, material.haigh_curve).min())
     i = int(np.argmin(goodman))
     regions = link_regions(reduced)
     point = np.asarray(link.end_a) + rotation @ reduced.nodes[i]
     return LinkFatigue(link.name, float(alternating.max()), float(alternating[i]), float(mean[i]),
-                       float(goodman[i]), float(gerber.min()), REGIONS[regions[i]], tuple(float(x) for x in point))
+                       float(goodman[i]), float(gerber.min()), REGIONS[regions[i]], tuple(float(x) for x in point),
+                       haigh)
 
 
 def equivalent_alternating(alternating, mean, ultimate: float) -> np.ndarray:
@@ -359,7 +389,8 @@ def miner_damage(equivalents, cycles, material) -> np.ndarray:
 
 
 def _solved(case: Case, points: tuple, reduced: dict | None):
-    """Yield ``(point, scene, means, result)`` per single-frequency *points*, on one prepared scene."""
+    """Yield ``(point, scene, means, tension, result)`` per single-frequency *points*, on one prepared scene
+    (*tension*: each link's preload axial force, N)."""
     from workbook.solve.pipeline import prepare
 
     highest = max(points, key=lambda point: point.frequency)
@@ -368,8 +399,9 @@ def _solved(case: Case, points: tuple, reduced: dict | None):
     assert model is not None
     with scene:
         means = link_coordinates(scene)
+        tension = {name: -float(value) for name, value in link_compression(scene, prepared.preload.hinge_forces).items()}
         for point in points:
-            yield point, scene, means, model.result(point, case.analysis.steady_tolerance)
+            yield point, scene, means, tension, model.result(point, case.analysis.steady_tolerance)
 
 
 def _spectrum_damage(case: Case, spectrum: SpeedSpectrum, reduced: dict | None) -> SpectrumDamage:
@@ -379,7 +411,7 @@ def _spectrum_damage(case: Case, spectrum: SpeedSpectrum, reduced: dict | None) 
     points = tuple(spectrum.at(case.excitations, f) for f, _ in speeds)
     equivalents: dict = {}
     found: dict = {}
-    for _, scene, means, result in _solved(case, points, reduced):
+    for _, scene, means, _, result in _solved(case, points, reduced):
         for name in (name for name in case.link_map if name in means):
             link, body = case.link_map[name], scene.reduced[name]
             if name not in found:
@@ -441,14 +473,15 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
     seconds = 0.0
     for item in case.excitations:
         points = item.expand() if isinstance(item, (Sweep, Simultaneous)) else (item,)
-        for point, scene, means, result in _solved(case, points, reduced):
+        for point, scene, means, tension, result in _solved(case, points, reduced):
             start = time.perf_counter()
             amplitudes, links = {}, {}
+            axial = link_compression(scene, result.hinge_phasors)
             for name in (name for name in case.link_map if name in means):
                 body = scene.reduced[name]
                 amplitudes[name] = state_stress(body, result.link_phasors[name])
-                links[name] = link_fatigue(case.link_map[name], body, means[name], amplitudes[name],
-                                           scene.links[name].rotation)
+                found = link_fatigue(case.link_map[name], body, means[name], amplitudes[name], scene.links[name].rotation)
+                links[name] = dataclasses.replace(found, axial_force=tension[name], axial_amplitude=float(abs(axial[name])))
             seconds += time.perf_counter() - start
             answers.append(ExcitationFatigue(point.name, point.frequency, links, amplitudes))
             if not mean_stress:

@@ -220,7 +220,7 @@ def _stop_on_free_motions(scene: Scene, modes: list[Mode]) -> None:
         raise MechanismError(case.name, [mode.description for mode in free], loose)
 
 
-def link_compression(scene: Scene, forces: dict) -> dict[str, float]:
+def link_compression(scene: Scene, forces: dict) -> dict:
     """Axial compression of every link from the hinge forces on its eyes, N
     (negative: tension).
 
@@ -228,10 +228,11 @@ def link_compression(scene: Scene, forces: dict) -> dict[str, float]:
     ----------
     scene : Scene
     forces : dict of str to ndarray, shape (3,)
-        Force of each hinge on its marker-0 body (:meth:`Scene.hinge_forces`), N.
+        Force of each hinge on its marker-0 body (:meth:`Scene.hinge_forces`), N;
+        complex hinge force phasors give the axial force phasors.
     """
     case = scene.case
-    compression = {link.name: 0.0 for link in case.links}
+    compression: dict = {link.name: 0.0 for link in case.links}
     for hinge in case.hinges:
         first = marker_bodies(hinge)[0]
         for body in hinge.bodies:
@@ -242,7 +243,7 @@ def link_compression(scene: Scene, forces: dict) -> dict[str, float]:
             on_link = forces[hinge.name] if body == first else -forces[hinge.name]
             # eye a pushed towards b, or eye b towards a: compression (half from each eye)
             sign = 1.0 if link.eye_at(hinge.position) == "a" else -1.0
-            compression[body] += 0.5 * sign * float(on_link @ axis)
+            compression[body] += 0.5 * sign * (on_link @ axis)
     return compression
 
 
