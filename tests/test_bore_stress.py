@@ -133,6 +133,8 @@ def test_load_case_bore_peaks_follow_the_axial_force_on_both_meshes(cache_dir, m
         np.testing.assert_allclose(row.peaks, [p.peak(row.axial_force) for p in pair])
         assert row.change == pytest.approx(row.peaks[1] / row.peaks[0] - 1)
         assert row.converged == (abs(row.change) <= CONVERGENCE_TOLERANCE)
+        assert row.yield_margin == pytest.approx(STEEL.yield_strength / row.peaks[1] - 1)
+        assert row.ultimate_margin == pytest.approx(STEEL.ultimate_strength / (1.5 * row.peaks[1]) - 1)
     # the same relative change at any force of one sign: the peak is linear in it
     assert study.rows[0].change == pytest.approx(study.rows[2].change)
     assert study.rows[1].peaks[0] < study.rows[0].peaks[0]        # compression bears on the other half

@@ -105,6 +105,7 @@ def bore_convergence(case, results) -> BoreStudy:
     from workbook.solve.load_cases import margin
 
     peaks: dict = {}
+    materials: dict = {}
     sharing: dict = {}
     skipped = []
     for link in case.links:
@@ -114,6 +115,7 @@ def bore_convergence(case, results) -> BoreStudy:
             skipped.append(link.name)
             continue
         peaks[link.name] = [bore_peaks(link.model, size) for size in convergence_sizes(link.model)]
+        materials[link.name] = link.model.material
         sharing.setdefault(link.model.key(), []).append(link.name)
     rows = []
     for result in results:
@@ -122,7 +124,7 @@ def bore_convergence(case, results) -> BoreStudy:
                 continue
             coarse, fine = (p.peak(stress.axial_force) for p in peaks[name])
             change = fine / coarse - 1.0 if coarse > 0 else 0.0
-            material = case.link_map[name].model.material
+            material = materials[name]
             rows.append(BoreConvergence(result.load_case.name, name, stress.axial_force, stress.von_mises,
                                         tuple(p.bore_element_size for p in peaks[name]), (coarse, fine), change,
                                         abs(change) <= CONVERGENCE_TOLERANCE, margin(material.yield_strength, fine),
