@@ -62,10 +62,10 @@ def _constraint_text(name: str, record: Record) -> str:
 def read_optimise_sheet(reader, records: list[Record], case: Case) -> OptimiseSheet | None:
     """The Optimise sheet's problem (None: no rows); each bad cell reported to *reader*
     (a :class:`~workbook.excel.sheets.SheetReader`)."""
-    from workbook.design.optimise import OBJECTIVES, constraint, variable, variable_name
-
     if not records:
         return None
+    from workbook.design.optimise import OBJECTIVES, constraint, variable, variable_name  # SciPy: only for the sheet
+
     rotors = [item.name for item in case.excitations if isinstance(item, SINGLE_FREQUENCY_KINDS)]
     variables, constraints, bands = {}, [], {}
     given: dict = {"objective": None, "starts": None}
