@@ -167,6 +167,17 @@ def test_a_bad_uncertainty_is_refused_naming_it(text):
         Uncertainty.parse(text)
 
 
+@pytest.mark.parametrize("option", ["lp.csv:-3%", "lp.csv:0%"])
+def test_a_record_option_with_a_bad_uncertainty_names_the_uncertainty(option):
+    """A tail that reads as a number is the uncertainty, refused when not positive (not taken for the path)."""
+    from workbook.cli.update import _record_option
+
+    with pytest.raises(UsageError, match="measurement uncertainty"):
+        _record_option(option)
+    assert _record_option("C:lp.csv") == ("C:lp.csv", None)
+    assert _record_option("lp.csv:0.5%")[1].value == pytest.approx(0.005)
+
+
 def test_uncertainties_for_some_records_only_are_refused(mount, exact):
     truth, t = exact
     with pytest.raises(UsageError, match="for every record or none"):

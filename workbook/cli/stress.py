@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
+from workbook.errors import UsageError
 
 __all__ = ["arguments", "print_bore_convergence", "print_bore_fatigue", "print_fatigue_factors"]
 
@@ -42,6 +43,10 @@ def run(args) -> int:
     from workbook.solve.fatigue import solve_fatigue
     from workbook.solve.load_cases import solve_load_cases
 
+    for option, folder in (("--vtu", args.vtu), ("--png", args.png)):
+        if folder and Path(folder).exists() and not Path(folder).is_dir():
+            raise UsageError(f"{option} {folder}: a file of that name is there; give a folder for the "
+                             "files, one per link")
     case = load_case(args.case, run=args.run)
     chosen = chosen_load_cases(case, args.load_case)
     fatigue = solve_fatigue(case)

@@ -95,7 +95,7 @@ def _record_option(text: str) -> tuple:
     from workbook.rig.updating import Uncertainty
 
     path, colon, tail = text.rpartition(":")
-    if not colon or not path or not re.fullmatch(r"\s*[0-9.][0-9.eE+\-\s]*%?\s*", tail):
+    if not colon or not path or not re.fullmatch(r"\s*[+\-]?[0-9.][0-9.eE+\-\s]*%?\s*", tail):
         return text, None
     return path, Uncertainty.parse(tail)
 
