@@ -16,7 +16,7 @@ median of its repeats:
 - the parts of one load case over all links: the stress fields alone, the
   regions, the von Mises and the largest principal stresses.
 
-Target (issue 26): all links and both rotors after the reduction in 0.1 s
+Target: all links and both rotors after the reduction in 0.1 s
 or less. Before (the closed-form principal stress, the regions made once
 per mesh and the complex state in one real product) and after, one run of
 each source tree back to back on the shared 2-core machine, load average
