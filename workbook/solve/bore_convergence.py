@@ -104,6 +104,8 @@ def bore_convergence(case, results) -> BoreStudy:
     from flexbodies.bore_stress import bore_peaks, convergence_sizes
     from workbook.solve.load_cases import margin
 
+    if not results:         # nothing to converge: no sub-model is meshed
+        return BoreStudy([], {}, {}, ())
     peaks: dict = {}
     materials: dict = {}
     sharing: dict = {}
