@@ -13,8 +13,8 @@ import pytest
 
 from workbook.errors import CaseError
 from workbook.model.case import ENGINE, PYLON, AnalysisSettings, Case, Engine, HarmonicForce, Hinge, PointForce, RotatingForce
-from workbook.scene.bearing import hinge_frame
 from workbook.scene.build import build_scene
+from workbook.scene.hinge_law_base import hinge_frame
 from workbook.solve.harmonic import harmonic_model
 from workbook.solve.pipeline import run_case
 from workbook.solve.preload import solve_preload

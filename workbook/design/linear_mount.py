@@ -47,37 +47,31 @@ from workbook.solve.stages import link_warnings
 if TYPE_CHECKING:
     from flexbodies.reduced import ReducedLink
 
-__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_frames", "channel_springs"]
+__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_springs"]
 
 
-def channel_frames(case: Case, channels: list[str]) -> np.ndarray:
-    """Each force channel's directions as rows (C, 3, 3): a hinge's frame, a transducer's global axes."""
-    from workbook.scene.bearing import hinge_frame
+def channel_springs(case: Case, channels: list[str]) -> ChannelSprings:
+    """The springs of the force channels *channels* of *case*: the hinges' as their laws give them
+    (:meth:`~workbook.scene.hinge_law_base.HingeLaw.matrices`), then the transducers' along the global axes."""
+    from workbook.scene.hinge_laws import law_of
 
-    by_name = {hinge.name: hinge for hinge in case.hinges}
-    return np.array([hinge_frame(case, by_name[name]) if name in by_name else np.eye(3) for name in channels])
-
-
-def channel_springs(case: Case, channels: list[str], frames: np.ndarray) -> ChannelSprings:
-    """The springs of the force channels *channels* (hinges, then transducers) of *case*, in their
-    *frames* (:func:`channel_frames`)."""
     hinge_loss, _ = loss_factors(case)
     by_name = {hinge.name: hinge for hinge in case.hinges}
-    values = np.zeros((3, len(channels), 3))        # stiffness, damping, loss factor per direction
+    springs = np.zeros((3, len(channels), 3, 3))        # stiffness, damping, loss factors
     for k, name in enumerate(channels):
         hinge = by_name.get(name)
         if hinge is None:
             rig = case.test_rig
             assert rig is not None
-            values[0, k], values[1, k] = rig.stiffness, rig.damping
+            springs[0, k], springs[1, k] = np.diag(rig.stiffness), np.diag(rig.damping)
             continue
-        values[0, k] = hinge.values("stiffness")
+        stiffness, damping, loss = law_of(case, hinge).matrices(case, hinge)
+        springs[0, k] = stiffness
         if case.effects.hinge_damping:
-            values[1, k] = hinge.values("damping")
+            springs[1, k] = damping
         if name in hinge_loss:
-            values[2, k] = hinge.values("loss_factor")
-    stiffness, damping, loss = np.einsum("cia,xci,cib->xcab", frames, values, frames)
-    return ChannelSprings(stiffness, damping, loss @ stiffness)
+            springs[2, k] = loss
+    return ChannelSprings(springs[0], springs[1], springs[2] @ springs[0])
 
 
 @dataclass(frozen=True)
@@ -191,7 +185,6 @@ class LinearMount:
         self.case = case
         self.items = items
         self.channels = channels
-        self.frames = channel_frames(case, channels)
         self.pylon = pylon
         self._cards = cards
         self._preloads = preloads
@@ -301,7 +294,7 @@ class LinearMount:
         As :meth:`evaluate`.
         """
         self.check(case)
-        springs = channel_springs(case, self.channels, self.frames)
+        springs = channel_springs(case, self.channels)
         solutions = []
         for item in case.excitations:
             prepared = self.items[item.name]
@@ -338,7 +331,7 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
     expansion = expand_scene(scene, points)
     size = len(expansion.state)
     forces = scene.hinge_forces()
-    base_springs = channel_springs(case, channels, channel_frames(case, channels))
+    base_springs = channel_springs(case, channels)
     state = expansion.channels.state(total(expansion, np.zeros(size)))
     own = np.einsum("cab,cb->ca", base_springs.stiffness, state.separation)
     exudyn = np.array([forces[name] for name in channels])

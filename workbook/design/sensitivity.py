@@ -226,9 +226,9 @@ def _parameter_change(mount: LinearMount, values: dict, name: str, case: Case, s
     value = values[name]
     step = 1e-3 * (abs(value) or 1.0)
     changed = design_case(mount, {**values, name: value + step})
-    base = channel_springs(case, mount.channels, mount.frames) if springs is None else springs
+    base = channel_springs(case, mount.channels) if springs is None else springs
     change = ChannelSprings(*((a - b) / step for a, b in zip(
-        dataclasses.astuple(channel_springs(changed, mount.channels, mount.frames)), dataclasses.astuple(base),
+        dataclasses.astuple(channel_springs(changed, mount.channels)), dataclasses.astuple(base),
         strict=True)))
     return change, (changed.engine.mass - case.engine.mass) / step
 

@@ -18,48 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from workbook.model.case import ENGINE, PYLON, Case, Hinge
-from workbook.scene.hinge_law_base import Connector, HingeLaw
+from workbook.model.case import Case, Hinge
+from workbook.scene.hinge_law_base import Connector, HingeLaw, hinge_matrix
 
-__all__ = ["hinge_frame", "hinge_matrix", "exudyn_bearing_function", "PerDirectionLaw", "PER_DIRECTION"]
-
-
-def hinge_frame(case: Case, hinge: Hinge) -> np.ndarray:
-    """The hinge's directions radial 1, radial 2, axial as rows, global coordinates.
-
-    The hinge's own ``frame`` when given; else the frame of the link it sits
-    on (radial 1 along the link towards eye B, axial along the link's bore
-    axis, see :func:`flexbodies.exudyn_body.link_rotation`); else (a hinge
-    between the pylon and the engine) the global axes.
-    """
-    from flexbodies.exudyn_body import link_rotation
-
-    if hinge.frame is not None:
-        return np.array(hinge.frame, dtype=float)
-    links = [body for body in hinge.bodies if body not in (PYLON, ENGINE)]
-    if not links:
-        return np.eye(3)
-    link = case.link_map[links[0]]
-    return link_rotation(link.end_a, link.end_b, link.bore_axis).T
-
-
-def hinge_matrix(case: Case, hinge: Hinge, name: str, values=None) -> np.ndarray:
-    """``R^T diag(values) R``: a per-direction quantity of *hinge* in global coordinates, shape (3, 3).
-
-    Parameters
-    ----------
-    case : Case
-    hinge : Hinge
-    name : {"stiffness", "damping", "loss_factor"}
-        The quantity (N/m, N s/m or dimensionless).
-    values : array_like, shape (3,), optional
-        Values to use instead of the hinge's own *name*.
-    """
-    values = hinge.values(name) if values is None else np.broadcast_to(np.asarray(values, dtype=float), (3,))
-    if np.ptp(values) == 0:
-        return values[0] * np.eye(3)
-    frame = hinge_frame(case, hinge)
-    return frame.T @ np.diag(values) @ frame
+__all__ = ["exudyn_bearing_function", "PerDirectionLaw", "PER_DIRECTION"]
 
 
 def exudyn_bearing_function(stiffness: np.ndarray, damping: np.ndarray):

@@ -7,7 +7,12 @@ without a user function. Any other law (one module, registered in
 :data:`workbook.scene.hinge_laws.HINGE_LAWS`) subclasses :class:`HingeLaw`:
 it says which hinges it takes, gives the connector's stiffness, damping and
 recorded symbolic ``springForceUserFunction``, the same force with NumPy
-(the reference for tests and plots), and its model-card entry.
+(the reference for tests and plots), its matrices as the frequency domain's
+linear models take them (:meth:`HingeLaw.matrices`: the harmonic model, the
+four-pole set and the linear mount ask the law, never the hinge's fields)
+and its model-card entry. A hinge's per-direction quantities act in global
+coordinates as ``R^T diag(values) R`` of its frame (:func:`hinge_frame`,
+:func:`hinge_matrix`; :mod:`workbook.scene.bearing`).
 
 A *nonlinear* law makes the scene nonlinear: the time domain resolves it;
 the frequency domain linearises it about the preloaded state (Exudyn's
@@ -23,9 +28,47 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from workbook.model.case import Case, Hinge
+from workbook.model.case import ENGINE, PYLON, Case, Hinge
 
-__all__ = ["Connector", "HingeLaw", "SpringDamper", "SPRING_DAMPER"]
+__all__ = ["Connector", "HingeLaw", "SpringDamper", "SPRING_DAMPER", "hinge_frame", "hinge_matrix"]
+
+
+def hinge_frame(case: Case, hinge: Hinge) -> np.ndarray:
+    """The hinge's directions radial 1, radial 2, axial as rows, global coordinates.
+
+    The hinge's own ``frame`` when given; else the frame of the link it sits
+    on (radial 1 along the link towards eye B, axial along the link's bore
+    axis, see :func:`flexbodies.exudyn_body.link_rotation`); else (a hinge
+    between the pylon and the engine) the global axes.
+    """
+    from flexbodies.exudyn_body import link_rotation
+
+    if hinge.frame is not None:
+        return np.array(hinge.frame, dtype=float)
+    links = [body for body in hinge.bodies if body not in (PYLON, ENGINE)]
+    if not links:
+        return np.eye(3)
+    link = case.link_map[links[0]]
+    return link_rotation(link.end_a, link.end_b, link.bore_axis).T
+
+
+def hinge_matrix(case: Case, hinge: Hinge, name: str, values=None) -> np.ndarray:
+    """``R^T diag(values) R``: a per-direction quantity of *hinge* in global coordinates, shape (3, 3).
+
+    Parameters
+    ----------
+    case : Case
+    hinge : Hinge
+    name : {"stiffness", "damping", "loss_factor"}
+        The quantity (N/m, N s/m or dimensionless).
+    values : array_like, shape (3,), optional
+        Values to use instead of the hinge's own *name*.
+    """
+    values = hinge.values(name) if values is None else np.broadcast_to(np.asarray(values, dtype=float), (3,))
+    if np.ptp(values) == 0:
+        return values[0] * np.eye(3)
+    frame = hinge_frame(case, hinge)
+    return frame.T @ np.diag(values) @ frame
 
 
 @dataclass(frozen=True)
@@ -100,6 +143,21 @@ class HingeLaw:
         stiffness, damping = hinge.values("stiffness"), hinge.values("damping")
         return stiffness * np.asarray(displacement, dtype=float) \
             + (damping + np.asarray(loss_time, dtype=float) * stiffness) * np.asarray(velocity, dtype=float)
+
+    def matrices(self, case: Case, hinge: Hinge) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The law as the frequency domain's linear models take it, global coordinates, shape (3, 3) each.
+
+        Returns
+        -------
+        stiffness : ndarray
+            S, N/m.
+        damping : ndarray
+            S_d, N s/m (the hinge's own, whether hinge damping is on or not).
+        loss : ndarray
+            E of the loss factors: the hysteretic force is ``i E S u``, dimensionless.
+        """
+        return (hinge_matrix(case, hinge, "stiffness"), hinge_matrix(case, hinge, "damping"),
+                hinge_matrix(case, hinge, "loss_factor"))
 
     def card_entry(self, case: Case) -> tuple[bool, str] | None:
         """The law's model-card entry (on, detail), None for none."""

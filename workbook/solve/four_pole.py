@@ -64,8 +64,7 @@ import numpy as np
 from workbook._renamed import renamed
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
-from workbook.scene.bearing import hinge_matrix
-from workbook.scene.hinge_laws import nonlinear_hinges
+from workbook.scene.hinge_laws import law_of, nonlinear_hinges
 
 __all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
            "REPORT_GRID"]
@@ -489,11 +488,9 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
         rows_k.append(sum(model.stiffness_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
         rows_h.append(sum(model.structural_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
         rows_d.append(sum(model.damping_output[3 * channel[h]:3 * channel[h] + 3] for h in carried) @ turn)
-        own_k = [hinge_matrix(mount, hinges[h], "stiffness") for h in carried]
-        direct_k.append(sum(k + (1j * hinge_matrix(mount, hinges[h], "loss_factor") @ k if damped else 0.0)
-                            for h, k in zip(carried, own_k, strict=True)))
-        direct_d.append(sum(hinge_matrix(mount, hinges[h], "damping") for h in carried) if damped
-                        else np.zeros((3, 3)))
+        laws = [law_of(mount, hinges[h]).matrices(mount, hinges[h]) for h in carried]
+        direct_k.append(sum(k + (1j * loss @ k if damped else 0.0) for k, _, loss in laws))
+        direct_d.append(sum(d for _, d, _ in laws) if damped else np.zeros((3, 3)))
     output_k, output_h, output_d = np.vstack(rows_k), np.vstack(rows_h), np.vstack(rows_d)
     direct_k, direct_d = sla.block_diag(*direct_k), sla.block_diag(*direct_d)
 

@@ -44,7 +44,6 @@ import scipy.linalg as sla
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.model.case import ENGINE, SingleFrequencyExcitation
-from workbook.scene.bearing import hinge_matrix
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.modes import Linearization, linearize
 from workbook.solve.truncation import residual_stiffness
@@ -300,7 +299,7 @@ def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.n
         jacobian = _central_difference(displacements, set_q, q0, range(len(q0)), COORDINATE_STEP) @ lin.basis
         for k, name in enumerate(lossy):
             rows = slice(3 * names.index(name), 3 * names.index(name) + 3)
-            output[rows] = hinge_matrix(scene.case, by_name[name], "loss_factor") @ stiffness_output[rows]
+            output[rows] = scene.hinges[name].hinge_law.matrices(scene.case, by_name[name])[2] @ stiffness_output[rows]
             structural += jacobian[3 * k:3 * k + 3].T @ output[rows]
     for name, eta in link_loss.items():
         modal_node = scene.links[name].nodes[1]
