@@ -21,7 +21,7 @@ import numpy as np
 from workbook.design.channel_set import ChannelState
 from workbook.design.expansion import SceneExpansion
 
-__all__ = ["ChannelSprings", "StateLoads", "Projection", "total", "rest_matrices", "static_residual",
+__all__ = ["ChannelSprings", "StateLoads", "Projection", "total", "rest_stiffness", "rest_matrices", "turned_mass", "static_residual",
            "normal_components", "without_normal", "tangent_stiffness", "static_state", "projection",
            "NEWTON_TOLERANCE", "NEWTON_STEPS"]
 
@@ -74,16 +74,69 @@ def total(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
     return expansion.reference + expansion.state + dq
 
 
-def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
-                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """M, K, D of the rest of the scene at the state change *dq*, full coordinates."""
-    mass, stiffness, damping = expansion.rest.matrices(dq)
+def rest_stiffness(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads) -> np.ndarray:
+    """K of the rest of the scene at the state change *dq*, full coordinates."""
+    stiffness = expansion.rest.matrices(dq)[1]
     for indices, added in loads.modal_stiffness:
         stiffness[np.ix_(indices, indices)] += added
+    return stiffness
+
+
+def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """M, K, D of the rest of the scene at the state change *dq*, full coordinates (M with each
+    Euler-parameter body's rotation exact, :func:`turned_mass`)."""
+    damping = expansion.rest.matrices(dq)[2]
+    mass = turned_mass(expansion, dq)
     q = total(expansion, dq)
     for indices, added in loads.mass:
         mass[np.ix_(indices, indices)] += added(q[indices])
-    return mass, stiffness, damping
+    return mass, rest_stiffness(expansion, dq, loads), damping
+
+
+def _rotation(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A (E, 3, 3) and the local ``G`` (E, 3, 4) of unit Euler parameters *theta* (E, 4), as Exudyn's
+    rigid-body nodes have them: body angular velocity ``G theta'``, global vector ``A v`` of a local v."""
+    p0, pv = theta[:, 0], theta[:, 1:]
+    skew = np.zeros((len(theta), 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -pv[:, 2], pv[:, 1], -pv[:, 0]
+    skew -= skew.transpose(0, 2, 1)
+    rotation = (2 * p0 ** 2 - 1)[:, None, None] * np.eye(3) + 2 * (np.einsum("ei,ej->eij", pv, pv)
+                                                                  + p0[:, None, None] * skew)
+    local = 2 * np.concatenate([-pv[:, :, None], p0[:, None, None] * np.eye(3) - skew], axis=2)
+    return rotation, local
+
+
+def turned_mass(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
+    """The rest's M at the state change *dq*, full coordinates, each Euler-parameter body's rotation exact.
+
+    A floating-frame body's kinetic energy depends on its velocities only
+    through the local ones, ``A^T r'``, ``G theta'`` and the modal rates, and
+    on its coordinates only through the modal ones; so its M at another
+    rotation is ``S^T M S`` of its M at the prepared rotation, ``S_r = A_0 A^T``
+    and ``S_theta = G_0^T G / 4`` on its position and parameters (identity
+    elsewhere). The other coordinates change M to first order (the expansion's
+    slopes). Without it M is of first order in the rotation: 1e-4 of a link's
+    M at a hundredth of a radian, and the answers of a design far from the
+    prepared one differ from the pipeline's by as much.
+    """
+    euler = expansion.euler_blocks
+    if not len(euler):
+        return expansion.rest.matrices(dq)[0]
+    nodes = np.concatenate([euler[:, :1] - 3 + np.arange(3), euler], axis=1)      # (E, 7): position, parameters
+    unturned = dq.copy()
+    unturned[nodes] = 0.0
+    mass = expansion.rest.matrices(unturned)[0]
+    at = [total(expansion, change)[euler] for change in (np.zeros_like(dq), dq)]
+    (base_rotation, base_local), (rotation, local) = (_rotation(theta / np.linalg.norm(theta, axis=1)[:, None])
+                                                      for theta in at)
+    turn = np.zeros((len(euler), 7, 7))
+    turn[:, :3, :3] = base_rotation @ rotation.transpose(0, 2, 1)
+    turn[:, 3:, 3:] = base_local.transpose(0, 2, 1) @ local / 4
+    for index, block in zip(nodes, turn, strict=True):
+        mass[:, index] = mass[:, index] @ block
+        mass[index, :] = block.T @ mass[index, :]
+    return mass
 
 
 def normal_components(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarray
@@ -123,12 +176,12 @@ def static_residual(expansion: SceneExpansion, dq: np.ndarray, springs: ChannelS
     return residual + without_normal(expansion, dq, expansion.channels.force(state, springs.stiffness))
 
 
-def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest_stiffness: np.ndarray,
+def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarray,
                       springs: ChannelSprings, state: ChannelState) -> np.ndarray:
     """The rest's stiffness plus every channel's ``J^T S J + (S d) . H``, full coordinates, with
     Exudyn's term of the normal force components (:func:`normal_components`)."""
     channels = expansion.channels
-    stiffness = rest_stiffness + channels.matrix(state, springs.stiffness, stiffness=springs.stiffness)
+    stiffness = rest + channels.matrix(state, springs.stiffness, stiffness=springs.stiffness)
     _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
     theta = total(expansion, dq)[expansion.euler_blocks]
     diagonal = expansion.euler_blocks
@@ -213,9 +266,8 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
     dq = start.copy()
     for step in range(1, NEWTON_STEPS + 1):
         state = expansion.channels.state(total(expansion, dq))
-        _, rest_stiffness, _ = rest_matrices(expansion, dq, loads)
         basis = projection(expansion, dq)
-        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness, springs, state))
+        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), springs, state))
         residual = basis.rows(static_residual(expansion, dq, springs, base_force, loads, state))
         update = np.linalg.solve(stiffness, -residual)
         full_update = basis.expand(update)
