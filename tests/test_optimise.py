@@ -203,6 +203,9 @@ def test_section_scale_is_the_best_of_a_brute_force_over_its_grid(mount):
     assert sorted(sections.index) == [0.8, 0.9, 1.0]
     assert (sections.loc[[0.8, 0.9], "distinct link reductions"] > 0).all()
     assert (sections["preparation s"] >= sections["reduction s"]).all()
+    with pytest.raises(InfeasibleProblem, match=r"section_scale (0.9|1) \(the least violating of the 2 scales"):
+        opt.optimise(mount.case, {"section_scale": (0.9, 1.0), **fast}, constraints=["displacement<=0.0005"],
+                     starts=1, mount=mount, section_step=0.1)
 
 
 @pytest.mark.slow

@@ -130,9 +130,10 @@ def run(args) -> int:
               f"{end['iterations']} iterations: {end['message']}")
     if result.sections is not None:
         sections = result.sections
-        print(f"\nsection scales tried: {len(sections)}, each {sections['distinct link reductions'].iloc[0]} "
-              f"distinct link reductions (computed, or loaded from the cache): {sections['reduction s'].sum():.1f} s "
-              f"reducing, {sections['preparation s'].sum():.1f} s preparing in all")
+        print(f"\nsection scales tried: {len(sections)} (scale 1: the case's own links), each other "
+              f"{sections['distinct link reductions'].max()} distinct link reductions (computed, or loaded from the "
+              f"cache): {sections['reduction s'].sum():.1f} s reducing, {sections['preparation s'].sum():.1f} s "
+              "preparing in all")
         print(sections.to_string(index=False, float_format=lambda v: f"{v:.6g}"))
     if result.pareto is not None:
         print(f"\nPareto front ({', '.join(result.pareto.objectives)}): {len(result.pareto.designs)} designs, "

@@ -740,7 +740,8 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     chosen_trial = min(trials, key=lambda trial: trial.key)
     best = chosen_trial.best()
     if best["violation"] > FEASIBLE:
-        _raise_infeasible(chosen_trial.problem, best.get("x", positions[0]))
+        _raise_infeasible(chosen_trial.problem, best.get("x", positions[0]), [] if section is None else [
+            f"{SECTION} {chosen_trial.scale:g} (the least violating of the {len(trials)} scales tried)"])
     at = chosen_trial.problem
     after = at.point(best["x"])
     optimum = with_frequencies(design_case(at.mount, after.values), after.peaks)    # the bands' peaks as speeds
@@ -894,12 +895,12 @@ def _start_pool(workers: int, starts: int):
     pool.shutdown(wait=True)
 
 
-def _raise_infeasible(problem: _Problem, x0: np.ndarray):
+def _raise_infeasible(problem: _Problem, x0: np.ndarray, held: list | None = None):
     closest = problem.point(_least_violation(problem, x0) if len(x0) else x0)
     violated = [f"{label}: {value:.4g} against {limit}"
                 for (label, value, limit), slack in zip(closest.measures, closest.g, strict=True) if slack < -FEASIBLE]
     held = [f"{v.name} at its {'low' if x <= ACTIVE else 'high'} end {v.value(float(round(x))):g}"
-            for v, x in zip(problem.variables, closest.x, strict=True) if x <= ACTIVE or x >= 1 - ACTIVE]
+            for v, x in zip(problem.variables, closest.x, strict=True) if x <= ACTIVE or x >= 1 - ACTIVE] + (held or [])
     raise InfeasibleProblem(violated or [f"{label}: {value:.4g} against {limit}" for label, value, limit
                                          in closest.measures], held)
 
