@@ -7,8 +7,10 @@ between them), the engine's static displacement at most 2 mm and every
 link's Goodman fatigue factor at least 2. Prints the wall time (the
 preparation apart; and the process's CPU time, which the machine's load
 changes less), the designs answered, the worst T before and after and
-the gain in dB, and which constraints and variables are active. Run with
-``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimise.py [starts] [band points] [SLSQP iterations]``.
+the gain in dB, and which constraints and variables are active. The
+starts run in *workers* processes (the CPU time is then this process's
+only). Run with ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_optimise.py [starts] [band points]
+[SLSQP iterations] [workers]``.
 """
 import sys
 import time
@@ -23,21 +25,21 @@ VARIABLES = {**{f"hinge_stiffness/{g}": (5e6, 2e8) for g in GROUPS},
 CONSTRAINTS = ("displacement<=0.002", "fatigue>=2")
 
 
-def main(starts: int = 2, points: int = 13, maxiter: int = 60) -> None:
+def main(starts: int = 2, points: int = 13, maxiter: int = 60, workers: int = 1) -> None:
     case = wb.reference_case()
     start = time.perf_counter()
     mount = wb.LinearMount.prepare(band_case(case, BANDS, points))
     prepared = time.perf_counter() - start
     cpu = time.process_time()
     result = wb.optimise(case, VARIABLES, constraints=CONSTRAINTS, starts=starts, mount=mount, bands=BANDS,
-                         band_points=points, maxiter=maxiter)
+                         band_points=points, maxiter=maxiter, workers=workers)
     cpu = time.process_time() - cpu
     table = result.table
     before, after = table.loc[("objective", "worst T (dB)"), ["before", "after"]]
     active = [name for (kind, name), row in table.iterrows() if row["active"] and kind in ("constraint", "variable")]
     bands = ", ".join(f"{name} {low:g}-{high:g} Hz" for name, (low, high) in BANDS.items())
     print(f"reference mount, {len(VARIABLES)} variables, bands {bands} ({points} points each, peaks refined), "
-          f"{', '.join(CONSTRAINTS)}, {starts} start(s) of at most {maxiter} SLSQP iterations")
+          f"{', '.join(CONSTRAINTS)}, {starts} start(s) of at most {maxiter} SLSQP iterations, {workers} worker(s)")
     print(f"{'quantity':<44}{'value':>14}")
     rows = [("preparation, s", f"{prepared:.1f}"), ("optimisation wall time, s", f"{result.seconds:.1f}"),
             ("optimisation CPU time, s", f"{cpu:.1f}"),
@@ -68,4 +70,4 @@ def _slacks(table) -> list:
 
 
 if __name__ == "__main__":
-    main(*(int(a) for a in sys.argv[1:4]))
+    main(*(int(a) for a in sys.argv[1:5]))

@@ -4,7 +4,7 @@ from __future__ import annotations
 import json
 
 import pytest
-from excel_helpers import column_of, copy_reference
+from excel_helpers import REFERENCE, TEMPLATE, column_of, copy_reference
 from openpyxl import load_workbook
 
 import workbook.excel.layout as L
@@ -15,9 +15,11 @@ from workbook.excel.reader import read_workbook
 
 
 def _with_sheet(path, rows, links_element_size=None):
-    """The workbook at *path* with an Optimise sheet of *rows* (dicts by header), SI units; with
-    *links_element_size* (mm) its links meshed so, and the reference sweep removed (the rotors only)."""
+    """The workbook at *path* with an Optimise sheet of *rows* (dicts by header), SI units, in place of its
+    own; with *links_element_size* (mm) its links meshed so, and the reference sweep removed (the rotors only)."""
     book = load_workbook(path)
+    if L.OPTIMISE.sheet in book.sheetnames:
+        del book[L.OPTIMISE.sheet]
     ws = book.create_sheet(L.OPTIMISE.sheet)
     for col, column in enumerate(L.OPTIMISE.columns, start=1):
         ws.cell(L.HEADER_ROW, col, column.header)
@@ -55,13 +57,35 @@ def test_the_sheet_reads_into_the_problem(tmp_path):
                                  Constraint("margin", 0.0), Constraint("modes_outside", (50.0, 70.0)))
     assert sheet.bands == {"LP rotor": (40.0, 62.0)}
     assert (sheet.objective, sheet.starts) == ("weighted", 2)
-    assert read_workbook(copy_reference(tmp_path, "plain.xlsx")).optimise is None
+    section = [{"kind": "variable", "name": "section_scale", "low": 0.9, "high": 1.1}]
+    assert read_workbook(_with_sheet(copy_reference(tmp_path, "section.xlsx"), section)).optimise.variables == \
+        {"section_scale": (0.9, 1.1)}
+
+
+def test_the_generated_workbooks_have_an_empty_optimise_sheet_and_older_ones_without_it_still_load(tmp_path):
+    """The template's and the reference workbook's Optimise sheet: headers, units, no row (a run never
+    optimises), an Instructions entry; a workbook written before the sheet existed reads to the same case."""
+    for path in (TEMPLATE, REFERENCE):
+        book = load_workbook(path)
+        ws = book[L.OPTIMISE.sheet]
+        assert [ws.cell(L.HEADER_ROW, col).value for col in range(1, 6)] == ["kind", "name", "low", "high", "value"]
+        assert [ws.cell(L.UNIT_ROW, col).value for col in range(3, 6)] == ["-"] * 3
+        assert ws.max_row == L.UNIT_ROW
+        assert any(str(row[0]).startswith("Optimise (optional") for row in book["Instructions"].values)
+        assert read_workbook(path).optimise is None
+    old = copy_reference(tmp_path, "old.xlsx")
+    book = load_workbook(old)
+    del book[L.OPTIMISE.sheet]
+    book.save(old)
+    read_old, read_new = read_workbook(old), read_workbook(REFERENCE)
+    assert read_old.optimise is None and read_old.case == read_new.case and read_old.runs == read_new.runs
 
 
 @pytest.mark.parametrize("row, words", [
     ({"kind": "variable", "name": "hinge_stifness/front", "low": 1e6, "high": 1e8}, ["cell B3", "hinge_stifness"]),
     ({"kind": "variable", "name": "hinge_stiffness/front", "low": 1e8, "high": 1e6}, ["cell C3:D3", "LOW < HIGH"]),
-    ({"kind": "variable", "name": "section_scale", "low": 0.8, "high": 1.2}, ["cell B3", "new link reduction"]),
+    ({"kind": "variable", "name": "clearance", "low": 0, "high": 1e-4}, ["cell B3", "new preparation"]),
+    ({"kind": "variable", "name": "section_scale", "low": 0, "high": 1.2}, ["cell C3:D3", "section > 0"]),
     ({"kind": "constraint", "name": "weight", "value": 3}, ["B3:E3", "fatigue>=FACTOR"]),
     ({"kind": "band", "name": "fan", "low": 40, "high": 62}, ["cell B3", "LP rotor, HP rotor"]),
     ({"kind": "band", "name": "LP rotor", "low": 62, "high": 40}, ["cell C3:D3", "0 < LOW < HIGH"]),

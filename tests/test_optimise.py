@@ -62,8 +62,11 @@ def test_constraint_and_variable_texts():
     for bad in ("sag<0.005", "modes_outside=70:50", "weight<=3", "sag<=-1", "fatigue>=0", "margin>=-1", "fatigue<=2"):
         with pytest.raises(InputError, match="expected"):
             opt.constraint(bad)
-    with pytest.raises(InputError, match="new link reduction"):
-        opt.variable("section_scale", 0.8, 1.2)
+    with pytest.raises(InputError, match="needs a new preparation"):
+        opt.variable("clearance", 0.0, 1e-4)
+    with pytest.raises(InputError, match="factor on the links' section > 0"):
+        opt.variable("section_scale", 0.0, 1.2)
+    assert not opt.variable("section_scale", 0.8, 1.2).log
     with pytest.raises(InputError, match="LOW < HIGH"):
         opt.variable("hinge_stiffness/front", 2e8, 1e7)
     v = opt.variable("hinge_stiffness/front/axial", 1e6, 1e8)
@@ -156,4 +159,62 @@ def test_optimise_command_writes_a_case_mountwb_run_reproduces(mount, tmp_path, 
     for run in runs:
         for d in "xyz":
             assert reported[f"{run['name']} {d}"] == pytest.approx(run["pylon"][d]["transmissibility"], rel=1e-6)
-    assert main(["optimise", "--vary", "section_scale=0.8:1.2"]) == 2
+    assert main(["optimise", "--vary", "clearance=0:1e-4"]) == 2
+    assert main(["optimise", str(case), "--vary", "section_scale=0.9:1.1", "--pareto"]) == 2
+
+
+def test_grid_minimum_finds_the_least_of_unimodal_sequences_asking_each_point_once():
+    """Golden-section search on a grid's indices against the brute-force minimum of random unimodal
+    sequences; a 21-point grid (0.8:1.2 in steps of 0.02) costs at most 8 points."""
+    from workbook.design.section_search import grid_minimum, section_grid
+
+    rng = np.random.default_rng(1)
+    for count in range(1, 40):
+        for _ in range(20):
+            least = int(rng.integers(0, count))
+            sequence = np.concatenate([np.sort(rng.random(least))[::-1] + 1, [0.5],
+                                       np.sort(rng.random(count - least - 1)) + 1])
+            asked: list = []
+            assert grid_minimum(count, lambda i, asked=asked, sequence=sequence: asked.append(i) or sequence[i]) == least
+            assert len(asked) == len(set(asked)) and (count != 21 or len(asked) <= 8)
+    np.testing.assert_allclose(section_grid(0.8, 1.2), np.linspace(0.8, 1.2, 21))
+    np.testing.assert_allclose(section_grid(0.8, 1.2, 0.15), np.linspace(0.8, 1.2, 4))    # steps of at most 0.15
+    with pytest.raises(InputError, match="positive step"):
+        section_grid(0.8, 1.2, 0.0)
+
+
+@pytest.mark.slow
+def test_section_scale_is_the_best_of_a_brute_force_over_its_grid(mount):
+    """section_scale 0.8:1.0 in steps of 0.1 with the hinge stiffness on the fast path and a displacement limit:
+    the chosen scale is the best of the fast variable's optimum at each of the three scales (each optimised
+    alone), the limit is met, and the cost of each scale is reported."""
+    from workbook.studies.parametric import parameter
+
+    fast, limit = {"hinge_stiffness/all": (1e7, 5e7)}, 0.002
+    result = opt.optimise(mount.case, {"section_scale": (0.8, 1.0), **fast}, constraints=[f"displacement<={limit}"],
+                          starts=1, mount=mount, section_step=0.1)
+    brute = {scale: opt.optimise(parameter("section_scale").apply(mount.case, scale), fast, starts=1,
+                                 constraints=[f"displacement<={limit}"]).table.loc[("objective", "worst T (dB)"), "after"]
+             for scale in (0.8, 0.9, 1.0)}
+    assert result.values["section_scale"] == min(brute, key=brute.get)
+    assert result.table.loc[("objective", "worst T (dB)"), "after"] == pytest.approx(min(brute.values()), abs=1e-6)
+    assert (result.table.xs("constraint")["after"] <= limit).all()
+    sections = result.sections.set_index("section_scale")
+    assert sorted(sections.index) == [0.8, 0.9, 1.0]
+    assert (sections.loc[[0.8, 0.9], "distinct link reductions"] > 0).all()
+    assert (sections["preparation s"] >= sections["reduction s"]).all()
+    with pytest.raises(InfeasibleProblem, match=r"section_scale (0.9|1) \(the least violating of the 2 scales"):
+        opt.optimise(mount.case, {"section_scale": (0.9, 1.0), **fast}, constraints=["displacement<=0.0005"],
+                     starts=1, mount=mount, section_step=0.1)
+
+
+@pytest.mark.slow
+def test_starts_in_two_worker_processes_give_the_serial_optimum(mount):
+    ranges = {"hinge_stiffness/all": (1e7, 5e7), "hinge_loss_factor/all": (0.01, 0.2)}
+    serial, parallel = (opt.optimise(mount.case, ranges, constraints=["displacement<=0.002"], starts=2, mount=mount,
+                                     workers=workers) for workers in (1, 2))
+    for name, value in serial.values.items():
+        assert parallel.values[name] == pytest.approx(value, rel=1e-9)
+    assert [end["objective"] for end in parallel.starts] == pytest.approx([end["objective"] for end in serial.starts],
+                                                                          rel=1e-9)
+    assert len(parallel.history) == len(serial.history)

@@ -27,7 +27,7 @@ INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.channel_set", "workbook.design.expansion",
     "workbook.design.kinematics", "workbook.design.sensitivity",
     "workbook.design.linear_mount", "workbook.design.optimise", "workbook.design.bands", "workbook.design.link_fatigue",
-    "workbook.design.link_margins",
+    "workbook.design.link_margins", "workbook.design.section_search",
     "workbook.answers", "workbook.answers.amplitude", "workbook.answers.hinge_curves", "workbook.answers.isolation",
     "workbook.answers.link_stiffness",
     "workbook.answers.link_table", "workbook.answers.model_card", "workbook.answers.results",

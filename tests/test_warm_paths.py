@@ -55,8 +55,10 @@ def test_run_of_a_rigid_case_imports_only_what_it_uses(tmp_path):
 
 def test_help_the_cache_listing_and_a_workbook_check_load_no_numerics(tmp_path):
     """Every command's parser is built for ``--help``: none of them may load SciPy or Exudyn to do it;
-    nor does checking a case workbook, which builds its case and runs nothing."""
-    for args in (["--help"], ["run", "--help"], ["cache", "info"], ["check", str(ROOT / "cases" / "reference.xlsx")]):
+    nor does checking a case workbook (the template's with its empty Optimise sheet), which builds its case and
+    runs nothing."""
+    for args in (["--help"], ["run", "--help"], ["cache", "info"], ["check", str(ROOT / "cases" / "reference.xlsx")],
+                 ["check", str(ROOT / "templates" / "case-template.xlsx")]):
         env = dict(os.environ, MOUNTWB_CACHE=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
         probe = ("import sys\nfrom workbook.cli.main import main\ntry:\n    main(sys.argv[1:])\nexcept SystemExit:\n"
                  "    pass\nprint('MODULES', *sorted(m for m in ('scipy', 'exudyn') if m in sys.modules))")

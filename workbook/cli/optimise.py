@@ -1,5 +1,6 @@
 """``mountwb optimise [CASE] [--vary NAME=LOW:HIGH ...] [--objective worst|weighted] [--constraint C ...]
-[--band EXCITATION=LOW:HIGH ...] [--starts N] [--iterations N] [--pareto [A,B]] [--output DIR] [--json]``.
+[--band EXCITATION=LOW:HIGH ...] [--starts N] [--workers N] [--section-step S] [--iterations N] [--pareto [A,B]]
+[--output DIR] [--json]``.
 
 Without ``--vary`` the problem is the case workbook's Optimise sheet
 (:mod:`workbook.excel.optimise_sheet`), the options' constraints and bands
@@ -9,7 +10,8 @@ Optimises the case's design on the fast linear mount
 (:mod:`workbook.design.optimise`): prints the before/after table (the
 objective, T per run and direction, every constraint with its value and
 whether it is active, each variable), each start's end, and the optimum's
-model card; ``--output DIR`` writes the optimised case (``optimum.json``,
+model card; with ``section_scale`` varied, each section scale tried with
+its cost (link reductions and preparation); ``--output DIR`` writes the optimised case (``optimum.json``,
 which ``mountwb run`` runs, and ``optimum.xlsx`` when a case workbook can
 hold it), the table, the history and the plot.
 """
@@ -17,11 +19,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 from typing import TYPE_CHECKING, Callable
 
 from workbook.cli.loading import is_workbook, load_case
 from workbook.cli.params import parse_ranges
 from workbook.design.bands import BAND_POINTS, band_text
+from workbook.design.section_search import SECTION_STEP
 from workbook.errors import UsageError
 
 if TYPE_CHECKING:
@@ -36,7 +40,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--vary", action="append", default=[], metavar="NAME=LOW:HIGH",
                         help="a design variable and its range, SI units (a study parameter: hinge_stiffness, "
                              "hinge_loss_factor, hinge_damping, per group and direction as "
-                             "hinge_stiffness/front/axial; transducer_stiffness; engine_mass); repeatable; "
+                             "hinge_stiffness/front/axial; transducer_stiffness; engine_mass; section_scale, the links' "
+                             "section, searched over a grid of scales, a new link reduction each); repeatable; "
                              "none: the problem of the case workbook's Optimise sheet")
     parser.add_argument("--objective", choices=("worst", "weighted"),
                         help="worst: the worst T over runs and directions, dB (default); weighted: the mean of T")
@@ -53,6 +58,10 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                              "are found as well")
     parser.add_argument("--starts", type=int, help="SLSQP starts: the case's design, then a Latin "
                         "hypercube (default 3)")
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
+                        help="processes the starts run in (default: every core); the result is the same as with 1")
+    parser.add_argument("--section-step", type=float, default=SECTION_STEP, metavar="S",
+                        help=f"section_scale: the largest step between the scales tried (default {SECTION_STEP:g})")
     parser.add_argument("--iterations", type=int, default=60, metavar="N",
                         help="SLSQP iterations per start at most (default 60)")
     parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
@@ -100,14 +109,15 @@ def run(args) -> int:
     result = optimise(case, variables, objective=objective, constraints=[*sheet.constraints, *args.constraint],
                       starts=args.starts or sheet.starts or 3, maxiter=args.iterations, pareto_objectives=objectives,
                       population=args.population, generations=args.generations, bands=bands,
-                      band_points=args.band_points)
+                      band_points=args.band_points, workers=args.workers, section_step=args.section_step)
     written = result.write(args.output) if args.output else []
     if args.json:
         table = result.table.reset_index()
         print(json.dumps({"case": case.name, "objective": objective, "values": result.values,
                           "table": table.to_dict(orient="records"), "starts": result.starts,
                           "evaluations": result.evaluations, "seconds": result.seconds,
-                          "fast_difference": result.fast_difference, "written": [str(p) for p in written]},
+                          "fast_difference": result.fast_difference, "written": [str(p) for p in written],
+                          "sections": None if result.sections is None else result.sections.to_dict(orient="records")},
                          indent=1, default=float))
         return 0
     print(f"{case.name}: {len(result.variables)} variable(s), {result.evaluations} designs with derivatives, "
@@ -118,6 +128,13 @@ def run(args) -> int:
     for end in result.starts:
         print(f"  {end['start']}: objective {end['objective']:.6g}, violation {end['violation']:.1e}, "
               f"{end['iterations']} iterations: {end['message']}")
+    if result.sections is not None:
+        sections = result.sections
+        print(f"\nsection scales tried: {len(sections)} (scale 1: the case's own links), each other "
+              f"{sections['distinct link reductions'].max()} distinct link reductions (computed, or loaded from the "
+              f"cache): {sections['reduction s'].sum():.1f} s reducing, {sections['preparation s'].sum():.1f} s "
+              "preparing in all")
+        print(sections.to_string(index=False, float_format=lambda v: f"{v:.6g}"))
     if result.pareto is not None:
         print(f"\nPareto front ({', '.join(result.pareto.objectives)}): {len(result.pareto.designs)} designs, "
               f"{result.pareto.evaluations} evaluations, {result.pareto.seconds:.1f} s")

@@ -27,16 +27,24 @@ design, then a Latin hypercube) on variables scaled to [0, 1], on a
 logarithmic scale for stiffness and damping, with the analytic derivatives
 of :func:`workbook.design.sensitivity.design_sensitivity` (the mounted
 modes' by their left and right eigenvectors). Every evaluation is on the
-fast path (:class:`~workbook.design.linear_mount.LinearMount`); a variable
-that needs a new link reduction (``section_scale``) is refused. The optimum
+fast path (:class:`~workbook.design.linear_mount.LinearMount`). The links'
+``section_scale`` needs a new link reduction per value: it is searched
+outside, over a grid of scales (:mod:`workbook.design.section_search`), a
+new linear mount prepared and the fast variables optimised at each scale
+the search asks for. The starts run in worker processes with ``workers``
+above 1, with the same result as one after another. The optimum
 is run once more through :func:`workbook.run_case`, whose T the result
 reports and ``mountwb run`` on the written case reproduces. :func:`pareto`
 gives a two-objective front by NSGA-II (pymoo).
 """
 from __future__ import annotations
 
+import contextlib
 import dataclasses
+import multiprocessing
+import signal
 import time
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -48,9 +56,11 @@ from workbook.design.bands import BAND_POINTS, band_case, band_peaks, with_frequ
 from workbook.design.linear_mount import DesignAnswer, LinearMount, points_of
 from workbook.design.link_fatigue import link_fatigue_factors
 from workbook.design.link_margins import link_margins, load_case_mounts
+from workbook.design.section_search import SECTION, SECTION_STEP, grid_minimum, section_grid
 from workbook.design.sensitivity import amplitude_change, design_case, design_sensitivity, point_change
 from workbook.errors import InfeasibleProblem, InputError, SimulationError
 from workbook.model.case import DIRECTIONS, Case, Sweep
+from workbook.processes import end_with_parent, stop_workers
 
 __all__ = ["Variable", "Constraint", "constraint", "variable", "variable_name", "optimise", "pareto", "OptimisationResult",
            "ParetoFront", "OBJECTIVES", "QUANTITIES", "MARGIN"]
@@ -71,6 +81,8 @@ MARGIN = 1e-6
 ACTIVE = 1e-4
 #: Normalised violation above which a design counts as infeasible.
 FEASIBLE = MARGIN / 2
+#: Why a front refuses the section scale.
+_FRONT_FAST_ONLY = f"a Pareto front varies the fast variables only; fix {SECTION} (or leave out the front)"
 #: Parameters on a logarithmic scale when their range is positive.
 _LOG = ("hinge_stiffness", "hinge_damping", "transducer_stiffness")
 #: Parameters the fast path follows.
@@ -108,20 +120,21 @@ class Variable:
 
 
 def variable_name(name: str) -> None:
-    """Check that *name* is a study parameter the fast path follows.
+    """Check that *name* is a study parameter the optimiser varies: one the fast path follows, or
+    ``section_scale`` (searched over a grid of scales, a new link reduction each).
 
     Raises
     ------
     InputError
-        An unknown name, or one that needs a new link reduction per design (``section_scale``).
+        An unknown name, or one the optimiser does not vary.
     """
     from workbook.studies.parametric import parameter
 
     parameter(name)
-    if name.partition("/")[0] not in _FAST:
-        raise InputError(f"variable {name!r}: the optimiser varies only what the fast linear mount follows "
-                         f"({', '.join(_FAST)}, per hinge group and direction); {name} needs a new preparation "
-                         "(section_scale: a new link reduction) per design: use 'mountwb study params' for it")
+    if name.partition("/")[0] not in _FAST and name != SECTION:
+        raise InputError(f"variable {name!r}: the optimiser varies what the fast linear mount follows "
+                         f"({', '.join(_FAST)}, per hinge group and direction) and {SECTION}; {name} needs a new "
+                         "preparation per design: use 'mountwb study params' for it")
 
 
 def variable(name: str, low: float, high: float) -> Variable:
@@ -130,14 +143,16 @@ def variable(name: str, low: float, high: float) -> Variable:
     Raises
     ------
     InputError
-        A parameter the fast path cannot follow (``section_scale`` needs a
-        new link reduction per design), an unknown name, or an empty range.
+        A parameter the optimiser does not vary, an unknown name, an empty
+        range, or a section scale range not above 0.
     """
     variable_name(name)
     if not (np.isfinite(low) and np.isfinite(high) and high > low):
         raise InputError(f"variable {name!r}: found the range {low:g}:{high:g}, expected LOW:HIGH with LOW < HIGH")
     if name.partition("/")[0] in _LOG and low < 0:
         raise InputError(f"variable {name!r}: found LOW {low:g}, expected a stiffness or damping >= 0")
+    if name == SECTION and not low > 0:
+        raise InputError(f"variable {name!r}: found LOW {low:g}, expected a factor on the links' section > 0")
     return Variable(name, float(low), float(high))
 
 
@@ -267,6 +282,10 @@ class _Problem:
         self.items = [item.name for item in mount.case.excitations]
         self.evaluations = 0
         self._cache: dict = {}
+
+    def __getstate__(self) -> dict:
+        """Pickled for a worker process without the designs answered already."""
+        return {**self.__dict__, "_cache": {}}
 
     def values(self, x: np.ndarray) -> dict:
         return {v.name: v.value(float(xi)) for v, xi in zip(self.variables, x, strict=True)}
@@ -422,6 +441,13 @@ class OptimisationResult:
     seconds : float
         Wall time (preparation, starts and the final run), s.
     pareto : ParetoFront or None
+    sections : pandas.DataFrame or None
+        With ``section_scale`` varied, per section scale tried: the best
+        objective of the fast variables there and its violation, the
+        distinct link reductions it needed and their time (computed, or
+        loaded from the disk cache), the preparation's and the optimisation's
+        time (s) and the designs answered; *history* and *starts* are those
+        of the chosen scale.
     """
 
     case: Case
@@ -438,6 +464,7 @@ class OptimisationResult:
     evaluations: int
     seconds: float
     pareto: ParetoFront | None = field(default=None)
+    sections: Any = field(default=None)
 
     def to_pandas(self):
         """The before/after table."""
@@ -480,7 +507,8 @@ class OptimisationResult:
 
     def write(self, directory: str | Path) -> list[Path]:
         """Write the optimised case (``optimum.json``; ``optimum.xlsx`` when a case workbook can hold it), the
-        table, the history (CSV), the Pareto front (CSV) and the plot into *directory*.
+        table, the history (CSV), the Pareto front and the section scales tried (CSV) and the plot into
+        *directory*.
 
         Returns
         -------
@@ -501,6 +529,9 @@ class OptimisationResult:
         if self.pareto is not None:
             written.append(folder / "pareto.csv")
             self.pareto.designs.to_csv(written[-1], index=False)
+        if self.sections is not None:
+            written.append(folder / "sections.csv")
+            self.sections.to_csv(written[-1], index=False)
         try:
             book = case_workbook(self.case, ())
         except UnwritableCase:
@@ -579,9 +610,9 @@ def _worst(rows: list, t: np.ndarray) -> dict:
             for k, d in enumerate(DIRECTIONS)}
 
 
-def _table(problem: _Problem, kind: str, weights: np.ndarray, before: _Point, after: _Point, exact: tuple):
+def _table(kind: str, weights: np.ndarray, before: _Point, after: _Point, exact: tuple, variables: list):
     """Before and after; the T rows (the worst of each excitation item and direction) of *after* from *exact*
-    (rows, T): the pipeline's run of the written optimum."""
+    (rows, T): the pipeline's run of the written optimum; *variables*: (Variable, before, after) each."""
     import pandas as pd
 
     rows = [("objective", "worst T (dB)" if kind == "worst" else "weighted mean T",
@@ -591,9 +622,10 @@ def _table(problem: _Problem, kind: str, weights: np.ndarray, before: _Point, af
     for (label, value_before, limit), (_, value_after, _), slack in zip(before.measures, after.measures, after.g,
                                                                          strict=True):
         rows.append(("constraint", label, value_before, value_after, limit, "active" if slack <= ACTIVE else ""))
-    for v, x in zip(problem.variables, after.x, strict=True):
+    for v, value_before, value_after in variables:
+        x = v.scaled(value_after)
         at = "at low" if x <= ACTIVE else "at high" if x >= 1 - ACTIVE else ""
-        rows.append(("variable", v.name, before.values[v.name], after.values[v.name], f"{v.low:g}:{v.high:g}", at))
+        rows.append(("variable", v.name, value_before, value_after, f"{v.low:g}:{v.high:g}", at))
     return pd.DataFrame(rows, columns=["kind", "name", "before", "after", "limit", "active"]).set_index(["kind", "name"])
 
 
@@ -610,14 +642,17 @@ def _weights(weights, runs: int) -> np.ndarray:
 def optimise(case: Case, variables: dict, objective: str = "worst", constraints=(), starts: int = 4,
              weights=None, seed: int = 0, maxiter: int = 60, pareto_objectives: tuple | None = None,
              population: int = 50, generations: int = 20, mount: LinearMount | None = None, bands: dict | None = None,
-             band_points: int = BAND_POINTS) -> OptimisationResult:
+             band_points: int = BAND_POINTS, workers: int = 1, section_step: float = SECTION_STEP
+             ) -> OptimisationResult:
     """The design of *case* within *variables* that minimises *objective* subject to *constraints*.
 
     Parameters
     ----------
     case : Case
     variables : dict of str to (float, float)
-        Study parameter name to its range (low, high), SI units.
+        Study parameter name to its range (low, high), SI units;
+        ``section_scale`` (a factor on the case's link sections) searched
+        over a grid of scales (:mod:`workbook.design.section_search`).
     objective : {"worst", "weighted"}
         Worst T over runs and directions (dB), or the weighted mean of T;
         a sweep's (a band's) runs include its peaks (:func:`~workbook.design.bands.band_peaks`).
@@ -632,7 +667,7 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     maxiter : int
         SLSQP iterations per start.
     pareto_objectives : (str, str), optional
-        Also a front of these two objectives (:func:`pareto`).
+        Also a front of these two objectives (:func:`pareto`; not with ``section_scale``).
     population, generations : int
         Of the front's NSGA-II.
     mount : LinearMount, optional
@@ -642,6 +677,10 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
         excitation becomes a sweep of *band_points* speeds over it
         (:func:`~workbook.design.bands.band_case`).
     band_points : int
+    workers : int
+        Processes the starts run in (1: one after another in this process); the result is the same.
+    section_step : float
+        Largest step between the section scales tried (``section_scale``'s tolerance).
 
     Returns
     -------
@@ -650,16 +689,17 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     Raises
     ------
     InputError
-        An unknown objective or constraint, or a variable the fast path cannot vary.
+        An unknown objective or constraint, or a variable the optimiser cannot vary.
     InfeasibleProblem
         No design within the ranges meets the constraints; names those that conflict.
     workbook.errors.SimulationError
-        As :meth:`LinearMount.evaluate` at the case's own design.
+        As :meth:`LinearMount.evaluate` at the case's own design; a worker process that died.
     """
     import pandas as pd
     from scipy.stats import qmc
 
     from workbook.solve.pipeline import run_case
+    from workbook.studies.parametric import parameter_value
 
     begin = time.perf_counter()
     if objective not in OBJECTIVES:
@@ -667,58 +707,200 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
     if starts < 1:
         raise InputError(f"starts: found {starts}, expected at least 1")
     chosen = [variable(name, *bounds) for name, bounds in variables.items()]
+    section = next((v for v in chosen if v.name == SECTION), None)
+    fast = [v for v in chosen if v.name != SECTION]
+    if section is not None:
+        grid = section_grid(section.low, section.high, section_step)
+        if pareto_objectives:
+            raise InputError(_FRONT_FAST_ONLY)
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
-    banded = band_case(case, bands, band_points) if bands else case
-    mount = mount or LinearMount.prepare(banded)
-    load_mounts = load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
-    problem = _Problem(mount, chosen, rules, load_mounts=load_mounts)
-    from workbook.studies.parametric import parameter_value
-
-    before_values = {v.name: parameter_value(mount.case, v.name) for v in chosen}
-    start = np.array([v.scaled(before_values[v.name]) for v in chosen])
-    before = problem.answer(before_values, start, np.ones(len(chosen)))
+    mount = mount or LinearMount.prepare(band_case(case, bands, band_points) if bands else case)
+    problem = _Problem(mount, fast, rules, load_mounts=_load_mounts(case, rules))
+    before_values = {v.name: parameter_value(mount.case, v.name) for v in fast}
+    start = np.array([v.scaled(before_values[v.name]) for v in fast])
+    before = problem.answer(before_values, start, np.ones(len(fast)))
     weight = _weights(weights, len(before.rows))
     positions = [np.clip(start, 0, 1)]
-    if starts > 1:
-        positions += list(qmc.LatinHypercube(d=len(chosen), seed=seed).random(starts - 1))
-    history: list = []
-    ends: list[dict[str, Any]] = []
-    for k, x0 in enumerate(positions):
-        try:
-            x, message, iterations = _run_start(problem, objective, weight, x0, k, history, maxiter)
-        except SimulationError as error:
-            ends.append({"start": k, "objective": np.nan, "violation": np.inf, "iterations": 0, "message": str(error)})
-            continue
-        point = problem.point(x)
-        ends.append({"start": k, "x": x, "objective": _objective_value(objective, weight, point),
-                     "violation": problem.violation(point), "iterations": iterations, "message": message})
-    feasible = [end for end in ends if end["violation"] <= FEASIBLE]
-    if not feasible:
-        _raise_infeasible(problem, min(ends, key=lambda end: end["violation"]).get("x", positions[0]))
-    best = min(feasible, key=lambda end: end["objective"])
-    after = problem.point(best["x"])
-    optimum = with_frequencies(design_case(mount, after.values), after.peaks)    # the bands' peaks as speeds
+    if starts > 1 and fast:
+        positions += list(qmc.LatinHypercube(d=len(fast), seed=seed).random(starts - 1))
+    with _start_pool(workers, len(positions)) as pool:
+        if section is None:
+            trials = [_trial(problem, objective, weight, positions, maxiter, pool)]
+        else:
+            tried: dict[int, _Trial] = {}
+
+            def key(index: int) -> tuple:
+                scaled, cost = (problem, {}) if grid[index] == 1.0 else \
+                    _section_problem(case, float(grid[index]), fast, rules, bands, band_points)   # 1: the case's own
+                tried[index] = _trial(scaled, objective, weight, positions, maxiter, pool, **cost)
+                return tried[index].key
+
+            grid_minimum(len(grid), key)
+            trials = [tried[index] for index in sorted(tried)]
+    chosen_trial = min(trials, key=lambda trial: trial.key)
+    best = chosen_trial.best()
+    if best["violation"] > FEASIBLE:
+        _raise_infeasible(chosen_trial.problem, best.get("x", positions[0]), [] if section is None else [
+            f"{SECTION} {chosen_trial.scale:g} (the least violating of the {len(trials)} scales tried)"])
+    at = chosen_trial.problem
+    after = at.point(best["x"])
+    optimum = with_frequencies(design_case(at.mount, after.values), after.peaks)    # the bands' peaks as speeds
     result = run_case(optimum)
     exact = np.array([run.transmissibility for run in result.runs])
-    fast = np.array([run.transmissibility for run in mount.evaluate(optimum).result.runs])
-    fast_difference = float(np.abs(exact - fast).max())
+    fast_t = np.array([run.transmissibility for run in at.mount.evaluate(optimum).result.runs])
     front = pareto(mount.case, variables, pareto_objectives, rules, population, generations, seed, mount) \
         if pareto_objectives else None
     exact_rows = [item.name for item in optimum.excitations for _ in points_of(item)]
+    rows = [(v, before_values[v.name], after.values[v.name]) for v in fast]
+    values = dict(after.values)
+    if section is not None:
+        rows.append((section, 1.0, chosen_trial.scale))
+        values[SECTION] = chosen_trial.scale
+    sections = pd.DataFrame([trial.row() for trial in trials]) if section is not None else None
     return OptimisationResult(
-        optimum, mount.case, chosen, rules, objective, after.values,
-        _table(problem, objective, weight, before, after, (exact_rows, exact)), pd.DataFrame(history, columns=[
-            "start", "iteration", "objective", "violation"]),
-        [{k: v for k, v in end.items() if k != "x"} for end in ends], result, fast_difference,
-        problem.evaluations, time.perf_counter() - begin, front)
+        optimum, mount.case, chosen, rules, objective, values,
+        _table(objective, weight, before, after, (exact_rows, exact), rows),
+        pd.DataFrame(chosen_trial.history, columns=["start", "iteration", "objective", "violation"]),
+        [{k: v for k, v in end.items() if k != "x"} for end in chosen_trial.ends], result,
+        float(np.abs(exact - fast_t).max()),
+        problem.evaluations + sum(trial.problem.evaluations for trial in trials if trial.problem is not problem),
+        time.perf_counter() - begin, front, sections)
 
 
-def _raise_infeasible(problem: _Problem, x0: np.ndarray):
-    closest = problem.point(_least_violation(problem, x0))
+def _load_mounts(case: Case, rules: list) -> list:
+    """The (load case, linear mount) pairs the margin constraints need (none without one)."""
+    return load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
+
+
+@dataclass
+class _Trial:
+    """The fast variables optimised on one prepared mount: at the case's own links, or at a section scale."""
+
+    problem: _Problem
+    ends: list                      # per start: its end (x, objective, violation, iterations, message)
+    history: list
+    seconds: float                  # the starts' wall time, s
+    scale: float = 1.0
+    reductions: int = 0
+    reduction_seconds: float = 0.0
+    preparation_seconds: float = 0.0
+
+    def best(self) -> dict:
+        """The best feasible end, else the least violating one."""
+        feasible = [end for end in self.ends if end["violation"] <= FEASIBLE]
+        if feasible:
+            return min(feasible, key=lambda end: end["objective"])
+        return min(self.ends, key=lambda end: end["violation"])
+
+    @property
+    def key(self) -> tuple:
+        """Orders trials: feasible before infeasible, then by objective (feasible) or by violation."""
+        end = self.best()
+        return (0, end["objective"]) if end["violation"] <= FEASIBLE else (1, end["violation"])
+
+    def row(self) -> dict:
+        """Its row of :attr:`OptimisationResult.sections`."""
+        end = self.best()
+        return {SECTION: self.scale, "objective": end["objective"], "violation": end["violation"],
+                "distinct link reductions": self.reductions, "reduction s": self.reduction_seconds,
+                "preparation s": self.preparation_seconds, "optimisation s": self.seconds,
+                "designs": self.problem.evaluations}
+
+
+def _section_problem(case: Case, scale: float, fast: list, rules: list, bands: dict | None,
+                     band_points: int) -> tuple[_Problem, dict]:
+    """The problem of the fast variables on *case* with its links' sections scaled by *scale*: its links
+    reduced (or loaded from the disk cache) and its linear mount prepared; and that cost (:class:`_Trial`'s
+    fields)."""
+    from workbook.scene.build import link_jobs, reduce_links
+    from workbook.studies.parametric import parameter
+
+    begin = time.perf_counter()
+    scaled = parameter(SECTION).apply(case, scale)
+    banded = band_case(scaled, bands, band_points) if bands else scaled
+    reduce_links(banded)
+    reduced = time.perf_counter()
+    problem = _Problem(LinearMount.prepare(banded), fast, rules, load_mounts=_load_mounts(scaled, rules))
+    return problem, {"scale": scale, "reductions": len(link_jobs(banded)), "reduction_seconds": reduced - begin,
+                     "preparation_seconds": time.perf_counter() - begin}
+
+
+def _trial(problem: _Problem, kind: str, weights: np.ndarray, positions: list, maxiter: int,
+           pool: ProcessPoolExecutor | None, **cost) -> _Trial:
+    """Every start on *problem* (in *pool*'s processes when there is one); *cost*: the preparation's
+    (:class:`_Trial`'s fields)."""
+    from concurrent.futures.process import BrokenProcessPool
+
+    begin = time.perf_counter()
+    if pool is None or len(positions) <= 1:
+        outcomes = [_start(problem, kind, weights, x0, k, maxiter) for k, x0 in enumerate(positions)]
+    else:
+        futures = [pool.submit(_start, problem, kind, weights, x0, k, maxiter) for k, x0 in enumerate(positions)]
+        try:
+            outcomes = [future.result() for future in futures]
+        except BrokenProcessPool:
+            raise SimulationError("a worker process running an optimisation start died (killed, or out of "
+                                  "memory); run with one worker to see the start's own error") from None
+        problem.evaluations += sum(count for _, _, count in outcomes)
+    return _Trial(problem, [end for end, _, _ in outcomes], [row for _, rows, _ in outcomes for row in rows],
+                  time.perf_counter() - begin, **cost)
+
+
+def _start(problem: _Problem, kind: str, weights: np.ndarray, x0: np.ndarray, start: int,
+           maxiter: int) -> tuple[dict, list, int]:
+    """One start, in this process or a worker's: its end (x included), its history rows and the designs it
+    answered. BLAS runs single-threaded, so that a start gives the same digits wherever it runs."""
+    from threadpoolctl import threadpool_limits
+
+    history: list = []
+    counted = problem.evaluations
+    with threadpool_limits(limits=1):
+        try:
+            if len(x0):
+                x, message, iterations = _run_start(problem, kind, weights, x0, start, history, maxiter)
+            else:
+                x, message, iterations = x0, "no fast variable: the design answered", 0
+            point = problem.point(x)
+        except SimulationError as error:
+            return ({"start": start, "objective": np.nan, "violation": np.inf, "iterations": 0,
+                     "message": str(error)}, history, problem.evaluations - counted)
+    end = {"start": start, "x": x, "objective": _objective_value(kind, weights, point),
+           "violation": problem.violation(point), "iterations": iterations, "message": message}
+    if not history:
+        history.append({"start": start, "iteration": 0, "objective": end["objective"], "violation": end["violation"]})
+    return end, history, problem.evaluations - counted
+
+
+def _start_worker() -> None:
+    """Set up a worker process of the starts: Ctrl-C is the parent's to handle, and it ends with its parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    end_with_parent()
+
+
+@contextlib.contextmanager
+def _start_pool(workers: int, starts: int):
+    """Worker processes for the starts (None: one worker or one start); stopped on an interrupt."""
+    if workers <= 1 or starts <= 1:
+        yield None
+        return
+    before = set(multiprocessing.active_children())
+    pool = ProcessPoolExecutor(max_workers=min(workers, starts), mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_start_worker)
+    try:
+        yield pool
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        stop_workers(set(multiprocessing.active_children()) - before)
+        raise
+    pool.shutdown(wait=True)
+
+
+def _raise_infeasible(problem: _Problem, x0: np.ndarray, held: list | None = None):
+    closest = problem.point(_least_violation(problem, x0) if len(x0) else x0)
     violated = [f"{label}: {value:.4g} against {limit}"
                 for (label, value, limit), slack in zip(closest.measures, closest.g, strict=True) if slack < -FEASIBLE]
     held = [f"{v.name} at its {'low' if x <= ACTIVE else 'high'} end {v.value(float(round(x))):g}"
-            for v, x in zip(problem.variables, closest.x, strict=True) if x <= ACTIVE or x >= 1 - ACTIVE]
+            for v, x in zip(problem.variables, closest.x, strict=True) if x <= ACTIVE or x >= 1 - ACTIVE] + (held or [])
     raise InfeasibleProblem(violated or [f"{label}: {value:.4g} against {limit}" for label, value, limit
                                          in closest.measures], held)
 
@@ -772,10 +954,11 @@ def pareto(case: Case, variables: dict, objectives: tuple = ("worst", "displacem
         if name not in known:
             raise InputError(f"Pareto objective {name!r}: expected one of {', '.join(known)}")
     chosen = [variable(name, *bounds) for name, bounds in variables.items()]
+    if any(v.name == SECTION for v in chosen):
+        raise InputError(_FRONT_FAST_ONLY)
     rules = [rule if isinstance(rule, Constraint) else constraint(rule) for rule in constraints]
     mount = mount or LinearMount.prepare(case)
-    load_mounts = load_case_mounts(case) if any(rule.quantity == LINK_MARGIN for rule in rules) else []
-    problem = _Problem(mount, chosen, rules, derivatives=False, load_mounts=load_mounts)
+    problem = _Problem(mount, chosen, rules, derivatives=False, load_mounts=_load_mounts(case, rules))
 
     rows = len(problem.point(np.full(len(chosen), 0.5)).g)     # constraint rows (a fatigue rule: one per link)
 

@@ -729,9 +729,9 @@ def read_workbook(path: str | Path) -> CaseBook:
     sha256 = hashlib.sha256(data).hexdigest()
     formulas, values = open_workbook(path, data)
     reader = _CaseReader(path, formulas, values)
-    tables = {table.sheet: reader.table(table) for table in (*L.TABLES, L.OPTIMISE)}
+    tables = {table.sheet: reader.table(table) for table in L.TABLES}
     reader.sheet_title(IMPEDANCE_SHEET)
-    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), L.OPTIMISE.sheet, IMPEDANCE_SHEET),
+    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), IMPEDANCE_SHEET),
                            (L.INSTRUCTIONS_SHEET,))
     if reader.merged_found:
         raise WorkbookError(reader.problems)

@@ -79,6 +79,9 @@ _INSTRUCTIONS = (
     "Links: yield, ultimate and endurance strength columns override the material preset's.",
     "Test data: measured force amplitudes (pylon sum or a hinge, per direction); "
     "the results show error = (sim - test) / test x 100 %.",
+    "Optimise (optional, empty: none): the design optimisation 'mountwb optimise CASE.xlsx' runs, one row per "
+    "variable (a study parameter with low and high, e.g. hinge_stiffness/front or section_scale), constraint, "
+    "speed band, objective or starts; SI units. A run never optimises.",
     "Check a workbook:  mountwb check CASE.xlsx     "
     "Run it:  mountwb run CASE.xlsx [--run NAME] [--report REPORT.xlsx]",
     "A run writes sheets named 'Result ...' back into the workbook and never changes the input sheets.",
@@ -266,6 +269,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.CASING.sheet: _rows_for_casing(case.engine.casing),
         L.RUNS.sheet: [dataclasses.asdict(run) for run in runs],
         L.TEST_DATA.sheet: [dataclasses.asdict(point) for point in tests],
+        L.OPTIMISE.sheet: [],       # no design optimisation asked: rows are the user's
     }
 
 
