@@ -6,15 +6,13 @@ import numpy as np
 import pytest
 
 from workbook import run_case
-from workbook.design.linear_mount import LinearMount
+from workbook.design.linear_mount import LinearMount, keeps_casing_modes
 from workbook.design.sensitivity import design_sensitivity, difference_sensitivity
 from workbook.model.case import ForceTransducers
 from workbook.model.reference import reference_case, reference_casing
 from workbook.rig.synthetic import synthetic_records
 from workbook.rig.updating import update_model
 from workbook.studies.parametric import parameter
-
-pytestmark = pytest.mark.slow
 
 #: The true casing is this much softer than the nominal model's.
 SOFTER = 0.8
@@ -52,6 +50,7 @@ def _errors(fast, exact):
                max(np.abs(f.hinge_amplitudes[n] - e.hinge_amplitudes[n]).max() for n in e.hinge_amplitudes) / scale)
 
 
+@pytest.mark.slow
 def test_the_prepared_casing_and_a_softer_one_are_the_pipeline_answers(mount, softer):
     """The core's bearings couple it to the casing in the rest of the scene: without them the excitation
     on the core reached no hinge (T = 0)."""
@@ -65,6 +64,7 @@ def test_the_prepared_casing_and_a_softer_one_are_the_pipeline_answers(mount, so
         assert t_error < 1e-6 and hinge_error < 1e-6
 
 
+@pytest.mark.slow
 def test_random_hinge_designs_on_a_flexible_casing_agree_with_the_pipeline(mount):
     """Within 3e-5 of T (found: up to 1.4e-5; the rigid engine 7e-7): springs 1 to 4 times stiffer move the
     engine by about 0.5 mrad, and the second-order expansion of the rest leaves its third-order term, the
@@ -79,6 +79,7 @@ def test_random_hinge_designs_on_a_flexible_casing_agree_with_the_pipeline(mount
             assert t_error < 3e-5 and hinge_error < 2e-5
 
 
+@pytest.mark.slow
 def test_the_casing_modulus_derivative_equals_central_differences(mount):
     modulus = 0.9 * mount.case.engine.casing.material.youngs_modulus
     values = {"casing_modulus": modulus, "hinge_stiffness/front": 3e7}
@@ -89,6 +90,7 @@ def test_the_casing_modulus_derivative_equals_central_differences(mount):
     assert np.abs(direct.gradient[..., 0]).max() * modulus > 1e-3 * direct.transmissibility.max()
 
 
+@pytest.mark.slow
 def test_updating_recovers_a_softer_casing_within_two_standard_errors(nominal, mount, softer):
     truth, result = softer
     records = synthetic_records(truth, result, (3, 4), noise=0.002)
@@ -98,3 +100,26 @@ def test_updating_recovers_a_softer_casing_within_two_standard_errors(nominal, m
     (value,), (error,) = update.values, update.standard_errors
     assert abs(value - expected) < 2 * error, (value, expected, error)
     assert error < 0.1 * value
+
+
+#: A casing reduced for 59 Hz: first free-free mode 100 Hz, so ``auto`` keeps the fixed-interface modes up to
+#: 4 x 59 = 236 Hz and the first one past it.
+FREQUENCIES = {"free_free_hz": np.array([100.0]), "fixed_interface_hz": np.array([150.0, 230.0, 260.0])}
+
+
+@pytest.mark.parametrize("modes, scale, prepared_hz, excitation_hz, kept", [
+    ("auto", 1.0, 59.0, 59.0, True),
+    ("auto", 1.05, 59.0, 59.0, True),     # 230 Hz x 1.025 = 235.7 Hz: still below the cut-off
+    ("auto", 0.8, 59.0, 59.0, False),     # 260 Hz x 0.894 = 232.6 Hz: the cut-off needs a fourth mode
+    ("auto", 1.1, 59.0, 59.0, False),     # 230 Hz x 1.049 = 241.2 Hz: two modes reach the cut-off
+    ("auto", 1.0, 59.0, 62.0, True),      # a cut-off of 248 Hz: the third mode still the first past it
+    ("auto", 1.0, 59.0, 66.0, False),     # a cut-off of 264 Hz: past the last mode kept
+    ("auto", 2.0, 20.0, 20.0, True),      # 20 Hz below a quarter of 100 Hz: static modes, and more so stiffer
+    ("auto", 0.5, 20.0, 20.0, False),     # a quarter of 70.7 Hz is below 20 Hz: modes wanted
+    ("static", 0.3, 59.0, 59.0, True),
+    (3, 0.3, 59.0, 59.0, True),
+])
+def test_a_casing_modulus_keeps_the_prepared_modes_unless_its_selection_changes(modes, scale, prepared_hz,
+                                                                              excitation_hz, kept):
+    frequencies = FREQUENCIES if modes != "static" else {**FREQUENCIES, "fixed_interface_hz": np.zeros(0)}
+    assert keeps_casing_modes(modes, frequencies, scale, prepared_hz, excitation_hz) is kept

@@ -56,7 +56,8 @@ from workbook.solve.stages import link_warnings
 if TYPE_CHECKING:
     from flexbodies.reduced import ReducedLink
 
-__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_frames", "channel_springs"]
+__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_frames", "channel_springs",
+           "keeps_casing_modes"]
 
 
 def channel_frames(case: Case, channels: list[str]) -> np.ndarray:
@@ -361,28 +362,42 @@ def _check_mode_decisions(case: Case, base: Case) -> None:
 
 def _check_casing_modes(case: Case, base: Case, items: dict) -> None:
     """The casing's mode selection at *case*'s modulus and frequencies must keep the prepared modes."""
-    from flexbodies.craig_bampton import kept_count
-    from flexbodies.selection import decide_modes
-
     casing = case.engine.casing
     for item, base_item in zip(case.excitations, base.excitations, strict=True):
         prepared = items[item.name].casing
         if casing is None or prepared is None:
             continue
-        reduced, root = prepared.reduced, np.sqrt(prepared.scale(case))
-        first = reduced.frequencies["free_free_hz"][0]
-        old = decide_modes(casing.modes, first, max(p.frequency for p in points_of(base_item)))
-        new = decide_modes(casing.modes, root * first, max(p.frequency for p in points_of(item)))
-        fixed = root * np.asarray(reduced.frequencies["fixed_interface_hz"])
-        if new.count is not None:
-            same = old.count == new.count
-        else:
-            same = len(fixed) > 0 and fixed[-1] >= new.cutoff_hz \
-                and kept_count(fixed, None, new.cutoff_hz) == len(fixed)
-        if not same:
+        if not keeps_casing_modes(casing.modes, prepared.reduced.frequencies, prepared.scale(case),
+                                  max(p.frequency for p in points_of(base_item)),
+                                  max(p.frequency for p in points_of(item))):
             raise OutsideDesignModel(case.name, f"the casing at {casing.material.youngs_modulus:g} Pa in "
                                      f"{item.name!r}: its mode selection {casing.modes!r} keeps other modes there "
                                      "(a count of modes keeps them)")
+
+
+def keeps_casing_modes(modes, frequencies: dict, scale: float, prepared_hz: float, excitation_hz: float) -> bool:
+    """Whether a casing reduced for *prepared_hz* keeps the same modes at *scale* times its modulus and
+    the highest excitation *excitation_hz* (Hz): its frequencies scale with ``sqrt(scale)``.
+
+    Parameters
+    ----------
+    modes : {"auto", "static"} or int or float
+        The casing's mode request.
+    frequencies : dict
+        The reduced casing's ``free_free_hz`` and the ``fixed_interface_hz`` of its kept modes, Hz.
+    """
+    from flexbodies.craig_bampton import kept_count
+    from flexbodies.selection import decide_modes
+
+    root = np.sqrt(scale)
+    first = frequencies["free_free_hz"][0]
+    old = decide_modes(modes, first, prepared_hz)
+    new = decide_modes(modes, root * first, excitation_hz)
+    if new.count is not None:
+        return old.count == new.count
+    fixed = root * np.asarray(frequencies["fixed_interface_hz"])
+    return bool(old.count is None and len(fixed) > 0 and fixed[-1] >= new.cutoff_hz
+                and kept_count(fixed, None, new.cutoff_hz) == len(fixed))
 
 
 def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str], points: list,
