@@ -3,7 +3,7 @@
 Model updating (:mod:`workbook.rig.updating`): the values of the parameters
 ``--vary`` (the names of ``study params --vary``: hinge stiffness, damping
 and loss factor, also per hinge group and direction, transducer stiffness,
-engine mass) within their bounds that make the case's T agree with the rig
+engine mass, a flexible casing's modulus) within their bounds that make the case's T agree with the rig
 records' measured T, by weighted least squares on the fast linear model.
 A record may state its measurement uncertainty after a colon, one standard
 deviation of its T, relative (``lp-1.csv:0.5%``) or absolute (``lp-1.csv:0.0004``):

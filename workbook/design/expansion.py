@@ -13,10 +13,12 @@ the scene is split into the parts the design sets and the parts it does not:
   positions), and its force ``F = S d + S_d d'`` takes any 3x3 stiffness
   ``S`` and damping ``S_d`` of the design;
 - the rest of the scene (bodies, static loads, rotors, the links' spin
-  restraints) is the system with every channel's spring and damper set to
-  zero: Exudyn's M, K and D of it and their first derivatives with respect
-  to the coordinates of each body (the bodies do not couple without the
-  channels, so one round of central differences serves every body);
+  restraints, a flexible engine's bearings and spin restraint) is the system
+  with every channel's spring and damper set to zero: Exudyn's M, K and D of
+  it and their first derivatives with respect to the coordinates of each
+  block of bodies (a body alone, or the bodies the rest joins: a flexible
+  engine's core and casing; blocks do not couple, so one round of central
+  differences serves every block);
 - the engine's excitation points keep their position Jacobians and Hessians.
 
 The expansion is exact in the design's springs at a fixed state and of second
@@ -229,24 +231,47 @@ def _channels_released(scene: Scene):
     return restore
 
 
+def _coupled_blocks(blocks: list[np.ndarray], matrices) -> list[np.ndarray]:
+    """*blocks* (each body's coordinates) joined where any of *matrices* (N, N) couples them.
+
+    Without the channels, bodies couple only through the connectors of the
+    rest: a flexible engine's bearings and spin restraint join its core to its
+    casing. Bodies so joined make one block of their coordinates.
+    """
+    coupled = np.zeros((len(blocks), len(blocks)), dtype=bool)
+    for matrix in matrices:
+        for i, rows in enumerate(blocks):
+            for j, columns in enumerate(blocks):
+                coupled[i, j] |= i != j and bool(np.any(matrix[np.ix_(rows, columns)]))
+    groups: list[set[int]] = []
+    for i in range(len(blocks)):
+        group = {i} | set(np.flatnonzero(coupled[i] | coupled[:, i]).tolist())
+        for other in [g for g in groups if g & group]:
+            groups.remove(other)
+            group |= other
+        groups.append(group)
+    return [np.concatenate([blocks[i] for i in sorted(group)]) for group in sorted(groups, key=min)]
+
+
 def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
     size = len(base)
-    blocks = list(_body_coordinates(scene).values())
-    width = max(len(block) for block in blocks)
-    coordinates = np.full((len(blocks), width), size, dtype=int)
-    for k, block in enumerate(blocks):
-        coordinates[k, :len(block)] = block
-    rows, columns = coordinates[:, :, None], coordinates[:, None, :]
-
-    def padded(matrix: np.ndarray) -> np.ndarray:
-        full = np.zeros((size + 1, size + 1))
-        full[:size, :size] = matrix
-        return full[rows, columns]
-
     restore = _channels_released(scene)
     try:
         set_state(base)
-        matrices = [padded(m) for m in _rest_matrices(scene.mbs)]
+        at_base = _rest_matrices(scene.mbs)
+        blocks = _coupled_blocks(list(_body_coordinates(scene).values()), at_base)
+        width = max(len(block) for block in blocks)
+        coordinates = np.full((len(blocks), width), size, dtype=int)
+        for k, block in enumerate(blocks):
+            coordinates[k, :len(block)] = block
+        rows, columns = coordinates[:, :, None], coordinates[:, None, :]
+
+        def padded(matrix: np.ndarray) -> np.ndarray:
+            full = np.zeros((size + 1, size + 1))
+            full[:size, :size] = matrix
+            return full[rows, columns]
+
+        matrices = [padded(m) for m in at_base]
         slopes = [np.zeros((len(blocks), width, width, width)) for _ in range(3)]
         for i in range(width):
             shifted = []

@@ -5,8 +5,9 @@
 item and keeps the scene as a :class:`~workbook.design.expansion.SceneExpansion`.
 :meth:`LinearMount.evaluate` then answers a design - the case with other
 hinge stiffness, damping or loss factors (per hinge and per direction),
-test-rig transducer springs, engine mass and inertia, or excitation
-frequencies and amplitudes - in NumPy alone: the preload equilibrium by
+test-rig transducer springs, engine mass and inertia, a flexible engine
+casing's Young's modulus, or excitation frequencies and amplitudes - in
+NumPy alone: the preload equilibrium by
 Newton (with the stress-stiffening passes of
 :mod:`workbook.solve.stress_stiffening`), the linearisation at it, and one
 complex solve per frequency. Its answers equal :func:`workbook.run_case`'s
@@ -14,6 +15,14 @@ complex solve per frequency. Its answers equal :func:`workbook.run_case`'s
 link's section or material, the geometry, the effects, a mode selection the
 new frequency changes) raises :class:`~workbook.errors.OutsideDesignModel`,
 naming the change: such a design needs a new preparation.
+
+A flexible casing's reduced stiffness scales with its modulus E exactly (its
+Craig-Bampton basis does not change), and its modal damping
+``2 zeta w_i`` with sqrt(E): a design at another E adds ``(E / E_0 - 1) K_r``
+and ``(sqrt(E / E_0) - 1) D_r`` to the prepared casing's modal coordinates.
+Only the casing's mode selection may change with E or the frequency (the
+low-frequency rule and a cut-off judge its frequencies, which scale with
+sqrt(E)): a design that changes the number of modes kept is refused.
 """
 from __future__ import annotations
 
@@ -47,7 +56,8 @@ from workbook.solve.stages import link_warnings
 if TYPE_CHECKING:
     from flexbodies.reduced import ReducedLink
 
-__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_springs"]
+__all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_springs",
+           "keeps_casing_modes"]
 
 
 def channel_springs(case: Case, channels: list[str]) -> ChannelSprings:
@@ -87,6 +97,23 @@ class _FlexibleLink:
     reduced_stiffness: np.ndarray      # K_r of the prepared scene (stiffened there or not)
     unloaded_hz: float                 # first pinned-pinned frequency without tension
     stiffening: object = field(repr=False)   # flexbodies LinkStiffening
+
+
+@dataclass(frozen=True)
+class _Casing:
+    """What the design evaluation needs of a flexible engine casing to change its modulus."""
+
+    modal: np.ndarray                  # full coordinates of its modal coordinates
+    stiffness: np.ndarray              # K_r at the prepared modulus
+    damping: np.ndarray                # its modal damping at the prepared modulus
+    modulus: float                     # the prepared modulus E_0, Pa
+    reduced: ReducedLink = field(repr=False)
+
+    def scale(self, case: Case) -> float:
+        """E / E_0 of the design *case*."""
+        casing = case.engine.casing
+        assert casing is not None
+        return float(casing.material.youngs_modulus) / self.modulus
 
 
 @dataclass(frozen=True)
@@ -135,6 +162,7 @@ class _Item:
     base_engine: Engine
     prepared_seconds: float
     stressed: dict = field(default_factory=dict)     # name -> StressedLink, the links with stress shapes
+    casing: _Casing | None = None                    # a flexible engine casing
 
 
 @dataclass(frozen=True)
@@ -166,7 +194,11 @@ def _normalised(case: Case, base: Case) -> Case:
     hinges = tuple(dataclasses.replace(h, stiffness=b.stiffness, damping=b.damping, loss_factor=b.loss_factor)
                    for h, b in zip(case.hinges, base.hinges, strict=True)) \
         if [h.name for h in case.hinges] == [b.name for b in base.hinges] else case.hinges
-    engine = dataclasses.replace(case.engine, mass=base.engine.mass, inertia=base.engine.inertia)
+    casing = case.engine.casing
+    if casing is not None and base.engine.casing is not None:
+        casing = dataclasses.replace(casing, material=dataclasses.replace(
+            casing.material, youngs_modulus=base.engine.casing.material.youngs_modulus))
+    engine = dataclasses.replace(case.engine, mass=base.engine.mass, inertia=base.engine.inertia, casing=casing)
     rig = case.test_rig
     if rig is not None and base.test_rig is not None:
         rig = dataclasses.replace(rig, stiffness=base.test_rig.stiffness, damping=base.test_rig.damping)
@@ -197,7 +229,7 @@ class LinearMount:
         ------
         OutsideDesignModel
             A case the design evaluation cannot answer: a flexible pylon,
-            clearance laws, a flexible engine, or a time-domain method.
+            clearance laws, or a time-domain method.
         workbook.errors.SimulationError
             As :func:`workbook.run_case`.
         """
@@ -206,8 +238,6 @@ class LinearMount:
 
         if case.flexible_pylon:
             raise OutsideDesignModel(case.name, "a flexible pylon (answered by the four-pole set)")
-        if case.engine.casing is not None:
-            raise OutsideDesignModel(case.name, "a flexible engine casing")
         items, cards, preloads = {}, {}, {}
         channels: list[str] = []
         pylon: list[str] = []
@@ -237,7 +267,7 @@ class LinearMount:
         base = self.case
         if _normalised(case, base) != base:
             raise OutsideDesignModel(case.name, "a change beyond hinge springs, transducer springs, engine mass "
-                                     "properties and excitation frequencies and amplitudes")
+                                     "properties, the casing's modulus and excitation frequencies and amplitudes")
         if [type(e) for e in case.excitations] != [type(e) for e in base.excitations] or \
                 [e.name for e in case.excitations] != [e.name for e in base.excitations]:
             raise OutsideDesignModel(case.name, "other excitations")
@@ -249,6 +279,7 @@ class LinearMount:
                         raise OutsideDesignModel(case.name, f"{excitation.name!r} acts at a point the prepared "
                                                  f"case has no excitation at ({point})")
         _check_mode_decisions(case, base)
+        _check_casing_modes(case, base, self.items)
 
     def follows(self, case: Case) -> bool:
         """Whether :meth:`evaluate` answers *case* (:meth:`check` passes)."""
@@ -322,6 +353,46 @@ def _check_mode_decisions(case: Case, base: Case) -> None:
                                      "selection may keep other modes")
 
 
+def _check_casing_modes(case: Case, base: Case, items: dict) -> None:
+    """The casing's mode selection at *case*'s modulus and frequencies must keep the prepared modes."""
+    casing = case.engine.casing
+    for item, base_item in zip(case.excitations, base.excitations, strict=True):
+        prepared = items[item.name].casing
+        if casing is None or prepared is None:
+            continue
+        if not keeps_casing_modes(casing.modes, prepared.reduced.frequencies, prepared.scale(case),
+                                  max(p.frequency for p in points_of(base_item)),
+                                  max(p.frequency for p in points_of(item))):
+            raise OutsideDesignModel(case.name, f"the casing at {casing.material.youngs_modulus:g} Pa in "
+                                     f"{item.name!r}: its mode selection {casing.modes!r} keeps other modes there "
+                                     "(a count of modes keeps them)")
+
+
+def keeps_casing_modes(modes, frequencies: dict, scale: float, prepared_hz: float, excitation_hz: float) -> bool:
+    """Whether a casing reduced for *prepared_hz* keeps the same modes at *scale* times its modulus and
+    the highest excitation *excitation_hz* (Hz): its frequencies scale with ``sqrt(scale)``.
+
+    Parameters
+    ----------
+    modes : {"auto", "static"} or int or float
+        The casing's mode request.
+    frequencies : dict
+        The reduced casing's ``free_free_hz`` and the ``fixed_interface_hz`` of its kept modes, Hz.
+    """
+    from flexbodies.craig_bampton import kept_count
+    from flexbodies.selection import decide_modes
+
+    root = np.sqrt(scale)
+    first = frequencies["free_free_hz"][0]
+    old = decide_modes(modes, first, prepared_hz)
+    new = decide_modes(modes, root * first, excitation_hz)
+    if new.count is not None:
+        return old.count == new.count
+    fixed = root * np.asarray(frequencies["fixed_interface_hz"])
+    return bool(old.count is None and len(fixed) > 0 and fixed[-1] >= new.cutoff_hz
+                and kept_count(fixed, None, new.cutoff_hz) == len(fixed))
+
+
 def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str], points: list,
                   seconds: float) -> _Item:
     from flexbodies.geometric_stiffness import link_stiffening
@@ -378,7 +449,23 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
                 link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
                 np.ascontiguousarray(shapes.transpose(1, 0, 2)), np.linalg.norm(shapes, ord=2, axis=(1, 2)))
     return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine, points, warnings,
-                 prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed)
+                 prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed,
+                 _prepared_casing(case, scene))
+
+
+def _prepared_casing(case: Case, scene: Scene) -> _Casing | None:
+    """The flexible engine casing of *scene*, or None."""
+    from flexbodies.exudyn_body import modal_damping_matrix
+
+    casing = case.engine.casing
+    if casing is None or scene.casing is None:
+        return None
+    reduced = scene.casing.reduced
+    stiffness = np.asarray(reduced.ffrf["stiffnessMatrixReduced"], dtype=float)
+    first = scene.mbs.GetNodeODE2Index(scene.casing.casing.nodes[1])
+    return _Casing(np.arange(first, first + stiffness.shape[0]), stiffness,
+                   modal_damping_matrix(reduced, casing.modal_damping), float(casing.material.youngs_modulus),
+                   reduced)
 
 
 @dataclass(frozen=True)
@@ -420,6 +507,9 @@ def _state_loads(case: Case, prepared: _Item, tensions: dict) -> StateLoads:
                     force[prepared.engine[:3]] += added_mass * np.asarray(load.acceleration)
     modal = [(link.modal, (tensions.get(link.name, 0.0) - link.base_tension) * link.geometric)
              for link in prepared.links if tensions.get(link.name, 0.0) != link.base_tension]
+    casing = prepared.casing
+    if casing is not None and casing.scale(case) != 1.0:
+        modal.append((casing.modal, (casing.scale(case) - 1.0) * casing.stiffness))
     return StateLoads(modal, mass, force)
 
 
@@ -530,6 +620,9 @@ def linear_model(case: Case, prepared: _Item, springs: ChannelSprings, state: _S
         block = np.ix_(link.modal, link.modal)
         damping[block] += link.stiffness_damping * added
         structural[block] += link.loss_factor * (link.reduced_stiffness + added)
+    casing = prepared.casing
+    if casing is not None:
+        damping[np.ix_(casing.modal, casing.modal)] += (np.sqrt(casing.scale(case)) - 1.0) * casing.damping
     basis = projection(expansion, dq)
     inputs = {}
     q = total(expansion, dq)

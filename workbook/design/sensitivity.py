@@ -2,9 +2,12 @@
 
 A parameter (a name of :func:`workbook.studies.parametric.parameter`:
 hinge stiffness, damping or loss factor, per hinge group and direction,
-transducer stiffness, engine mass) changes the channel springs and the
-engine's mass linearly; those changes are exact differences of the
-springs at two values. Through them it moves, in order:
+transducer stiffness, engine mass, a flexible casing's modulus) changes the
+channel springs, the engine's mass and the casing's modulus E linearly;
+those changes are exact differences at two values. The casing's reduced
+stiffness is ``E / E_0 K_r`` and its modal damping ``sqrt(E / E_0) D_r``,
+so ``dK/dE = K_r / E_0`` and ``dD/dE = D_r / (2 sqrt(E E_0))``. Through
+them it moves, in order:
 
 1. each preload solve of the stress-stiffening passes: ``dq = -K_t^-1
    (dR/dp + dR/dP dP/dp)``, the tensions P of a pass being the previous
@@ -167,8 +170,8 @@ def design_sensitivity(mount: LinearMount, values: dict) -> DesignSensitivity:
     motions: list = []
     for item, solution in zip(case.excitations, solutions, strict=True):
         states = _state_changes(case, solution, changes)
-        item_changes.append([_model_change(case, solution, springs, mass, state)
-                             for (springs, mass), state in zip(changes, states, strict=True)])
+        item_changes.append([_model_change(case, solution, change, state)
+                             for change, state in zip(changes, states, strict=True)])
         models = [model for model, _ in item_changes[-1]]
         for excitation in points_of(item):
             motion, d_motion, forces, d_forces = point_change(solution, models, excitation)
@@ -217,10 +220,20 @@ def amplitude_change(phasor: np.ndarray, change: np.ndarray) -> np.ndarray:
     return np.divide(np.real(np.conj(phasor) * change), size, out=np.zeros(shape), where=size > 0)
 
 
+@dataclass(frozen=True)
+class _Change:
+    """What one parameter changes, per unit of it: the springs, the engine's mass (kg) and the casing's modulus
+    (Pa)."""
+
+    springs: ChannelSprings
+    mass: float
+    modulus: float
+
+
 def _parameter_change(mount: LinearMount, values: dict, name: str, case: Case, springs: ChannelSprings | None
-                      ) -> tuple[ChannelSprings, float]:
-    """d(springs)/dp and d(engine mass)/dp: exact forward differences from the design *case* and its
-    *springs* (None: found here), both being linear in each parameter."""
+                      ) -> _Change:
+    """d(springs)/dp, d(engine mass)/dp and d(casing modulus)/dp: exact forward differences from the design
+    *case* and its *springs* (None: found here), all being linear in each parameter."""
     from workbook.design.linear_mount import channel_springs
 
     value = values[name]
@@ -230,11 +243,23 @@ def _parameter_change(mount: LinearMount, values: dict, name: str, case: Case, s
     change = ChannelSprings(*((a - b) / step for a, b in zip(
         dataclasses.astuple(channel_springs(changed, mount.channels)), dataclasses.astuple(base),
         strict=True)))
-    return change, (changed.engine.mass - case.engine.mass) / step
+    casing, other = case.engine.casing, changed.engine.casing
+    modulus = 0.0 if casing is None or other is None else \
+        (other.material.youngs_modulus - casing.material.youngs_modulus) / step
+    return _Change(change, (changed.engine.mass - case.engine.mass) / step, modulus)
+
+
+def _casing_stiffness_change(solution: ItemSolution, case: Case, modulus: float) -> tuple[np.ndarray, np.ndarray]:
+    """The casing's modal coordinates and the change of its reduced stiffness by the modulus change *modulus*
+    (Pa per unit of the parameter; coordinates empty without a casing)."""
+    casing = solution.prepared.casing
+    if casing is None or modulus == 0.0:
+        return np.zeros(0, dtype=int), np.zeros((0, 0))
+    return casing.modal, modulus / casing.modulus * casing.stiffness
 
 
 def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Per parameter change ``(springs, mass)``: d(dq)/dp of the final preload solve and d(tension)/dp of
+    """Per parameter change (:class:`_Change`): d(dq)/dp of the final preload solve and d(tension)/dp of
     each stiffened link, in pass order (each pass's tangent stiffness factorised once for all of them)."""
     prepared, base = solution.prepared, solution.springs
     expansion = prepared.expansion
@@ -256,24 +281,29 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
         factor = sla.lu_factor(basis.both(tangent_stiffness(expansion, dq, rest_stiffness, base, at)),
                                check_finite=False)
         jacobian = channels.outputs(at, base.stiffness)
-        for j, (springs, mass) in enumerate(changes):
+        for j, change in enumerate(changes):
+            springs = change.springs
             if d_forces[j] is not None:
                 by_link = -np.einsum("lcx,cx->l", prepared.compression, d_forces[j])
                 d_tension[j] = np.array([by_link[names.index(link.name)] if link.name in tensions else 0.0
                                          for link in prepared.links])
-            residual = without_normal(expansion, dq, channels.force(at, springs.stiffness)) - mass * gravity
-            for link, change in zip(prepared.links, d_tension[j], strict=True):
-                residual[link.modal] += change * (link.geometric @ q[link.modal])
+            residual = without_normal(expansion, dq, channels.force(at, springs.stiffness)) - change.mass * gravity
+            for link, tension in zip(prepared.links, d_tension[j], strict=True):
+                residual[link.modal] += tension * (link.geometric @ q[link.modal])
+            modal, casing = _casing_stiffness_change(solution, case, change.modulus)
+            residual[modal] += casing @ q[modal]
             d_state[j] = basis.expand(sla.lu_solve(factor, -basis.rows(residual), check_finite=False))
             d_forces[j] = prepared.sign * (np.einsum("cab,cb->ca", springs.stiffness, at.separation)
                                            + (jacobian @ d_state[j]).reshape(-1, 3))
     return list(zip(d_state, d_tension, strict=True))
 
 
-def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, mass: float, state_change: tuple):
+def _model_change(case: Case, solution: ItemSolution, change: _Change, state_change: tuple):
     """The derivative of the item's linear model (a model of the same form: Z, C and f are linear in it)
-    and of its state ``dq``, given the derivative of the state and tensions (:func:`_state_changes`)."""
+    and of its state ``dq``, given the parameter's *change* and the derivative of the state and tensions
+    (:func:`_state_changes`)."""
     prepared, state, model = solution.prepared, solution.state, solution.model
+    springs, mass = change.springs, change.mass
     expansion = prepared.expansion
     d_state, d_tension = state_change
     # along the state change: central differences of the whole linear model
@@ -290,13 +320,23 @@ def _model_change(case: Case, solution: ItemSolution, springs: ChannelSprings, m
     engine_mass = np.zeros((prepared.size,) * 2)
     engine_mass[prepared.engine[:3], prepared.engine[:3]] = mass
     added_mass = basis.both(engine_mass)
-    for link, change in zip(prepared.links, d_tension, strict=True):
+    for link, tension in zip(prepared.links, d_tension, strict=True):
         geometric = np.zeros((prepared.size,) * 2)
-        geometric[np.ix_(link.modal, link.modal)] = change * link.geometric
+        geometric[np.ix_(link.modal, link.modal)] = tension * link.geometric
         projected = basis.both(geometric)
         stiffness = stiffness + projected
         damping = damping + link.stiffness_damping * projected
         structural = structural + link.loss_factor * projected
+    modal, casing_stiffness = _casing_stiffness_change(solution, case, change.modulus)
+    if len(modal):
+        casing = prepared.casing
+        assert casing is not None
+        block = np.ix_(modal, modal)
+        full = np.zeros((prepared.size,) * 2)
+        full[block] = casing_stiffness
+        stiffness = stiffness + basis.both(full)
+        full[block] = change.modulus / (2.0 * np.sqrt(casing.scale(case)) * casing.modulus) * casing.damping
+        damping = damping + basis.both(full)
     outputs = tuple(basis.columns(prepared.sign * channels.outputs(at, spring))
                     for spring in (springs.stiffness, springs.damping, springs.structural))
 

@@ -4,7 +4,7 @@ Each record gives the measured T per direction of its run
 (:func:`workbook.rig.correlation.measure`). The parameters (names of
 :func:`workbook.studies.parametric.parameter`: hinge stiffness, damping or
 loss factor per hinge group and direction, transducer stiffness, engine
-mass) are fitted by weighted least squares on the fast linear model
+mass, a flexible casing's modulus) are fitted by weighted least squares on the fast linear model
 (:class:`~workbook.design.linear_mount.LinearMount`), with its analytic
 derivatives (:func:`~workbook.design.sensitivity.design_sensitivity`)::
 
@@ -34,8 +34,7 @@ them to convergence. The standard error of p is ``p sd(x)`` on a
 log scale. A parameter is not determined by the data when the condition
 number of the column-scaled ``J^T J`` exceeds :data:`CONDITION_LIMIT`, or its
 correlation with another exceeds :data:`CORRELATION_LIMIT` in magnitude: a
-warning names it. The casing's modulus (``casing_modulus``) is not fitted:
-the linear model refuses a flexible engine casing.
+warning names it.
 """
 from __future__ import annotations
 
@@ -262,7 +261,8 @@ def update_model(case: Case, records, variables: dict, *, uncertainty=None, peri
     RecordError
         A record that cannot be measured or whose transducers do not carry the case's pylon-side hinges.
     OutsideDesignModel
-        A case the linear model does not answer (a flexible casing, a flexible pylon, ...).
+        A case the linear model does not answer (a flexible pylon, a casing modulus within the bounds that
+        changes the casing's modes, ...).
     """
     from workbook.rig.correlation import measure
 
