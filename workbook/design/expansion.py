@@ -46,6 +46,9 @@ __all__ = ["RestBlocks", "SceneExpansion", "expand_scene"]
 POSITION_STEP = 1e-4
 #: Coordinate step of the derivatives of the rest's M, K and D.
 MATRIX_STEP = 1e-5
+#: Step in the Euler parameters of the second derivatives of the rest's K (larger than
+#: :data:`MATRIX_STEP`: a second difference divides the round-off of K by its square).
+CURVATURE_STEP = 1e-3
 
 
 @dataclass(frozen=True)
@@ -64,6 +67,13 @@ class RestBlocks:
         At the prepared state.
     mass_slope, stiffness_slope, damping_slope : ndarray, shape (B, b, b, b)
         ``[..., j]`` is the derivative with respect to the block's coordinate j.
+    turning : ndarray of int, shape (B, S)
+        Each block's Euler parameters (positions in the block, padded with
+        b: none).
+    stiffness_curvature : ndarray, shape (B, b, b, S, S)
+        The second derivatives of K with respect to them (a link's spin
+        restraint turns with the link: of first order, K would miss 1e-4 of
+        its entries at a hundredth of a radian).
     """
 
     size: int
@@ -74,12 +84,20 @@ class RestBlocks:
     mass_slope: np.ndarray
     stiffness_slope: np.ndarray
     damping_slope: np.ndarray
+    turning: np.ndarray
+    stiffness_curvature: np.ndarray
 
     def _local(self, dq: np.ndarray) -> np.ndarray:
         return np.append(dq, 0.0)[self.coordinates]
 
+    def _curved(self, local: np.ndarray, weight: float) -> np.ndarray:
+        """*weight* times the curvature term of K along the Euler parameters of *local* (B, b): (B, b, b)."""
+        turned = np.append(local, np.zeros((len(local), 1)), axis=1)[np.arange(len(local))[:, None], self.turning]
+        return weight * np.einsum("bijst,bs,bt->bij", self.stiffness_curvature, turned, turned)
+
     def matrices(self, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """M, K, D (N, N) at the state change *dq* (first order in it)."""
+        """M, K, D (N, N) at the state change *dq* (first order in it; K of second order in the Euler
+        parameters)."""
         local = self._local(dq)
         rows, columns = self.coordinates[:, :, None], self.coordinates[:, None, :]
         out = []
@@ -88,12 +106,15 @@ class RestBlocks:
             full = np.zeros((self.size + 1, self.size + 1))
             full[rows, columns] = matrix + np.einsum("bijk,bk->bij", slope, local)
             out.append(full[:self.size, :self.size])
-        return out[0], out[1], out[2]
+        curved = np.zeros((self.size + 1, self.size + 1))
+        curved[rows, columns] = self._curved(local, 0.5)
+        return out[0], out[1] + curved[:self.size, :self.size], out[2]
 
     def force_change(self, dq: np.ndarray) -> np.ndarray:
-        """The change of the rest's internal force over *dq* (N,): its stiffness at the mid state times *dq*."""
+        """The change of the rest's internal force over *dq* (N,): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""
         local = self._local(dq)
-        stiffness = self.stiffness + 0.5 * np.einsum("bijk,bk->bij", self.stiffness_slope, local)
+        stiffness = self.stiffness + 0.5 * np.einsum("bijk,bk->bij", self.stiffness_slope, local) \
+            + self._curved(local, 1.0 / 6.0)
         change = np.einsum("bij,bj->bi", stiffness, local)
         return np.bincount(self.coordinates.ravel(), change.ravel(), self.size + 1)[:self.size]
 
@@ -284,10 +305,49 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
                 shifted.append([padded(m) for m in _rest_matrices(scene.mbs)])
             for m in range(3):
                 slopes[m][:, :, :, i] = (shifted[0][m] - shifted[1][m]) / (2 * MATRIX_STEP)
+        turning = _turning(blocks, _euler_blocks(scene), width)
+        curvature = _stiffness_curvature(scene, set_state, base, coordinates, turning, matrices[1], padded)
     finally:
         set_state(base)
         restore()
-    return RestBlocks(size, coordinates, *matrices, *slopes)
+    return RestBlocks(size, coordinates, matrices[0], matrices[1], matrices[2], slopes[0], slopes[1], slopes[2],
+                      turning, curvature)
+
+
+def _turning(blocks: list[np.ndarray], euler: np.ndarray, width: int) -> np.ndarray:
+    """Each block's Euler parameters as positions in the block, padded with *width*: (B, S)."""
+    positions = [np.flatnonzero(np.isin(block, euler.ravel())) for block in blocks]
+    turning = np.full((len(blocks), max((len(p) for p in positions), default=0)), width, dtype=int)
+    for k, found in enumerate(positions):
+        turning[k, :len(found)] = found
+    return turning
+
+
+def _stiffness_curvature(scene: Scene, set_state, base: np.ndarray, coordinates: np.ndarray, turning: np.ndarray,
+                         stiffness: np.ndarray, padded) -> np.ndarray:
+    """The second derivatives of the rest's K along each block's Euler parameters: (B, b, b, S, S).
+
+    Central differences of step :data:`CURVATURE_STEP`, every block at once
+    (blocks do not couple without the channels)."""
+    count, width = turning.shape[1], coordinates.shape[1]
+    curvature = np.zeros((len(coordinates), width, width, count, count))
+    h = CURVATURE_STEP
+
+    def at(steps: dict[int, float]) -> np.ndarray:
+        state = base.copy()
+        for slot, step in steps.items():
+            for block, position in zip(coordinates, turning[:, slot], strict=True):
+                if position < width:
+                    state[block[position]] += step
+        set_state(state)
+        return padded(_rest_matrices(scene.mbs)[1])
+
+    for s in range(count):
+        curvature[..., s, s] = (at({s: h}) - 2 * stiffness + at({s: -h})) / h ** 2
+        for t in range(s + 1, count):
+            mixed = (at({s: h, t: h}) - at({s: h, t: -h}) - at({s: -h, t: h}) + at({s: -h, t: -h})) / (4 * h ** 2)
+            curvature[..., s, t] = curvature[..., t, s] = mixed
+    return curvature
 
 
 def _euler_blocks(scene: Scene) -> np.ndarray:
