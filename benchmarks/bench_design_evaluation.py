@@ -3,7 +3,9 @@
 Prints, for hinge designs with every hinge's stiffness scaled per direction
 (random factors 1 to 4), the median wall time of one design (both rotors)
 by each path and the largest normwise difference of T and of the hinge
-forces; then the median time of the derivatives of T and the hinge forces
+forces; the difference of T for designs far from the prepared one (every
+hinge's stiffness scaled by :data:`FAR_FACTORS`) with the engine's static
+sag there; then the median time of the derivatives of T and the hinge forces
 with respect to five parameters by the direct method and by central
 differences of whole evaluations, and their largest difference. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
@@ -18,6 +20,8 @@ import numpy as np
 import workbook as wb
 from workbook.design.sensitivity import difference_sensitivity
 
+#: Scale factors of every hinge's stiffness for the designs far from the prepared one.
+FAR_FACTORS = (0.25, 0.5, 2.0, 20.0, 80.0)
 PARAMETERS = ("hinge_stiffness/front", "hinge_stiffness/rear/axial", "hinge_loss_factor/thrust", "engine_mass",
               "hinge_damping/all")
 
@@ -68,6 +72,17 @@ def main(count: int = 5) -> None:
     print(f"{'direct (design_sensitivity)':<24}{statistics.median(direct_times):>16.4f}")
     print(f"{'central differences':<24}{statistics.median(difference_times):>16.4f}")
     print(f"largest difference of dT/dp, relative to each parameter's largest: {max(gradient_errors):.1e}")
+    print("\nevery hinge's stiffness scaled, far from the prepared design")
+    print(f"{'factor':>8}{'engine sag, mm':>16}{'T difference':>14}")
+    for factor in FAR_FACTORS:
+        design = dataclasses.replace(case, hinges=tuple(
+            dataclasses.replace(h, stiffness=tuple(h.values("stiffness") * factor)) for h in case.hinges))
+        answer = mount.evaluate(design)
+        exact = wb.run_case(design)
+        sag = max(abs(float(engine[2])) for engine in answer.engine_static.values())
+        difference = max(np.abs(f.transmissibility - e.transmissibility).max() / e.transmissibility.max()
+                         for f, e in zip(answer.result.runs, exact.runs, strict=True))
+        print(f"{factor:>8g}{1e3 * sag:>16.2f}{difference:>14.1e}")
 
 
 if __name__ == "__main__":

@@ -1,10 +1,11 @@
 """The preloaded scene as a Taylor expansion that NumPy can re-solve.
 
 A design evaluation (:mod:`workbook.design.linear_mount`) moves the mount
-only a little from the preloaded state the scene was prepared at (static
-displacements of micrometres against link lengths of decimetres), but
-changes its springs, the engine's mass properties and the loads a lot. So
-the scene is split into the parts the design sets and the parts it does not:
+a little from the preloaded state the scene was prepared at (static
+displacements of millimetres against link lengths of decimetres: the links
+turn by up to a few hundredths of a radian), but changes its springs, the
+engine's mass properties and the loads a lot. So the scene is split into
+the parts the design sets and the parts it does not:
 
 - every force channel (hinge or test-rig transducer) is an Exudyn Cartesian
   spring-damper between two markers; its marker separation
@@ -18,12 +19,19 @@ the scene is split into the parts the design sets and the parts it does not:
   it and their first derivatives with respect to the coordinates of each
   block of bodies (a body alone, or the bodies the rest joins: a flexible
   engine's core and casing; blocks do not couple, so one round of central
-  differences serves every block);
+  differences serves every block), and K's second derivatives with respect
+  to the blocks' Euler parameters (the links' spin restraints turn with
+  them);
 - the engine's excitation points keep their position Jacobians and Hessians.
 
 The expansion is exact in the design's springs at a fixed state and of second
-order (channels) or first order (the rest) in the change of state; the
-neglected terms are of the order of the squared rotations, about 1e-8.
+order (channels) in the change of state; the rest's K is of second order in
+the Euler parameters and of first order in the other coordinates, its M is
+turned exactly with each body's rotation
+(:func:`workbook.design.assembly.turned_mass`) and of first order in the
+other coordinates, its D of first order. ``benchmarks/bench_design_evaluation.py``
+prints how far the answers then are from the pipeline's for designs far
+from the prepared one.
 """
 from __future__ import annotations
 
