@@ -45,7 +45,7 @@ from workbook.solve.harmonic import point_phasors
 from workbook.solve.stages import link_warnings
 
 if TYPE_CHECKING:
-    from flexbodies.reduced import ReducedLink
+    from flexbodies.reduced import ReducedBody
 
 __all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_frames", "channel_springs"]
 
@@ -104,7 +104,7 @@ class StressedLink:
     link : workbook.model.case.Link
     coordinates : ndarray of int
         Its modal coordinates among the item's full coordinates.
-    reduced : flexbodies.ReducedLink
+    reduced : flexbodies.ReducedBody
         With its stress shapes.
     rotation : ndarray, shape (3, 3)
         Link frame to global.
@@ -117,7 +117,7 @@ class StressedLink:
 
     link: Link
     coordinates: np.ndarray
-    reduced: ReducedLink = field(repr=False)
+    reduced: ReducedBody = field(repr=False)
     rotation: np.ndarray = field(repr=False)
     component_shapes: np.ndarray = field(repr=False)
     node_norms: np.ndarray = field(repr=False)
