@@ -121,12 +121,12 @@ def _homogeneous(rotation, translation) -> np.ndarray:
 _SPIN_AXIS_FRAME = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
-def exudyn_cms_interface(link: ReducedBody, node_type: str = "NodeType.RotationEulerParameters"):
-    """Exudyn's ``ObjectFFRFreducedOrderInterface`` filled from a reduced link.
+def exudyn_cms_interface(body: ReducedBody, node_type: str = "NodeType.RotationEulerParameters"):
+    """Exudyn's ``ObjectFFRFreducedOrderInterface`` filled from a reduced body (a link, the casing).
 
     Parameters
     ----------
-    link : ReducedBody
+    body : ReducedBody
     node_type : str
         Rotation parametrisation of the frame node (Euler parameters by default).
 
@@ -141,30 +141,30 @@ def exudyn_cms_interface(link: ReducedBody, node_type: str = "NodeType.RotationE
 
     n_rot = 4 if node_type.endswith("EulerParameters") else 3
     cms = ObjectFFRFreducedOrderInterface()
-    data = {key: link.ffrf[key] for key in FFRF_KEYS}
+    data = {key: body.ffrf[key] for key in FFRF_KEYS}
     data.update(
-        modeBasis=link.mode_basis,
+        modeBasis=body.mode_basis,
         trigList=[],
         postProcessingModes={},
         rigidBodyNodeType=node_type,
-        infoList=np.array([link.n_modes, len(link.nodes), 3, n_rot, 3 + n_rot, 3 + n_rot + link.n_modes]),
+        infoList=np.array([body.n_modes, len(body.nodes), 3, n_rot, 3 + n_rot, 3 + n_rot + body.n_modes]),
     )
     cms.SetWithDictionary(data)
     # Exudyn takes the triangles as an array as well; its own reader turns them into a list of lists,
-    # which cost more than the rest of adding a link to a scene
-    cms.trigList = link.surface_triangles
+    # which cost more than the rest of adding a body to a scene
+    cms.trigList = body.surface_triangles
     return cms
 
 
-def modal_damping_matrix(link: ReducedBody, ratio: float) -> np.ndarray:
-    """Damping of the link's modal coordinates that gives each elastic mode the damping ratio *ratio*.
+def modal_damping_matrix(body: ReducedBody, ratio: float) -> np.ndarray:
+    """Damping of a reduced body's modal coordinates that gives each elastic mode the damping ratio *ratio*.
 
     The body's modal coordinates are mass-normalised modes with a diagonal
     reduced stiffness, so the matrix is ``diag(2 zeta w_i)``, N s/m per unit
     modal mass (``w_i`` from the reduced stiffness, rad/s).
     """
-    stiffness = np.diag(np.asarray(link.ffrf["stiffnessMatrixReduced"], dtype=float))
-    mass = np.diag(np.asarray(link.ffrf["massMatrixReduced"], dtype=float))
+    stiffness = np.diag(np.asarray(body.ffrf["stiffnessMatrixReduced"], dtype=float))
+    mass = np.diag(np.asarray(body.ffrf["massMatrixReduced"], dtype=float))
     return np.diag(2.0 * ratio * np.sqrt(np.clip(stiffness, 0.0, None) * mass))
 
 

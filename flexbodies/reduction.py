@@ -1,4 +1,4 @@
-"""From an FE model of a link to a :class:`~flexbodies.reduced.ReducedBody`.
+"""From an FE model of a free body (a link, the casing) to a :class:`~flexbodies.reduced.ReducedBody`.
 
 Steps: tie the bores to master nodes (:mod:`~flexbodies.interfaces`),
 compute the reference frequencies of the coupled FE model
