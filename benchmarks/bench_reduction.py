@@ -234,9 +234,9 @@ def warm_links(repeats: int) -> None:
 
     import numpy as np
 
-    from flexbodies.cache import LinkCache
+    from flexbodies.cache import BodyCache
     from flexbodies.link import reduce_link_set
-    from flexbodies.reduced import load_reduced_link
+    from flexbodies.reduced import load_reduced_body
     from workbook.model.reference import reference_case
 
     case = reference_case()
@@ -252,13 +252,13 @@ def warm_links(repeats: int) -> None:
         target = folder / f"z{path.name}"
         np.savez_compressed(target, **arrays)
         compressed.append(target)
-    store = LinkCache(folder)
+    store = BodyCache(folder)
     keys = [path.stem.split("-", 1)[1] for path in files]
-    stored_s, _ = _timed(lambda: [load_reduced_link(path) for path in files], repeats)
-    zipped_s, _ = _timed(lambda: [load_reduced_link(path) for path in compressed], repeats)
+    stored_s, _ = _timed(lambda: [load_reduced_body(path) for path in files], repeats)
+    zipped_s, _ = _timed(lambda: [load_reduced_body(path) for path in compressed], repeats)
     for key in keys:
-        store.load_link(key)
-    memory_s, _ = _timed(lambda: [store.load_link(key) for key in keys], repeats)
+        store.load_body(key)
+    memory_s, _ = _timed(lambda: [store.load_body(key) for key in keys], repeats)
     size = sum(p.stat().st_size for p in files) / 1e6
     size_z = sum(p.stat().st_size for p in compressed) / 1e6
     shutil.rmtree(folder)

@@ -2,7 +2,7 @@
 
 The matrices are ordered node-major: DOF ``3*i + c`` is displacement
 component ``c`` (x, y, z) of finite element node ``i``, where the nodes are
-``LinkMesh.nodes`` (vertices and, for quadratic elements, the edge/face/cell
+``BodyMesh.nodes`` (vertices and, for quadratic elements, the edge/face/cell
 nodes).
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ import skfem
 
 from .errors import TangledElements
 from .materials import Material
-from .meshing import Bore, LinkMesh
+from .meshing import BodyMesh, Bore
 
 __all__ = ["FEModel", "Bore", "assemble", "INTEGRATION_ORDERS", "tangled_elements"]
 
@@ -77,7 +77,7 @@ class FEModel:
         return float(ex @ (self.mass @ ex))
 
 
-def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = None) -> FEModel:
+def assemble(link_mesh: BodyMesh, material: Material, intorder: int | None = None) -> FEModel:
     """Assemble linear elastic stiffness and consistent mass of a link.
 
     scikit-fem gives the shape functions, their gradients and the
@@ -88,7 +88,7 @@ def assemble(link_mesh: LinkMesh, material: Material, intorder: int | None = Non
 
     Parameters
     ----------
-    link_mesh : LinkMesh
+    link_mesh : BodyMesh
         The meshed link (m) with its bores.
     material : Material
         Isotropic linear elastic material (Pa, kg/m^3).

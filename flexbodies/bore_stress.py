@@ -95,7 +95,7 @@ def bearing_load(link_mesh, bore, direction, force: float) -> np.ndarray:
 
     Parameters
     ----------
-    link_mesh : flexbodies.meshing.LinkMesh
+    link_mesh : flexbodies.meshing.BodyMesh
     bore : flexbodies.bores.Bore
         One of ``link_mesh.bores``.
     direction : array_like, shape (3,)

@@ -1,9 +1,14 @@
-"""The on-disk store of reduced links: verified entries, a lock per link, and no run stopped by it.
+"""The on-disk store of reduced bodies: verified entries, a lock per body, and no run stopped by it.
 
-Two kinds of entry, each named by its key (a hash of every input it depends on):
+The links, the engine casing and the mesh pylon share it. Three kinds of
+entry, each named by its key (a hash of every input it depends on):
 
-- ``fe-<key>.json``: the reference frequencies of a link's FE model;
-- ``link-<key>.npz``: a reduced link (:mod:`flexbodies.reduced`).
+- ``fe-<key>.json``: the reference frequencies of a body's FE model;
+- ``link-<key>.npz``: a reduced free body, a link or the casing
+  (:class:`~flexbodies.reduced.ReducedBody`; the name is the files' since
+  the first release);
+- ``clamped-<key>.npz``: a reduced clamped body, the mesh pylon
+  (:class:`~flexbodies.reduced.ClampedReduction`).
 
 Both carry their own key and a SHA-256 checksum of their content. An entry
 whose stored key is not the key of its name, whose checksum does not match,
@@ -13,7 +18,7 @@ never used, and replaced by the recomputed entry.
 The store never stops a run: a folder that cannot be created, read or
 written (read-only, full, or ``MOUNTWB_CACHE`` naming a file) gives one
 warning naming the folder and the reason, and the run goes on without the
-store. Two processes that need the same link compute it once: the first
+store. Two processes that need the same body compute it once: the first
 holds a lock file (``.<key>.lock``) while it computes, the second waits for
 it (at most :func:`lock_timeout` s, then computes on its own with a warning)
 and loads the result. Temporary files that a killed process left behind
@@ -34,15 +39,25 @@ from pathlib import Path
 
 import numpy as np
 
+from workbook._renamed import renamed, renamed_names
+
 from .atomic import replacing
-from .reduced import ReducedLink, ReducedLinkFileError, load_reduced_link, save_reduced_link
+from .reduced import (
+    ClampedReduction,
+    ReducedBody,
+    ReducedBodyFileError,
+    load_clamped_reduction,
+    load_reduced_body,
+    save_clamped_reduction,
+    save_reduced_body,
+)
 
 try:  # POSIX; elsewhere processes do not share work, each computes its own entries
     import fcntl
 except ImportError:  # pragma: no cover - not on the platforms tested
     fcntl = None  # type: ignore[assignment]
 
-__all__ = ["LinkCache", "default_cache_dir", "lock_timeout", "STALE_SECONDS", "SUMMARY_SCHEMA", "EntryReport"]
+__all__ = ["BodyCache", "default_cache_dir", "lock_timeout", "STALE_SECONDS", "SUMMARY_SCHEMA", "EntryReport"]
 
 log = logging.getLogger(__name__)
 
@@ -51,7 +66,7 @@ SUMMARY_SCHEMA = "mountwb-fe-summary"
 STALE_SECONDS = 600.0
 #: Default wait for another process's lock, s (``MOUNTWB_CACHE_LOCK_TIMEOUT`` overrides).
 DEFAULT_LOCK_TIMEOUT = 900.0
-#: Reduced links kept in memory per process (a parameter study reuses them across rows).
+#: Reduced bodies kept in memory per process (a parameter study reuses them across rows).
 MEMORY_ENTRIES = 16
 _POLL_SECONDS = 0.1
 
@@ -62,7 +77,7 @@ _unusable: dict = {}
 _unwritable: dict = {}
 #: Folders whose stale temporary files were looked for in this process.
 _swept: set = set()
-#: (folder, key) -> (ReducedLink, signature of its file when remembered), most recent last.
+#: Entry file -> (ReducedBody or ClampedReduction, signature of the file when remembered), most recent last.
 _memory: OrderedDict = OrderedDict()
 
 
@@ -98,7 +113,7 @@ def _digest(text: str) -> str:
 
 @dataclass(frozen=True)
 class EntryReport:
-    """One entry of the store as :meth:`LinkCache.verify` found it.
+    """One entry of the store as :meth:`BodyCache.verify` found it.
 
     Attributes
     ----------
@@ -114,7 +129,7 @@ class EntryReport:
     problem: str | None
 
 
-class LinkCache:
+class BodyCache:
     """The store in one folder, or no store at all.
 
     Parameters
@@ -158,7 +173,7 @@ class LinkCache:
         self._warn(error, "cannot be written")
 
     def _warn(self, error: OSError, what: str) -> None:
-        _warn_once(("folder", self.folder), "reduced-link cache %s %s (%s); going on without caching",
+        _warn_once(("folder", self.folder), "reduced-body cache %s %s (%s); going on without caching",
                    self.folder, what, _reason(error))
 
     def _sweep(self) -> None:
@@ -177,7 +192,7 @@ class LinkCache:
         """Temporary files of the store older than ``age`` s."""
         now = time.time()
         found = []
-        for pattern in (".fe-*.tmp", ".link-*.tmp"):
+        for pattern in (".fe-*.tmp", ".link-*.tmp", ".clamped-*.tmp"):
             for path in self.folder.glob(pattern):
                 try:
                     if now - path.stat().st_mtime > age:
@@ -207,7 +222,7 @@ class LinkCache:
             return read_summary_file(path, key)
         except FileNotFoundError:
             return None
-        except (OSError, ReducedLinkFileError) as error:
+        except (OSError, ReducedBodyFileError) as error:
             self.report_corrupt(path, error)
             return None
 
@@ -220,44 +235,65 @@ class LinkCache:
                   "checksum": _digest(json.dumps(values, sort_keys=True))}
         self._write(self.summary_path(key), lambda temporary: temporary.write_text(json.dumps(record)))
 
-    # -- reduced links ----------------------------------------------------------------------
+    # -- reduced bodies ---------------------------------------------------------------------
 
-    def link_path(self, key: str) -> Path:
+    def body_path(self, key: str) -> Path:
         return self.folder / f"link-{key}.npz"
 
-    def load_link(self, key: str) -> ReducedLink | None:
-        """The reduced link stored under ``key``, or None (missing or corrupt)."""
+    def load_body(self, key: str) -> ReducedBody | None:
+        """The reduced body stored under ``key``, or None (missing or corrupt)."""
+        return self._load(self.body_path(key), key, load_reduced_body)
+
+    def save_body(self, key: str, body: ReducedBody) -> None:
+        """Store a reduced body under ``key`` (also in this process's memory)."""
+        self._save(self.body_path(key), body, save_reduced_body)
+
+    def clamped_path(self, key: str) -> Path:
+        return self.folder / f"clamped-{key}.npz"
+
+    def load_clamped(self, key: str) -> ClampedReduction | None:
+        """The clamped reduction stored under ``key``, or None (missing or corrupt)."""
+        return self._load(self.clamped_path(key), key, load_clamped_reduction)
+
+    def save_clamped(self, key: str, reduction: ClampedReduction) -> None:
+        """Store a clamped reduction under ``key`` (also in this process's memory)."""
+        self._save(self.clamped_path(key), reduction, save_clamped_reduction)
+
+    def _load(self, path: Path, key: str, read):
+        """The entry *read* from *path* (in memory while its file is unchanged), or None (missing or corrupt)."""
         if not self.enabled:
             return None
-        path = self.link_path(key)
-        remembered = _memory.get((self.folder, key))
+        remembered = _memory.get(path)
         if remembered is not None and remembered[1] == file_signature(path):
-            _memory.move_to_end((self.folder, key))
+            _memory.move_to_end(path)
             return remembered[0]
         if not self.usable() or not path.exists():
             return None
         try:
-            link = load_reduced_link(path, key=key)
-        except ReducedLinkFileError as error:
+            entry = read(path, key=key)
+        except ReducedBodyFileError as error:
             self.report_corrupt(path, error)
             return None
-        self._remember(key, link)
-        return link
+        self._remember(path, entry)
+        return entry
 
-    def save_link(self, key: str, link: ReducedLink) -> None:
-        """Store a reduced link under ``key`` (also in this process's memory)."""
+    def _save(self, path: Path, entry, write) -> None:
         if not self.enabled:
             return
         if self.writable():
-            self._write(self.link_path(key), lambda temporary: save_reduced_link(link, temporary))
-        self._remember(key, link)
+            self._write(path, lambda temporary: write(entry, temporary))
+        self._remember(path, entry)
 
-    def _remember(self, key: str, link: ReducedLink) -> None:
-        """Keep a link in memory while its file stays as it is now (or absent, without a store)."""
-        _memory[(self.folder, key)] = (link, file_signature(self.link_path(key)))
-        _memory.move_to_end((self.folder, key))
+    def _remember(self, path: Path, entry) -> None:
+        """Keep an entry in memory while its file stays as it is now (or absent, without a store)."""
+        _memory[path] = (entry, file_signature(path))
+        _memory.move_to_end(path)
         while len(_memory) > MEMORY_ENTRIES:
             _memory.popitem(last=False)
+
+    load_link = renamed("load_link", "load_body()", load_body)
+    save_link = renamed("save_link", "save_body()", save_body)
+    link_path = renamed("link_path", "body_path()", body_path)
 
     def report_corrupt(self, path: Path, error: Exception) -> None:
         """Warn once that an entry cannot be used; it will be recomputed and replaced."""
@@ -307,9 +343,9 @@ class LinkCache:
                 return False
             if not waiting:
                 waiting = True
-                log.info("waiting for another process computing the same link (%s)", path)
+                log.info("waiting for another process computing the same body (%s)", path)
             if time.monotonic() - start > timeout:
-                log.warning("waited %g s for %s, held by another process computing the same link; computing it here "
+                log.warning("waited %g s for %s, held by another process computing the same body; computing it here "
                             "as well (MOUNTWB_CACHE_LOCK_TIMEOUT sets the wait)", timeout, path)
                 return False
             time.sleep(_POLL_SECONDS)
@@ -320,7 +356,8 @@ class LinkCache:
         """Every entry file in the folder, summaries first."""
         if not self.folder.is_dir():
             return []
-        return sorted(self.folder.glob("fe-*.json")) + sorted(self.folder.glob("link-*.npz"))
+        return (sorted(self.folder.glob("fe-*.json")) + sorted(self.folder.glob("link-*.npz"))
+                + sorted(self.folder.glob("clamped-*.npz")))
 
     def verify(self) -> list:
         """Check every entry's key and checksum; a list of :class:`EntryReport`."""
@@ -330,10 +367,12 @@ class LinkCache:
             try:
                 if path.suffix == ".json":
                     read_summary_file(path, key)
+                elif path.name.startswith("clamped-"):
+                    load_clamped_reduction(path, key=key)
                 else:
-                    load_reduced_link(path, key=key)
+                    load_reduced_body(path, key=key)
                 problem = None
-            except (OSError, ReducedLinkFileError) as error:
+            except (OSError, ReducedBodyFileError) as error:
                 problem = str(error)
             reports.append(EntryReport(path, path.stat().st_size, problem))
         return reports
@@ -345,8 +384,8 @@ class LinkCache:
         files = self.entries() + sorted(self.folder.glob(".*.lock")) + self.stale_temporaries(age=0.0)
         for path in files:
             path.unlink(missing_ok=True)
-        for key in [k for k in _memory if k[0] == self.folder]:
-            del _memory[key]
+        for path in [p for p in _memory if p.parent == self.folder]:
+            del _memory[path]
         return len(files)
 
 
@@ -376,7 +415,7 @@ def read_summary_file(path: Path, key: str | None = None) -> dict:
     Raises
     ------
     FileNotFoundError
-    ReducedLinkFileError
+    ReducedBodyFileError
         Not a summary, another key's, or altered.
     """
     try:
@@ -389,9 +428,12 @@ def read_summary_file(path: Path, key: str | None = None) -> dict:
     except FileNotFoundError:
         raise
     except (ValueError, KeyError, TypeError) as error:
-        raise ReducedLinkFileError(f"{path}: not a frequency summary ({error})") from None
+        raise ReducedBodyFileError(f"{path}: not a frequency summary ({error})") from None
     if key is not None and stored_key != key:
-        raise ReducedLinkFileError(f"{path}: holds the entry of key {stored_key}, not of {key}")
+        raise ReducedBodyFileError(f"{path}: holds the entry of key {stored_key}, not of {key}")
     if _digest(json.dumps(values, sort_keys=True)) != checksum:
-        raise ReducedLinkFileError(f"{path}: checksum mismatch, the file was altered or damaged")
+        raise ReducedBodyFileError(f"{path}: checksum mismatch, the file was altered or damaged")
     return frequencies
+
+
+__getattr__ = renamed_names(__name__, {"LinkCache": "BodyCache"})

@@ -1,7 +1,8 @@
 """A body's Craig-Bampton reductions for several excitations, from the cache or made once.
 
-Links (:mod:`flexbodies.link`) and the engine casing
-(:mod:`flexbodies.casing_reduction`) share this path:
+Free bodies share this path: links (:mod:`flexbodies.link`) and the engine
+casing (:mod:`flexbodies.casing_reduction`). The mesh pylon, clamped, has its
+own reduction (:mod:`flexbodies.pylon_reduction`) in the same cache.
 
 1. the body's inputs (its fingerprint) hash to the key of its FE summary,
    the reference frequencies its mode decisions are judged on;
@@ -19,7 +20,7 @@ from typing import Callable
 
 import numpy as np
 
-from .cache import LinkCache
+from .cache import BodyCache
 from .reduced import package_version, with_decision
 
 __all__ = ["record_hash", "entry_key", "stored_reductions", "cached_reductions"]
@@ -37,12 +38,12 @@ def entry_key(fe_hash: str, decision) -> str:
     return record_hash({"fe": fe_hash, "modes": decision.key, "basis": 2})
 
 
-def stored_reductions(cache: LinkCache, fe_hash: str, decide: Callable, excitations_hz) -> tuple:
+def stored_reductions(cache: BodyCache, fe_hash: str, decide: Callable, excitations_hz) -> tuple:
     """The stored frequencies, the decisions, their keys and the stored reductions (None where missing).
 
     Parameters
     ----------
-    cache : LinkCache
+    cache : BodyCache
     fe_hash : str
         :func:`record_hash` of the body's fingerprint.
     decide : callable
@@ -59,7 +60,7 @@ def stored_reductions(cache: LinkCache, fe_hash: str, decide: Callable, excitati
         return None, None, None, None
     decisions = [decide(frequencies, f) for f in excitations_hz]
     keys = [entry_key(fe_hash, d) for d in decisions]
-    return frequencies, decisions, keys, [cache.load_link(key) for key in keys]
+    return frequencies, decisions, keys, [cache.load_body(key) for key in keys]
 
 
 def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepare: Callable, *, cache_dir=None,
@@ -84,30 +85,30 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
 
     Returns
     -------
-    tuple of ReducedLink
+    tuple of ReducedBody
         One per excitation, in order, each carrying its own decision;
         ``cache_hit`` tells whether it was loaded.
     """
     excitations_hz = list(excitations_hz)
-    cache = LinkCache(cache_dir, enabled=use_cache)
+    cache = BodyCache(cache_dir, enabled=use_cache)
     fe_hash = record_hash(fingerprint)
 
     def complete(stored):
-        links = stored[3]
-        return links is not None and all(link is not None for link in links)
+        bodies = stored[3]
+        return bodies is not None and all(body is not None for body in bodies)
 
-    def answer(decisions, keys, links, made):
-        return tuple(with_decision(link, d, cache_hit=True) if link is not None else with_decision(made[key], d, False)
-                     for link, d, key in zip(links, decisions, keys, strict=True))
+    def answer(decisions, keys, bodies, made):
+        return tuple(with_decision(body, d, cache_hit=True) if body is not None else with_decision(made[key], d, False)
+                     for body, d, key in zip(bodies, decisions, keys, strict=True))
 
-    frequencies, decisions, keys, links = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
+    frequencies, decisions, keys, bodies = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
     if complete(stored):
-        return answer(decisions, keys, links, {})
+        return answer(decisions, keys, bodies, {})
     with cache.lock(fe_hash):
         # another process may have made the entries while this one waited
-        frequencies, decisions, keys, links = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
+        frequencies, decisions, keys, bodies = stored = stored_reductions(cache, fe_hash, decide, excitations_hz)
         if complete(stored):
-            return answer(decisions, keys, links, {})
+            return answer(decisions, keys, bodies, {})
         from .reduction import reduce_for_decisions  # scikit-fem and the solvers: only when a reduction is made
 
         known = frequencies is not None
@@ -116,11 +117,11 @@ def cached_reductions(fingerprint: dict, decide: Callable, excitations_hz, prepa
             cache.write_summary(fe_hash, frequencies)
             decisions = [decide(frequencies, f) for f in excitations_hz]
             keys = [entry_key(fe_hash, d) for d in decisions]
-            links = [None] * len(decisions)
-        missing = {key: decision for key, decision, link in zip(keys, decisions, links, strict=True) if link is None}
+            bodies = [None] * len(decisions)
+        missing = {key: decision for key, decision, body in zip(keys, decisions, bodies, strict=True) if body is None}
         infos = [{"inputs": fingerprint, "input_hash": key, "package_version": package_version(), **timings}
                  for key in missing]
         made = dict(zip(missing, reduce_for_decisions(coupled, solver, list(missing.values()), frequencies, infos), strict=True))
-        for key, link in made.items():
-            cache.save_link(key, link)
-        return answer(decisions, keys, links, made)
+        for key, body in made.items():
+            cache.save_body(key, body)
+        return answer(decisions, keys, bodies, made)

@@ -27,7 +27,7 @@ import numpy as np
 from .errors import LinkModelError
 
 if TYPE_CHECKING:  # meshing loads gmsh, meshio and scikit-fem: imported where a casing is meshed
-    from .meshing import LinkMesh
+    from .meshing import BodyMesh
 
 __all__ = ["MountRing", "CasingGeometry", "CasingInterface", "mesh_casing", "casing_interfaces",
            "default_casing_element_size", "ElementSizeTooLarge", "element_size_error"]
@@ -146,7 +146,7 @@ def default_casing_element_size(geometry: CasingGeometry) -> float:
     return min(2.0 * geometry.thickness, geometry.radius / 4.0)
 
 
-def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> LinkMesh:
+def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> BodyMesh:
     """Mesh a parametric casing with quadratic tetrahedra (gmsh, OpenCASCADE).
 
     Parameters
@@ -157,13 +157,13 @@ def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> 
 
     Returns
     -------
-    LinkMesh
+    BodyMesh
         The casing's mesh in its frame, without bores (its interfaces come
         from :func:`casing_interfaces`).
     """
     import gmsh
 
-    from .meshing import LinkMesh, generate_tet10, gmsh_model, skfem_mesh
+    from .meshing import BodyMesh, generate_tet10, gmsh_model, skfem_mesh
 
     size = default_casing_element_size(geometry) if element_size is None else float(element_size)
     if not (math.isfinite(size) and size > 0):
@@ -181,7 +181,7 @@ def mesh_casing(geometry: CasingGeometry, element_size: float | None = None) -> 
         occ.synchronize()
         points, cells = generate_tet10(size, curvature_points=_CURVATURE_POINTS)
     mesh, _ = skfem_mesh("tetra10", points, cells)
-    return LinkMesh(mesh=mesh, bores=(), source=f"gmsh casing mesh, element size {size * 1e3:.4g} mm")
+    return BodyMesh(mesh=mesh, bores=(), source=f"gmsh casing mesh, element size {size * 1e3:.4g} mm")
 
 
 #: Each smaller element size tried for one that meshes is this share of the last.
@@ -261,7 +261,7 @@ class CasingInterface:
     reach: float
 
 
-def casing_interfaces(casing_mesh: LinkMesh, interfaces, source: str) -> LinkMesh:
+def casing_interfaces(casing_mesh: BodyMesh, interfaces, source: str) -> BodyMesh:
     """The casing mesh with one resolved :class:`~flexbodies.meshing.Bore` per interface.
 
     Each interface is the set of boundary faces whose centroids lie within

@@ -5,12 +5,12 @@ assemble, couple the interfaces (:mod:`flexbodies.casing`: the mount eyes
 and the bearing planes, any number of them), factorise the interior
 stiffness once, reduce for every mode decision
 (:func:`flexbodies.reduction.reduce_for_decisions`) into a
-:class:`~flexbodies.reduced.ReducedLink` in the casing frame. Only the
+:class:`~flexbodies.reduced.ReducedBody` in the casing frame. Only the
 fundamental of the low-frequency rule differs: a casing has no two-pin
 mounting of its own, so its first *free-free* elastic frequency decides
 (static modes only while the excitation is below a quarter of it).
 
-The store is the links' (:class:`flexbodies.cache.LinkCache`): the
+The store is every body's (:class:`flexbodies.cache.BodyCache`): the
 free-free frequencies under the hash of every input, the reduced casing
 under that hash and the mode decision.
 """
@@ -29,7 +29,7 @@ from .cached_reduction import cached_reductions
 from .casing import CasingGeometry, casing_interfaces, default_casing_element_size, element_size_error, mesh_casing
 from .exudyn_body import exudyn_cms_interface, modal_damping_matrix
 from .materials import TITANIUM, Material
-from .reduced import SCHEMA_VERSION, ReducedLink
+from .reduced import SCHEMA_VERSION, ReducedBody
 from .selection import MOUNTED_BOUNDARY, decide_modes
 
 # Meshing (gmsh, meshio), assembly (scikit-fem) and the reduction load where a casing is reduced: a run
@@ -144,7 +144,7 @@ def reduce_casing(model: CasingModel, modes="auto", excitations_hz=(None,), *, c
 
     Returns
     -------
-    tuple of ReducedLink
+    tuple of ReducedBody
         One per excitation, in the casing frame; one master node per
         interface, in order. ``frequencies["free_free_hz"]`` holds the six
         lowest elastic free-free frequencies of the FE model
@@ -199,14 +199,14 @@ class ExudynCasing:
     mass: float
 
 
-def add_casing_to_exudyn(mbs, casing: ReducedLink, position, *, modal_damping_ratio: float = 0.0,
+def add_casing_to_exudyn(mbs, casing: ReducedBody, position, *, modal_damping_ratio: float = 0.0,
                          name: str = "") -> ExudynCasing:
     """Add a reduced casing as an ``ObjectFFRFreducedOrder`` whose frame sits at *position* (global axes).
 
     Parameters
     ----------
     mbs : exudyn.MainSystem
-    casing : ReducedLink
+    casing : ReducedBody
         From :func:`reduce_casing`.
     position : 3 floats
         Global position of the casing frame's origin, m.

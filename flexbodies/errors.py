@@ -7,9 +7,10 @@ exception out of :mod:`flexbodies` is a defect, not the user's input.
 """
 from __future__ import annotations
 
+from workbook._renamed import renamed_names
 from workbook.errors import InputError
 
-__all__ = ["LinkModelError", "TangledElements", "ReducedLinkFileError"]
+__all__ = ["LinkModelError", "TangledElements", "ReducedBodyFileError"]
 
 
 class LinkModelError(InputError):
@@ -32,5 +33,8 @@ class TangledElements(LinkModelError):
         self.count, self.total = count, total
 
 
-class ReducedLinkFileError(InputError):
-    """A reduced-link file that cannot be trusted: unreadable, incomplete, altered or of another version."""
+class ReducedBodyFileError(InputError):
+    """A reduced-body file that cannot be trusted: unreadable, incomplete, altered or of another version."""
+
+
+__getattr__ = renamed_names(__name__, {"ReducedLinkFileError": "ReducedBodyFileError"})

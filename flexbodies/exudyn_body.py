@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import LinkModelError
-from .reduced import ReducedLink
+from .reduced import ReducedBody
 
 __all__ = ["ExudynLink", "add_link_to_exudyn", "exudyn_cms_interface", "modal_damping_matrix", "export_exudyn_file",
            "link_rotation", "DEFAULT_SPIN_FREQUENCY_HZ"]
@@ -121,12 +121,12 @@ def _homogeneous(rotation, translation) -> np.ndarray:
 _SPIN_AXIS_FRAME = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
 
 
-def exudyn_cms_interface(link: ReducedLink, node_type: str = "NodeType.RotationEulerParameters"):
-    """Exudyn's ``ObjectFFRFreducedOrderInterface`` filled from a reduced link.
+def exudyn_cms_interface(body: ReducedBody, node_type: str = "NodeType.RotationEulerParameters"):
+    """Exudyn's ``ObjectFFRFreducedOrderInterface`` filled from a reduced body (a link, the casing).
 
     Parameters
     ----------
-    link : ReducedLink
+    body : ReducedBody
     node_type : str
         Rotation parametrisation of the frame node (Euler parameters by default).
 
@@ -141,34 +141,34 @@ def exudyn_cms_interface(link: ReducedLink, node_type: str = "NodeType.RotationE
 
     n_rot = 4 if node_type.endswith("EulerParameters") else 3
     cms = ObjectFFRFreducedOrderInterface()
-    data = {key: link.ffrf[key] for key in FFRF_KEYS}
+    data = {key: body.ffrf[key] for key in FFRF_KEYS}
     data.update(
-        modeBasis=link.mode_basis,
+        modeBasis=body.mode_basis,
         trigList=[],
         postProcessingModes={},
         rigidBodyNodeType=node_type,
-        infoList=np.array([link.n_modes, len(link.nodes), 3, n_rot, 3 + n_rot, 3 + n_rot + link.n_modes]),
+        infoList=np.array([body.n_modes, len(body.nodes), 3, n_rot, 3 + n_rot, 3 + n_rot + body.n_modes]),
     )
     cms.SetWithDictionary(data)
     # Exudyn takes the triangles as an array as well; its own reader turns them into a list of lists,
-    # which cost more than the rest of adding a link to a scene
-    cms.trigList = link.surface_triangles
+    # which cost more than the rest of adding a body to a scene
+    cms.trigList = body.surface_triangles
     return cms
 
 
-def modal_damping_matrix(link: ReducedLink, ratio: float) -> np.ndarray:
-    """Damping of the link's modal coordinates that gives each elastic mode the damping ratio *ratio*.
+def modal_damping_matrix(body: ReducedBody, ratio: float) -> np.ndarray:
+    """Damping of a reduced body's modal coordinates that gives each elastic mode the damping ratio *ratio*.
 
     The body's modal coordinates are mass-normalised modes with a diagonal
     reduced stiffness, so the matrix is ``diag(2 zeta w_i)``, N s/m per unit
     modal mass (``w_i`` from the reduced stiffness, rad/s).
     """
-    stiffness = np.diag(np.asarray(link.ffrf["stiffnessMatrixReduced"], dtype=float))
-    mass = np.diag(np.asarray(link.ffrf["massMatrixReduced"], dtype=float))
+    stiffness = np.diag(np.asarray(body.ffrf["stiffnessMatrixReduced"], dtype=float))
+    mass = np.diag(np.asarray(body.ffrf["massMatrixReduced"], dtype=float))
     return np.diag(2.0 * ratio * np.sqrt(np.clip(stiffness, 0.0, None) * mass))
 
 
-def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping, mass_damping, modal_ratio, name):
+def _add_flexible(mbs, link: ReducedBody, position, rotation, stiffness_damping, mass_damping, modal_ratio, name):
     import exudyn as exu
 
     cms = exudyn_cms_interface(link)
@@ -191,7 +191,7 @@ def _add_flexible(mbs, link: ReducedLink, position, rotation, stiffness_damping,
     return body, (items["nRigidBody"], items["nGenericODE2"]), markers
 
 
-def _add_rigid(mbs, link: ReducedLink, position, rotation, name):
+def _add_rigid(mbs, link: ReducedBody, position, rotation, name):
     import exudyn as exu
     from exudyn.rigidBodyUtilities import RotationMatrix2EulerParameters
 
@@ -214,7 +214,7 @@ def _add_rigid(mbs, link: ReducedLink, position, rotation, name):
 
 def add_link_to_exudyn(
     mbs,
-    link: ReducedLink,
+    link: ReducedBody,
     end_a,
     end_b,
     *,
@@ -231,7 +231,7 @@ def add_link_to_exudyn(
     Parameters
     ----------
     mbs : exudyn.MainSystem
-    link : ReducedLink
+    link : ReducedBody
     end_a, end_b : array_like, shape (3,)
         Global positions of the centres of eye A and eye B, m. Their distance
         must equal the link's eye distance.
@@ -292,7 +292,7 @@ def add_link_to_exudyn(
     )
 
 
-def export_exudyn_file(link: ReducedLink, path) -> Path:
+def export_exudyn_file(link: ReducedBody, path) -> Path:
     """Write a reduced link in Exudyn's own reduced-body format.
 
     A plain Exudyn script loads it without this package::
@@ -307,7 +307,7 @@ def export_exudyn_file(link: ReducedLink, path) -> Path:
 
     Parameters
     ----------
-    link : ReducedLink
+    link : ReducedBody
     path : str or Path
         Target file; ``.npz`` is appended when missing.
 

@@ -53,10 +53,10 @@ from .cache import MEMORY_ENTRIES, default_cache_dir, file_signature
 from .frequencies import mounted_constraint_basis
 from .interior import InteriorSolver
 from .materials import Material
-from .reduced import ReducedLink
+from .reduced import ReducedBody
 
 if TYPE_CHECKING:  # meshing and assembly load scikit-fem and gmsh: imported where a link is assembled
-    from .meshing import LinkMesh
+    from .meshing import BodyMesh
 
 __all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement",
            "mesh_stiffening", "coupled_stiffening", "link_stiffening", "has_stiffening", "save_stiffening", "stiffened",
@@ -143,12 +143,12 @@ class LinkStiffening:
         return float(loaded / unloaded - 1.0)
 
 
-def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Material) -> np.ndarray:
+def stress_field(link_mesh: BodyMesh, displacement: np.ndarray, material: Material) -> np.ndarray:
     """Cauchy stress of a small displacement field at the initial-stress form's integration points.
 
     Parameters
     ----------
-    link_mesh : LinkMesh
+    link_mesh : BodyMesh
     displacement : ndarray, shape (3 n,)
         Node-major nodal displacements, m.
     material : Material
@@ -166,7 +166,7 @@ def stress_field(link_mesh: LinkMesh, displacement: np.ndarray, material: Materi
     return 2 * material.shear_modulus * strain + material.lame_lambda * trace * np.eye(3)[:, :, None, None]
 
 
-def _scalar_basis(link_mesh: LinkMesh):
+def _scalar_basis(link_mesh: BodyMesh):
     """The scalar element of the mesh at the initial-stress form's integration order (DOF i is node i).
 
     scikit-fem is imported here, not with the module: a run that only loads
@@ -182,7 +182,7 @@ def _initial_stress(u, v, w):
     return np.einsum("ij...,i...,j...->...", w["sigma"], u.grad, v.grad)
 
 
-def geometric_stiffness(link_mesh: LinkMesh, stress: np.ndarray) -> sp.csr_matrix:
+def geometric_stiffness(link_mesh: BodyMesh, stress: np.ndarray) -> sp.csr_matrix:
     """Initial-stress form of a stress field on the scalar element, ``int sigma_ij dN_a/dx_i dN_b/dx_j dV``.
 
     The FE geometric stiffness is this matrix ``G`` times the 3 x 3 identity
@@ -190,7 +190,7 @@ def geometric_stiffness(link_mesh: LinkMesh, stress: np.ndarray) -> sp.csr_matri
 
     Parameters
     ----------
-    link_mesh : LinkMesh
+    link_mesh : BodyMesh
     stress : ndarray, shape (3, 3, n_elements, n_points)
         From :func:`stress_field`, Pa.
 
@@ -234,13 +234,13 @@ def _buckling_load(stiffness: np.ndarray, geometric: np.ndarray) -> float:
     return float(1.0 / kappa.max()) if kappa.max() > 0 else float("inf")
 
 
-def mesh_stiffening(link_mesh: LinkMesh, material: Material, interface: str = "RBE2",
+def mesh_stiffening(link_mesh: BodyMesh, material: Material, interface: str = "RBE2",
                     fixed_modes: int = PINNED_FIXED_MODES) -> LinkStiffening:
     """The geometric stiffness of a meshed link per newton of tension.
 
     Parameters
     ----------
-    link_mesh : LinkMesh
+    link_mesh : BodyMesh
         Two bores, A first.
     material : Material
     interface : {"RBE2", "RBE3"}
@@ -259,14 +259,14 @@ def mesh_stiffening(link_mesh: LinkMesh, material: Material, interface: str = "R
     return coupled_stiffening(link_mesh, coupled, solver, material, fixed_modes)
 
 
-def coupled_stiffening(link_mesh: LinkMesh, coupled, solver: InteriorSolver, material: Material,
+def coupled_stiffening(link_mesh: BodyMesh, coupled, solver: InteriorSolver, material: Material,
                        fixed_modes: int = PINNED_FIXED_MODES, rotation=None) -> LinkStiffening:
     """The geometric stiffness of a link per newton of tension, from its coupled model and the
     factorisation of its interior (those of its reduction, when the FE model is in the mesh's frame).
 
     Parameters
     ----------
-    link_mesh : LinkMesh
+    link_mesh : BodyMesh
         The mesh *coupled* was assembled from.
     coupled : flexbodies.reduction.CoupledModel
     solver : InteriorSolver
@@ -384,12 +384,12 @@ def save_stiffening(model, stiffening: LinkStiffening, *, cache_dir=None) -> Pat
     return path
 
 
-def stiffened(link: ReducedLink, stiffening: LinkStiffening, tension: float) -> ReducedLink:
+def stiffened(link: ReducedBody, stiffening: LinkStiffening, tension: float) -> ReducedBody:
     """The reduced link with its modal stiffness under an axial tension: ``K_r + P K_G,r``.
 
     Parameters
     ----------
-    link : ReducedLink
+    link : ReducedBody
     stiffening : LinkStiffening
         Of the link's model (:func:`link_stiffening`).
     tension : float
@@ -397,7 +397,7 @@ def stiffened(link: ReducedLink, stiffening: LinkStiffening, tension: float) -> 
 
     Returns
     -------
-    ReducedLink
+    ReducedBody
         A copy; ``info["axial_tension_N"]`` records the tension.
     """
     if int(link.master_nodes[0]) != stiffening.scalar.shape[0]:

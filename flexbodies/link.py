@@ -3,7 +3,7 @@
 :class:`LinkModel` names everything a reduction depends on: a parametric
 geometry (or a user's mesh file with its bores), the material, the mesh
 size and the interface coupling. :func:`reduce_link` turns it into a
-:class:`~flexbodies.reduced.ReducedLink` for a mode request, and keeps the
+:class:`~flexbodies.reduced.ReducedBody` for a mode request, and keeps the
 result on disk under the hash of its inputs:
 
 - ``fe-<hash>.json``: the reference frequencies of the FE model (the mounted
@@ -26,12 +26,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .cache import LinkCache, default_cache_dir
+from .cache import BodyCache, default_cache_dir
 from .cached_reduction import cached_reductions, record_hash, stored_reductions
 from .errors import LinkModelError
 from .geometry import LinkGeometry, default_element_size
 from .materials import STEEL, Material
-from .reduced import SCHEMA_VERSION, ReducedLink
+from .reduced import SCHEMA_VERSION, ReducedBody
 from .selection import decide_modes
 
 # The modules that mesh (gmsh, meshio), assemble (scikit-fem) and reduce a link are imported where a
@@ -120,7 +120,7 @@ class LinkModel:
         return record_hash(self.fingerprint())
 
     def meshed(self):
-        """The link's mesh (a :class:`flexbodies.meshing.LinkMesh`): the parametric geometry meshed,
+        """The link's mesh (a :class:`flexbodies.meshing.BodyMesh`): the parametric geometry meshed,
         or the mesh file read."""
         from .meshing import load_mesh, mesh_link
 
@@ -184,7 +184,7 @@ def _meshed_fe_model(model: LinkModel) -> tuple:
 
 
 def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = None, *, cache_dir=None,
-                use_cache: bool = True) -> ReducedLink:
+                use_cache: bool = True) -> ReducedBody:
     """Reduce a link for a mode request, reusing the cache where the inputs match.
 
     Parameters
@@ -201,7 +201,7 @@ def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = No
 
     Returns
     -------
-    ReducedLink
+    ReducedBody
         ``cache_hit`` tells whether it was loaded; ``info`` holds the inputs,
         their hash and the time of each stage in s.
     """
@@ -228,7 +228,7 @@ def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_
     -------
     bool
     """
-    cache = LinkCache(cache_dir)
+    cache = BodyCache(cache_dir)
     _, _, _, links = stored_reductions(cache, record_hash(model.fingerprint()), _decider(modes), list(excitations_hz))
     if links is None or any(link is None for link in links):
         return False
@@ -262,7 +262,7 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
 
     Returns
     -------
-    tuple of ReducedLink
+    tuple of ReducedBody
         One per excitation, in order, each carrying its own decision.
     """
     def prepare(frequencies):

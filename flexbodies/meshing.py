@@ -1,4 +1,4 @@
-"""Volume meshes of connecting links, with their bore surfaces identified.
+"""Volume meshes of bodies (links, the engine casing, the mesh pylon), with their bore surfaces identified.
 
 Two ways in:
 
@@ -8,7 +8,7 @@ Two ways in:
   Abaqus ``.inp``, ``.vtu``, ...), with bores found geometrically or from
   named node sets.
 
-Both return a :class:`LinkMesh`: a scikit-fem mesh whose finite element nodes
+Both return a :class:`BodyMesh`: a scikit-fem mesh whose finite element nodes
 (vertices and, for quadratic elements, edge/face/cell nodes) are numbered as
 ``mesh.doflocs``, plus the resolved :class:`Bore` surfaces.
 
@@ -31,11 +31,13 @@ import numpy as np
 import skfem
 from skfem.io.meshio import HEX_MAPPING
 
+from workbook._renamed import renamed_names
+
 from .bores import Bore, BoreSpec
 from .errors import LinkModelError
 from .geometry import LinkGeometry, default_element_size
 
-__all__ = ["Bore", "BoreSpec", "LinkMesh", "mesh_link", "load_mesh", "mesh_pieces", "default_element_size", "gmsh_model",
+__all__ = ["Bore", "BoreSpec", "BodyMesh", "mesh_link", "load_mesh", "mesh_pieces", "default_element_size", "gmsh_model",
            "generate_tet10", "refine_near", "skfem_mesh", "surface_basis"]
 
 logger = logging.getLogger(__name__)
@@ -65,8 +67,8 @@ _GMSH_LOCK = threading.Lock()
 
 
 @dataclass(frozen=True)
-class LinkMesh:
-    """A scikit-fem volume mesh of a link and its resolved bores.
+class BodyMesh:
+    """A scikit-fem volume mesh of a body (a link, the casing, the mesh pylon) and its resolved bores.
 
     Parameters
     ----------
@@ -88,7 +90,7 @@ class LinkMesh:
                             f"use one of {', '.join(c.__name__ for c in _SUPPORTED_MESHES)}")
 
     @classmethod
-    def from_skfem(cls, mesh: skfem.Mesh, bores=(), source: str = "scikit-fem mesh") -> "LinkMesh":
+    def from_skfem(cls, mesh: skfem.Mesh, bores=(), source: str = "scikit-fem mesh") -> "BodyMesh":
         """Wrap a scikit-fem mesh and resolve geometric bore specifications.
 
         Parameters
@@ -102,7 +104,7 @@ class LinkMesh:
 
         Returns
         -------
-        LinkMesh
+        BodyMesh
         """
         resolved = tuple(_resolve_bore(mesh, spec, source, node_sets=None) for spec in bores)
         return cls(mesh=mesh, bores=resolved, source=source)
@@ -162,7 +164,7 @@ class LinkMesh:
 
 
 def mesh_link(geometry: LinkGeometry, element_size: float | None = None,
-              bore_element_size: float | None = None) -> LinkMesh:
+              bore_element_size: float | None = None) -> BodyMesh:
     """Mesh a parametric link with quadratic tetrahedra (gmsh, OpenCASCADE).
 
     The mesh is deterministic: the same input gives the same nodes and
@@ -183,7 +185,7 @@ def mesh_link(geometry: LinkGeometry, element_size: float | None = None,
 
     Returns
     -------
-    LinkMesh
+    BodyMesh
         Quadratic tetrahedra; bores "A" (centre at the origin) and "B"
         (centre at ``(length, 0, 0)``), both along local z.
     """
@@ -206,12 +208,12 @@ def mesh_link(geometry: LinkGeometry, element_size: float | None = None,
         BoreSpec("B", centre=(g.length, 0.0, 0.0), axis=(0.0, 0.0, 1.0), radius=g.bore_radius),
     )
     refined = "" if fine is None else f", {fine * 1e3:.4g} mm at the bores"
-    link = LinkMesh.from_skfem(mesh, specs, source=f"gmsh link mesh, element size {size * 1e3:.4g} mm{refined}")
+    link = BodyMesh.from_skfem(mesh, specs, source=f"gmsh link mesh, element size {size * 1e3:.4g} mm{refined}")
     logger.info("meshed link: %s", link.describe())
     return link
 
 
-def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None) -> LinkMesh:
+def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None) -> BodyMesh:
     """Read a user's link mesh with meshio and resolve its bores.
 
     Parameters
@@ -229,7 +231,7 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
 
     Returns
     -------
-    LinkMesh
+    BodyMesh
 
     Raises
     ------
@@ -267,7 +269,7 @@ def load_mesh(path, bores, *, scale: float = 1.0, file_format: str | None = None
     _check_one_piece(mesh, path)
     node_sets = _NodeSets(data, fe_index, path)
     resolved = tuple(_resolve_bore(mesh, spec, str(path), node_sets) for spec in bores)
-    link = LinkMesh(mesh=mesh, bores=resolved, source=str(path))
+    link = BodyMesh(mesh=mesh, bores=resolved, source=str(path))
     logger.info("loaded link mesh: %s", link.describe())
     return link
 
@@ -643,7 +645,7 @@ def _unit_load(v, w):
 
 
 def _surface_triangles(mesh) -> np.ndarray:
-    """Outward-oriented triangles over the boundary faces (see LinkMesh.surface_triangles)."""
+    """Outward-oriented triangles over the boundary faces (see BodyMesh.surface_triangles)."""
     facets = mesh.boundary_facets()
     corner = mesh.facets[:, facets]
     if corner.shape[0] == 4:
@@ -697,3 +699,6 @@ def _orient_outward(mesh, tris: np.ndarray, owners: np.ndarray) -> np.ndarray:
     tris = tris.copy()
     tris[1:, flip] = tris[2:0:-1, flip]
     return tris
+
+
+__getattr__ = renamed_names(__name__, {"LinkMesh": "BodyMesh"})

@@ -1,4 +1,4 @@
-"""From an FE model of a link to a :class:`~flexbodies.reduced.ReducedLink`.
+"""From an FE model of a free body (a link, the casing) to a :class:`~flexbodies.reduced.ReducedBody`.
 
 Steps: tie the bores to master nodes (:mod:`~flexbodies.interfaces`),
 compute the reference frequencies of the coupled FE model
@@ -21,7 +21,7 @@ from .frequencies import free_free_frequencies, mounted_frequencies
 from .interfaces import InterfaceCoupling, couple_interfaces, rigid_motion_rows
 from .interior import InteriorSolver
 from .invariants import ffrf_invariants
-from .reduced import ReducedLink
+from .reduced import ReducedBody
 from .selection import ModeDecision
 from .stress import NodalStress
 
@@ -137,7 +137,7 @@ class InertiaFlexibility:
 
 
 def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeDecision, frequencies: dict,
-                   info: dict, flexibility: InertiaFlexibility | None = None) -> ReducedLink:
+                   info: dict, flexibility: InertiaFlexibility | None = None) -> ReducedBody:
     """The reduced link of a Craig-Bampton basis: elastic modes, node-wise basis, floating-frame invariants.
 
     Parameters
@@ -157,7 +157,7 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
 
     Returns
     -------
-    ReducedLink
+    ReducedBody
     """
     start = time.perf_counter()
     coupling = coupled.coupling
@@ -185,7 +185,7 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
         fe_description=fe.description,
         reduction_seconds=info.get("reduction_seconds", 0.0) + time.perf_counter() - start,
     )
-    return ReducedLink(
+    return ReducedBody(
         nodes=nodes,
         master_nodes=n_fe + np.arange(n_if),
         interface_names=coupling.names,
@@ -223,7 +223,7 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
 
     Returns
     -------
-    list of ReducedLink
+    list of ReducedBody
         One per decision.
     """
     start = time.perf_counter()

@@ -2,7 +2,7 @@
 
 At reduction time the stress field of every elastic mode of a link (its
 *stress shape*) is computed once on the link's own mesh and kept with the
-reduced link (:attr:`~flexbodies.reduced.ReducedLink.stress_modes`), so the
+reduced link (:attr:`~flexbodies.reduced.ReducedBody.stress_modes`), so the
 stress of any state of the modal coordinates ``q`` is one matrix product,
 ``sigma = S q``, with no FE solve. The rigid-body motion of the floating
 frame carries no stress.
@@ -32,8 +32,8 @@ import scipy.sparse as sp
 from .materials import Material
 
 if TYPE_CHECKING:  # meshing loads scikit-fem and gmsh: imported where a link is meshed
-    from .meshing import LinkMesh
-    from .reduced import ReducedLink
+    from .meshing import BodyMesh
+    from .reduced import ReducedBody
 
 __all__ = ["VOIGT", "REGIONS", "NodalStress", "nodal_stress_operator", "von_mises", "max_principal",
            "link_regions", "state_stress", "alternating_von_mises", "signed_von_mises", "goodman_factor",
@@ -97,12 +97,12 @@ class NodalStress:
         return out
 
 
-def nodal_stress_operator(link_mesh: LinkMesh, material: Material, rotation=None) -> NodalStress:
+def nodal_stress_operator(link_mesh: BodyMesh, material: Material, rotation=None) -> NodalStress:
     """The nodal-averaged stress operator of a meshed link.
 
     Parameters
     ----------
-    link_mesh : LinkMesh
+    link_mesh : BodyMesh
     material : Material
     rotation : ndarray, shape (3, 3), optional
         The link frame against the mesh's (default: the same frame), as
@@ -293,7 +293,7 @@ _regions: OrderedDict = OrderedDict()
 _REGIONS_KEPT = 32
 
 
-def link_regions(link: ReducedLink) -> np.ndarray:
+def link_regions(link: ReducedBody) -> np.ndarray:
     """Which region of the link each FE node lies in: 0 eye A, 1 shank, 2 eye B (:data:`REGIONS`).
 
     A node within the eye's outer radius of an eye centre (the bore radius
@@ -318,7 +318,7 @@ def link_regions(link: ReducedLink) -> np.ndarray:
     return regions
 
 
-def _regions_of(link: ReducedLink) -> np.ndarray:
+def _regions_of(link: ReducedBody) -> np.ndarray:
     n = int(link.master_nodes[0])
     nodes = link.nodes[:n]
     geometry = (link.info.get("inputs") or {}).get("geometry")
@@ -335,12 +335,12 @@ def _regions_of(link: ReducedLink) -> np.ndarray:
     return regions
 
 
-def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
+def state_stress(link: ReducedBody, modal_coordinates) -> np.ndarray:
     """The stress field of a state of a link's modal coordinates, ``S q``.
 
     Parameters
     ----------
-    link : ReducedLink
+    link : ReducedBody
         Reduced with its stress shapes.
     modal_coordinates : array_like, shape (n_modes,)
         Real, or complex for the amplitude of a harmonic state.
@@ -365,14 +365,14 @@ def state_stress(link: ReducedLink, modal_coordinates) -> np.ndarray:
     return (matrix @ q).reshape(n, 6)
 
 
-def write_vtu(path, link: ReducedLink, fields: dict, modes: int = 0):
+def write_vtu(path, link: ReducedBody, fields: dict, modes: int = 0):
     """Write a link's surface with nodal fields as a VTU file (meshio) that ParaView opens.
 
     Parameters
     ----------
     path : str or Path
         The ``.vtu`` file.
-    link : ReducedLink
+    link : ReducedBody
         Its surface triangles and FE nodes (link frame, m).
     fields : dict of str to ndarray, shape (n,) or (n, k)
         Point data at the FE nodes (e.g. a stress field, shape (n, 6), Pa).

@@ -7,7 +7,7 @@ from flexbodies import STEEL, LinkGeometry, LinkModel
 from flexbodies.assembly import assemble
 from flexbodies.bore_stress import BORE_DIVISIONS, bearing_load, bore_peaks, convergence_sizes
 from flexbodies.eigen import factorize, free_dofs
-from flexbodies.meshing import BoreSpec, LinkMesh, generate_tet10, gmsh_model, mesh_link, refine_near, skfem_mesh
+from flexbodies.meshing import BodyMesh, BoreSpec, generate_tet10, gmsh_model, mesh_link, refine_near, skfem_mesh
 from flexbodies.stress import max_principal, nodal_stress_operator
 
 #: A square-ended lug: width H, hole d = H/2, hole centre L = H from the loaded end, held 3 H behind the
@@ -24,7 +24,7 @@ def _frocht_hill(d_over_h: float) -> float:
     return 12.882 - 52.714 * x + 89.762 * x**2 - 51.667 * x**3
 
 
-def _lug(bore_size: float | None, curvature_points: int) -> LinkMesh:
+def _lug(bore_size: float | None, curvature_points: int) -> BodyMesh:
     size = H / 4
     with gmsh_model("lug") as gmsh:
         occ = gmsh.model.occ
@@ -39,10 +39,10 @@ def _lug(bore_size: float | None, curvature_points: int) -> LinkMesh:
             refine_near(bore, bore_size, size, D / 2)
         points, cells = generate_tet10(size, curvature_points)
     mesh, _ = skfem_mesh("tetra10", points, cells)
-    return LinkMesh.from_skfem(mesh, [BoreSpec("pin", centre=(0, 0, 0), axis=(0, 0, 1), radius=D / 2)])
+    return BodyMesh.from_skfem(mesh, [BoreSpec("pin", centre=(0, 0, 0), axis=(0, 0, 1), radius=D / 2)])
 
 
-def _lug_factor(link_mesh: LinkMesh) -> float:
+def _lug_factor(link_mesh: BodyMesh) -> float:
     """Peak largest principal stress over the net-section nominal stress, the pin pushing towards the end."""
     fe = assemble(link_mesh, STEEL)
     held = np.flatnonzero(fe.nodes[:, 0] < -HELD + 1e-9)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-from flexbodies import LinkGeometry, LinkModel, load_reduced_link, reduce_link
+from flexbodies import LinkGeometry, LinkModel, load_reduced_body, reduce_link
 from flexbodies.cache import STALE_SECONDS
 from workbook.cli.main import main
 
@@ -148,7 +148,7 @@ def test_cache_command_lists_verifies_and_clears(tmp_path, capsys):
     (path,) = tmp_path.glob("link-*.npz")
     (tmp_path / "notes.txt").write_text("not the cache's")
     assert main(["cache", "info", "--folder", folder]) == 0
-    assert "1 reduced link(s), 1 frequency summary" in capsys.readouterr().out
+    assert "1 reduced body(ies), 0 clamped reduction(s), 1 frequency summary" in capsys.readouterr().out
     assert main(["cache", "verify", "--folder", folder]) == 0
     assert "2 entries checked, 0 corrupt" in capsys.readouterr().out
     data = bytearray(path.read_bytes())
@@ -162,4 +162,4 @@ def test_cache_command_lists_verifies_and_clears(tmp_path, capsys):
     assert (tmp_path / "notes.txt").exists(), "clear removes the store's files only"
     again = reduce_link(MODEL, "static", cache_dir=tmp_path)
     assert not again.cache_hit and again.mass == link.mass
-    assert load_reduced_link(path).input_hash == link.input_hash
+    assert load_reduced_body(path).input_hash == link.input_hash

@@ -16,7 +16,7 @@ from flexbodies.assembly import FEModel, assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.geometry import LinkGeometry
 from flexbodies.materials import STEEL, TITANIUM, Material, material
-from flexbodies.meshing import LinkMesh, mesh_link
+from flexbodies.meshing import BodyMesh, mesh_link
 
 # Prismatic bar: 0.5 m long, 20 mm x 20 mm (slenderness L/h = 25, L/r = 87).
 # Timoshenko (shear + rotary inertia) lowers the first cantilever frequency
@@ -43,7 +43,7 @@ def _bar_mesh(mesh_cls, nx: int, nyz: int):
 @pytest.fixture(scope="module")
 def bar() -> FEModel:
     """Quadratic-tetrahedron bar, 50 x 2 x 2 cells (7575 DOF)."""
-    return assemble(LinkMesh(_bar_mesh(skfem.MeshTet2, 50, 2)), STEEL)
+    return assemble(BodyMesh(_bar_mesh(skfem.MeshTet2, 50, 2)), STEEL)
 
 
 @pytest.fixture(scope="module")
@@ -143,7 +143,7 @@ def test_bar_cantilever_first_bending_frequency(bar):
 
 def test_quadratic_hexahedra_cantilever():
     """Quadratic hexahedra (27 points per element by default) converge as well."""
-    model = assemble(LinkMesh(_bar_mesh(skfem.MeshHex2, 20, 1)), TITANIUM)
+    model = assemble(BodyMesh(_bar_mesh(skfem.MeshHex2, 20, 1)), TITANIUM)
     freqs, _ = natural_frequencies(model.stiffness, model.mass, 1, fixed=_clamped_x0(model), shift_hz=10.0)
     assert freqs[0] == pytest.approx(_cantilever_euler_bernoulli_hz(TITANIUM), rel=5e-3)
     assert model.description.startswith("quadratic hexahedra")
@@ -151,25 +151,25 @@ def test_quadratic_hexahedra_cantilever():
 
 def test_linear_tetrahedra_lock_in_bending():
     """Why quadratic elements are required: linear tetrahedra are far too stiff."""
-    model = assemble(LinkMesh(_bar_mesh(skfem.MeshTet1, 50, 2)), STEEL)
+    model = assemble(BodyMesh(_bar_mesh(skfem.MeshTet1, 50, 2)), STEEL)
     freqs, _ = natural_frequencies(model.stiffness, model.mass, 1, fixed=_clamped_x0(model), shift_hz=10.0)
     assert freqs[0] > 1.2 * _cantilever_euler_bernoulli_hz(STEEL)  # measured +30 %
 
 
 def test_mirrored_elements_are_accepted_and_tangled_ones_rejected():
     mesh = skfem.MeshHex1.init_tensor(*[np.linspace(0.0, 0.01, 3)] * 3)
-    reference = assemble(LinkMesh(mesh), STEEL).stiffness
+    reference = assemble(BodyMesh(mesh), STEEL).stiffness
     # Mirror every element (swap the two 4-node faces): valid, same matrix.
     t = mesh.t.copy()
     bottom, top = _opposite_hex_faces(mesh)
     t[bottom + top] = mesh.t[top + bottom]
-    mirrored = assemble(LinkMesh(skfem.MeshHex1(mesh.doflocs, t)), STEEL).stiffness
+    mirrored = assemble(BodyMesh(skfem.MeshHex1(mesh.doflocs, t)), STEEL).stiffness
     assert abs(mirrored - reference).max() <= 1e-9 * abs(reference).max()
     # Swap two diagonally opposite corners of one element: tangled.
     t = mesh.t.copy()
     t[[bottom[0], top[2]], 0] = t[[top[2], bottom[0]], 0]
     with pytest.raises(ValueError, match="1 of 8 elements are tangled"):
-        assemble(LinkMesh(skfem.MeshHex1(mesh.doflocs, t), source="twisted.vtu"), STEEL)
+        assemble(BodyMesh(skfem.MeshHex1(mesh.doflocs, t), source="twisted.vtu"), STEEL)
 
 
 def _opposite_hex_faces(mesh):
@@ -220,7 +220,7 @@ def test_assembly_equals_scikit_fems_forms(mesh_cls):
     from flexbodies.validation import scikit_fem_matrices
 
     mesh = _bar_mesh(mesh_cls, 4, 2)
-    model = assemble(LinkMesh(mesh), TITANIUM)
+    model = assemble(BodyMesh(mesh), TITANIUM)
     stiffness, mass = scikit_fem_matrices(mesh, TITANIUM)
     for ours, theirs in ((model.stiffness, stiffness), (model.mass, mass)):
         assert abs(ours - theirs).max() <= 1e-12 * abs(theirs).max()

@@ -18,7 +18,7 @@ from conftest import COARSE_ELEMENT_SIZE
 from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
-from flexbodies.meshing import LinkMesh
+from flexbodies.meshing import BodyMesh
 from workbook.errors import MechanismError, ResonanceError, SimulationError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
@@ -174,7 +174,7 @@ def _free_bending_hz(poisson_ratio: float) -> np.ndarray:
     length, side = 0.5, 0.02
     solid = Material("bar", youngs_modulus=210e9, poisson_ratio=poisson_ratio, density=7850.0)
     x, yz = np.linspace(0, length, 51), np.linspace(-side / 2, side / 2, 3)
-    bar = assemble(LinkMesh(skfem.MeshTet2.from_mesh(skfem.MeshTet1.init_tensor(x, yz, yz))), solid)
+    bar = assemble(BodyMesh(skfem.MeshTet2.from_mesh(skfem.MeshTet1.init_tensor(x, yz, yz))), solid)
     frequencies, _ = natural_frequencies(bar.stiffness, bar.mass, 8, shift_hz=100.0)
     return frequencies[6:8]
 

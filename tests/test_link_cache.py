@@ -6,7 +6,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from flexbodies import STEEL, TITANIUM, LinkGeometry, LinkModel, ReducedLinkFileError, load_reduced_link, reduce_link, save_reduced_link
+from flexbodies import STEEL, TITANIUM, LinkGeometry, LinkModel, ReducedBodyFileError, load_reduced_body, reduce_link, save_reduced_body
 from flexbodies.reduced import SCHEMA_VERSION
 
 #: A small, coarse link: these tests are about files, not accuracy.
@@ -98,45 +98,45 @@ def test_a_corrupted_file_is_not_used(tmp_path, caplog):
     good = reduce_link(_model(), "static", cache_dir=tmp_path)
     (path,) = _link_files(tmp_path)
     _corrupt(path)
-    with pytest.raises(ReducedLinkFileError, match=path.name):
-        load_reduced_link(path)
+    with pytest.raises(ReducedBodyFileError, match=path.name):
+        load_reduced_body(path)
     with caplog.at_level(logging.WARNING, logger="flexbodies.link"):
         again = reduce_link(_model(), "static", cache_dir=tmp_path)
     assert not again.cache_hit
     assert any("recomputing" in r.message for r in caplog.records)
     np.testing.assert_allclose(again.frequencies["reduced_hz"], good.frequencies["reduced_hz"], rtol=1e-10)
-    assert load_reduced_link(path).input_hash == good.input_hash, "the damaged file was replaced"
+    assert load_reduced_body(path).input_hash == good.input_hash, "the damaged file was replaced"
 
 
 def test_an_altered_array_fails_the_checksum(tmp_path):
     link = reduce_link(_model(), "static", cache_dir=tmp_path, use_cache=False)
-    path = save_reduced_link(link, tmp_path / "link.npz")
+    path = save_reduced_body(link, tmp_path / "link.npz")
     with np.load(path) as data:
         arrays = {k: data[k] for k in data.files}
     arrays["mode_basis"] = arrays["mode_basis"] * 1.001  # a valid archive with wrong numbers
     np.savez_compressed(path, **arrays)
-    with pytest.raises(ReducedLinkFileError, match="checksum"):
-        load_reduced_link(path)
+    with pytest.raises(ReducedBodyFileError, match="checksum"):
+        load_reduced_body(path)
 
 
 def test_a_file_of_another_version_is_rejected(tmp_path):
     link = reduce_link(_model(), "static", cache_dir=tmp_path, use_cache=False)
-    path = save_reduced_link(link, tmp_path / "link.npz")
+    path = save_reduced_body(link, tmp_path / "link.npz")
     with np.load(path) as data:
         arrays = {k: data[k] for k in data.files}
     meta = json.loads(str(arrays["meta"]))
     meta["schema_version"] = 99
     arrays["meta"] = np.array(json.dumps(meta))
     np.savez_compressed(path, **arrays)
-    with pytest.raises(ReducedLinkFileError, match="version 99"):
-        load_reduced_link(path)
+    with pytest.raises(ReducedBodyFileError, match="version 99"):
+        load_reduced_body(path)
 
 
 def test_a_file_that_is_not_an_archive_is_rejected(tmp_path):
     path = tmp_path / "link.npz"
     path.write_text("not a reduced link")
-    with pytest.raises(ReducedLinkFileError, match="not a readable"):
-        load_reduced_link(path)
+    with pytest.raises(ReducedBodyFileError, match="not a readable"):
+        load_reduced_body(path)
     assert not zipfile.is_zipfile(path)
 
 
@@ -166,7 +166,7 @@ def test_another_keys_entry_is_recomputed_with_one_warning(tmp_path, caplog, kin
     def entry(model):
         if kind.startswith("fe-"):
             return dirty / kind.format(key=model.key())
-        (path,) = [p for p in _link_files(dirty) if load_reduced_link(p).info["inputs"] == model.fingerprint()]
+        (path,) = [p for p in _link_files(dirty) if load_reduced_body(p).info["inputs"] == model.fingerprint()]
         return path
 
     target = entry(titanium)

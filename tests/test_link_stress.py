@@ -7,7 +7,7 @@ from flexbodies import STEEL, LinkGeometry, LinkModel
 from flexbodies.errors import LinkModelError
 from flexbodies.link import _meshed_fe_model, reduce_link
 from flexbodies.materials import Material
-from flexbodies.reduced import load_reduced_link, save_reduced_link
+from flexbodies.reduced import load_reduced_body, save_reduced_body
 from flexbodies.reduction import couple
 from flexbodies.stress import link_regions, max_principal, nodal_stress_operator, state_stress, von_mises
 
@@ -96,7 +96,7 @@ def test_cantilever_in_bending_gives_mc_over_i(reduced, full):
 
 
 def test_stress_shapes_survive_the_file(reduced, tmp_path):
-    loaded = load_reduced_link(save_reduced_link(reduced, tmp_path / "link.npz"))
+    loaded = load_reduced_body(save_reduced_body(reduced, tmp_path / "link.npz"))
     assert loaded.stress_modes.shape == (reduced.master_nodes[0], 6, reduced.n_modes)
     np.testing.assert_array_equal(loaded.stress_modes, reduced.stress_modes)
 

@@ -13,7 +13,7 @@ import skfem
 from flexbodies.assembly import assemble
 from flexbodies.frequencies import clamped_frequencies
 from flexbodies.materials import STEEL
-from flexbodies.meshing import Bore, LinkMesh
+from flexbodies.meshing import BodyMesh, Bore
 from flexbodies.reduction import couple
 from flexbodies.verification import verify_coupled
 
@@ -34,7 +34,7 @@ def bar():
     """Quadratic tetrahedra, 24 x 2 x 2 cells, end faces tied rigidly (RBE2) to masters A (x = 0) and B (x = L)."""
     yz = np.linspace(-SIDE / 2, SIDE / 2, 3)
     mesh = skfem.MeshTet2.from_mesh(skfem.MeshTet1.init_tensor(np.linspace(0, LENGTH, 25), yz, yz))
-    fe = assemble(LinkMesh(mesh, (_face(mesh, "A", 0.0), _face(mesh, "B", LENGTH))), STEEL)
+    fe = assemble(BodyMesh(mesh, (_face(mesh, "A", 0.0), _face(mesh, "B", LENGTH))), STEEL)
     return couple(fe, "RBE2")
 
 

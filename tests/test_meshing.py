@@ -12,7 +12,7 @@ from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.geometry import LinkGeometry
 from flexbodies.materials import STEEL
-from flexbodies.meshing import BoreSpec, LinkMesh, default_element_size, load_mesh, mesh_link
+from flexbodies.meshing import BodyMesh, BoreSpec, default_element_size, load_mesh, mesh_link
 
 REFERENCE = LinkGeometry(length=0.30, eye_outer_radius=0.030, bore_radius=0.015,
                          thickness=0.025, shank_width=0.040, shank_thickness=0.025)
@@ -25,18 +25,18 @@ def _geometric_specs(g: LinkGeometry):
             BoreSpec("B", centre=(g.length, 0, 0), axis=(0, 0, -1), radius=g.bore_radius)]
 
 
-def _frequencies(link: LinkMesh) -> np.ndarray:
+def _frequencies(link: BodyMesh) -> np.ndarray:
     model = assemble(link, STEEL)
     return natural_frequencies(model.stiffness, model.mass, 9, shift_hz=200.0)[0][6:]
 
 
 @pytest.fixture(scope="module")
-def reference_mesh() -> LinkMesh:
+def reference_mesh() -> BodyMesh:
     return mesh_link(REFERENCE)
 
 
 @pytest.fixture(scope="module")
-def coarse_mesh() -> LinkMesh:
+def coarse_mesh() -> BodyMesh:
     return mesh_link(REFERENCE, element_size=COARSE)
 
 
@@ -148,7 +148,7 @@ def test_user_mesh_round_trip(tmp_path, coarse_mesh, coarse_frequencies, suffix,
 def test_quadratic_hexahedron_file(tmp_path):
     """hexahedron27 in meshio's (VTK's) node order maps onto scikit-fem's."""
     x = np.linspace(0.0, 0.02, 3)
-    link = LinkMesh(skfem.MeshHex2.from_mesh(skfem.MeshHex1.init_tensor(x, x, x)))
+    link = BodyMesh(skfem.MeshHex2.from_mesh(skfem.MeshHex1.init_tensor(x, x, x)))
     path = tmp_path / "cube.vtu"
     meshio.write(path, link.to_meshio())
     loaded = load_mesh(path, [])

@@ -70,7 +70,7 @@ INTERNAL_MODULES = (
     "flexbodies.casing", "flexbodies.casing_reduction", "flexbodies.craig_bampton", "flexbodies.eigen",
     "flexbodies.exudyn_body", "flexbodies.frequencies", "flexbodies.geometric_stiffness", "flexbodies.geometry",
     "flexbodies.interfaces", "flexbodies.interior", "flexbodies.invariants", "flexbodies.link",
-    "flexbodies.materials", "flexbodies.meshing", "flexbodies.reduced", "flexbodies.reduction",
+    "flexbodies.materials", "flexbodies.meshing", "flexbodies.pylon_reduction", "flexbodies.reduced", "flexbodies.reduction",
     "flexbodies.selection", "flexbodies.stress", "flexbodies.validation", "flexbodies.verification",
 )
 
@@ -122,3 +122,28 @@ def test_importing_a_package_loads_none_of_the_heavy_dependencies(package, heavy
     code = f"import sys, {package}; print(sorted(m for m in {heavy!r} if m in sys.modules))"
     loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert loaded == "[]"
+
+
+@pytest.mark.parametrize("module, old, new", [
+    ("flexbodies", "ReducedLink", "ReducedBody"), ("flexbodies", "LinkMesh", "BodyMesh"),
+    ("flexbodies", "ReducedLinkFileError", "ReducedBodyFileError"), ("flexbodies", "load_reduced_link", "load_reduced_body"),
+    ("flexbodies", "save_reduced_link", "save_reduced_body"), ("flexbodies.reduced", "ReducedLink", "ReducedBody"),
+    ("flexbodies.cache", "LinkCache", "BodyCache"), ("flexbodies.meshing", "LinkMesh", "BodyMesh"),
+    ("flexbodies.errors", "ReducedLinkFileError", "ReducedBodyFileError"),
+])
+def test_a_former_name_of_the_general_machinery_warns_and_is_the_new_one(module, old, new):
+    namespace = importlib.import_module(module)
+    with pytest.warns(DeprecationWarning, match=f"{module}.{old} is now {module}.{new}; {old} goes in version 0.3"):
+        value = getattr(namespace, old)
+    assert value is getattr(namespace, new)
+    assert old not in getattr(namespace, "__all__", ())
+
+
+def test_a_former_method_of_the_cache_warns_and_calls_the_new_one(tmp_path):
+    from flexbodies.cache import BodyCache
+
+    store = BodyCache(tmp_path)
+    with pytest.warns(DeprecationWarning, match=r"BodyCache.load_link\(\) is now load_body\(\)"):
+        assert store.load_link("absent") is None
+    with pytest.warns(DeprecationWarning, match=r"BodyCache.link_path\(\) is now body_path\(\)"):
+        assert store.link_path("k") == store.body_path("k")

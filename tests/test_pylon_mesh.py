@@ -3,10 +3,14 @@
 Closed forms: a clamped square bar's static compliance at a pin bore near
 its tip (axial L / EA; bending L^3 / 3EI plus shear L / (k G A)). The whole
 mount: a very stiff mesh is the rigid pylon, a soft one changes the answer.
-Bad meshes are refused naming the field.
+Bad meshes are refused naming the field. A second run loads the reduction
+from the cache of the reduced bodies, bit for bit.
 """
 import dataclasses
 import json
+import pickle
+import subprocess
+import sys
 
 import gmsh
 import numpy as np
@@ -14,12 +18,13 @@ import pytest
 from test_sdof import sdof_case
 
 from flexbodies.materials import Material
+from flexbodies.pylon_reduction import MINIMUM_MODES, reduce_pylon
 from workbook.cli.main import main
 from workbook.errors import EXIT_BAD_INPUT, CaseError
 from workbook.model.case import AnalysisSettings, HarmonicForce
 from workbook.model.codec import from_json, to_json
 from workbook.model.pylon_beam import BoxBeamPylon
-from workbook.model.pylon_mesh import MINIMUM_MODES, MeshPylon, mesh_pylon_model
+from workbook.model.pylon_mesh import MeshPylon, mesh_pylon_model
 from workbook.solve.pipeline import run_case
 
 STEEL_BAR = Material("steel", youngs_modulus=210e9, poisson_ratio=0.3, density=7850.0)
@@ -89,6 +94,38 @@ def test_the_reduced_compliance_is_the_full_fe_compliance_below_the_cutoff(tmp_p
     # up to the highest frequency asked for, 30 Hz, near the bar's first bending mode on its pin (about 40 Hz)
     for a, b in zip(kept.compliance([5.0, 20.0, 30.0]), many.compliance([5.0, 20.0, 30.0]), strict=True):
         assert np.abs(a - b).max() <= 1e-4 * np.abs(b).max()
+
+
+#: A second process: the pickled pylon model reduced from the cache, its arrays saved, and whether it was
+#: loaded and whether scikit-fem (meshing and assembly) was imported.
+SECOND_RUN = """
+import json, pickle, sys
+import numpy as np
+from flexbodies.pylon_reduction import reduce_pylon
+model, highest, cache, out = pickle.load(open(sys.argv[1], "rb"))
+reduced = reduce_pylon(model, highest, cache_dir=cache)
+np.savez(out, **reduced.arrays())
+print(json.dumps({"cache_hit": reduced.cache_hit, "skfem": "skfem" in sys.modules}))
+"""
+
+
+def test_a_second_run_loads_the_reduced_pylon_from_the_cache(tmp_path, monkeypatch):
+    pylon = _bar(tmp_path, size=0.02)
+    model, cache = pylon.model([(LENGTH, 0.0, 0.0)]), tmp_path / "cache"
+    monkeypatch.setenv("MOUNTWB_CACHE", str(cache))
+    first = reduce_pylon(model, 30.0)
+    assert not first.cache_hit and len(list(cache.glob("clamped-*.npz"))) == 1
+    (tmp_path / "job.pickle").write_bytes(pickle.dumps((model, 30.0, cache, tmp_path / "second.npz")))
+    done = subprocess.run([sys.executable, "-c", SECOND_RUN, str(tmp_path / "job.pickle")], capture_output=True,
+                          text=True, check=True)
+    assert json.loads(done.stdout) == {"cache_hit": True, "skfem": False}, "the second run reduced the pylon again"
+    with np.load(tmp_path / "second.npz") as second:
+        for name, value in first.arrays().items():
+            np.testing.assert_array_equal(second[name], value, err_msg=name)
+    # the pylon as a case prepares it: from the cache; another frequency range is another mode rule, another entry
+    structure, facts = mesh_pylon_model(pylon, [(LENGTH, 0.0, 0.0)], 30.0)
+    assert facts["cache_hit"] and np.array_equal(structure.stiffness, first.stiffness)
+    assert not mesh_pylon_model(pylon, [(LENGTH, 0.0, 0.0)], 300.0)[1]["cache_hit"]
 
 
 def _plate_case(tmp_path, modulus=70e9):

@@ -11,7 +11,7 @@ from excel_helpers import copy_reference, set_cells
 from flexbodies import LinkGeometry, LinkModel, reduce_link, reduce_link_set
 from flexbodies.geometric_stiffness import link_stiffening, mesh_stiffening, stiffened
 from flexbodies.materials import STEEL
-from flexbodies.meshing import Bore, LinkMesh
+from flexbodies.meshing import BodyMesh, Bore
 from workbook.cli.main import main
 from workbook.errors import EXIT_TROUBLE, BucklingError, CaseError, WorkbookError, exit_code
 from workbook.excel.reader import read_workbook
@@ -27,7 +27,7 @@ BAR_LENGTH, BAR_SIDE = 0.6, 0.02
 EULER_LOAD = np.pi ** 2 * STEEL.youngs_modulus * BAR_SIDE ** 4 / 12 / BAR_LENGTH ** 2
 
 
-def _bar() -> LinkMesh:
+def _bar() -> BodyMesh:
     """Quadratic tetrahedra, 40 x 2 x 2 boxes; each end face is a "bore" tied to a master at its centre."""
     mesh = skfem.MeshTet2.from_mesh(skfem.MeshTet.init_tensor(
         np.linspace(0.0, BAR_LENGTH, 41), *[np.linspace(-BAR_SIDE / 2, BAR_SIDE / 2, 3)] * 2))
@@ -38,7 +38,7 @@ def _bar() -> LinkMesh:
         return Bore(name, np.array([x, 0.0, 0.0]), np.array([0.0, 0.0, 1.0]), BAR_SIDE / 2, nodes,
                     np.full(len(nodes), BAR_SIDE ** 2 / len(nodes)))
 
-    return LinkMesh(mesh, (end("A", 0.0), end("B", BAR_LENGTH)), "bar")
+    return BodyMesh(mesh, (end("A", 0.0), end("B", BAR_LENGTH)), "bar")
 
 
 @pytest.fixture(scope="module")

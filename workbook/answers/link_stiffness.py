@@ -18,7 +18,7 @@ def axial_stiffness(link) -> float:
 
     Parameters
     ----------
-    link : flexbodies.ReducedLink
+    link : flexbodies.ReducedBody
 
     Returns
     -------

@@ -11,7 +11,7 @@ from workbook.model.case import Case
 
 __all__ = ["link_table"]
 
-#: Stages whose times make up a reduction, as stored in ``ReducedLink.info``.
+#: Stages whose times make up a reduction, as stored in ``ReducedBody.info``.
 _STAGES = ("mesh_seconds", "assembly_seconds", "frequency_seconds", "reduction_seconds", "stiffening_seconds")
 
 
@@ -21,7 +21,7 @@ def link_table(case: Case, reduced: dict) -> pd.DataFrame:
     Parameters
     ----------
     case : Case
-    reduced : dict of str to flexbodies.ReducedLink
+    reduced : dict of str to flexbodies.ReducedBody
         From :func:`workbook.scene.build.reduce_links`.
 
     Returns

@@ -1,4 +1,4 @@
-"""``mountwb cache {info,verify,clear} [--folder DIR]``: the store of reduced links.
+"""``mountwb cache {info,verify,clear} [--folder DIR]``: the store of reduced bodies (links, casing, mesh pylon).
 
 ``info`` lists the folder, its entries and their size; ``verify`` checks
 every entry's key and checksum and names each corrupt one (exit 1 when
@@ -26,18 +26,19 @@ def _size(total: int) -> str:
 
 
 def cache(args) -> int:
-    from flexbodies.cache import LinkCache
+    from flexbodies.cache import BodyCache
 
-    store = LinkCache(args.folder)
+    store = BodyCache(args.folder)
     if args.action == "clear":
         print(f"{store.folder}: removed {store.clear()} file(s)")
         return 0
     if args.action == "info":
         entries = store.entries()
         summaries = sum(1 for path in entries if path.suffix == ".json")
+        clamped = sum(1 for path in entries if path.name.startswith("clamped-"))
         total = sum(path.stat().st_size for path in entries)
-        print(f"{store.folder}: {len(entries) - summaries} reduced link(s), {summaries} frequency summary(ies), "
-              f"{_size(total)}")
+        print(f"{store.folder}: {len(entries) - summaries - clamped} reduced body(ies), {clamped} clamped reduction(s), "
+              f"{summaries} frequency summary(ies), {_size(total)}")
         for path in store.stale_temporaries():
             print(f"  stale temporary file (the next run removes it): {path.name}")
         return 0

@@ -61,7 +61,7 @@ COMMANDS = {
     "optimise": ("optimise the design on the fast linear mount: the worst T (dB) or a weighted mean within static "
                  "displacement and mode-band constraints; before/after table, the optimised case, a Pareto front",
                  optimise.arguments),
-    "cache": ("the store of reduced links: info, verify (keys and checksums), clear", cache.arguments),
+    "cache": ("the store of reduced bodies: info, verify (keys and checksums), clear", cache.arguments),
 }
 
 

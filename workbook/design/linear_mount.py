@@ -54,7 +54,7 @@ from workbook.solve.harmonic import point_phasors
 from workbook.solve.stages import link_warnings
 
 if TYPE_CHECKING:
-    from flexbodies.reduced import ReducedLink
+    from flexbodies.reduced import ReducedBody
 
 __all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_springs",
            "keeps_casing_modes"]
@@ -107,7 +107,7 @@ class _Casing:
     stiffness: np.ndarray              # K_r at the prepared modulus
     damping: np.ndarray                # its modal damping at the prepared modulus
     modulus: float                     # the prepared modulus E_0, Pa
-    reduced: ReducedLink = field(repr=False)
+    reduced: ReducedBody = field(repr=False)
 
     def scale(self, case: Case) -> float:
         """E / E_0 of the design *case*."""
@@ -125,7 +125,7 @@ class StressedLink:
     link : workbook.model.case.Link
     coordinates : ndarray of int
         Its modal coordinates among the item's full coordinates.
-    reduced : flexbodies.ReducedLink
+    reduced : flexbodies.ReducedBody
         With its stress shapes.
     rotation : ndarray, shape (3, 3)
         Link frame to global.
@@ -138,7 +138,7 @@ class StressedLink:
 
     link: Link
     coordinates: np.ndarray
-    reduced: ReducedLink = field(repr=False)
+    reduced: ReducedBody = field(repr=False)
     rotation: np.ndarray = field(repr=False)
     component_shapes: np.ndarray = field(repr=False)
     node_norms: np.ndarray = field(repr=False)

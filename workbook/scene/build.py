@@ -224,7 +224,7 @@ class Scene:
         The pylon (``ObjectGround``).
     engine : EngineItems
     links : dict of str to flexbodies.ExudynLink
-    reduced : dict of str to flexbodies.ReducedLink
+    reduced : dict of str to flexbodies.ReducedBody
     hinges : dict of str to HingeItems
     transducers : dict of str to TransducerItems
         Test-rig force transducers by name (empty: the pylon pins are on
@@ -461,7 +461,7 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneou
 
     Returns
     -------
-    dict of str to flexbodies.ReducedLink
+    dict of str to flexbodies.ReducedBody
 
     Raises
     ------
@@ -515,7 +515,7 @@ def build_scene(case: Case, excitation: SingleFrequencyExcitation | Simultaneous
     excitation : RotatingForce or HarmonicForce, optional
         The excitation to apply (with the case's smooth start); None builds
         the static scene only.
-    reduced : dict of str to flexbodies.ReducedLink, optional
+    reduced : dict of str to flexbodies.ReducedBody, optional
         Reduced links from :func:`reduce_links` (computed when omitted).
     exact_loss_factors : bool
         False (for a time integration): the loss factors of hinges and links

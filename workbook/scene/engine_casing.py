@@ -42,7 +42,7 @@ class CasingItems:
 
     Attributes
     ----------
-    reduced : flexbodies.ReducedLink
+    reduced : flexbodies.ReducedBody
         The reduced casing (casing frame).
     casing : flexbodies.casing_reduction.ExudynCasing
     core : CoreBody

@@ -28,7 +28,7 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from flexbodies.cache import LinkCache
+from flexbodies.cache import BodyCache
 from flexbodies.geometry import default_element_size
 from flexbodies.link import LinkModel, is_reduced, reduce_link_set
 from workbook.processes import end_with_parent, stop_workers
@@ -61,7 +61,7 @@ class LinkJob:
     stiffening: bool
 
     def reduce(self) -> tuple:
-        """Reduce (or load) the link in this process: one ``ReducedLink`` per excitation frequency."""
+        """Reduce (or load) the link in this process: one ``ReducedBody`` per excitation frequency."""
         return reduce_link_set(self.model, self.modes, self.excitations_hz, stiffening=self.stiffening)
 
     def expected_work(self) -> float:
@@ -140,7 +140,7 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
     """
     limit = available_cores() if workers is None else workers
     if (limit < 2 or "fork" not in multiprocessing.get_all_start_methods() or multiprocessing.current_process().daemon
-            or not LinkCache().writable()):
+            or not BodyCache().writable()):
         return 0
     # the largest first: a long job started last would decide when the workers are done
     pending = sorted((job for job in jobs if not job.cached()), key=LinkJob.expected_work, reverse=True)

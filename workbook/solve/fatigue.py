@@ -211,7 +211,7 @@ class FatigueResult:
     stress_seconds : float
         Wall time of the stress recovery and the factors, all links and
         excitations, s.
-    reduced : dict of str to flexbodies.ReducedLink
+    reduced : dict of str to flexbodies.ReducedBody
         The flexible links of that run (their meshes and stress shapes).
     spectra : list of SpectrumDamage
         The Miner sums of the case's speed spectra.
@@ -300,7 +300,7 @@ def link_fatigue(link, reduced, mean_coordinates, amplitude: np.ndarray, rotatio
     ----------
     link : workbook.model.case.Link
         Its material has endurance and ultimate strengths.
-    reduced : flexbodies.ReducedLink
+    reduced : flexbodies.ReducedBody
     mean_coordinates : array_like, shape (n_modes,)
         The preloaded state's modal coordinates.
     amplitude : ndarray, complex, shape (n, 6)
@@ -444,7 +444,7 @@ def solve_fatigue(case: Case, *, reduced: dict | None = None) -> FatigueResult:
     ----------
     case : Case
         On a rigid pylon.
-    reduced : dict of str to flexbodies.ReducedLink, optional
+    reduced : dict of str to flexbodies.ReducedBody, optional
         The case's reduced links (reduced, or loaded, for the highest
         frequency of each excitation when omitted).
 

@@ -140,7 +140,7 @@ def link_stress(link, reduced, modal_coordinates, axial_force: float, rotation, 
     Parameters
     ----------
     link : workbook.model.case.Link
-    reduced : flexbodies.ReducedLink
+    reduced : flexbodies.ReducedBody
     modal_coordinates : array_like or None
         The link's elastic coordinates (None: a rigid link).
     axial_force : float
@@ -197,7 +197,7 @@ def solve_load_case(case: Case, load_case: LoadCase, *, reduced: dict | None = N
     ----------
     case : Case
     load_case : LoadCase
-    reduced : dict of str to flexbodies.ReducedLink, optional
+    reduced : dict of str to flexbodies.ReducedBody, optional
         The case's reduced links (reduced, or loaded, when omitted).
 
     Raises
