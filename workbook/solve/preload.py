@@ -154,7 +154,8 @@ def spring_roundoff_force(scene: Scene) -> float:
     ``|p|``, known to the machine epsilon ``eps``: its round-off is
     ``k eps |p|``, which a Newton tolerance must not undercut (a 1e12 N/m
     transducer 1.7 m from the origin: 4e-4 N, ten times the default
-    tolerance on the reference mount). Returned with a margin of
+    tolerance on the reference mount). The springs are the hinges, the
+    rig's transducers and a flexible engine's bearings. Returned with a margin of
     :data:`ROUNDOFF_MARGIN`.
     """
     case = scene.case
@@ -162,6 +163,8 @@ def spring_roundoff_force(scene: Scene) -> float:
     if scene.transducers:
         assert case.test_rig is not None
         stiffness += list(case.test_rig.stiffness)
+    if case.engine.casing is not None:
+        stiffness += list(case.engine.casing.bearing_stiffness)
     reach = max((float(np.abs(h.position).max()) for h in case.hinges), default=0.0)
     return ROUNDOFF_MARGIN * max(stiffness, default=0.0) * np.finfo(float).eps * max(reach, 1.0)
 
