@@ -18,7 +18,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING, TIME_STARTS
+from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING, TIME_STARTS, Engine, ForceTransducers, Hinge, Link
+from workbook.model.field_spec import field_spec
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -120,6 +121,17 @@ def _num(key, header, si_unit=DIMENSIONLESS, *, unit=None, required=False, help=
     return Column(key, header, "number", si_unit, unit, required, help=help)
 
 
+def _field(cls: type, name: str, header: str, *, unit: str | None = None,
+           required: bool = False) -> tuple[Column, ...]:
+    """The column of field *name* of the case dataclass *cls* (three of a vector): key, SI unit and help
+    line from the field's spec (:mod:`workbook.model.field_spec`); *unit* is the template's display unit."""
+    described = field_spec(cls, name)
+    key = described.column or name
+    if described.check in ("vector3", "direction"):
+        return _xyz(key, header, described.unit or DIMENSIONLESS, unit=unit, required=required, help=described.help)
+    return (_num(key, header, described.unit or DIMENSIONLESS, unit=unit, required=required, help=described.help),)
+
+
 def _material_columns(preset_help: str) -> tuple:
     """The material columns of a sheet: a preset, and E, nu and density overriding it."""
     return (Column("material", "material", "choice", choices=("steel", "titanium"), help=preset_help),
@@ -207,17 +219,17 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
 ))
 
 ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(
-    _num("mass", "mass", "kg", required=True, help="engine mass (t accepted)"),
-    *_xyz("cg", "CG", "m", required=True, help="centre of gravity"),
-    *(_num(f"i{ij}", f"I{ij}", "kg*m^2", required=ij in ("xx", "yy", "zz"),
+    *_field(Engine, "mass", "mass", required=True),
+    *_field(Engine, "center_of_mass", "CG", required=True),
+    *(_num(f"i{ij}", f"I{ij}", field_spec(Engine, "inertia").unit, required=ij in ("xx", "yy", "zz"),
            help=f"inertia tensor component {ij} about the CG (off-diagonal: empty = 0)")
       for ij in ("xx", "yy", "zz", "xy", "xz", "yz")),
 ))
 
 LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh file", columns=(
     Column("name", "name", "text", required=True, help="unique link name"),
-    *_xyz("end_a", "end A", "m", required=True, help="centre of eye A"),
-    *_xyz("end_b", "end B", "m", required=True, help="centre of eye B"),
+    *_field(Link, "end_a", "end A", required=True),
+    *_field(Link, "end_b", "end B", required=True),
     _num("length", "length", "m", help="eye distance; empty: from the ends, given: checked against them"),
     *_material_columns("preset material"),
     _num("eye_outer_radius", "eye outer radius", "m", unit="mm", help="parametric link: eye outer radius"),
@@ -229,10 +241,10 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     Column("interface", "interface", "choice", choices=("RBE2", "RBE3"), help="bore coupling"),
     Column("modes", "modes", "modes", help="auto, static, a mode count or a cut-off such as '2000 Hz'"),
     Column("flexible", "flexible", "yesno", help="no: rigid link"),
-    _num("stiffness_damping", "stiffness damping", "s", help="Rayleigh stiffness-proportional damping"),
-    _num("mass_damping", "mass damping", "1/s", help="Rayleigh mass-proportional damping"),
-    _num("spin_frequency_hz", "spin frequency", "Hz", help="torsional restraint about the link axis"),
-    *_xyz("bore_axis", "bore axis", DIMENSIONLESS, help="global direction of the bore axes (empty: default)"),
+    *_field(Link, "stiffness_damping", "stiffness damping"),
+    *_field(Link, "mass_damping", "mass damping"),
+    *_field(Link, "spin_frequency_hz", "spin frequency"),
+    *_field(Link, "bore_axis", "bore axis"),
     Column("mesh_file", "mesh file", "text", help="mesh file, relative to the workbook (instead of a geometry)"),
     Column("mesh_unit", "mesh unit", "unit", help="length unit of the mesh file (e.g. mm)"),
     Column("bore_a_set", "bore A node set", "text", help="mesh: node set of bore A"),
@@ -240,8 +252,8 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     *_xyz("mesh_bore_a", "mesh bore A", "m", unit="mm", help="mesh: a point on bore A's axis, mesh frame"),
     *_xyz("mesh_bore_b", "mesh bore B", "m", unit="mm", help="mesh: a point on bore B's axis, mesh frame"),
     *_xyz("mesh_bore_axis", "mesh bore axis", DIMENSIONLESS, help="mesh: bore axis direction, mesh frame"),
-    _num("loss_factor", "loss factor", help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"),
-    _num("modal_damping", "modal damping", help="damping ratio zeta of each elastic mode of the link (empty: 0)"),
+    *_field(Link, "loss_factor", "loss factor"),
+    *_field(Link, "modal_damping", "modal damping"),
     *(_num(key, key.replace("_", " "), "Pa", unit="MPa", help=f"{what} overriding the preset's (load cases, fatigue)")
       for key, what in (("yield_strength", "tensile yield strength (0.2 % proof)"),
                         ("ultimate_strength", "tensile ultimate strength"),
@@ -256,17 +268,15 @@ HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", 
     Column("name", "name", "text", required=True, help="unique hinge name"),
     Column("body_a", "body A", "text", required=True, help="pylon, engine or a link name"),
     Column("body_b", "body B", "text", required=True, help="pylon, engine or a link name"),
-    *_xyz("position", "position", "m", required=True, help="hinge centre: an eye centre of its links"),
-    _num("stiffness", "stiffness", "N/m", required=True,
-         help="translational stiffness (with the radial 2 or axial columns: radial 1)"),
-    _num("damping", "damping", "N*s/m", help="translational damping (empty: 0)"),
-    _num("radial_clearance", "radial clearance", "m", unit="mm", help="bearing gap (empty: 0)"),
-    _num("contact_stiffness", "contact stiffness", "N/m", help="stiffness once the gap closes"),
-    _num("loss_factor", "loss factor", help="structural loss factor eta, k (1 + i eta) (empty: 0)"),
-    *(_num(f"{key}_{suffix}", f"{header} {direction}", unit, help=f"{header} along the hinge frame's {direction} "
-           f"direction (empty: as '{header}')")
-      for key, header, unit in (("stiffness", "stiffness", "N/m"), ("damping", "damping", "N*s/m"),
-                                ("loss_factor", "loss factor", DIMENSIONLESS))
+    *_field(Hinge, "position", "position", required=True),
+    *_field(Hinge, "stiffness", "stiffness", required=True),
+    *_field(Hinge, "damping", "damping"),
+    *_field(Hinge, "radial_clearance", "radial clearance", unit="mm"),
+    *_field(Hinge, "contact_stiffness", "contact stiffness"),
+    *_field(Hinge, "loss_factor", "loss factor"),
+    *(_num(f"{key}_{suffix}", f"{header} {direction}", field_spec(Hinge, key).unit,
+           help=f"{header} along the hinge frame's {direction} direction (empty: as '{header}')")
+      for key, header in (("stiffness", "stiffness"), ("damping", "damping"), ("loss_factor", "loss factor"))
       for suffix, direction in (("radial_2", "radial 2"), ("axial", "axial"))),
     *_xyz("frame_radial_1", "frame radial 1", DIMENSIONLESS,
           help="hinge frame: radial 1 direction, unit length (empty: the link's frame)"),
@@ -348,9 +358,9 @@ ROTORS = Table("Rotors", optional=True,
 
 TEST_RIG = Table("Test rig", single_row=True, optional=True,
                  help="the rig's three-way force transducers under the pylon pins (empty: rigid ground)", columns=(
-    *_xyz("stiffness", "stiffness", "N/m", required=True, help="stiffness of each transducer with its fixture"),
-    _num("mass", "mass", "kg", help="moving mass of each transducer with its fitting (empty: 1 kg)"),
-    *_xyz("damping", "damping", "N*s/m", help="damping of each transducer (empty: 0)"),
+    *_field(ForceTransducers, "stiffness", "stiffness", required=True),
+    *_field(ForceTransducers, "mass", "mass"),
+    *_field(ForceTransducers, "damping", "damping"),
 ))
 
 CASING_RINGS = ("front_ring", "rear_ring")

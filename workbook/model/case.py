@@ -28,7 +28,8 @@ import numpy as np
 from workbook.errors import CaseError
 from workbook.model import fields
 from workbook.model.casing import CASING, EngineCasing
-from workbook.model.fields import MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
+from workbook.model.field_spec import check_fields, documented, spec
+from workbook.model.fields import HINGE_DIRECTIONS, MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
 from workbook.model.load_cases import LoadCase
 from workbook.model.pylon import PylonModel
 from workbook.model.pylon_beam import BoxBeamPylon
@@ -36,6 +37,7 @@ from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_legacy import accept_legacy_pylons, legacy_pylon
 from workbook.model.pylon_mesh import MeshPylon
 from workbook.model.spectrum import SpeedSpectrum
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
@@ -122,32 +124,26 @@ def _set(obj: Any, name: str, value: Any) -> None:
     object.__setattr__(obj, name, value)
 
 
+@documented
 @dataclass(frozen=True)
 class Engine:
-    """The engine: one rigid body, or a flexible casing and a rigid core.
+    """The engine: one rigid body, or a flexible casing and a rigid core."""
 
-    Parameters
-    ----------
-    mass : float
-        Mass in kg.
-    center_of_mass : 3 floats
-        Centre of gravity in the global frame, m.
-    inertia : 3x3 floats
-        Inertia tensor about the centre of gravity, global axes, kg m^2.
-    casing : EngineCasing or None
-        The casing as a flexible body (None: the engine is one rigid body);
-        see :mod:`workbook.model.casing`.
-    """
-
-    mass: float
-    center_of_mass: Vector3
-    inertia: tuple[Vector3, Vector3, Vector3]
-    casing: EngineCasing | None = None
+    mass: float = field(metadata=spec("Mass of the engine", unit="kg", minimum=0.0, strictly=True,
+                                      help="engine mass (t accepted)"))
+    center_of_mass: Vector3 = field(metadata=spec(
+        "Centre of gravity in the global frame", type="3 floats", check="vector3", unit="m", column="cg",
+        help="centre of gravity"))
+    inertia: tuple[Vector3, Vector3, Vector3] = field(metadata=spec(
+        "Inertia tensor about the centre of gravity, global axes: symmetric, positive definite, its principal "
+        "moments obeying the triangle inequality", type="3x3 floats", check="own", unit="kg*m^2"))
+    casing: EngineCasing | None = field(default=None, metadata=spec(
+        "The casing as a flexible body (None: the engine is one rigid body); see :mod:`workbook.model.casing`",
+        type="EngineCasing", check="own", optional=True))
 
     def __post_init__(self):
         item = "engine"
-        _set(self, "mass", fields.positive_number(item, "mass", self.mass))
-        _set(self, "center_of_mass", fields.vector3(item, "center_of_mass", self.center_of_mass))
+        check_fields(self, item)
         try:
             rows = tuple(fields.vector3(item, "inertia", row) for row in self.inertia)
         except TypeError:
@@ -172,64 +168,55 @@ class Engine:
         return np.array(self.inertia)
 
 
+@documented
 @dataclass(frozen=True)
 class Link:
-    """A connecting link with a ball hinge eye at each end.
+    """A connecting link with a ball hinge eye at each end."""
 
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"front-left"``.
-    end_a, end_b : 3 floats
-        Global positions of the centres of eye A and eye B, m. Their distance
-        must equal the link model's eye distance.
-    model : flexbodies.LinkModel
-        Geometry or mesh, material, meshing and interface choices.
-    modes : {"auto", "static"} or int or ModeCutoff or str
-        Craig-Bampton fixed-interface modes kept: the low-frequency rule, none,
-        a count, or a cut-off frequency (:class:`ModeCutoff` or ``"500 Hz"``);
-        see :func:`mode_request`.
-    flexible : bool
-        False models the link as a rigid body with the same mass properties.
-    stiffness_damping : float
-        Rayleigh stiffness-proportional damping of the link, s.
-    mass_damping : float
-        Rayleigh mass-proportional damping of the link, 1/s.
-    loss_factor : float
-        Material loss factor eta of the link (complex modulus: the link's
-        elastic stiffness acts as K (1 + i eta)), dimensionless, >= 0.
-    modal_damping : float
-        Damping ratio zeta of each of the link's elastic modes (the
-        free-free modes of its reduced model, the coordinates of its
-        flexible body): a modal damper ``2 zeta w_i`` per mass-normalised
-        mode, in both domains; dimensionless, 0 <= zeta < 1.
-    spin_frequency_hz : float or None
-        Frequency of the torsional restraint of the free spin about the link
-        axis (None: the flexbodies default).
-    bore_axis : 3 floats or None
-        Global direction of the bore axes (None: the flexbodies default).
-    """
-
-    name: str
-    end_a: Vector3
-    end_b: Vector3
-    model: Any
-    modes: ModeRequest = "auto"
-    flexible: bool = True
-    stiffness_damping: float = 0.0
-    mass_damping: float = 0.0
-    spin_frequency_hz: float | None = None
-    bore_axis: Vector3 | None = None
-    loss_factor: float = 0.0
-    modal_damping: float = 0.0
+    name: str = field(metadata=spec('Unique name, e.g. ``"front-left"``', type="str", check="own"))
+    end_a: Vector3 = field(metadata=spec(
+        "Global position of the centre of eye A", type="3 floats", check="vector3", unit="m",
+        help="centre of eye A"))
+    end_b: Vector3 = field(metadata=spec(
+        "Global position of the centre of eye B: as far from *end_a* as the link model's eye distance",
+        type="3 floats", check="vector3", unit="m", help="centre of eye B"))
+    model: Any = field(metadata=spec("Geometry or mesh, material, meshing and interface choices",
+                                     type="flexbodies.LinkModel", check="own"))
+    modes: ModeRequest = field(default="auto", metadata=spec(
+        "Craig-Bampton fixed-interface modes kept: the low-frequency rule, none, a count, or a cut-off frequency "
+        '(:class:`ModeCutoff` or ``"500 Hz"``); see :func:`mode_request`',
+        type='{"auto", "static"} or int or ModeCutoff or str', check="own"))
+    flexible: bool = field(default=True, metadata=spec(
+        "False models the link as a rigid body with the same mass properties", type="bool", check="flag"))
+    stiffness_damping: float = field(default=0.0, metadata=spec(
+        "Rayleigh stiffness-proportional damping of the link", unit="s", minimum=0.0,
+        help="Rayleigh stiffness-proportional damping"))
+    mass_damping: float = field(default=0.0, metadata=spec(
+        "Rayleigh mass-proportional damping of the link", unit="1/s", minimum=0.0,
+        help="Rayleigh mass-proportional damping"))
+    spin_frequency_hz: float | None = field(default=None, metadata=spec(
+        "Frequency of the torsional restraint of the free spin about the link axis (None: the flexbodies "
+        "default)", unit="Hz", minimum=0.0, strictly=True, optional=True,
+        help="torsional restraint about the link axis"))
+    bore_axis: Vector3 | None = field(default=None, metadata=spec(
+        "Global direction of the bore axes (None: the flexbodies default)", type="3 floats", check="vector3",
+        unit=DIMENSIONLESS, optional=True, help="global direction of the bore axes (empty: default)"))
+    loss_factor: float = field(default=0.0, metadata=spec(
+        "Material loss factor eta of the link (complex modulus: the link's elastic stiffness acts as "
+        "K (1 + i eta))", unit=DIMENSIONLESS, minimum=0.0,
+        help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"))
+    modal_damping: float = field(default=0.0, metadata=spec(
+        "Damping ratio zeta of each of the link's elastic modes (the free-free modes of its reduced model, "
+        "the coordinates of its flexible body): a modal damper ``2 zeta w_i`` per mass-normalised mode, in "
+        "both domains; below 1", unit=DIMENSIONLESS, minimum=0.0,
+        help="damping ratio zeta of each elastic mode of the link (empty: 0)"))
 
     def __post_init__(self):
         item = f"link {self.name!r}"
         fields.nonempty_name("link", self.name)
         if self.name in _RESERVED:
             raise CaseError(item, "name", self.name, f"a name other than {_RESERVED}")
-        _set(self, "end_a", fields.vector3(item, "end_a", self.end_a))
-        _set(self, "end_b", fields.vector3(item, "end_b", self.end_b))
+        check_fields(self, item)
         if self.length <= POINT_TOLERANCE:
             raise CaseError(item, "end_b", self.end_b, "a point apart from end_a")
         geometry = getattr(self.model, "geometry", None)
@@ -238,19 +225,8 @@ class Link:
                             f"a point {geometry.length:g} m from end_a (the link's eye distance); "
                             f"the ends are {self.length:g} m apart")
         _set(self, "modes", mode_request(self.modes, item))
-        if not isinstance(self.flexible, bool):
-            raise CaseError(item, "flexible", self.flexible, "True or False")
-        _set(self, "stiffness_damping",
-             fields.number(item, "stiffness_damping", self.stiffness_damping, minimum=0.0))
-        _set(self, "mass_damping", fields.number(item, "mass_damping", self.mass_damping, minimum=0.0))
-        _set(self, "loss_factor", fields.number(item, "loss_factor", self.loss_factor, minimum=0.0))
-        _set(self, "modal_damping", fields.number(item, "modal_damping", self.modal_damping, minimum=0.0))
         if self.modal_damping >= 1.0:
             raise CaseError(item, "modal_damping", self.modal_damping, "a damping ratio >= 0 and < 1")
-        if self.spin_frequency_hz is not None:
-            _set(self, "spin_frequency_hz", fields.positive_number(item, "spin_frequency_hz", self.spin_frequency_hz))
-        if self.bore_axis is not None:
-            _set(self, "bore_axis", fields.vector3(item, "bore_axis", self.bore_axis))
 
     @property
     def length(self) -> float:
@@ -263,25 +239,6 @@ class Link:
             if np.linalg.norm(np.subtract(point, end)) <= POINT_TOLERANCE:
                 return eye
         return None
-
-
-#: Names of a hinge's three directions (:attr:`Hinge.frame`).
-HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
-
-
-def _per_direction(item: str, name: str, value: Any, *, strictly: bool) -> float | tuple[float, ...]:
-    """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
-
-    A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
-    """
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
-        return fields.number(item, name, value, minimum=0.0, strictly=strictly)
-    values = tuple(value)
-    if len(values) != 3:
-        raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
-                                           f"{len(values)} given")
-    return tuple(fields.number(item, f"{name}[{direction}]", v, minimum=0.0, strictly=strictly)
-                 for v, direction in zip(values, HINGE_DIRECTIONS, strict=True))
 
 
 def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
@@ -300,6 +257,7 @@ def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
     return rows
 
 
+@documented
 @dataclass(frozen=True)
 class Hinge:
     """A ball hinge: a translational spring-damper between two bodies.
@@ -309,47 +267,38 @@ class Hinge:
     the hinge's frame (:data:`HINGE_DIRECTIONS`): two radial and one along
     the bore (pin) axis, as a spherical bearing in a link eye is stiffer
     radially than along its pin.
-
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"front-up-left"``.
-    body_a, body_b : str
-        The two bodies joined: ``"pylon"``, ``"engine"`` or a link name.
-    position : 3 floats
-        Hinge centre, m; on a link it must be one of the link's eye centres.
-    stiffness : float or 3 floats
-        Translational stiffness, N/m: in every direction, or per direction
-        of the frame.
-    damping : float or 3 floats
-        Translational (viscous) damping, N s/m, likewise.
-    radial_clearance : float
-        Gap of the spherical bearing, m (0: no clearance law is built).
-    contact_stiffness : float or None
-        Stiffness once the gap is closed, N/m (None: *stiffness*).
-    loss_factor : float or 3 floats
-        Structural (hysteretic) loss factor eta, dimensionless, >= 0: the
-        hinge's stiffness acts as k (1 + i eta), a damping force in phase
-        with the velocity whose size does not grow with the frequency
-        (docs/physics.md, hinge damping); likewise one or three values.
-    frame : 3x3 floats or None
-        The hinge's directions radial 1, radial 2, axial as rows, in global
-        coordinates (orthonormal). None: the frame of the link the hinge
-        sits on (radial 1 along the link towards eye B, axial along its
-        bore axis), or the global axes x, y, z for a hinge between the
-        pylon and the engine. Only per-direction values use it.
     """
 
-    name: str
-    body_a: str
-    body_b: str
-    position: Vector3
-    stiffness: float | Vector3
-    damping: float | Vector3 = 0.0
-    radial_clearance: float = 0.0
-    contact_stiffness: float | None = None
-    loss_factor: float | Vector3 = 0.0
-    frame: tuple[Vector3, Vector3, Vector3] | None = None
+    name: str = field(metadata=spec('Unique name, e.g. ``"front-up-left"``', type="str", check="own"))
+    body_a: str = field(metadata=spec('A body joined: ``"pylon"``, ``"engine"`` or a link name', type="str",
+                                      check="own"))
+    body_b: str = field(metadata=spec("The other body joined, likewise", type="str", check="own"))
+    position: Vector3 = field(metadata=spec(
+        "Hinge centre; on a link it must be one of the link's eye centres", type="3 floats", check="vector3",
+        unit="m", help="hinge centre: an eye centre of its links"))
+    stiffness: float | Vector3 = field(metadata=spec(
+        "Translational stiffness: in every direction, or per direction of the frame", type="float or 3 floats",
+        check="per_direction", unit="N/m", minimum=0.0, strictly=True,
+        help="translational stiffness (with the radial 2 or axial columns: radial 1)"))
+    damping: float | Vector3 = field(default=0.0, metadata=spec(
+        "Translational (viscous) damping, likewise", type="float or 3 floats", check="per_direction",
+        unit="N*s/m", minimum=0.0, help="translational damping (empty: 0)"))
+    radial_clearance: float = field(default=0.0, metadata=spec(
+        "Gap of the spherical bearing (0: no clearance law is built)", unit="m", minimum=0.0,
+        help="bearing gap (empty: 0)"))
+    contact_stiffness: float | None = field(default=None, metadata=spec(
+        "Stiffness once the gap is closed (None: *stiffness*)", unit="N/m", minimum=0.0, strictly=True,
+        optional=True, help="stiffness once the gap closes"))
+    loss_factor: float | Vector3 = field(default=0.0, metadata=spec(
+        "Structural (hysteretic) loss factor eta: the hinge's stiffness acts as k (1 + i eta), a damping force "
+        "in phase with the velocity whose size does not grow with the frequency (docs/physics.md, hinge "
+        "damping); likewise one or three values", type="float or 3 floats", check="per_direction",
+        unit=DIMENSIONLESS, minimum=0.0, help="structural loss factor eta, k (1 + i eta) (empty: 0)"))
+    frame: tuple[Vector3, Vector3, Vector3] | None = field(default=None, metadata=spec(
+        "The hinge's directions radial 1, radial 2, axial as rows, in global coordinates (orthonormal). None: "
+        "the frame of the link the hinge sits on (radial 1 along the link towards eye B, axial along its bore "
+        "axis), or the global axes x, y, z for a hinge between the pylon and the engine. Only per-direction "
+        "values use it", type="3x3 floats", check="own", optional=True))
 
     def __post_init__(self):
         item = f"hinge {self.name!r}"
@@ -359,14 +308,7 @@ class Hinge:
                 raise CaseError(item, name, getattr(self, name), "a body name")
         if self.body_a == self.body_b:
             raise CaseError(item, "body_b", self.body_b, "a body other than body_a")
-        _set(self, "position", fields.vector3(item, "position", self.position))
-        _set(self, "stiffness", _per_direction(item, "stiffness", self.stiffness, strictly=True))
-        _set(self, "damping", _per_direction(item, "damping", self.damping, strictly=False))
-        _set(self, "radial_clearance",
-             fields.number(item, "radial_clearance", self.radial_clearance, minimum=0.0))
-        if self.contact_stiffness is not None:
-            _set(self, "contact_stiffness", fields.positive_number(item, "contact_stiffness", self.contact_stiffness))
-        _set(self, "loss_factor", _per_direction(item, "loss_factor", self.loss_factor, strictly=False))
+        check_fields(self, item)
         if self.frame is not None:
             _set(self, "frame", _frame(self.frame, item))
         if self.radial_clearance > 0 and not self.isotropic:
@@ -447,6 +389,7 @@ class Gravity:
 StaticLoad = PointForce | PointMoment | Gravity
 
 
+@documented
 @dataclass(frozen=True)
 class ForceTransducers:
     """The test rig's three-way force transducers between the pylon pins and the rigid ground.
@@ -458,41 +401,26 @@ class ForceTransducers:
     one): a point mass at the pin on a spring-damper to ground, and the pin's
     hinges attach to that mass. The transducer forces are what the rig
     measures, so they make the pylon force.
-
-    Parameters
-    ----------
-    stiffness : 3 floats
-        Stiffness of each transducer with its fixture in the global x, y, z
-        directions, N/m (a three-component piezoelectric force link with its
-        mounting is of order 1e8 to 1e9 N/m).
-    mass : float
-        Moving half of each transducer plus the fitting bolted to it, kg. The
-        default 1 kg is a force link of this load range (a few hundred grams,
-        half of it moving) with the clevis block of the pin on it; the mass
-        only has to be there (a node between two springs needs one in
-        Exudyn): at 1e8 N/m it resonates at 1.6 kHz, far above the rotor
-        frequencies. It carries no weight in the scene: a rig zeroes its
-        transducers with the fitting mounted, before the engine is hung.
-    damping : 3 floats
-        Viscous damping of each transducer in x, y, z, N s/m (piezoelectric
-        force links are very lightly damped: default 0).
     """
 
-    stiffness: Vector3
-    mass: float = 1.0
-    damping: Vector3 = (0.0, 0.0, 0.0)
+    stiffness: Vector3 = field(metadata=spec(
+        "Stiffness of each transducer with its fixture in the global x, y, z directions (a three-component "
+        "piezoelectric force link with its mounting is of order 1e8 to 1e9 N/m)", type="3 floats",
+        check="vector3", unit="N/m", minimum=0.0, strictly=True, help="stiffness of each transducer with its fixture"))
+    mass: float = field(default=1.0, metadata=spec(
+        "Moving half of each transducer plus the fitting bolted to it. The default 1 kg is a force link of this "
+        "load range (a few hundred grams, half of it moving) with the clevis block of the pin on it; the mass "
+        "only has to be there (a node between two springs needs one in Exudyn): at 1e8 N/m it resonates at "
+        "1.6 kHz, far above the rotor frequencies. It carries no weight in the scene: a rig zeroes its "
+        "transducers with the fitting mounted, before the engine is hung", unit="kg", minimum=0.0,
+        strictly=True, help="moving mass of each transducer with its fitting (empty: 1 kg)"))
+    damping: Vector3 = field(default=(0.0, 0.0, 0.0), metadata=spec(
+        "Viscous damping of each transducer in x, y, z (piezoelectric force links are very lightly damped: "
+        "default 0)", type="3 floats", check="vector3", unit="N*s/m", minimum=0.0,
+        help="damping of each transducer (empty: 0)"))
 
     def __post_init__(self):
-        item = "test-rig force transducers"
-        stiffness = fields.vector3(item, "stiffness", self.stiffness)
-        if min(stiffness) <= 0:
-            raise CaseError(item, "stiffness", self.stiffness, "three numbers > 0 (N/m in x, y, z)")
-        damping = fields.vector3(item, "damping", self.damping)
-        if min(damping) < 0:
-            raise CaseError(item, "damping", self.damping, "three numbers >= 0 (N s/m in x, y, z)")
-        _set(self, "stiffness", stiffness)
-        _set(self, "damping", damping)
-        _set(self, "mass", fields.positive_number(item, "mass", self.mass))
+        check_fields(self, "test-rig force transducers")
 
 
 #: A test-rig transducer is named by this prefix and the pylon-side hinges it carries.
