@@ -17,7 +17,7 @@ from numpydoc.docscrape import NumpyDocString
 
 from workbook.errors import CaseError
 from workbook.excel import layout
-from workbook.model.case import Engine, ForceTransducers, Hinge, Link
+from workbook.model.case import AnalysisSettings, Effects, Engine, ForceTransducers, Hinge, Link, Rotor
 from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.reference import reference_case
 
@@ -28,6 +28,9 @@ DESCRIBED = {
     Link: (CASE.links[0], layout.LINKS),
     Hinge: (CASE.hinges[0], layout.HINGES),
     ForceTransducers: (ForceTransducers((2e8, 2e8, 3e8)), layout.TEST_RIG),
+    Rotor: (Rotor("LP spool", 2.5, frequency_hz=80.0), layout.ROTORS),
+    AnalysisSettings: (AnalysisSettings(), layout.CASE),
+    Effects: (Effects(), layout.CASE),
 }
 
 
@@ -67,6 +70,20 @@ def test_a_bad_one_of_three_per_direction_values_is_named_by_its_direction(cls, 
         dataclasses.replace(valid, **{name: (1.0, 1.0, described.minimum - 1.0)})
 
 
+@pytest.mark.parametrize("cls, name, described", [(cls, name, described) for cls in DESCRIBED
+                                                   for name, described in _specs(cls)
+                                                   if described.check in ("choice", "flag")],
+                         ids=lambda p: getattr(p, "__name__", p))
+def test_a_choice_or_flag_takes_only_its_values(cls, name, described):
+    valid, _ = DESCRIBED[cls]
+    expected = " or ".join(map(repr, described.choices)) if described.choices else "True or False"
+    with pytest.raises(CaseError) as refused:
+        dataclasses.replace(valid, **{name: "maybe"})
+    assert str(refused.value).endswith(f"field '{name}': found 'maybe', expected {expected}")
+    for value in described.choices or (True, False):
+        assert getattr(dataclasses.replace(valid, **{name: value}), name) == value
+
+
 @pytest.mark.parametrize("cls", DESCRIBED, ids=lambda c: c.__name__)
 def test_a_field_is_normalised_to_floats(cls):
     valid, _ = DESCRIBED[cls]
@@ -85,7 +102,7 @@ def test_the_docstring_lists_every_field_with_its_unit_and_bound(cls):
     for name, described in _specs(cls):
         text = " ".join(parameters[name].desc)
         assert described.unit_words in text and described.bound in text, (name, text)
-        assert parameters[name].type.startswith(described.type)
+        assert parameters[name].type == described.type_words
 
 
 @pytest.mark.parametrize("cls", DESCRIBED, ids=lambda c: c.__name__)

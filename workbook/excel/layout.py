@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING, TIME_STARTS, Engine, ForceTransducers, Hinge, Link
+from workbook.model.case import DIRECTIONS, AnalysisSettings, Effects, Engine, ForceTransducers, Hinge, Link, Rotor
 from workbook.model.field_spec import field_spec
 from workbook.model.units import DIMENSIONLESS
 
@@ -123,10 +123,14 @@ def _num(key, header, si_unit=DIMENSIONLESS, *, unit=None, required=False, help=
 
 def _field(cls: type, name: str, header: str, *, unit: str | None = None,
            required: bool = False) -> tuple[Column, ...]:
-    """The column of field *name* of the case dataclass *cls* (three of a vector): key, SI unit and help
-    line from the field's spec (:mod:`workbook.model.field_spec`); *unit* is the template's display unit."""
+    """The column of field *name* of the case dataclass *cls* (three of a vector): key, SI unit, choices and
+    help line from the field's spec (:mod:`workbook.model.field_spec`); *unit* is the template's display unit."""
     described = field_spec(cls, name)
     key = described.column or name
+    if described.check == "choice":
+        return (Column(key, header, "choice", required=required, choices=described.choices, help=described.help),)
+    if described.check == "flag":
+        return (Column(key, header, "yesno", required=required, help=described.help),)
     if described.check in ("vector3", "direction"):
         return _xyz(key, header, described.unit or DIMENSIONLESS, unit=unit, required=required, help=described.help)
     return (_num(key, header, described.unit or DIMENSIONLESS, unit=unit, required=required, help=described.help),)
@@ -181,41 +185,29 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
     Column("description", "description", "text", help="free text"),
     Column("steps_per_period", "steps per period", "integer", DIMENSIONLESS,
            help="time steps per excitation period (at least 8; 40 recommended)"),
-    _num("ramp_periods", "ramp periods", help="periods over which the excitation rises"),
-    _num("settle_time_constants", "settle time constants",
-         help="settle time after the ramp in decay time constants of the least damped mounted mode"),
-    _num("settle_time", "settle time", "s", help="fixed settle time (empty: from the damping)"),
+    *_field(AnalysisSettings, "ramp_periods", "ramp periods"),
+    *_field(AnalysisSettings, "settle_time_constants", "settle time constants"),
+    *_field(AnalysisSettings, "settle_time", "settle time"),
     Column("measured_periods", "measured periods", "integer", DIMENSIONLESS,
            help="periods per measured window"),
-    _num("steady_tolerance", "steady tolerance", help="largest change between the two last windows"),
-    _num("spectral_radius", "spectral radius", help="generalized-alpha spectral radius (0 to 1)"),
-    _num("newton_tolerance", "newton tolerance", help="Newton tolerance relative to the load scale"),
-    _num("equilibrium_tolerance", "equilibrium tolerance",
-         help="largest relative mismatch of the static equilibrium"),
+    *_field(AnalysisSettings, "steady_tolerance", "steady tolerance"),
+    *_field(AnalysisSettings, "spectral_radius", "spectral radius"),
+    *_field(AnalysisSettings, "newton_tolerance", "newton tolerance"),
+    *_field(AnalysisSettings, "equilibrium_tolerance", "equilibrium tolerance"),
     Column("step_halvings", "step halvings", "integer", DIMENSIONLESS,
            help="a segment whose Newton iteration fails is run again with the step halved, at most this often"),
-    _num("time_budget", "time budget", "s", help="wall time one run may take (empty: no limit)"),
-    _num("divergence_displacement", "divergence limit", "m", unit="mm",
-         help="engine displacement from the preloaded position that stops a run as diverging"),
-    Column("method", "method", "choice", choices=ANALYSIS_METHODS,
-           help="time: time domain; frequency: frequency domain about the preload; auto: frequency domain "
-                "unless a clearance makes the scene nonlinear"),
-    Column("flexible_links", "flexible links", "yesno", help="no: every link rigid"),
-    Column("preload", "preload", "yesno", help="solve the static loads first"),
-    Column("hinge_damping", "hinge damping", "yesno", help="no: hinge damping set to zero"),
-    Column("link_damping", "link damping", "yesno", help="no: link Rayleigh damping set to zero"),
-    Column("clearance", "clearance", "yesno", help="no: hinge gaps ignored"),
-    Column("gyroscopics", "gyroscopics", "yesno",
-           help="no: the rotors' gyroscopic moments are not built (their inertia stays lumped in the engine)"),
-    Column("rig_sensors", "rig sensors", "yesno",
-           help="no: the pylon pins sit on rigid ground even when the Test rig sheet gives transducers"),
-    Column("stress_stiffening", "stress stiffening", "choice", choices=STRESS_STIFFENING,
-           help="the flexible links' geometric stiffness of their axial preload, with a buckling check: on; off; "
-                "auto: on for a link whose preload moves its first pinned-pinned mode by more than 0.5 %"),
-    Column("start", "start", "choice", choices=TIME_STARTS,
-           help="where a time-domain run starts: steady: in the steady state of its linearised scene (two windows "
-                "suffice); rest: from rest with the smooth start and the settle time; auto: steady unless a "
-                "clearance makes the scene nonlinear"),
+    *_field(AnalysisSettings, "time_budget", "time budget"),
+    *_field(AnalysisSettings, "divergence_displacement", "divergence limit", unit="mm"),
+    *_field(AnalysisSettings, "method", "method"),
+    *_field(Effects, "flexible_links", "flexible links"),
+    *_field(Effects, "preload", "preload"),
+    *_field(Effects, "hinge_damping", "hinge damping"),
+    *_field(Effects, "link_damping", "link damping"),
+    *_field(Effects, "clearance", "clearance"),
+    *_field(Effects, "gyroscopics", "gyroscopics"),
+    *_field(Effects, "rig_sensors", "rig sensors"),
+    *_field(Effects, "stress_stiffening", "stress stiffening"),
+    *_field(AnalysisSettings, "start", "start"),
 ))
 
 ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(
@@ -349,9 +341,8 @@ ROTORS = Table("Rotors", optional=True,
                help="spinning rotors whose gyroscopic moments act on the engine (their mass and inertia are "
                     "in the Engine sheet)", columns=(
     Column("name", "name", "text", required=True, help="unique rotor name"),
-    _num("polar_inertia", "polar inertia", "kg*m^2", required=True,
-         help="polar moment of inertia about the spin axis"),
-    _num("frequency_hz", "speed", "Hz", required=True, help="spin speed (rpm accepted)"),
+    *_field(Rotor, "polar_inertia", "polar inertia", required=True),
+    *_field(Rotor, "frequency_hz", "speed", required=True),
     Column("axis", "spin axis", "choice", choices=DIRECTIONS,
            help="spin axis in engine coordinates, spinning right-handed about it (empty: x)"),
 ))

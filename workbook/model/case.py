@@ -689,6 +689,7 @@ SingleFrequencyExcitation = RotatingForce | HarmonicForce | Imbalance
 SINGLE_FREQUENCY_KINDS = (RotatingForce, HarmonicForce, Imbalance)
 
 
+@documented
 @dataclass(frozen=True)
 class Rotor(_OneFrequency):
     """A rotor spinning at constant speed in the engine: its gyroscopic moment.
@@ -700,33 +701,27 @@ class Rotor(_OneFrequency):
     moment ``M = -dh/dt = -Ip Omega (omega x a)``. The rotor's mass and
     transverse inertia stay lumped in the rigid engine (``Case.engine``);
     only this moment is added (``Effects.gyroscopics``).
-
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"LP spool"``.
-    polar_inertia : float
-        Polar moment of inertia Ip about the spin axis, kg m^2 (> 0).
-    frequency_hz, rpm : float
-        Spin speed; give exactly one.
-    axis : 3 floats
-        Spin axis in engine coordinates (the global axes at the reference
-        state); normalised here. The rotor spins right-handed about it.
     """
 
-    name: str
-    polar_inertia: float
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    axis: Vector3 = (1.0, 0.0, 0.0)
+    name: str = field(metadata=spec('Unique name, e.g. ``"LP spool"``', type="str", check="own"))
+    polar_inertia: float = field(metadata=spec(
+        "Polar moment of inertia Ip about the spin axis", unit="kg*m^2", minimum=0.0, strictly=True,
+        help="polar moment of inertia about the spin axis"))
+    frequency_hz: float | None = field(default=None, metadata=spec(
+        "Spin speed; give exactly one of *frequency_hz* and *rpm*", check="own", unit="Hz", minimum=0.0,
+        strictly=True, optional=True, help="spin speed (rpm accepted)"))
+    rpm: float | None = field(default=None, metadata=spec(
+        "Spin speed in revolutions per minute, instead of *frequency_hz*; > 0", check="own", optional=True))
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
+        "Spin axis in engine coordinates (the global axes at the reference state); normalised here. The rotor "
+        "spins right-handed about it", type="3 floats", check="direction", unit=DIMENSIONLESS))
 
     def __post_init__(self):
         item = f"rotor {self.name!r}"
         fields.nonempty_name("rotor", self.name)
-        _set(self, "polar_inertia", fields.number(item, "polar_inertia", self.polar_inertia, minimum=0.0,
-                                            strictly=True))
+        check_fields(self, item)
         _frequency(item, self.frequency_hz, self.rpm)
-        axis = np.array(fields.direction(item, "axis", self.axis))
+        axis = np.asarray(self.axis)
         _set(self, "axis", tuple(float(v) for v in axis / np.linalg.norm(axis)))
 
     @property
@@ -919,160 +914,126 @@ class Simultaneous:
 Excitation = RotatingForce | HarmonicForce | Imbalance | Sweep | Simultaneous
 
 
+@documented
 @dataclass(frozen=True)
 class AnalysisSettings:
-    """How a time-domain run is set up and checked.
+    """How a time-domain run is set up and checked."""
 
-    Parameters
-    ----------
-    steps_per_period : int
-        Time steps per period of the excitation (at least 40: 20 gave
-        amplitudes about 1 % low; the error is about (2 pi / n)^2 / 6).
-    ramp_periods : float
-        The excitation rises smoothly (raised cosine) over this many periods,
-        which keeps the mounted modes from being excited by the start.
-    settle_time_constants : float
-        Settle time after the ramp, in decay time constants 1/(zeta w) of the
-        least damped mounted mode (one is ample after the smooth start: on the
-        reference mount even none changed T by less than 0.05 %).
-    settle_time : float or None
-        Fixed settle time after the ramp, s (None: from the damping).
-    measured_periods : int
-        Periods per measured window; two consecutive windows are compared.
-    steady_tolerance : float
-        Largest relative change of the pylon-force amplitudes between the two
-        windows for the run to count as steady.
-    spectral_radius : float
-        Generalized-alpha spectral radius at infinite frequency (1: no
-        numerical damping).
-    newton_tolerance : float
-        Newton absolute tolerance relative to the load scale (largest of the
-        static load and the excitation amplitude).
-    equilibrium_tolerance : float
-        Largest relative mismatch between the pylon-side hinge forces and the
-        applied static loads.
-    method : {"auto", "time", "frequency"}
-        The analysis answering the case: ``"auto"`` (the default: frequency
-        domain when the scene is linear, time domain when a clearance law
-        makes it nonlinear, see :mod:`workbook.solve.method`), time domain,
-        or frequency domain (harmonic solution of the scene linearised about
-        the preload). A sweep on a linear scene always takes one
-        linearisation for all its frequencies.
-    step_halvings : int
-        When Newton's method fails in a segment of the time integration, the
-        segment is run again with the step halved, at most this many times
-        (0: no retry) before the run stops with the time and the cause.
-    time_budget : float or None
-        Wall time one run (one excitation) may take, s; checked between
-        segments of the integration (None: no limit).
-    divergence_displacement : float
-        Engine centre-of-gravity displacement from the preloaded position
-        above which the run stops as diverging, m.
-    start : {"auto", "steady", "rest"}
-        Where a time-domain run starts (:mod:`workbook.solve.steady_start`):
-        in the steady state of its linearised scene, the excitation in full
-        from the first step (``"steady"``); at rest, the excitation rising
-        over ``ramp_periods`` and the settle time after it (``"rest"``);
-        ``"auto"`` (the default): steady when the scene is linear, at rest
-        when a hinge clearance makes it nonlinear.
-    """
-
-    steps_per_period: int = 40
-    ramp_periods: float = 10.0
-    settle_time_constants: float = 1.0
-    settle_time: float | None = None
-    measured_periods: int = 20
-    steady_tolerance: float = 0.005
-    spectral_radius: float = 0.9
-    newton_tolerance: float = 1e-6
-    equilibrium_tolerance: float = 1e-6
-    method: AnalysisMethod = "auto"
-    step_halvings: int = 4
-    time_budget: float | None = None
-    divergence_displacement: float = 0.05
-    start: TimeStart = "auto"
+    steps_per_period: int = field(default=40, metadata=spec(
+        "Time steps per period of the excitation (at least 8; 40 recommended: 20 gave amplitudes about 1 % low; "
+        "the error is about (2 pi / n)^2 / 6)", type="int", check="own"))
+    ramp_periods: float = field(default=10.0, metadata=spec(
+        "The excitation rises smoothly (raised cosine) over this many periods, which keeps the mounted modes "
+        "from being excited by the start", unit=DIMENSIONLESS, minimum=0.0,
+        help="periods over which the excitation rises"))
+    settle_time_constants: float = field(default=1.0, metadata=spec(
+        "Settle time after the ramp, in decay time constants 1/(zeta w) of the least damped mounted mode (one "
+        "is ample after the smooth start: on the reference mount even none changed T by less than 0.05 %)",
+        unit=DIMENSIONLESS, minimum=0.0,
+        help="settle time after the ramp in decay time constants of the least damped mounted mode"))
+    settle_time: float | None = field(default=None, metadata=spec(
+        "Fixed settle time after the ramp (None: from the damping)", unit="s", minimum=0.0, optional=True,
+        help="fixed settle time (empty: from the damping)"))
+    measured_periods: int = field(default=20, metadata=spec(
+        "Periods per measured window; two consecutive windows are compared", type="int", check="own"))
+    steady_tolerance: float = field(default=0.005, metadata=spec(
+        "Largest relative change of the pylon-force amplitudes between the two windows for the run to count "
+        "as steady", unit=DIMENSIONLESS, minimum=0.0, strictly=True,
+        help="largest change between the two last windows"))
+    spectral_radius: float = field(default=0.9, metadata=spec(
+        "Generalized-alpha spectral radius at infinite frequency (1: no numerical damping), at most 1",
+        unit=DIMENSIONLESS, minimum=0.0, help="generalized-alpha spectral radius (0 to 1)"))
+    newton_tolerance: float = field(default=1e-6, metadata=spec(
+        "Newton absolute tolerance relative to the load scale (largest of the static load and the excitation "
+        "amplitude)", unit=DIMENSIONLESS, minimum=0.0, strictly=True,
+        help="Newton tolerance relative to the load scale"))
+    equilibrium_tolerance: float = field(default=1e-6, metadata=spec(
+        "Largest relative mismatch between the pylon-side hinge forces and the applied static loads",
+        unit=DIMENSIONLESS, minimum=0.0, strictly=True, help="largest relative mismatch of the static equilibrium"))
+    method: AnalysisMethod = field(default="auto", metadata=spec(
+        'The analysis answering the case: ``"auto"`` (the default: frequency domain when the scene is linear, '
+        "time domain when a clearance law makes it nonlinear, see :mod:`workbook.solve.method`), time domain, "
+        "or frequency domain (harmonic solution of the scene linearised about the preload). A sweep on a "
+        "linear scene always takes one linearisation for all its frequencies", check="choice",
+        choices=ANALYSIS_METHODS,
+        help="time: time domain; frequency: frequency domain about the preload; auto: frequency domain "
+             "unless a clearance makes the scene nonlinear"))
+    step_halvings: int = field(default=4, metadata=spec(
+        "When Newton's method fails in a segment of the time integration, the segment is run again with the "
+        "step halved, at most this many times (0: no retry; at most 20) before the run stops with the time "
+        "and the cause", type="int", check="own"))
+    time_budget: float | None = field(default=None, metadata=spec(
+        "Wall time one run (one excitation) may take; checked between segments of the integration (None: no "
+        "limit)", unit="s", minimum=0.0, strictly=True, optional=True,
+        help="wall time one run may take (empty: no limit)"))
+    divergence_displacement: float = field(default=0.05, metadata=spec(
+        "Engine centre-of-gravity displacement from the preloaded position above which the run stops as "
+        "diverging", unit="m", minimum=0.0, strictly=True,
+        help="engine displacement from the preloaded position that stops a run as diverging"))
+    start: TimeStart = field(default="auto", metadata=spec(
+        "Where a time-domain run starts (:mod:`workbook.solve.steady_start`): in the steady state of its "
+        'linearised scene, the excitation in full from the first step (``"steady"``); at rest, the excitation '
+        'rising over ``ramp_periods`` and the settle time after it (``"rest"``); ``"auto"`` (the default): '
+        "steady when the scene is linear, at rest when a hinge clearance makes it nonlinear", check="choice",
+        choices=TIME_STARTS,
+        help="where a time-domain run starts: steady: in the steady state of its linearised scene (two windows "
+             "suffice); rest: from rest with the smooth start and the settle time; auto: steady unless a "
+             "clearance makes the scene nonlinear"))
 
     def __post_init__(self):
         item = "analysis settings"
-        if self.start not in TIME_STARTS:
-            raise CaseError(item, "start", self.start, " or ".join(repr(s) for s in TIME_STARTS))
         if isinstance(self.step_halvings, bool) or not isinstance(self.step_halvings, int) \
                 or not 0 <= self.step_halvings <= 20:
             raise CaseError(item, "step_halvings", self.step_halvings, "a whole number from 0 to 20")
-        if self.time_budget is not None:
-            _set(self, "time_budget", fields.positive_number(item, "time_budget", self.time_budget))
-        _set(self, "divergence_displacement", fields.positive_number(item, "divergence_displacement",
-                                                                     self.divergence_displacement))
-        if self.method not in ANALYSIS_METHODS:
-            raise CaseError(item, "method", self.method, " or ".join(repr(m) for m in ANALYSIS_METHODS))
         for name in ("steps_per_period", "measured_periods"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise CaseError(item, name, value, "a positive whole number")
         if self.steps_per_period < 8:
             raise CaseError(item, "steps_per_period", self.steps_per_period, "at least 8")
-        _set(self, "ramp_periods", fields.number(item, "ramp_periods", self.ramp_periods, minimum=0.0))
-        _set(self, "settle_time_constants", fields.number(item, "settle_time_constants", self.settle_time_constants, minimum=0.0))
-        if self.settle_time is not None:
-            _set(self, "settle_time", fields.number(item, "settle_time", self.settle_time, minimum=0.0))
-        for name in ("steady_tolerance", "newton_tolerance", "equilibrium_tolerance"):
-            _set(self, name, fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True))
-        rho = fields.number(item, "spectral_radius", self.spectral_radius, minimum=0.0)
-        if rho > 1:
-            raise CaseError(item, "spectral_radius", rho, "a number from 0 to 1")
-        _set(self, "spectral_radius", rho)
+        check_fields(self, item)
+        if self.spectral_radius > 1:
+            raise CaseError(item, "spectral_radius", self.spectral_radius, "a number from 0 to 1")
 
 
+@documented
 @dataclass(frozen=True)
 class Effects:
-    """The physical effects a case asks for; what is off is not built.
+    """The physical effects a case asks for; what is off is not built."""
 
-    Parameters
-    ----------
-    flexible_links : bool
-        Links as reduced flexible bodies where the link asks for it; False
-        makes every link rigid.
-    preload : bool
-        Apply the static loads and solve the preloaded equilibrium first.
-    hinge_damping : bool
-        Hinge damping as given; False sets it to zero.
-    link_damping : bool
-        Rayleigh damping of the flexible links as given; False sets it to zero.
-    clearance : bool
-        Hinge clearance laws where a gap > 0 is given; False ignores the gaps.
-    rig_sensors : bool
-        The test rig's force transducers where the case gives them
-        (``Case.test_rig``); False mounts the pylon pins on rigid ground.
-    gyroscopics : bool
-        Build the rotors' gyroscopic moments when the case gives rotors
-        (``Case.rotors``); False leaves the rotors as inertia lumped in the
-        engine.
-    stress_stiffening : {"auto", "on", "off"}
-        The geometric stiffness of each flexible link's axial preload
-        (:mod:`workbook.solve.stress_stiffening`): "on" for every flexible
-        link, "auto" for the links whose preload moves their first
-        pinned-pinned mode by more than
-        :data:`~workbook.solve.stress_stiffening.AUTO_SHIFT`, "off" for none
-        (and no buckling check of the links).
-    """
-
-    flexible_links: bool = True
-    preload: bool = True
-    hinge_damping: bool = True
-    link_damping: bool = True
-    clearance: bool = True
-    rig_sensors: bool = True
-    gyroscopics: bool = True
-    stress_stiffening: StressStiffening = "auto"
+    flexible_links: bool = field(default=True, metadata=spec(
+        "Links as reduced flexible bodies where the link asks for it; False makes every link rigid", type="bool",
+        check="flag", help="no: every link rigid"))
+    preload: bool = field(default=True, metadata=spec(
+        "Apply the static loads and solve the preloaded equilibrium first", type="bool", check="flag",
+        help="solve the static loads first"))
+    hinge_damping: bool = field(default=True, metadata=spec(
+        "Hinge damping as given; False sets it to zero", type="bool", check="flag",
+        help="no: hinge damping set to zero"))
+    link_damping: bool = field(default=True, metadata=spec(
+        "Rayleigh damping of the flexible links as given; False sets it to zero", type="bool", check="flag",
+        help="no: link Rayleigh damping set to zero"))
+    clearance: bool = field(default=True, metadata=spec(
+        "Hinge clearance laws where a gap > 0 is given; False ignores the gaps", type="bool", check="flag",
+        help="no: hinge gaps ignored"))
+    rig_sensors: bool = field(default=True, metadata=spec(
+        "The test rig's force transducers where the case gives them (``Case.test_rig``); False mounts the "
+        "pylon pins on rigid ground", type="bool", check="flag",
+        help="no: the pylon pins sit on rigid ground even when the Test rig sheet gives transducers"))
+    gyroscopics: bool = field(default=True, metadata=spec(
+        "Build the rotors' gyroscopic moments when the case gives rotors (``Case.rotors``); False leaves the "
+        "rotors as inertia lumped in the engine", type="bool", check="flag",
+        help="no: the rotors' gyroscopic moments are not built (their inertia stays lumped in the engine)"))
+    stress_stiffening: StressStiffening = field(default="auto", metadata=spec(
+        "The geometric stiffness of each flexible link's axial preload (:mod:`workbook.solve.stress_stiffening`): "
+        '"on" for every flexible link, "auto" for the links whose preload moves their first pinned-pinned mode '
+        'by more than :data:`~workbook.solve.stress_stiffening.AUTO_SHIFT`, "off" for none (and no buckling '
+        "check of the links)", check="choice", choices=STRESS_STIFFENING,
+        help="the flexible links' geometric stiffness of their axial preload, with a buckling check: on; off; "
+             "auto: on for a link whose preload moves its first pinned-pinned mode by more than 0.5 %"))
 
     def __post_init__(self):
-        for item in dataclasses.fields(self):
-            if item.name == "stress_stiffening":
-                if self.stress_stiffening not in STRESS_STIFFENING:
-                    raise CaseError("effects", item.name, self.stress_stiffening,
-                                    " or ".join(repr(s) for s in STRESS_STIFFENING))
-            elif not isinstance(getattr(self, item.name), bool):
-                raise CaseError("effects", item.name, getattr(self, item.name), "True or False")
+        check_fields(self, "effects")
 
 
 @dataclass(frozen=True)

@@ -23,9 +23,9 @@ from workbook.model.units import DIMENSIONLESS
 __all__ = ["FieldSpec", "spec", "field_spec", "check_fields", "documented"]
 
 #: How a field is checked: a number, three numbers, a non-zero direction, one number or three (one per
-#: direction of a hinge frame), True or False; ``"own"``: by the class's own code (the spec only
-#: describes it).
-Check = Literal["number", "vector3", "direction", "per_direction", "flag", "own"]
+#: direction of a hinge frame), True or False, one of the spec's choices; ``"own"``: by the class's own
+#: code (the spec only describes it).
+Check = Literal["number", "vector3", "direction", "per_direction", "flag", "choice", "own"]
 
 _METADATA_KEY = "spec"
 _T = TypeVar("_T")
@@ -52,6 +52,8 @@ class FieldSpec:
         The value must be above *minimum*, not equal to it.
     optional : bool
         None is a value (the field's default says what it means).
+    choices : tuple of str
+        The values of a ``"choice"`` field.
     column : str or None
         Key of the field's sheet column (of its three ``_x``, ``_y``, ``_z``
         columns for a vector); None: the field's name.
@@ -66,6 +68,7 @@ class FieldSpec:
     minimum: float = -math.inf
     strictly: bool = False
     optional: bool = False
+    choices: tuple[str, ...] = ()
     column: str | None = None
     help: str = ""
 
@@ -75,6 +78,12 @@ class FieldSpec:
         if self.minimum == -math.inf:
             return ""
         return f"{'>' if self.strictly else '>='} {self.minimum:g}"
+
+    @property
+    def type_words(self) -> str:
+        """The numpydoc type: *type*, the set of *choices*, ``or None`` if *optional*."""
+        kind = "{" + ", ".join(f'"{choice}"' for choice in self.choices) + "}" if self.choices else self.type
+        return f"{kind} or None" if self.optional else kind
 
     @property
     def unit_words(self) -> str:
@@ -126,6 +135,10 @@ def _checked(field: FieldSpec, item: str, name: str, value: Any) -> Any:
         if not isinstance(value, bool):
             raise CaseError(item, name, value, "True or False")
         return value
+    if field.check == "choice":
+        if value not in field.choices:
+            raise CaseError(item, name, value, " or ".join(repr(choice) for choice in field.choices))
+        return value
     if field.check == "direction":
         return fields.direction(item, name, value)
     if field.check == "per_direction":
@@ -148,7 +161,7 @@ def documented(cls: type[_T]) -> type[_T]:
         raise TypeError(f"{cls.__name__}: fields without a spec: {', '.join(missing)}")
     lines = [inspect.cleandoc(cls.__doc__ or ""), "", "Parameters", "----------"]
     for name, field in specs.items():
-        lines.append(f"{name} : {field.type}{' or None' if field.optional else ''}")
+        lines.append(f"{name} : {field.type_words}")
         lines += textwrap.wrap(_description(field), width=76, initial_indent="    ", subsequent_indent="    ")
     cls.__doc__ = "\n".join(lines) + "\n"
     return cls
