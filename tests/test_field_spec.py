@@ -18,8 +18,9 @@ from numpydoc.docscrape import NumpyDocString
 from workbook.errors import CaseError
 from workbook.excel import layout
 from workbook.model.case import AnalysisSettings, Effects, Engine, ForceTransducers, Hinge, Link, Rotor
+from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
-from workbook.model.reference import reference_case
+from workbook.model.reference import reference_case, reference_casing
 
 CASE = reference_case()
 #: A valid instance of each described class, and the sheet its fields are read from.
@@ -31,6 +32,7 @@ DESCRIBED = {
     Rotor: (Rotor("LP spool", 2.5, frequency_hz=80.0), layout.ROTORS),
     AnalysisSettings: (AnalysisSettings(), layout.CASE),
     Effects: (Effects(), layout.CASE),
+    EngineCasing: (reference_casing(), layout.CASING),
 }
 
 
@@ -43,8 +45,8 @@ BOUNDED = [(cls, name, described) for cls in DESCRIBED for name, described in _s
 
 
 def _at(described: FieldSpec, value: float):
-    """*value* in the shape of the field: one number, or three (one of them *value*)."""
-    return (1.0, 1.0, value) if described.check == "vector3" else value
+    """*value* in the shape of the field: one number, or two or three (one of them *value*)."""
+    return {"vector3": (1.0, 1.0, value), "pair": (1.0, value)}.get(described.check, value)
 
 
 @pytest.mark.parametrize("cls, name, described", BOUNDED, ids=lambda p: getattr(p, "__name__", p))
@@ -91,7 +93,7 @@ def test_a_field_is_normalised_to_floats(cls):
         value = getattr(valid, name)
         if described.check == "number" and value is not None:
             assert type(value) is float, name
-        if described.check == "vector3" and value is not None:
+        if described.check in ("vector3", "pair") and value is not None:
             assert type(value) is tuple and all(type(v) is float for v in value), name
 
 

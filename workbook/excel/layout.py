@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from workbook.model.case import DIRECTIONS, AnalysisSettings, Effects, Engine, ForceTransducers, Hinge, Link, Rotor
+from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import field_spec
 from workbook.model.units import DIMENSIONLESS
 
@@ -369,15 +370,15 @@ CASING = Table("Engine casing", single_row=True, optional=True,
         _num(f"{ring}_width", f"{ring.replace('_', ' ')} width", "m", unit="mm", help="mount ring: axial width"),
         _num(f"{ring}_radius", f"{ring.replace('_', ' ')} radius", "m", unit="mm",
              help="mount ring: outer radius"))),
-    *(_num(key, f"bearing {k} x", "m", required=k <= 2, help="a bearing plane (the rotors' seat)")
+    *(_num(key, f"bearing {k} x", field_spec(EngineCasing, "bearing_planes").unit, required=k <= 2, help="a bearing plane (the rotors' seat)")
       for k, key in enumerate(CASING_BEARINGS, start=1)),
     *_material_columns("preset material (empty: titanium)"),
-    _num("element_size", "element size", "m", unit="mm", help="mesh size (empty: default)"),
-    _num("spider_radius", "spider radius", "m", unit="mm", help="casing surface tied to each mount eye (empty: 80 mm)"),
-    _num("bearing_band", "bearing band", "m", unit="mm", help="casing surface tied to each bearing plane"),
-    _num("bearing_axial", "bearing axial stiffness", "N/m", help="each bearing (empty: 1e10 N/m)"),
-    _num("bearing_radial", "bearing radial stiffness", "N/m", help="each bearing (empty: 1e10 N/m)"),
-    _num("modal_damping", "modal damping", help="damping ratio of each elastic casing mode (empty: 0.02)"),
+    *_field(EngineCasing, "element_size", "element size", unit="mm"),
+    *_field(EngineCasing, "spider_radius", "spider radius", unit="mm"),
+    *_field(EngineCasing, "bearing_band", "bearing band", unit="mm"),
+    *(_num(f"bearing_{direction}", f"bearing {direction} stiffness", field_spec(EngineCasing, "bearing_stiffness").unit,
+           help="each bearing (empty: 1e10 N/m)") for direction in ("axial", "radial")),
+    *_field(EngineCasing, "modal_damping", "modal damping"),
     Column("modes", "modes", "modes", help="auto, static or a mode count"),
     Column("mesh_file", "mesh file", "text", help="mesh file, relative to the workbook (instead of a geometry)"),
     Column("mesh_unit", "mesh unit", "unit", help="length unit of the mesh file (e.g. mm)"),

@@ -23,11 +23,13 @@ from workbook.model.units import DIMENSIONLESS
 __all__ = ["FieldSpec", "spec", "field_spec", "check_fields", "documented"]
 
 #: How a field is checked: a number, three numbers, a non-zero direction, one number or three (one per
-#: direction of a hinge frame), True or False, one of the spec's choices; ``"own"``: by the class's own
-#: code (the spec only describes it).
-Check = Literal["number", "vector3", "direction", "per_direction", "flag", "choice", "own"]
+#: direction of a hinge frame), two numbers (radial, axial; *minimum* 0), True or False, one of the spec's
+#: choices; ``"own"``: by the class's own code (the spec only describes it).
+Check = Literal["number", "vector3", "direction", "per_direction", "pair", "flag", "choice", "own"]
 
 _METADATA_KEY = "spec"
+#: Keeps a bound (``> 0``) on one line of the docstring.
+_GLUE = "\u00a0"
 _T = TypeVar("_T")
 
 
@@ -139,6 +141,8 @@ def _checked(field: FieldSpec, item: str, name: str, value: Any) -> Any:
         if value not in field.choices:
             raise CaseError(item, name, value, " or ".join(repr(choice) for choice in field.choices))
         return value
+    if field.check == "pair":
+        return fields.pair(item, name, value, strictly=field.strictly)
     if field.check == "direction":
         return fields.direction(item, name, value)
     if field.check == "per_direction":
@@ -162,13 +166,14 @@ def documented(cls: type[_T]) -> type[_T]:
     lines = [inspect.cleandoc(cls.__doc__ or ""), "", "Parameters", "----------"]
     for name, field in specs.items():
         lines.append(f"{name} : {field.type_words}")
-        lines += textwrap.wrap(_description(field), width=76, initial_indent="    ", subsequent_indent="    ")
+        lines += [line.replace(_GLUE, " ") for line in textwrap.wrap(
+            _description(field), width=76, initial_indent="    ", subsequent_indent="    ")]
     cls.__doc__ = "\n".join(lines) + "\n"
     return cls
 
 
 def _description(field: FieldSpec) -> str:
     """The docstring text of a field: its description, unit and bound."""
-    said = ", ".join(part for part in (field.unit_words, field.bound) if part)
+    said = ", ".join(part for part in (field.unit_words, field.bound.replace(" ", _GLUE)) if part)
     doc = field.doc.rstrip(".")
     return f"{doc}; {said}." if said else f"{doc}."
