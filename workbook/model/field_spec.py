@@ -111,9 +111,17 @@ def field_spec(cls: type, name: str) -> FieldSpec:
     raise KeyError(f"{cls.__name__}.{name} has no field spec")
 
 
-def _specs(cls: Any) -> list[tuple[str, FieldSpec]]:
-    return [(item.name, item.metadata[_METADATA_KEY]) for item in dataclasses.fields(cls)
-            if _METADATA_KEY in item.metadata]
+_SPECS: dict[type, tuple[tuple[str, FieldSpec], ...]] = {}
+
+
+def _specs(cls: type) -> tuple[tuple[str, FieldSpec], ...]:
+    """Name and spec of each field of dataclass *cls* that has one, in field order (found once per class)."""
+    found = _SPECS.get(cls)
+    if found is None:
+        found = _SPECS[cls] = tuple((item.name, item.metadata[_METADATA_KEY])
+                                    for item in dataclasses.fields(cls)
+                                    if _METADATA_KEY in item.metadata)
+    return found
 
 
 def check_fields(obj: Any, item: str) -> None:
@@ -147,6 +155,7 @@ def _checked(field: FieldSpec, item: str, name: str, value: Any) -> Any:
         return fields.direction(item, name, value)
     if field.check == "per_direction":
         return fields.per_direction(item, name, value, minimum=field.minimum, strictly=field.strictly)
+    # "vector3"
     vector = fields.vector3(item, name, value)
     if field.bound and not all(v > field.minimum if field.strictly else v >= field.minimum for v in vector):
         raise CaseError(item, name, value, f"three numbers {field.bound} ({field.unit_words} in x, y, z)")
