@@ -17,7 +17,7 @@ from numpydoc.docscrape import NumpyDocString
 
 from workbook.errors import CaseError
 from workbook.excel import layout
-from workbook.model.case import AnalysisSettings, Effects, Engine, ForceTransducers, Hinge, Link, Rotor
+from workbook.model.case import AnalysisSettings, Effects, Engine, ForceTransducers, Gravity, Hinge, Link, PointForce, PointMoment, Rotor
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.reference import reference_case, reference_casing
@@ -33,6 +33,9 @@ DESCRIBED = {
     AnalysisSettings: (AnalysisSettings(), layout.CASE),
     Effects: (Effects(), layout.CASE),
     EngineCasing: (reference_casing(), layout.CASING),
+    PointForce: (PointForce("thrust", (2.3e4, 0.0, 0.0), (0.9, 0.0, 0.0)), layout.STATIC_LOADS),
+    PointMoment: (PointMoment("torque", (1e4, 0.0, 0.0)), layout.STATIC_LOADS),
+    Gravity: (Gravity(), layout.STATIC_LOADS),
 }
 
 

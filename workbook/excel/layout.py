@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import DIRECTIONS, AnalysisSettings, Effects, Engine, ForceTransducers, Hinge, Link, Rotor
+from workbook.model.case import DIRECTIONS, AnalysisSettings, Effects, Engine, ForceTransducers, Gravity, Hinge, Link, PointForce, PointMoment, Rotor
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import field_spec
 from workbook.model.units import DIMENSIONLESS
@@ -281,10 +281,10 @@ STATIC_LOADS = Table("Static loads", help="constant loads solved first (the prel
     Column("name", "name", "text", required=True, help="unique load name"),
     Column("type", "type", "choice", required=True, choices=("force", "moment", "gravity"),
            help="force at a point, moment, or gravity on every body"),
-    *_xyz("force", "force", "N", help="force"),
-    *_xyz("point", "point", "m", help="point of the force"),
-    *_xyz("moment", "moment", "N*m", help="moment"),
-    *_xyz("acceleration", "acceleration", "m/s^2", help="gravitational acceleration ('g' = 9.80665 m/s^2)"),
+    *_field(PointForce, "force", "force"),
+    *_field(PointForce, "point", "point"),
+    *_field(PointMoment, "moment", "moment"),
+    *_field(Gravity, "acceleration", "acceleration"),
 ))
 
 EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a sweep runs one at many frequencies",

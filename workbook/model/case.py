@@ -346,44 +346,52 @@ class Hinge:
         return float(self.values("stiffness").max())
 
 
+_LOAD_NAME = spec("Unique name of the static load", type="str", check="own")
+
+
+@documented
 @dataclass(frozen=True)
 class PointForce:
-    """A constant force on the engine at a point (thrust, a static load), N and m."""
+    """A constant force on the engine at a point (thrust, a static load)."""
 
-    name: str
-    force: Vector3
-    point: Vector3
+    name: str = field(metadata=_LOAD_NAME)
+    force: Vector3 = field(metadata=spec("The force, global axes", type="3 floats", check="vector3", unit="N",
+                                         help="force"))
+    point: Vector3 = field(metadata=spec("Where it acts, global frame", type="3 floats", check="vector3", unit="m",
+                                         help="point of the force"))
 
     def __post_init__(self):
-        item = f"static load {self.name!r}"
         fields.nonempty_name("static load", self.name)
-        _set(self, "force", fields.vector3(item, "force", self.force))
-        _set(self, "point", fields.vector3(item, "point", self.point))
+        check_fields(self, f"static load {self.name!r}")
 
 
+@documented
 @dataclass(frozen=True)
 class PointMoment:
-    """A constant moment on the engine, N m."""
+    """A constant moment on the engine."""
 
-    name: str
-    moment: Vector3
+    name: str = field(metadata=_LOAD_NAME)
+    moment: Vector3 = field(metadata=spec("The moment, global axes", type="3 floats", check="vector3", unit="N*m",
+                                          help="moment"))
 
     def __post_init__(self):
-        item = f"static load {self.name!r}"
         fields.nonempty_name("static load", self.name)
-        _set(self, "moment", fields.vector3(item, "moment", self.moment))
+        check_fields(self, f"static load {self.name!r}")
 
 
+@documented
 @dataclass(frozen=True)
 class Gravity:
-    """Gravitational acceleration acting on every body (engine and links), m/s^2."""
+    """Gravitational acceleration acting on every body (engine and links)."""
 
-    name: str = "gravity"
-    acceleration: Vector3 = (0.0, 0.0, -9.81)
+    name: str = field(default="gravity", metadata=_LOAD_NAME)
+    acceleration: Vector3 = field(default=(0.0, 0.0, -9.81), metadata=spec(
+        "The acceleration of gravity, global axes (z up: 1 g level flight is (0, 0, -9.81))", type="3 floats",
+        check="vector3", unit="m/s^2", help="gravitational acceleration ('g' = 9.80665 m/s^2)"))
 
     def __post_init__(self):
         fields.nonempty_name("static load", self.name)
-        _set(self, "acceleration", fields.vector3(f"static load {self.name!r}", "acceleration", self.acceleration))
+        check_fields(self, f"static load {self.name!r}")
 
 
 StaticLoad = PointForce | PointMoment | Gravity
