@@ -17,7 +17,20 @@ from numpydoc.docscrape import NumpyDocString
 
 from workbook.errors import CaseError
 from workbook.excel import layout
-from workbook.model.case import AnalysisSettings, Effects, Engine, ForceTransducers, Gravity, Hinge, Link, PointForce, PointMoment, Rotor
+from workbook.model.case import (
+    AnalysisSettings,
+    Effects,
+    Engine,
+    ForceTransducers,
+    Gravity,
+    HarmonicForce,
+    Hinge,
+    Link,
+    PointForce,
+    PointMoment,
+    RotatingForce,
+    Rotor,
+)
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.reference import reference_case, reference_casing
@@ -36,6 +49,8 @@ DESCRIBED = {
     PointForce: (PointForce("thrust", (2.3e4, 0.0, 0.0), (0.9, 0.0, 0.0)), layout.STATIC_LOADS),
     PointMoment: (PointMoment("torque", (1e4, 0.0, 0.0)), layout.STATIC_LOADS),
     Gravity: (Gravity(), layout.STATIC_LOADS),
+    RotatingForce: (RotatingForce("LP rotor", (0.2, 0.0, 0.0), frequency_hz=50.0, unbalance=0.01), layout.EXCITATIONS),
+    HarmonicForce: (HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, rpm=3000.0), layout.EXCITATIONS),
 }
 
 

@@ -18,7 +18,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import DIRECTIONS, AnalysisSettings, Effects, Engine, ForceTransducers, Gravity, Hinge, Link, PointForce, PointMoment, Rotor
+from workbook.model.case import (
+    DIRECTIONS,
+    AnalysisSettings,
+    Effects,
+    Engine,
+    ForceTransducers,
+    Gravity,
+    HarmonicForce,
+    Hinge,
+    Link,
+    PointForce,
+    PointMoment,
+    RotatingForce,
+    Rotor,
+)
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import field_spec
 from workbook.model.units import DIMENSIONLESS
@@ -293,13 +307,13 @@ EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a
     Column("type", "type", "choice", required=True, choices=("rotating", "harmonic", "imbalance plane"),
            help="rotating imbalance force, fixed-direction harmonic force, or one plane of a several-plane "
                 "imbalance (rows of the same name are the planes of one rotor: speed and axis on the first)"),
-    *_xyz("point", "point", "m", required=True, help="point of application on the engine"),
-    _num("frequency", "frequency", "Hz", help="frequency (rpm accepted); empty for a sweep"),
-    _num("amplitude", "amplitude", "N", help="force amplitude"),
-    _num("unbalance", "unbalance", "kg*m", help="rotating: unbalance m e instead of the amplitude ('g' = gram)"),
-    *_xyz("axis", "axis", DIMENSIONLESS, help="rotating: spin axis (empty: x)"),
-    *_xyz("direction", "direction", DIMENSIONLESS, help="harmonic: force direction"),
-    _num("phase", "phase", "deg", help="phase at t = 0 (empty: 0)"),
+    *_field(HarmonicForce, "point", "point", required=True),
+    *_field(HarmonicForce, "frequency_hz", "frequency"),
+    *_field(HarmonicForce, "amplitude", "amplitude"),
+    *_field(RotatingForce, "unbalance", "unbalance"),
+    *_field(RotatingForce, "axis", "axis"),
+    *_field(HarmonicForce, "direction", "direction"),
+    *_field(HarmonicForce, "phase_deg", "phase"),
     _num("sweep_from", "sweep from", "Hz", help="sweep: first frequency"),
     _num("sweep_to", "sweep to", "Hz", help="sweep: last frequency"),
     Column("sweep_points", "sweep points", "integer", DIMENSIONLESS, help="sweep: number of frequencies"),

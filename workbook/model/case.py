@@ -475,6 +475,14 @@ class _OneFrequency:
         return _frequency("", self.frequency_hz, self.rpm)
 
 
+_EXCITATION_NAME = spec('Unique name, e.g. ``"LP rotor"``', type="str", check="own")
+_SPEED = spec("Frequency; give exactly one of *frequency_hz* and *rpm*", check="own", unit="Hz", minimum=0.0,
+              strictly=True, optional=True, column="frequency", help="frequency (rpm accepted); empty for a sweep")
+_RPM = spec("Frequency in revolutions per minute, instead of *frequency_hz*; > 0", check="own", optional=True)
+_PHASE = spec("Phase at t = 0", unit="deg", column="phase", help="phase at t = 0 (empty: 0)")
+
+
+@documented
 @dataclass(frozen=True)
 class RotatingForce(_OneFrequency):
     """A rotating imbalance force on the engine.
@@ -483,45 +491,32 @@ class RotatingForce(_OneFrequency):
     about it: ``F(t) = A (u cos(wt + phase) + v sin(wt + phase))`` with
     ``(u, v, axis)`` a right-handed orthonormal triad (for axis x: u = y,
     v = z, i.e. lateral plus vertical).
-
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"LP rotor"``.
-    point : 3 floats
-        The rotor's imbalance plane on the engine axis, m.
-    frequency_hz, rpm : float
-        Rotor speed; give exactly one.
-    amplitude, unbalance : float
-        Force amplitude A in N, or the unbalance m*e in kg m (then
-        A = m e w^2); give exactly one.
-    axis : 3 floats
-        Spin axis (not necessarily unit length).
-    phase_deg : float
-        Phase at t = 0, degrees.
     """
 
-    name: str
-    point: Vector3
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    amplitude: float | None = None
-    unbalance: float | None = None
-    axis: Vector3 = (1.0, 0.0, 0.0)
-    phase_deg: float = 0.0
+    name: str = field(metadata=_EXCITATION_NAME)
+    point: Vector3 = field(metadata=spec(
+        "The rotor's imbalance plane on the engine axis", type="3 floats", check="vector3", unit="m",
+        help="point of application on the engine"))
+    frequency_hz: float | None = field(default=None, metadata=_SPEED)
+    rpm: float | None = field(default=None, metadata=_RPM)
+    amplitude: float | None = field(default=None, metadata=spec(
+        "Force amplitude A; give exactly one of *amplitude* and *unbalance*", unit="N", minimum=0.0,
+        strictly=True, optional=True, help="force amplitude"))
+    unbalance: float | None = field(default=None, metadata=spec(
+        "The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
+        help="rotating: unbalance m e instead of the amplitude ('g' = gram)"))
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
+        "Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
+        help="rotating: spin axis (empty: x)"))
+    phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         fields.nonempty_name("excitation", self.name)
-        _set(self, "point", fields.vector3(item, "point", self.point))
+        check_fields(self, item)
         _frequency(item, self.frequency_hz, self.rpm)
         if (self.amplitude is None) == (self.unbalance is None):
             raise CaseError(item, "amplitude", self.amplitude, "either amplitude or unbalance, not both")
-        for name in ("amplitude", "unbalance"):
-            if getattr(self, name) is not None:
-                _set(self, name, fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True))
-        _set(self, "axis", fields.direction(item, "axis", self.axis))
-        _set(self, "phase_deg", fields.number(item, "phase_deg", self.phase_deg))
 
     @property
     def force_amplitude(self) -> float:
@@ -551,42 +546,27 @@ class RotatingForce(_OneFrequency):
         return ((self.point, *self.force_coefficients()),)
 
 
+@documented
 @dataclass(frozen=True)
 class HarmonicForce(_OneFrequency):
-    """A fixed-direction harmonic force on the engine: ``F(t) = A d cos(wt + phase)``.
+    """A fixed-direction harmonic force on the engine: ``F(t) = A d cos(wt + phase)``."""
 
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    point : 3 floats
-        Point of application on the engine, m.
-    direction : 3 floats
-        Direction d (normalised here).
-    frequency_hz, rpm : float
-        Frequency; give exactly one.
-    amplitude : float
-        Force amplitude A, N.
-    phase_deg : float
-        Phase at t = 0, degrees.
-    """
-
-    name: str
-    point: Vector3
-    direction: Vector3
-    amplitude: float
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    phase_deg: float = 0.0
+    name: str = field(metadata=_EXCITATION_NAME)
+    point: Vector3 = field(metadata=spec("Point of application on the engine", type="3 floats", check="vector3",
+                                         unit="m", help="point of application on the engine"))
+    direction: Vector3 = field(metadata=spec("Direction d (normalised where it is used)", type="3 floats",
+                                             check="direction", unit=DIMENSIONLESS, help="harmonic: force direction"))
+    amplitude: float = field(metadata=spec("Force amplitude A", unit="N", minimum=0.0, strictly=True,
+                                           help="force amplitude"))
+    frequency_hz: float | None = field(default=None, metadata=_SPEED)
+    rpm: float | None = field(default=None, metadata=_RPM)
+    phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         fields.nonempty_name("excitation", self.name)
-        _set(self, "point", fields.vector3(item, "point", self.point))
-        _set(self, "direction", fields.direction(item, "direction", self.direction))
-        _set(self, "amplitude", fields.positive_number(item, "amplitude", self.amplitude))
+        check_fields(self, item)
         _frequency(item, self.frequency_hz, self.rpm)
-        _set(self, "phase_deg", fields.number(item, "phase_deg", self.phase_deg))
 
     @property
     def force_amplitude(self) -> float:
