@@ -40,6 +40,8 @@ PLAIN_RAISES = {
     ("workbook/answers/isolation.py", "pylon_sum"): "a mount without pylon-side hinges is refused earlier as a mechanism",
     ("workbook/excel/layout.py", "Column.__post_init__"): "the package's own column table",
     ("workbook/excel/layout.py", "Table.column"): "the package's own column table",
+    ("workbook/model/field_spec.py", "field_spec"): "a field the package's own column table names",
+    ("workbook/model/field_spec.py", "documented"): "a case dataclass of the package without its field specs",
     ("workbook/scene/structural_damping.py", "equivalent_viscous_damping"): "frequencies the case checks are > 0",
     ("workbook/solve/preload.py", "applied_static_force"): "bodies of the scene the package built",
     ("workbook/studies/parallel.py", "_run_processes"): "a value the study runner sets",

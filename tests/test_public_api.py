@@ -44,7 +44,7 @@ INTERNAL_MODULES = (
     "workbook.excel.runs", "workbook.excel.sheets", "workbook.excel.styling", "workbook.excel.template",
     "workbook.excel.writer",
     "workbook.model", "workbook.model.case", "workbook.model.casing", "workbook.model.codec",
-    "workbook.model.drawing", "workbook.model.fields", "workbook.model.load_cases", "workbook.model.pylon",
+    "workbook.model.drawing", "workbook.model.field_spec", "workbook.model.fields", "workbook.model.load_cases", "workbook.model.pylon",
     "workbook.model.pylon_beam", "workbook.model.pylon_legacy", "workbook.model.pylon_impedance",
     "workbook.model.spectrum",
     "workbook.model.pylon_mesh", "workbook.model.reference", "workbook.model.units",

@@ -18,7 +18,23 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbook.model.case import ANALYSIS_METHODS, DIRECTIONS, STRESS_STIFFENING, TIME_STARTS
+from workbook.model.case import (
+    DIRECTIONS,
+    AnalysisSettings,
+    Effects,
+    Engine,
+    ForceTransducers,
+    Gravity,
+    HarmonicForce,
+    Hinge,
+    Link,
+    PointForce,
+    PointMoment,
+    RotatingForce,
+    Rotor,
+)
+from workbook.model.casing import EngineCasing
+from workbook.model.field_spec import field_spec
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -120,6 +136,21 @@ def _num(key, header, si_unit=DIMENSIONLESS, *, unit=None, required=False, help=
     return Column(key, header, "number", si_unit, unit, required, help=help)
 
 
+def _field(cls: type, name: str, header: str, *, unit: str | None = None,
+           required: bool = False) -> tuple[Column, ...]:
+    """The column of field *name* of the case dataclass *cls* (three of a vector): key, SI unit, choices and
+    help line from the field's spec (:mod:`workbook.model.field_spec`); *unit* is the template's display unit."""
+    described = field_spec(cls, name)
+    key = described.column or name
+    if described.check == "choice":
+        return (Column(key, header, "choice", required=required, choices=described.choices, help=described.help),)
+    if described.check == "flag":
+        return (Column(key, header, "yesno", required=required, help=described.help),)
+    if described.check in ("vector3", "direction"):
+        return _xyz(key, header, described.unit or DIMENSIONLESS, unit=unit, required=required, help=described.help)
+    return (_num(key, header, described.unit or DIMENSIONLESS, unit=unit, required=required, help=described.help),)
+
+
 def _material_columns(preset_help: str) -> tuple:
     """The material columns of a sheet: a preset, and E, nu and density overriding it."""
     return (Column("material", "material", "choice", choices=("steel", "titanium"), help=preset_help),
@@ -169,55 +200,43 @@ CASE = Table("Case", single_row=True, help="case name, analysis settings and the
     Column("description", "description", "text", help="free text"),
     Column("steps_per_period", "steps per period", "integer", DIMENSIONLESS,
            help="time steps per excitation period (at least 8; 40 recommended)"),
-    _num("ramp_periods", "ramp periods", help="periods over which the excitation rises"),
-    _num("settle_time_constants", "settle time constants",
-         help="settle time after the ramp in decay time constants of the least damped mounted mode"),
-    _num("settle_time", "settle time", "s", help="fixed settle time (empty: from the damping)"),
+    *_field(AnalysisSettings, "ramp_periods", "ramp periods"),
+    *_field(AnalysisSettings, "settle_time_constants", "settle time constants"),
+    *_field(AnalysisSettings, "settle_time", "settle time"),
     Column("measured_periods", "measured periods", "integer", DIMENSIONLESS,
            help="periods per measured window"),
-    _num("steady_tolerance", "steady tolerance", help="largest change between the two last windows"),
-    _num("spectral_radius", "spectral radius", help="generalized-alpha spectral radius (0 to 1)"),
-    _num("newton_tolerance", "newton tolerance", help="Newton tolerance relative to the load scale"),
-    _num("equilibrium_tolerance", "equilibrium tolerance",
-         help="largest relative mismatch of the static equilibrium"),
+    *_field(AnalysisSettings, "steady_tolerance", "steady tolerance"),
+    *_field(AnalysisSettings, "spectral_radius", "spectral radius"),
+    *_field(AnalysisSettings, "newton_tolerance", "newton tolerance"),
+    *_field(AnalysisSettings, "equilibrium_tolerance", "equilibrium tolerance"),
     Column("step_halvings", "step halvings", "integer", DIMENSIONLESS,
            help="a segment whose Newton iteration fails is run again with the step halved, at most this often"),
-    _num("time_budget", "time budget", "s", help="wall time one run may take (empty: no limit)"),
-    _num("divergence_displacement", "divergence limit", "m", unit="mm",
-         help="engine displacement from the preloaded position that stops a run as diverging"),
-    Column("method", "method", "choice", choices=ANALYSIS_METHODS,
-           help="time: time domain; frequency: frequency domain about the preload; auto: frequency domain "
-                "unless a clearance makes the scene nonlinear"),
-    Column("flexible_links", "flexible links", "yesno", help="no: every link rigid"),
-    Column("preload", "preload", "yesno", help="solve the static loads first"),
-    Column("hinge_damping", "hinge damping", "yesno", help="no: hinge damping set to zero"),
-    Column("link_damping", "link damping", "yesno", help="no: link Rayleigh damping set to zero"),
-    Column("clearance", "clearance", "yesno", help="no: hinge gaps ignored"),
-    Column("gyroscopics", "gyroscopics", "yesno",
-           help="no: the rotors' gyroscopic moments are not built (their inertia stays lumped in the engine)"),
-    Column("rig_sensors", "rig sensors", "yesno",
-           help="no: the pylon pins sit on rigid ground even when the Test rig sheet gives transducers"),
-    Column("stress_stiffening", "stress stiffening", "choice", choices=STRESS_STIFFENING,
-           help="the flexible links' geometric stiffness of their axial preload, with a buckling check: on; off; "
-                "auto: on for a link whose preload moves its first pinned-pinned mode by more than 0.5 %"),
-    Column("start", "start", "choice", choices=TIME_STARTS,
-           help="where a time-domain run starts: steady: in the steady state of its linearised scene (two windows "
-                "suffice); rest: from rest with the smooth start and the settle time; auto: steady unless a "
-                "clearance makes the scene nonlinear"),
+    *_field(AnalysisSettings, "time_budget", "time budget"),
+    *_field(AnalysisSettings, "divergence_displacement", "divergence limit", unit="mm"),
+    *_field(AnalysisSettings, "method", "method"),
+    *_field(Effects, "flexible_links", "flexible links"),
+    *_field(Effects, "preload", "preload"),
+    *_field(Effects, "hinge_damping", "hinge damping"),
+    *_field(Effects, "link_damping", "link damping"),
+    *_field(Effects, "clearance", "clearance"),
+    *_field(Effects, "gyroscopics", "gyroscopics"),
+    *_field(Effects, "rig_sensors", "rig sensors"),
+    *_field(Effects, "stress_stiffening", "stress stiffening"),
+    *_field(AnalysisSettings, "start", "start"),
 ))
 
 ENGINE = Table("Engine", single_row=True, help="the rigid engine", columns=(
-    _num("mass", "mass", "kg", required=True, help="engine mass (t accepted)"),
-    *_xyz("cg", "CG", "m", required=True, help="centre of gravity"),
-    *(_num(f"i{ij}", f"I{ij}", "kg*m^2", required=ij in ("xx", "yy", "zz"),
+    *_field(Engine, "mass", "mass", required=True),
+    *_field(Engine, "center_of_mass", "CG", required=True),
+    *(_num(f"i{ij}", f"I{ij}", field_spec(Engine, "inertia").unit, required=ij in ("xx", "yy", "zz"),
            help=f"inertia tensor component {ij} about the CG (off-diagonal: empty = 0)")
       for ij in ("xx", "yy", "zz", "xy", "xz", "yz")),
 ))
 
 LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh file", columns=(
     Column("name", "name", "text", required=True, help="unique link name"),
-    *_xyz("end_a", "end A", "m", required=True, help="centre of eye A"),
-    *_xyz("end_b", "end B", "m", required=True, help="centre of eye B"),
+    *_field(Link, "end_a", "end A", required=True),
+    *_field(Link, "end_b", "end B", required=True),
     _num("length", "length", "m", help="eye distance; empty: from the ends, given: checked against them"),
     *_material_columns("preset material"),
     _num("eye_outer_radius", "eye outer radius", "m", unit="mm", help="parametric link: eye outer radius"),
@@ -229,10 +248,10 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     Column("interface", "interface", "choice", choices=("RBE2", "RBE3"), help="bore coupling"),
     Column("modes", "modes", "modes", help="auto, static, a mode count or a cut-off such as '2000 Hz'"),
     Column("flexible", "flexible", "yesno", help="no: rigid link"),
-    _num("stiffness_damping", "stiffness damping", "s", help="Rayleigh stiffness-proportional damping"),
-    _num("mass_damping", "mass damping", "1/s", help="Rayleigh mass-proportional damping"),
-    _num("spin_frequency_hz", "spin frequency", "Hz", help="torsional restraint about the link axis"),
-    *_xyz("bore_axis", "bore axis", DIMENSIONLESS, help="global direction of the bore axes (empty: default)"),
+    *_field(Link, "stiffness_damping", "stiffness damping"),
+    *_field(Link, "mass_damping", "mass damping"),
+    *_field(Link, "spin_frequency_hz", "spin frequency"),
+    *_field(Link, "bore_axis", "bore axis"),
     Column("mesh_file", "mesh file", "text", help="mesh file, relative to the workbook (instead of a geometry)"),
     Column("mesh_unit", "mesh unit", "unit", help="length unit of the mesh file (e.g. mm)"),
     Column("bore_a_set", "bore A node set", "text", help="mesh: node set of bore A"),
@@ -240,8 +259,8 @@ LINKS = Table("Links", help="connecting links: a parametric geometry or a mesh f
     *_xyz("mesh_bore_a", "mesh bore A", "m", unit="mm", help="mesh: a point on bore A's axis, mesh frame"),
     *_xyz("mesh_bore_b", "mesh bore B", "m", unit="mm", help="mesh: a point on bore B's axis, mesh frame"),
     *_xyz("mesh_bore_axis", "mesh bore axis", DIMENSIONLESS, help="mesh: bore axis direction, mesh frame"),
-    _num("loss_factor", "loss factor", help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"),
-    _num("modal_damping", "modal damping", help="damping ratio zeta of each elastic mode of the link (empty: 0)"),
+    *_field(Link, "loss_factor", "loss factor"),
+    *_field(Link, "modal_damping", "modal damping"),
     *(_num(key, key.replace("_", " "), "Pa", unit="MPa", help=f"{what} overriding the preset's (load cases, fatigue)")
       for key, what in (("yield_strength", "tensile yield strength (0.2 % proof)"),
                         ("ultimate_strength", "tensile ultimate strength"),
@@ -256,17 +275,15 @@ HINGES = Table("Hinges", help="ball hinges: spring-dampers between two bodies", 
     Column("name", "name", "text", required=True, help="unique hinge name"),
     Column("body_a", "body A", "text", required=True, help="pylon, engine or a link name"),
     Column("body_b", "body B", "text", required=True, help="pylon, engine or a link name"),
-    *_xyz("position", "position", "m", required=True, help="hinge centre: an eye centre of its links"),
-    _num("stiffness", "stiffness", "N/m", required=True,
-         help="translational stiffness (with the radial 2 or axial columns: radial 1)"),
-    _num("damping", "damping", "N*s/m", help="translational damping (empty: 0)"),
-    _num("radial_clearance", "radial clearance", "m", unit="mm", help="bearing gap (empty: 0)"),
-    _num("contact_stiffness", "contact stiffness", "N/m", help="stiffness once the gap closes"),
-    _num("loss_factor", "loss factor", help="structural loss factor eta, k (1 + i eta) (empty: 0)"),
-    *(_num(f"{key}_{suffix}", f"{header} {direction}", unit, help=f"{header} along the hinge frame's {direction} "
-           f"direction (empty: as '{header}')")
-      for key, header, unit in (("stiffness", "stiffness", "N/m"), ("damping", "damping", "N*s/m"),
-                                ("loss_factor", "loss factor", DIMENSIONLESS))
+    *_field(Hinge, "position", "position", required=True),
+    *_field(Hinge, "stiffness", "stiffness", required=True),
+    *_field(Hinge, "damping", "damping"),
+    *_field(Hinge, "radial_clearance", "radial clearance", unit="mm"),
+    *_field(Hinge, "contact_stiffness", "contact stiffness"),
+    *_field(Hinge, "loss_factor", "loss factor"),
+    *(_num(f"{key}_{suffix}", f"{header} {direction}", field_spec(Hinge, key).unit,
+           help=f"{header} along the hinge frame's {direction} direction (empty: as '{header}')")
+      for key, header in (("stiffness", "stiffness"), ("damping", "damping"), ("loss_factor", "loss factor"))
       for suffix, direction in (("radial_2", "radial 2"), ("axial", "axial"))),
     *_xyz("frame_radial_1", "frame radial 1", DIMENSIONLESS,
           help="hinge frame: radial 1 direction, unit length (empty: the link's frame)"),
@@ -278,10 +295,10 @@ STATIC_LOADS = Table("Static loads", help="constant loads solved first (the prel
     Column("name", "name", "text", required=True, help="unique load name"),
     Column("type", "type", "choice", required=True, choices=("force", "moment", "gravity"),
            help="force at a point, moment, or gravity on every body"),
-    *_xyz("force", "force", "N", help="force"),
-    *_xyz("point", "point", "m", help="point of the force"),
-    *_xyz("moment", "moment", "N*m", help="moment"),
-    *_xyz("acceleration", "acceleration", "m/s^2", help="gravitational acceleration ('g' = 9.80665 m/s^2)"),
+    *_field(PointForce, "force", "force"),
+    *_field(PointForce, "point", "point"),
+    *_field(PointMoment, "moment", "moment"),
+    *_field(Gravity, "acceleration", "acceleration"),
 ))
 
 EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a sweep runs one at many frequencies",
@@ -290,13 +307,13 @@ EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a
     Column("type", "type", "choice", required=True, choices=("rotating", "harmonic", "imbalance plane"),
            help="rotating imbalance force, fixed-direction harmonic force, or one plane of a several-plane "
                 "imbalance (rows of the same name are the planes of one rotor: speed and axis on the first)"),
-    *_xyz("point", "point", "m", required=True, help="point of application on the engine"),
-    _num("frequency", "frequency", "Hz", help="frequency (rpm accepted); empty for a sweep"),
-    _num("amplitude", "amplitude", "N", help="force amplitude"),
-    _num("unbalance", "unbalance", "kg*m", help="rotating: unbalance m e instead of the amplitude ('g' = gram)"),
-    *_xyz("axis", "axis", DIMENSIONLESS, help="rotating: spin axis (empty: x)"),
-    *_xyz("direction", "direction", DIMENSIONLESS, help="harmonic: force direction"),
-    _num("phase", "phase", "deg", help="phase at t = 0 (empty: 0)"),
+    *_field(HarmonicForce, "point", "point", required=True),
+    *_field(HarmonicForce, "frequency_hz", "frequency"),
+    *_field(HarmonicForce, "amplitude", "amplitude"),
+    *_field(RotatingForce, "unbalance", "unbalance"),
+    *_field(RotatingForce, "axis", "axis"),
+    *_field(HarmonicForce, "direction", "direction"),
+    *_field(HarmonicForce, "phase_deg", "phase"),
     _num("sweep_from", "sweep from", "Hz", help="sweep: first frequency"),
     _num("sweep_to", "sweep to", "Hz", help="sweep: last frequency"),
     Column("sweep_points", "sweep points", "integer", DIMENSIONLESS, help="sweep: number of frequencies"),
@@ -339,18 +356,17 @@ ROTORS = Table("Rotors", optional=True,
                help="spinning rotors whose gyroscopic moments act on the engine (their mass and inertia are "
                     "in the Engine sheet)", columns=(
     Column("name", "name", "text", required=True, help="unique rotor name"),
-    _num("polar_inertia", "polar inertia", "kg*m^2", required=True,
-         help="polar moment of inertia about the spin axis"),
-    _num("frequency_hz", "speed", "Hz", required=True, help="spin speed (rpm accepted)"),
+    *_field(Rotor, "polar_inertia", "polar inertia", required=True),
+    *_field(Rotor, "frequency_hz", "speed", required=True),
     Column("axis", "spin axis", "choice", choices=DIRECTIONS,
            help="spin axis in engine coordinates, spinning right-handed about it (empty: x)"),
 ))
 
 TEST_RIG = Table("Test rig", single_row=True, optional=True,
                  help="the rig's three-way force transducers under the pylon pins (empty: rigid ground)", columns=(
-    *_xyz("stiffness", "stiffness", "N/m", required=True, help="stiffness of each transducer with its fixture"),
-    _num("mass", "mass", "kg", help="moving mass of each transducer with its fitting (empty: 1 kg)"),
-    *_xyz("damping", "damping", "N*s/m", help="damping of each transducer (empty: 0)"),
+    *_field(ForceTransducers, "stiffness", "stiffness", required=True),
+    *_field(ForceTransducers, "mass", "mass"),
+    *_field(ForceTransducers, "damping", "damping"),
 ))
 
 CASING_RINGS = ("front_ring", "rear_ring")
@@ -368,15 +384,15 @@ CASING = Table("Engine casing", single_row=True, optional=True,
         _num(f"{ring}_width", f"{ring.replace('_', ' ')} width", "m", unit="mm", help="mount ring: axial width"),
         _num(f"{ring}_radius", f"{ring.replace('_', ' ')} radius", "m", unit="mm",
              help="mount ring: outer radius"))),
-    *(_num(key, f"bearing {k} x", "m", required=k <= 2, help="a bearing plane (the rotors' seat)")
+    *(_num(key, f"bearing {k} x", field_spec(EngineCasing, "bearing_planes").unit, required=k <= 2, help="a bearing plane (the rotors' seat)")
       for k, key in enumerate(CASING_BEARINGS, start=1)),
     *_material_columns("preset material (empty: titanium)"),
-    _num("element_size", "element size", "m", unit="mm", help="mesh size (empty: default)"),
-    _num("spider_radius", "spider radius", "m", unit="mm", help="casing surface tied to each mount eye (empty: 80 mm)"),
-    _num("bearing_band", "bearing band", "m", unit="mm", help="casing surface tied to each bearing plane"),
-    _num("bearing_axial", "bearing axial stiffness", "N/m", help="each bearing (empty: 1e10 N/m)"),
-    _num("bearing_radial", "bearing radial stiffness", "N/m", help="each bearing (empty: 1e10 N/m)"),
-    _num("modal_damping", "modal damping", help="damping ratio of each elastic casing mode (empty: 0.02)"),
+    *_field(EngineCasing, "element_size", "element size", unit="mm"),
+    *_field(EngineCasing, "spider_radius", "spider radius", unit="mm"),
+    *_field(EngineCasing, "bearing_band", "bearing band", unit="mm"),
+    *(_num(f"bearing_{direction}", f"bearing {direction} stiffness", field_spec(EngineCasing, "bearing_stiffness").unit,
+           help="each bearing (empty: 1e10 N/m)") for direction in ("axial", "radial")),
+    *_field(EngineCasing, "modal_damping", "modal damping"),
     Column("modes", "modes", "modes", help="auto, static or a mode count"),
     Column("mesh_file", "mesh file", "text", help="mesh file, relative to the workbook (instead of a geometry)"),
     Column("mesh_unit", "mesh unit", "unit", help="length unit of the mesh file (e.g. mm)"),

@@ -28,7 +28,8 @@ import numpy as np
 from workbook.errors import CaseError
 from workbook.model import fields
 from workbook.model.casing import CASING, EngineCasing
-from workbook.model.fields import MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
+from workbook.model.field_spec import check_fields, documented, spec
+from workbook.model.fields import HINGE_DIRECTIONS, MAX_MODE_COUNT, MAX_SWEEP_POINTS, bounded_count
 from workbook.model.load_cases import LoadCase
 from workbook.model.pylon import PylonModel
 from workbook.model.pylon_beam import BoxBeamPylon
@@ -36,6 +37,7 @@ from workbook.model.pylon_impedance import PylonImpedance
 from workbook.model.pylon_legacy import accept_legacy_pylons, legacy_pylon
 from workbook.model.pylon_mesh import MeshPylon
 from workbook.model.spectrum import SpeedSpectrum
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["PYLON", "ENGINE", "DIRECTIONS", "HINGE_DIRECTIONS", "Engine", "Link", "Hinge",
     "PointForce", "PointMoment", "Gravity", "RotatingForce", "HarmonicForce",
@@ -122,32 +124,26 @@ def _set(obj: Any, name: str, value: Any) -> None:
     object.__setattr__(obj, name, value)
 
 
+@documented
 @dataclass(frozen=True)
 class Engine:
-    """The engine: one rigid body, or a flexible casing and a rigid core.
+    """The engine: one rigid body, or a flexible casing and a rigid core."""
 
-    Parameters
-    ----------
-    mass : float
-        Mass in kg.
-    center_of_mass : 3 floats
-        Centre of gravity in the global frame, m.
-    inertia : 3x3 floats
-        Inertia tensor about the centre of gravity, global axes, kg m^2.
-    casing : EngineCasing or None
-        The casing as a flexible body (None: the engine is one rigid body);
-        see :mod:`workbook.model.casing`.
-    """
-
-    mass: float
-    center_of_mass: Vector3
-    inertia: tuple[Vector3, Vector3, Vector3]
-    casing: EngineCasing | None = None
+    mass: float = field(metadata=spec("Mass of the engine", unit="kg", minimum=0.0, strictly=True,
+                                      help="engine mass (t accepted)"))
+    center_of_mass: Vector3 = field(metadata=spec(
+        "Centre of gravity in the global frame", type="3 floats", check="vector3", unit="m", column="cg",
+        help="centre of gravity"))
+    inertia: tuple[Vector3, Vector3, Vector3] = field(metadata=spec(
+        "Inertia tensor about the centre of gravity, global axes: symmetric, positive definite, its principal "
+        "moments obeying the triangle inequality", type="3x3 floats", check="own", unit="kg*m^2"))
+    casing: EngineCasing | None = field(default=None, metadata=spec(
+        "The casing as a flexible body (None: the engine is one rigid body); see :mod:`workbook.model.casing`",
+        type="EngineCasing", check="own", optional=True))
 
     def __post_init__(self):
         item = "engine"
-        _set(self, "mass", fields.positive_number(item, "mass", self.mass))
-        _set(self, "center_of_mass", fields.vector3(item, "center_of_mass", self.center_of_mass))
+        check_fields(self, item)
         try:
             rows = tuple(fields.vector3(item, "inertia", row) for row in self.inertia)
         except TypeError:
@@ -172,64 +168,55 @@ class Engine:
         return np.array(self.inertia)
 
 
+@documented
 @dataclass(frozen=True)
 class Link:
-    """A connecting link with a ball hinge eye at each end.
+    """A connecting link with a ball hinge eye at each end."""
 
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"front-left"``.
-    end_a, end_b : 3 floats
-        Global positions of the centres of eye A and eye B, m. Their distance
-        must equal the link model's eye distance.
-    model : flexbodies.LinkModel
-        Geometry or mesh, material, meshing and interface choices.
-    modes : {"auto", "static"} or int or ModeCutoff or str
-        Craig-Bampton fixed-interface modes kept: the low-frequency rule, none,
-        a count, or a cut-off frequency (:class:`ModeCutoff` or ``"500 Hz"``);
-        see :func:`mode_request`.
-    flexible : bool
-        False models the link as a rigid body with the same mass properties.
-    stiffness_damping : float
-        Rayleigh stiffness-proportional damping of the link, s.
-    mass_damping : float
-        Rayleigh mass-proportional damping of the link, 1/s.
-    loss_factor : float
-        Material loss factor eta of the link (complex modulus: the link's
-        elastic stiffness acts as K (1 + i eta)), dimensionless, >= 0.
-    modal_damping : float
-        Damping ratio zeta of each of the link's elastic modes (the
-        free-free modes of its reduced model, the coordinates of its
-        flexible body): a modal damper ``2 zeta w_i`` per mass-normalised
-        mode, in both domains; dimensionless, 0 <= zeta < 1.
-    spin_frequency_hz : float or None
-        Frequency of the torsional restraint of the free spin about the link
-        axis (None: the flexbodies default).
-    bore_axis : 3 floats or None
-        Global direction of the bore axes (None: the flexbodies default).
-    """
-
-    name: str
-    end_a: Vector3
-    end_b: Vector3
-    model: Any
-    modes: ModeRequest = "auto"
-    flexible: bool = True
-    stiffness_damping: float = 0.0
-    mass_damping: float = 0.0
-    spin_frequency_hz: float | None = None
-    bore_axis: Vector3 | None = None
-    loss_factor: float = 0.0
-    modal_damping: float = 0.0
+    name: str = field(metadata=spec('Unique name, e.g. ``"front-left"``', type="str", check="own"))
+    end_a: Vector3 = field(metadata=spec(
+        "Global position of the centre of eye A", type="3 floats", check="vector3", unit="m",
+        help="centre of eye A"))
+    end_b: Vector3 = field(metadata=spec(
+        "Global position of the centre of eye B: as far from *end_a* as the link model's eye distance",
+        type="3 floats", check="vector3", unit="m", help="centre of eye B"))
+    model: Any = field(metadata=spec("Geometry or mesh, material, meshing and interface choices",
+                                     type="flexbodies.LinkModel", check="own"))
+    modes: ModeRequest = field(default="auto", metadata=spec(
+        "Craig-Bampton fixed-interface modes kept: the low-frequency rule, none, a count, or a cut-off frequency "
+        '(:class:`ModeCutoff` or ``"500 Hz"``); see :func:`mode_request`',
+        type='{"auto", "static"} or int or ModeCutoff or str', check="own"))
+    flexible: bool = field(default=True, metadata=spec(
+        "False models the link as a rigid body with the same mass properties", type="bool", check="flag"))
+    stiffness_damping: float = field(default=0.0, metadata=spec(
+        "Rayleigh stiffness-proportional damping of the link", unit="s", minimum=0.0,
+        help="Rayleigh stiffness-proportional damping"))
+    mass_damping: float = field(default=0.0, metadata=spec(
+        "Rayleigh mass-proportional damping of the link", unit="1/s", minimum=0.0,
+        help="Rayleigh mass-proportional damping"))
+    spin_frequency_hz: float | None = field(default=None, metadata=spec(
+        "Frequency of the torsional restraint of the free spin about the link axis (None: the flexbodies "
+        "default)", unit="Hz", minimum=0.0, strictly=True, optional=True,
+        help="torsional restraint about the link axis"))
+    bore_axis: Vector3 | None = field(default=None, metadata=spec(
+        "Global direction of the bore axes (None: the flexbodies default)", type="3 floats", check="vector3",
+        unit=DIMENSIONLESS, optional=True, help="global direction of the bore axes (empty: default)"))
+    loss_factor: float = field(default=0.0, metadata=spec(
+        "Material loss factor eta of the link (complex modulus: the link's elastic stiffness acts as "
+        "K (1 + i eta))", unit=DIMENSIONLESS, minimum=0.0,
+        help="material loss factor eta: complex modulus E (1 + i eta) (empty: 0)"))
+    modal_damping: float = field(default=0.0, metadata=spec(
+        "Damping ratio zeta of each of the link's elastic modes (the free-free modes of its reduced model, "
+        "the coordinates of its flexible body): a modal damper ``2 zeta w_i`` per mass-normalised mode, in "
+        "both domains; below 1", unit=DIMENSIONLESS, minimum=0.0,
+        help="damping ratio zeta of each elastic mode of the link (empty: 0)"))
 
     def __post_init__(self):
         item = f"link {self.name!r}"
         fields.nonempty_name("link", self.name)
         if self.name in _RESERVED:
             raise CaseError(item, "name", self.name, f"a name other than {_RESERVED}")
-        _set(self, "end_a", fields.vector3(item, "end_a", self.end_a))
-        _set(self, "end_b", fields.vector3(item, "end_b", self.end_b))
+        check_fields(self, item)
         if self.length <= POINT_TOLERANCE:
             raise CaseError(item, "end_b", self.end_b, "a point apart from end_a")
         geometry = getattr(self.model, "geometry", None)
@@ -238,19 +225,8 @@ class Link:
                             f"a point {geometry.length:g} m from end_a (the link's eye distance); "
                             f"the ends are {self.length:g} m apart")
         _set(self, "modes", mode_request(self.modes, item))
-        if not isinstance(self.flexible, bool):
-            raise CaseError(item, "flexible", self.flexible, "True or False")
-        _set(self, "stiffness_damping",
-             fields.number(item, "stiffness_damping", self.stiffness_damping, minimum=0.0))
-        _set(self, "mass_damping", fields.number(item, "mass_damping", self.mass_damping, minimum=0.0))
-        _set(self, "loss_factor", fields.number(item, "loss_factor", self.loss_factor, minimum=0.0))
-        _set(self, "modal_damping", fields.number(item, "modal_damping", self.modal_damping, minimum=0.0))
         if self.modal_damping >= 1.0:
             raise CaseError(item, "modal_damping", self.modal_damping, "a damping ratio >= 0 and < 1")
-        if self.spin_frequency_hz is not None:
-            _set(self, "spin_frequency_hz", fields.positive_number(item, "spin_frequency_hz", self.spin_frequency_hz))
-        if self.bore_axis is not None:
-            _set(self, "bore_axis", fields.vector3(item, "bore_axis", self.bore_axis))
 
     @property
     def length(self) -> float:
@@ -263,25 +239,6 @@ class Link:
             if np.linalg.norm(np.subtract(point, end)) <= POINT_TOLERANCE:
                 return eye
         return None
-
-
-#: Names of a hinge's three directions (:attr:`Hinge.frame`).
-HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
-
-
-def _per_direction(item: str, name: str, value: Any, *, strictly: bool) -> float | tuple[float, ...]:
-    """*value* as one number or three numbers (one per hinge direction), each >= 0 (> 0 if *strictly*).
-
-    A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
-    """
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
-        return fields.number(item, name, value, minimum=0.0, strictly=strictly)
-    values = tuple(value)
-    if len(values) != 3:
-        raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
-                                           f"{len(values)} given")
-    return tuple(fields.number(item, f"{name}[{direction}]", v, minimum=0.0, strictly=strictly)
-                 for v, direction in zip(values, HINGE_DIRECTIONS, strict=True))
 
 
 def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
@@ -300,6 +257,7 @@ def _frame(value: Any, item: str) -> tuple[Vector3, Vector3, Vector3]:
     return rows
 
 
+@documented
 @dataclass(frozen=True)
 class Hinge:
     """A ball hinge: a translational spring-damper between two bodies.
@@ -309,47 +267,38 @@ class Hinge:
     the hinge's frame (:data:`HINGE_DIRECTIONS`): two radial and one along
     the bore (pin) axis, as a spherical bearing in a link eye is stiffer
     radially than along its pin.
-
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"front-up-left"``.
-    body_a, body_b : str
-        The two bodies joined: ``"pylon"``, ``"engine"`` or a link name.
-    position : 3 floats
-        Hinge centre, m; on a link it must be one of the link's eye centres.
-    stiffness : float or 3 floats
-        Translational stiffness, N/m: in every direction, or per direction
-        of the frame.
-    damping : float or 3 floats
-        Translational (viscous) damping, N s/m, likewise.
-    radial_clearance : float
-        Gap of the spherical bearing, m (0: no clearance law is built).
-    contact_stiffness : float or None
-        Stiffness once the gap is closed, N/m (None: *stiffness*).
-    loss_factor : float or 3 floats
-        Structural (hysteretic) loss factor eta, dimensionless, >= 0: the
-        hinge's stiffness acts as k (1 + i eta), a damping force in phase
-        with the velocity whose size does not grow with the frequency
-        (docs/physics.md, hinge damping); likewise one or three values.
-    frame : 3x3 floats or None
-        The hinge's directions radial 1, radial 2, axial as rows, in global
-        coordinates (orthonormal). None: the frame of the link the hinge
-        sits on (radial 1 along the link towards eye B, axial along its
-        bore axis), or the global axes x, y, z for a hinge between the
-        pylon and the engine. Only per-direction values use it.
     """
 
-    name: str
-    body_a: str
-    body_b: str
-    position: Vector3
-    stiffness: float | Vector3
-    damping: float | Vector3 = 0.0
-    radial_clearance: float = 0.0
-    contact_stiffness: float | None = None
-    loss_factor: float | Vector3 = 0.0
-    frame: tuple[Vector3, Vector3, Vector3] | None = None
+    name: str = field(metadata=spec('Unique name, e.g. ``"front-up-left"``', type="str", check="own"))
+    body_a: str = field(metadata=spec('A body joined: ``"pylon"``, ``"engine"`` or a link name', type="str",
+                                      check="own"))
+    body_b: str = field(metadata=spec("The other body joined, likewise", type="str", check="own"))
+    position: Vector3 = field(metadata=spec(
+        "Hinge centre; on a link it must be one of the link's eye centres", type="3 floats", check="vector3",
+        unit="m", help="hinge centre: an eye centre of its links"))
+    stiffness: float | Vector3 = field(metadata=spec(
+        "Translational stiffness: in every direction, or per direction of the frame", type="float or 3 floats",
+        check="per_direction", unit="N/m", minimum=0.0, strictly=True,
+        help="translational stiffness (with the radial 2 or axial columns: radial 1)"))
+    damping: float | Vector3 = field(default=0.0, metadata=spec(
+        "Translational (viscous) damping, likewise", type="float or 3 floats", check="per_direction",
+        unit="N*s/m", minimum=0.0, help="translational damping (empty: 0)"))
+    radial_clearance: float = field(default=0.0, metadata=spec(
+        "Gap of the spherical bearing (0: no clearance law is built)", unit="m", minimum=0.0,
+        help="bearing gap (empty: 0)"))
+    contact_stiffness: float | None = field(default=None, metadata=spec(
+        "Stiffness once the gap is closed (None: *stiffness*)", unit="N/m", minimum=0.0, strictly=True,
+        optional=True, help="stiffness once the gap closes"))
+    loss_factor: float | Vector3 = field(default=0.0, metadata=spec(
+        "Structural (hysteretic) loss factor eta: the hinge's stiffness acts as k (1 + i eta), a damping force "
+        "in phase with the velocity whose size does not grow with the frequency (docs/physics.md, hinge "
+        "damping); likewise one or three values", type="float or 3 floats", check="per_direction",
+        unit=DIMENSIONLESS, minimum=0.0, help="structural loss factor eta, k (1 + i eta) (empty: 0)"))
+    frame: tuple[Vector3, Vector3, Vector3] | None = field(default=None, metadata=spec(
+        "The hinge's directions radial 1, radial 2, axial as rows, in global coordinates (orthonormal). None: "
+        "the frame of the link the hinge sits on (radial 1 along the link towards eye B, axial along its bore "
+        "axis), or the global axes x, y, z for a hinge between the pylon and the engine. Only per-direction "
+        "values use it", type="3x3 floats", check="own", optional=True))
 
     def __post_init__(self):
         item = f"hinge {self.name!r}"
@@ -359,14 +308,7 @@ class Hinge:
                 raise CaseError(item, name, getattr(self, name), "a body name")
         if self.body_a == self.body_b:
             raise CaseError(item, "body_b", self.body_b, "a body other than body_a")
-        _set(self, "position", fields.vector3(item, "position", self.position))
-        _set(self, "stiffness", _per_direction(item, "stiffness", self.stiffness, strictly=True))
-        _set(self, "damping", _per_direction(item, "damping", self.damping, strictly=False))
-        _set(self, "radial_clearance",
-             fields.number(item, "radial_clearance", self.radial_clearance, minimum=0.0))
-        if self.contact_stiffness is not None:
-            _set(self, "contact_stiffness", fields.positive_number(item, "contact_stiffness", self.contact_stiffness))
-        _set(self, "loss_factor", _per_direction(item, "loss_factor", self.loss_factor, strictly=False))
+        check_fields(self, item)
         if self.frame is not None:
             _set(self, "frame", _frame(self.frame, item))
         if self.radial_clearance > 0 and not self.isotropic:
@@ -404,49 +346,58 @@ class Hinge:
         return float(self.values("stiffness").max())
 
 
+_LOAD_NAME = spec("Unique name of the static load", type="str", check="own")
+
+
+@documented
 @dataclass(frozen=True)
 class PointForce:
-    """A constant force on the engine at a point (thrust, a static load), N and m."""
+    """A constant force on the engine at a point (thrust, a static load)."""
 
-    name: str
-    force: Vector3
-    point: Vector3
+    name: str = field(metadata=_LOAD_NAME)
+    force: Vector3 = field(metadata=spec("The force, global axes", type="3 floats", check="vector3", unit="N",
+                                         help="force"))
+    point: Vector3 = field(metadata=spec("Where it acts, global frame", type="3 floats", check="vector3", unit="m",
+                                         help="point of the force"))
 
     def __post_init__(self):
-        item = f"static load {self.name!r}"
         fields.nonempty_name("static load", self.name)
-        _set(self, "force", fields.vector3(item, "force", self.force))
-        _set(self, "point", fields.vector3(item, "point", self.point))
+        check_fields(self, f"static load {self.name!r}")
 
 
+@documented
 @dataclass(frozen=True)
 class PointMoment:
-    """A constant moment on the engine, N m."""
+    """A constant moment on the engine."""
 
-    name: str
-    moment: Vector3
+    name: str = field(metadata=_LOAD_NAME)
+    moment: Vector3 = field(metadata=spec("The moment, global axes", type="3 floats", check="vector3", unit="N*m",
+                                          help="moment"))
 
     def __post_init__(self):
-        item = f"static load {self.name!r}"
         fields.nonempty_name("static load", self.name)
-        _set(self, "moment", fields.vector3(item, "moment", self.moment))
+        check_fields(self, f"static load {self.name!r}")
 
 
+@documented
 @dataclass(frozen=True)
 class Gravity:
-    """Gravitational acceleration acting on every body (engine and links), m/s^2."""
+    """Gravitational acceleration acting on every body (engine and links)."""
 
-    name: str = "gravity"
-    acceleration: Vector3 = (0.0, 0.0, -9.81)
+    name: str = field(default="gravity", metadata=_LOAD_NAME)
+    acceleration: Vector3 = field(default=(0.0, 0.0, -9.81), metadata=spec(
+        "The acceleration of gravity, global axes (z up: 1 g level flight is (0, 0, -9.81))", type="3 floats",
+        check="vector3", unit="m/s^2", help="gravitational acceleration ('g' = 9.80665 m/s^2)"))
 
     def __post_init__(self):
         fields.nonempty_name("static load", self.name)
-        _set(self, "acceleration", fields.vector3(f"static load {self.name!r}", "acceleration", self.acceleration))
+        check_fields(self, f"static load {self.name!r}")
 
 
 StaticLoad = PointForce | PointMoment | Gravity
 
 
+@documented
 @dataclass(frozen=True)
 class ForceTransducers:
     """The test rig's three-way force transducers between the pylon pins and the rigid ground.
@@ -458,41 +409,26 @@ class ForceTransducers:
     one): a point mass at the pin on a spring-damper to ground, and the pin's
     hinges attach to that mass. The transducer forces are what the rig
     measures, so they make the pylon force.
-
-    Parameters
-    ----------
-    stiffness : 3 floats
-        Stiffness of each transducer with its fixture in the global x, y, z
-        directions, N/m (a three-component piezoelectric force link with its
-        mounting is of order 1e8 to 1e9 N/m).
-    mass : float
-        Moving half of each transducer plus the fitting bolted to it, kg. The
-        default 1 kg is a force link of this load range (a few hundred grams,
-        half of it moving) with the clevis block of the pin on it; the mass
-        only has to be there (a node between two springs needs one in
-        Exudyn): at 1e8 N/m it resonates at 1.6 kHz, far above the rotor
-        frequencies. It carries no weight in the scene: a rig zeroes its
-        transducers with the fitting mounted, before the engine is hung.
-    damping : 3 floats
-        Viscous damping of each transducer in x, y, z, N s/m (piezoelectric
-        force links are very lightly damped: default 0).
     """
 
-    stiffness: Vector3
-    mass: float = 1.0
-    damping: Vector3 = (0.0, 0.0, 0.0)
+    stiffness: Vector3 = field(metadata=spec(
+        "Stiffness of each transducer with its fixture in the global x, y, z directions (a three-component "
+        "piezoelectric force link with its mounting is of order 1e8 to 1e9 N/m)", type="3 floats",
+        check="vector3", unit="N/m", minimum=0.0, strictly=True, help="stiffness of each transducer with its fixture"))
+    mass: float = field(default=1.0, metadata=spec(
+        "Moving half of each transducer plus the fitting bolted to it. The default 1 kg is a force link of this "
+        "load range (a few hundred grams, half of it moving) with the clevis block of the pin on it; the mass "
+        "only has to be there (a node between two springs needs one in Exudyn): at 1e8 N/m it resonates at "
+        "1.6 kHz, far above the rotor frequencies. It carries no weight in the scene: a rig zeroes its "
+        "transducers with the fitting mounted, before the engine is hung", unit="kg", minimum=0.0,
+        strictly=True, help="moving mass of each transducer with its fitting (empty: 1 kg)"))
+    damping: Vector3 = field(default=(0.0, 0.0, 0.0), metadata=spec(
+        "Viscous damping of each transducer in x, y, z (piezoelectric force links are very lightly damped: "
+        "default 0)", type="3 floats", check="vector3", unit="N*s/m", minimum=0.0,
+        help="damping of each transducer (empty: 0)"))
 
     def __post_init__(self):
-        item = "test-rig force transducers"
-        stiffness = fields.vector3(item, "stiffness", self.stiffness)
-        if min(stiffness) <= 0:
-            raise CaseError(item, "stiffness", self.stiffness, "three numbers > 0 (N/m in x, y, z)")
-        damping = fields.vector3(item, "damping", self.damping)
-        if min(damping) < 0:
-            raise CaseError(item, "damping", self.damping, "three numbers >= 0 (N s/m in x, y, z)")
-        _set(self, "stiffness", stiffness)
-        _set(self, "damping", damping)
-        _set(self, "mass", fields.positive_number(item, "mass", self.mass))
+        check_fields(self, "test-rig force transducers")
 
 
 #: A test-rig transducer is named by this prefix and the pylon-side hinges it carries.
@@ -539,6 +475,14 @@ class _OneFrequency:
         return _frequency("", self.frequency_hz, self.rpm)
 
 
+_EXCITATION_NAME = spec('Unique name, e.g. ``"LP rotor"``', type="str", check="own")
+_SPEED = spec("Frequency; give exactly one of *frequency_hz* and *rpm*", check="own", unit="Hz", minimum=0.0,
+              strictly=True, optional=True, column="frequency", help="frequency (rpm accepted); empty for a sweep")
+_RPM = spec("Frequency in revolutions per minute, instead of *frequency_hz*; > 0", check="own", optional=True)
+_PHASE = spec("Phase at t = 0", unit="deg", column="phase", help="phase at t = 0 (empty: 0)")
+
+
+@documented
 @dataclass(frozen=True)
 class RotatingForce(_OneFrequency):
     """A rotating imbalance force on the engine.
@@ -547,45 +491,32 @@ class RotatingForce(_OneFrequency):
     about it: ``F(t) = A (u cos(wt + phase) + v sin(wt + phase))`` with
     ``(u, v, axis)`` a right-handed orthonormal triad (for axis x: u = y,
     v = z, i.e. lateral plus vertical).
-
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"LP rotor"``.
-    point : 3 floats
-        The rotor's imbalance plane on the engine axis, m.
-    frequency_hz, rpm : float
-        Rotor speed; give exactly one.
-    amplitude, unbalance : float
-        Force amplitude A in N, or the unbalance m*e in kg m (then
-        A = m e w^2); give exactly one.
-    axis : 3 floats
-        Spin axis (not necessarily unit length).
-    phase_deg : float
-        Phase at t = 0, degrees.
     """
 
-    name: str
-    point: Vector3
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    amplitude: float | None = None
-    unbalance: float | None = None
-    axis: Vector3 = (1.0, 0.0, 0.0)
-    phase_deg: float = 0.0
+    name: str = field(metadata=_EXCITATION_NAME)
+    point: Vector3 = field(metadata=spec(
+        "The rotor's imbalance plane on the engine axis", type="3 floats", check="vector3", unit="m",
+        help="point of application on the engine"))
+    frequency_hz: float | None = field(default=None, metadata=_SPEED)
+    rpm: float | None = field(default=None, metadata=_RPM)
+    amplitude: float | None = field(default=None, metadata=spec(
+        "Force amplitude A; give exactly one of *amplitude* and *unbalance*", unit="N", minimum=0.0,
+        strictly=True, optional=True, help="force amplitude"))
+    unbalance: float | None = field(default=None, metadata=spec(
+        "The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
+        help="rotating: unbalance m e instead of the amplitude ('g' = gram)"))
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
+        "Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
+        help="rotating: spin axis (empty: x)"))
+    phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         fields.nonempty_name("excitation", self.name)
-        _set(self, "point", fields.vector3(item, "point", self.point))
+        check_fields(self, item)
         _frequency(item, self.frequency_hz, self.rpm)
         if (self.amplitude is None) == (self.unbalance is None):
             raise CaseError(item, "amplitude", self.amplitude, "either amplitude or unbalance, not both")
-        for name in ("amplitude", "unbalance"):
-            if getattr(self, name) is not None:
-                _set(self, name, fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True))
-        _set(self, "axis", fields.direction(item, "axis", self.axis))
-        _set(self, "phase_deg", fields.number(item, "phase_deg", self.phase_deg))
 
     @property
     def force_amplitude(self) -> float:
@@ -615,42 +546,27 @@ class RotatingForce(_OneFrequency):
         return ((self.point, *self.force_coefficients()),)
 
 
+@documented
 @dataclass(frozen=True)
 class HarmonicForce(_OneFrequency):
-    """A fixed-direction harmonic force on the engine: ``F(t) = A d cos(wt + phase)``.
+    """A fixed-direction harmonic force on the engine: ``F(t) = A d cos(wt + phase)``."""
 
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    point : 3 floats
-        Point of application on the engine, m.
-    direction : 3 floats
-        Direction d (normalised here).
-    frequency_hz, rpm : float
-        Frequency; give exactly one.
-    amplitude : float
-        Force amplitude A, N.
-    phase_deg : float
-        Phase at t = 0, degrees.
-    """
-
-    name: str
-    point: Vector3
-    direction: Vector3
-    amplitude: float
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    phase_deg: float = 0.0
+    name: str = field(metadata=_EXCITATION_NAME)
+    point: Vector3 = field(metadata=spec("Point of application on the engine", type="3 floats", check="vector3",
+                                         unit="m", help="point of application on the engine"))
+    direction: Vector3 = field(metadata=spec("Direction d (normalised where it is used)", type="3 floats",
+                                             check="direction", unit=DIMENSIONLESS, help="harmonic: force direction"))
+    amplitude: float = field(metadata=spec("Force amplitude A", unit="N", minimum=0.0, strictly=True,
+                                           help="force amplitude"))
+    frequency_hz: float | None = field(default=None, metadata=_SPEED)
+    rpm: float | None = field(default=None, metadata=_RPM)
+    phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         fields.nonempty_name("excitation", self.name)
-        _set(self, "point", fields.vector3(item, "point", self.point))
-        _set(self, "direction", fields.direction(item, "direction", self.direction))
-        _set(self, "amplitude", fields.positive_number(item, "amplitude", self.amplitude))
+        check_fields(self, item)
         _frequency(item, self.frequency_hz, self.rpm)
-        _set(self, "phase_deg", fields.number(item, "phase_deg", self.phase_deg))
 
     @property
     def force_amplitude(self) -> float:
@@ -761,6 +677,7 @@ SingleFrequencyExcitation = RotatingForce | HarmonicForce | Imbalance
 SINGLE_FREQUENCY_KINDS = (RotatingForce, HarmonicForce, Imbalance)
 
 
+@documented
 @dataclass(frozen=True)
 class Rotor(_OneFrequency):
     """A rotor spinning at constant speed in the engine: its gyroscopic moment.
@@ -772,33 +689,27 @@ class Rotor(_OneFrequency):
     moment ``M = -dh/dt = -Ip Omega (omega x a)``. The rotor's mass and
     transverse inertia stay lumped in the rigid engine (``Case.engine``);
     only this moment is added (``Effects.gyroscopics``).
-
-    Parameters
-    ----------
-    name : str
-        Unique name, e.g. ``"LP spool"``.
-    polar_inertia : float
-        Polar moment of inertia Ip about the spin axis, kg m^2 (> 0).
-    frequency_hz, rpm : float
-        Spin speed; give exactly one.
-    axis : 3 floats
-        Spin axis in engine coordinates (the global axes at the reference
-        state); normalised here. The rotor spins right-handed about it.
     """
 
-    name: str
-    polar_inertia: float
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    axis: Vector3 = (1.0, 0.0, 0.0)
+    name: str = field(metadata=spec('Unique name, e.g. ``"LP spool"``', type="str", check="own"))
+    polar_inertia: float = field(metadata=spec(
+        "Polar moment of inertia Ip about the spin axis", unit="kg*m^2", minimum=0.0, strictly=True,
+        help="polar moment of inertia about the spin axis"))
+    frequency_hz: float | None = field(default=None, metadata=spec(
+        "Spin speed; give exactly one of *frequency_hz* and *rpm*", check="own", unit="Hz", minimum=0.0,
+        strictly=True, optional=True, help="spin speed (rpm accepted)"))
+    rpm: float | None = field(default=None, metadata=spec(
+        "Spin speed in revolutions per minute, instead of *frequency_hz*; > 0", check="own", optional=True))
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
+        "Spin axis in engine coordinates (the global axes at the reference state); normalised here. The rotor "
+        "spins right-handed about it", type="3 floats", check="direction", unit=DIMENSIONLESS))
 
     def __post_init__(self):
         item = f"rotor {self.name!r}"
         fields.nonempty_name("rotor", self.name)
-        _set(self, "polar_inertia", fields.number(item, "polar_inertia", self.polar_inertia, minimum=0.0,
-                                            strictly=True))
+        check_fields(self, item)
         _frequency(item, self.frequency_hz, self.rpm)
-        axis = np.array(fields.direction(item, "axis", self.axis))
+        axis = np.asarray(self.axis)
         _set(self, "axis", tuple(float(v) for v in axis / np.linalg.norm(axis)))
 
     @property
@@ -991,160 +902,126 @@ class Simultaneous:
 Excitation = RotatingForce | HarmonicForce | Imbalance | Sweep | Simultaneous
 
 
+@documented
 @dataclass(frozen=True)
 class AnalysisSettings:
-    """How a time-domain run is set up and checked.
+    """How a time-domain run is set up and checked."""
 
-    Parameters
-    ----------
-    steps_per_period : int
-        Time steps per period of the excitation (at least 40: 20 gave
-        amplitudes about 1 % low; the error is about (2 pi / n)^2 / 6).
-    ramp_periods : float
-        The excitation rises smoothly (raised cosine) over this many periods,
-        which keeps the mounted modes from being excited by the start.
-    settle_time_constants : float
-        Settle time after the ramp, in decay time constants 1/(zeta w) of the
-        least damped mounted mode (one is ample after the smooth start: on the
-        reference mount even none changed T by less than 0.05 %).
-    settle_time : float or None
-        Fixed settle time after the ramp, s (None: from the damping).
-    measured_periods : int
-        Periods per measured window; two consecutive windows are compared.
-    steady_tolerance : float
-        Largest relative change of the pylon-force amplitudes between the two
-        windows for the run to count as steady.
-    spectral_radius : float
-        Generalized-alpha spectral radius at infinite frequency (1: no
-        numerical damping).
-    newton_tolerance : float
-        Newton absolute tolerance relative to the load scale (largest of the
-        static load and the excitation amplitude).
-    equilibrium_tolerance : float
-        Largest relative mismatch between the pylon-side hinge forces and the
-        applied static loads.
-    method : {"auto", "time", "frequency"}
-        The analysis answering the case: ``"auto"`` (the default: frequency
-        domain when the scene is linear, time domain when a clearance law
-        makes it nonlinear, see :mod:`workbook.solve.method`), time domain,
-        or frequency domain (harmonic solution of the scene linearised about
-        the preload). A sweep on a linear scene always takes one
-        linearisation for all its frequencies.
-    step_halvings : int
-        When Newton's method fails in a segment of the time integration, the
-        segment is run again with the step halved, at most this many times
-        (0: no retry) before the run stops with the time and the cause.
-    time_budget : float or None
-        Wall time one run (one excitation) may take, s; checked between
-        segments of the integration (None: no limit).
-    divergence_displacement : float
-        Engine centre-of-gravity displacement from the preloaded position
-        above which the run stops as diverging, m.
-    start : {"auto", "steady", "rest"}
-        Where a time-domain run starts (:mod:`workbook.solve.steady_start`):
-        in the steady state of its linearised scene, the excitation in full
-        from the first step (``"steady"``); at rest, the excitation rising
-        over ``ramp_periods`` and the settle time after it (``"rest"``);
-        ``"auto"`` (the default): steady when the scene is linear, at rest
-        when a hinge clearance makes it nonlinear.
-    """
-
-    steps_per_period: int = 40
-    ramp_periods: float = 10.0
-    settle_time_constants: float = 1.0
-    settle_time: float | None = None
-    measured_periods: int = 20
-    steady_tolerance: float = 0.005
-    spectral_radius: float = 0.9
-    newton_tolerance: float = 1e-6
-    equilibrium_tolerance: float = 1e-6
-    method: AnalysisMethod = "auto"
-    step_halvings: int = 4
-    time_budget: float | None = None
-    divergence_displacement: float = 0.05
-    start: TimeStart = "auto"
+    steps_per_period: int = field(default=40, metadata=spec(
+        "Time steps per period of the excitation (at least 8; 40 recommended: 20 gave amplitudes about 1 % low; "
+        "the error is about (2 pi / n)^2 / 6)", type="int", check="own"))
+    ramp_periods: float = field(default=10.0, metadata=spec(
+        "The excitation rises smoothly (raised cosine) over this many periods, which keeps the mounted modes "
+        "from being excited by the start", unit=DIMENSIONLESS, minimum=0.0,
+        help="periods over which the excitation rises"))
+    settle_time_constants: float = field(default=1.0, metadata=spec(
+        "Settle time after the ramp, in decay time constants 1/(zeta w) of the least damped mounted mode (one "
+        "is ample after the smooth start: on the reference mount even none changed T by less than 0.05 %)",
+        unit=DIMENSIONLESS, minimum=0.0,
+        help="settle time after the ramp in decay time constants of the least damped mounted mode"))
+    settle_time: float | None = field(default=None, metadata=spec(
+        "Fixed settle time after the ramp (None: from the damping)", unit="s", minimum=0.0, optional=True,
+        help="fixed settle time (empty: from the damping)"))
+    measured_periods: int = field(default=20, metadata=spec(
+        "Periods per measured window; two consecutive windows are compared", type="int", check="own"))
+    steady_tolerance: float = field(default=0.005, metadata=spec(
+        "Largest relative change of the pylon-force amplitudes between the two windows for the run to count "
+        "as steady", unit=DIMENSIONLESS, minimum=0.0, strictly=True,
+        help="largest change between the two last windows"))
+    spectral_radius: float = field(default=0.9, metadata=spec(
+        "Generalized-alpha spectral radius at infinite frequency (1: no numerical damping), at most 1",
+        unit=DIMENSIONLESS, minimum=0.0, help="generalized-alpha spectral radius (0 to 1)"))
+    newton_tolerance: float = field(default=1e-6, metadata=spec(
+        "Newton absolute tolerance relative to the load scale (largest of the static load and the excitation "
+        "amplitude)", unit=DIMENSIONLESS, minimum=0.0, strictly=True,
+        help="Newton tolerance relative to the load scale"))
+    equilibrium_tolerance: float = field(default=1e-6, metadata=spec(
+        "Largest relative mismatch between the pylon-side hinge forces and the applied static loads",
+        unit=DIMENSIONLESS, minimum=0.0, strictly=True, help="largest relative mismatch of the static equilibrium"))
+    method: AnalysisMethod = field(default="auto", metadata=spec(
+        'The analysis answering the case: ``"auto"`` (the default: frequency domain when the scene is linear, '
+        "time domain when a clearance law makes it nonlinear, see :mod:`workbook.solve.method`), time domain, "
+        "or frequency domain (harmonic solution of the scene linearised about the preload). A sweep on a "
+        "linear scene always takes one linearisation for all its frequencies", check="choice",
+        choices=ANALYSIS_METHODS,
+        help="time: time domain; frequency: frequency domain about the preload; auto: frequency domain "
+             "unless a clearance makes the scene nonlinear"))
+    step_halvings: int = field(default=4, metadata=spec(
+        "When Newton's method fails in a segment of the time integration, the segment is run again with the "
+        "step halved, at most this many times (0: no retry; at most 20) before the run stops with the time "
+        "and the cause", type="int", check="own"))
+    time_budget: float | None = field(default=None, metadata=spec(
+        "Wall time one run (one excitation) may take; checked between segments of the integration (None: no "
+        "limit)", unit="s", minimum=0.0, strictly=True, optional=True,
+        help="wall time one run may take (empty: no limit)"))
+    divergence_displacement: float = field(default=0.05, metadata=spec(
+        "Engine centre-of-gravity displacement from the preloaded position above which the run stops as "
+        "diverging", unit="m", minimum=0.0, strictly=True,
+        help="engine displacement from the preloaded position that stops a run as diverging"))
+    start: TimeStart = field(default="auto", metadata=spec(
+        "Where a time-domain run starts (:mod:`workbook.solve.steady_start`): in the steady state of its "
+        'linearised scene, the excitation in full from the first step (``"steady"``); at rest, the excitation '
+        'rising over ``ramp_periods`` and the settle time after it (``"rest"``); ``"auto"`` (the default): '
+        "steady when the scene is linear, at rest when a hinge clearance makes it nonlinear", check="choice",
+        choices=TIME_STARTS,
+        help="where a time-domain run starts: steady: in the steady state of its linearised scene (two windows "
+             "suffice); rest: from rest with the smooth start and the settle time; auto: steady unless a "
+             "clearance makes the scene nonlinear"))
 
     def __post_init__(self):
         item = "analysis settings"
-        if self.start not in TIME_STARTS:
-            raise CaseError(item, "start", self.start, " or ".join(repr(s) for s in TIME_STARTS))
         if isinstance(self.step_halvings, bool) or not isinstance(self.step_halvings, int) \
                 or not 0 <= self.step_halvings <= 20:
             raise CaseError(item, "step_halvings", self.step_halvings, "a whole number from 0 to 20")
-        if self.time_budget is not None:
-            _set(self, "time_budget", fields.positive_number(item, "time_budget", self.time_budget))
-        _set(self, "divergence_displacement", fields.positive_number(item, "divergence_displacement",
-                                                                     self.divergence_displacement))
-        if self.method not in ANALYSIS_METHODS:
-            raise CaseError(item, "method", self.method, " or ".join(repr(m) for m in ANALYSIS_METHODS))
         for name in ("steps_per_period", "measured_periods"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise CaseError(item, name, value, "a positive whole number")
         if self.steps_per_period < 8:
             raise CaseError(item, "steps_per_period", self.steps_per_period, "at least 8")
-        _set(self, "ramp_periods", fields.number(item, "ramp_periods", self.ramp_periods, minimum=0.0))
-        _set(self, "settle_time_constants", fields.number(item, "settle_time_constants", self.settle_time_constants, minimum=0.0))
-        if self.settle_time is not None:
-            _set(self, "settle_time", fields.number(item, "settle_time", self.settle_time, minimum=0.0))
-        for name in ("steady_tolerance", "newton_tolerance", "equilibrium_tolerance"):
-            _set(self, name, fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True))
-        rho = fields.number(item, "spectral_radius", self.spectral_radius, minimum=0.0)
-        if rho > 1:
-            raise CaseError(item, "spectral_radius", rho, "a number from 0 to 1")
-        _set(self, "spectral_radius", rho)
+        check_fields(self, item)
+        if self.spectral_radius > 1:
+            raise CaseError(item, "spectral_radius", self.spectral_radius, "a number from 0 to 1")
 
 
+@documented
 @dataclass(frozen=True)
 class Effects:
-    """The physical effects a case asks for; what is off is not built.
+    """The physical effects a case asks for; what is off is not built."""
 
-    Parameters
-    ----------
-    flexible_links : bool
-        Links as reduced flexible bodies where the link asks for it; False
-        makes every link rigid.
-    preload : bool
-        Apply the static loads and solve the preloaded equilibrium first.
-    hinge_damping : bool
-        Hinge damping as given; False sets it to zero.
-    link_damping : bool
-        Rayleigh damping of the flexible links as given; False sets it to zero.
-    clearance : bool
-        Hinge clearance laws where a gap > 0 is given; False ignores the gaps.
-    rig_sensors : bool
-        The test rig's force transducers where the case gives them
-        (``Case.test_rig``); False mounts the pylon pins on rigid ground.
-    gyroscopics : bool
-        Build the rotors' gyroscopic moments when the case gives rotors
-        (``Case.rotors``); False leaves the rotors as inertia lumped in the
-        engine.
-    stress_stiffening : {"auto", "on", "off"}
-        The geometric stiffness of each flexible link's axial preload
-        (:mod:`workbook.solve.stress_stiffening`): "on" for every flexible
-        link, "auto" for the links whose preload moves their first
-        pinned-pinned mode by more than
-        :data:`~workbook.solve.stress_stiffening.AUTO_SHIFT`, "off" for none
-        (and no buckling check of the links).
-    """
-
-    flexible_links: bool = True
-    preload: bool = True
-    hinge_damping: bool = True
-    link_damping: bool = True
-    clearance: bool = True
-    rig_sensors: bool = True
-    gyroscopics: bool = True
-    stress_stiffening: StressStiffening = "auto"
+    flexible_links: bool = field(default=True, metadata=spec(
+        "Links as reduced flexible bodies where the link asks for it; False makes every link rigid", type="bool",
+        check="flag", help="no: every link rigid"))
+    preload: bool = field(default=True, metadata=spec(
+        "Apply the static loads and solve the preloaded equilibrium first", type="bool", check="flag",
+        help="solve the static loads first"))
+    hinge_damping: bool = field(default=True, metadata=spec(
+        "Hinge damping as given; False sets it to zero", type="bool", check="flag",
+        help="no: hinge damping set to zero"))
+    link_damping: bool = field(default=True, metadata=spec(
+        "Rayleigh damping of the flexible links as given; False sets it to zero", type="bool", check="flag",
+        help="no: link Rayleigh damping set to zero"))
+    clearance: bool = field(default=True, metadata=spec(
+        "Hinge clearance laws where a gap > 0 is given; False ignores the gaps", type="bool", check="flag",
+        help="no: hinge gaps ignored"))
+    rig_sensors: bool = field(default=True, metadata=spec(
+        "The test rig's force transducers where the case gives them (``Case.test_rig``); False mounts the "
+        "pylon pins on rigid ground", type="bool", check="flag",
+        help="no: the pylon pins sit on rigid ground even when the Test rig sheet gives transducers"))
+    gyroscopics: bool = field(default=True, metadata=spec(
+        "Build the rotors' gyroscopic moments when the case gives rotors (``Case.rotors``); False leaves the "
+        "rotors as inertia lumped in the engine", type="bool", check="flag",
+        help="no: the rotors' gyroscopic moments are not built (their inertia stays lumped in the engine)"))
+    stress_stiffening: StressStiffening = field(default="auto", metadata=spec(
+        "The geometric stiffness of each flexible link's axial preload (:mod:`workbook.solve.stress_stiffening`): "
+        '"on" for every flexible link, "auto" for the links whose preload moves their first pinned-pinned mode '
+        'by more than :data:`~workbook.solve.stress_stiffening.AUTO_SHIFT`, "off" for none (and no buckling '
+        "check of the links)", check="choice", choices=STRESS_STIFFENING,
+        help="the flexible links' geometric stiffness of their axial preload, with a buckling check: on; off; "
+             "auto: on for a link whose preload moves its first pinned-pinned mode by more than 0.5 %"))
 
     def __post_init__(self):
-        for item in dataclasses.fields(self):
-            if item.name == "stress_stiffening":
-                if self.stress_stiffening not in STRESS_STIFFENING:
-                    raise CaseError("effects", item.name, self.stress_stiffening,
-                                    " or ".join(repr(s) for s in STRESS_STIFFENING))
-            elif not isinstance(getattr(self, item.name), bool):
-                raise CaseError("effects", item.name, getattr(self, item.name), "True or False")
+        check_fields(self, "effects")
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ position x in the casing frame is the case's x.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +28,9 @@ from flexbodies.casing import CasingGeometry, CasingInterface, MountRing, defaul
 from flexbodies.casing_reduction import CasingModel
 from flexbodies.materials import TITANIUM, Material
 from workbook.errors import CaseError
-from workbook.model.fields import MAX_MODE_COUNT, bounded_count, pair, positive_number
+from workbook.model.field_spec import check_fields, documented, spec
+from workbook.model.fields import MAX_MODE_COUNT, bounded_count, positive_number
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["EngineCasing", "CoreBody", "split_engine", "CASING", "MountRing", "CasingGeometry",
            "DEFAULT_BEARING_STIFFNESS", "parallel_axis", "casing_origin", "bearing_name",
@@ -51,59 +53,49 @@ DEFAULT_CASING_DAMPING = 0.02
 _ITEM = "engine casing"
 
 
+@documented
 @dataclass(frozen=True)
 class EngineCasing:
-    """The engine's casing as a flexible body (``Engine.casing``).
+    """The engine's casing as a flexible body (``Engine.casing``)."""
 
-    Attributes
-    ----------
-    bearing_planes : tuple of float
-        x of the planes where the rotors sit on the casing (two or more,
-        within the casing), m.
-    geometry : CasingGeometry, optional
-        A parametric casing in the casing frame (exactly one of ``geometry``
-        and ``mesh``).
-    mesh : str, optional
-        A mesh file (meshio: .msh, .inp, .vtu, ...) in the casing frame.
-    scale : float
-        Factor from the mesh file's units to m.
-    material : flexbodies.Material
-    element_size : float, optional
-        Mesh size of a parametric casing, m.
-    spider_radius : float
-        Each mount eye is tied (RBE2) to the casing surface within this
-        distance of the eye point, m.
-    bearing_band : float, optional
-        Each bearing plane is tied to the casing surface within this distance
-        of the plane, m (default: the element size; 0.05 m for a mesh file).
-    bearing_stiffness : 2 floats
-        Radial and axial stiffness of each bearing connector, N/m.
-    bearing_damping : 2 floats
-        Radial and axial damping of each bearing connector, N s/m.
-    core_spin_hz : float
-        Frequency of the core's spin about the axis on the casing, Hz (sets the
-        torsional restraint between them).
-    modal_damping : float
-        Damping ratio zeta of each elastic mode of the casing (a modal damper
-        ``2 zeta w_i`` per mass-normalised mode), 0 <= zeta < 1.
-    modes : {"auto", "static"} or int
-        Fixed-interface modes of the casing: the low-frequency rule on its first
-        free-free frequency, none, or a count.
-    """
-
-    bearing_planes: tuple
-    geometry: CasingGeometry | None = None
-    mesh: str | None = None
-    scale: float = 1.0
-    material: Material = TITANIUM
-    element_size: float | None = None
-    spider_radius: float = DEFAULT_SPIDER_RADIUS
-    bearing_band: float | None = None
-    bearing_stiffness: tuple = DEFAULT_BEARING_STIFFNESS
-    bearing_damping: tuple = (0.0, 0.0)
-    core_spin_hz: float = DEFAULT_CORE_SPIN_HZ
-    modal_damping: float = DEFAULT_CASING_DAMPING
-    modes: str | int = "auto"
+    bearing_planes: tuple = field(metadata=spec(
+        "x of the planes where the rotors sit on the casing (two or more, within the casing)", type="tuple of float",
+        check="own", unit="m"))
+    geometry: CasingGeometry | None = field(default=None, metadata=spec(
+        "A parametric casing in the casing frame (exactly one of ``geometry`` and ``mesh``)", type="CasingGeometry",
+        check="own", optional=True))
+    mesh: str | None = field(default=None, metadata=spec(
+        "A mesh file (meshio: .msh, .inp, .vtu, ...) in the casing frame", type="str", check="own", optional=True))
+    scale: float = field(default=1.0, metadata=spec(
+        "Factor from the mesh file's units to m, > 0 (checked for a mesh file only)", check="own"))
+    material: Material = field(default=TITANIUM, metadata=spec("The casing's material", type="flexbodies.Material",
+                                                               check="own"))
+    element_size: float | None = field(default=None, metadata=spec(
+        "Mesh size of a parametric casing", unit="m", minimum=0.0, strictly=True, optional=True,
+        help="mesh size (empty: default)"))
+    spider_radius: float = field(default=DEFAULT_SPIDER_RADIUS, metadata=spec(
+        "Each mount eye is tied (RBE2) to the casing surface within this distance of the eye point", unit="m",
+        minimum=0.0, strictly=True, help="casing surface tied to each mount eye (empty: 80 mm)"))
+    bearing_band: float | None = field(default=None, metadata=spec(
+        "Each bearing plane is tied to the casing surface within this distance of the plane (None: the element "
+        "size; 0.05 m for a mesh file)", unit="m", minimum=0.0, strictly=True, optional=True,
+        help="casing surface tied to each bearing plane"))
+    bearing_stiffness: tuple = field(default=DEFAULT_BEARING_STIFFNESS, metadata=spec(
+        "Radial and axial stiffness of each bearing connector", type="2 floats", check="pair", unit="N/m",
+        minimum=0.0, strictly=True))
+    bearing_damping: tuple = field(default=(0.0, 0.0), metadata=spec(
+        "Radial and axial damping of each bearing connector", type="2 floats", check="pair", unit="N*s/m",
+        minimum=0.0))
+    core_spin_hz: float = field(default=DEFAULT_CORE_SPIN_HZ, metadata=spec(
+        "Frequency of the core's spin about the axis on the casing (sets the torsional restraint between them)",
+        unit="Hz", minimum=0.0, strictly=True))
+    modal_damping: float = field(default=DEFAULT_CASING_DAMPING, metadata=spec(
+        "Damping ratio zeta of each elastic mode of the casing (a modal damper ``2 zeta w_i`` per "
+        "mass-normalised mode), below 1", unit=DIMENSIONLESS, minimum=0.0,
+        help="damping ratio of each elastic casing mode (empty: 0.02)"))
+    modes: str | int = field(default="auto", metadata=spec(
+        "Fixed-interface modes of the casing: the low-frequency rule on its first free-free frequency, none, or "
+        "a count", type='{"auto", "static"} or int', check="own"))
 
     def __post_init__(self):
         if (self.geometry is None) == (self.mesh is None):
@@ -119,14 +111,9 @@ class EngineCasing:
             object.__setattr__(self, "scale", positive_number(_ITEM, "scale", self.scale))
         if not isinstance(self.material, Material):
             raise CaseError(_ITEM, "material", self.material, "a flexbodies Material")
-        for name in ("spider_radius", "core_spin_hz") + (("element_size",) if self.element_size is not None else ()) \
-                + (("bearing_band",) if self.bearing_band is not None else ()):
-            object.__setattr__(self, name, positive_number(_ITEM, name, getattr(self, name)))
-        object.__setattr__(self, "bearing_stiffness", pair(_ITEM, "bearing_stiffness", self.bearing_stiffness, strictly=True))
-        object.__setattr__(self, "bearing_damping", pair(_ITEM, "bearing_damping", self.bearing_damping, strictly=False))
-        zeta = self.modal_damping
-        if isinstance(zeta, bool) or not (isinstance(zeta, (int, float)) and 0 <= zeta < 1):
-            raise CaseError(_ITEM, "modal_damping", zeta, "a damping ratio, 0 <= zeta < 1")
+        check_fields(self, _ITEM)
+        if self.modal_damping >= 1.0:
+            raise CaseError(_ITEM, "modal_damping", self.modal_damping, "a damping ratio >= 0 and < 1")
         if not (self.modes in ("auto", "static") or (isinstance(self.modes, int) and not isinstance(self.modes, bool)
                                                        and self.modes >= 0)):
             raise CaseError(_ITEM, "modes", self.modes, "'auto', 'static' or a count >= 0")

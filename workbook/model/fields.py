@@ -10,8 +10,8 @@ from typing import Any
 
 from workbook.errors import CaseError
 
-__all__ = ["number", "positive_number", "vector3", "pair", "direction", "nonempty_name", "bounded_count",
-           "MAX_SWEEP_POINTS", "MAX_MODE_COUNT"]
+__all__ = ["number", "positive_number", "vector3", "pair", "direction", "per_direction", "nonempty_name",
+           "bounded_count", "MAX_SWEEP_POINTS", "MAX_MODE_COUNT", "HINGE_DIRECTIONS"]
 
 #: Most frequencies of one sweep, or speeds of one run-up: each is a solve of its own (a time-domain point
 #: takes seconds), and a longer list is a slip (1e6 typed for 100) whose building alone costs minutes and
@@ -20,6 +20,8 @@ MAX_SWEEP_POINTS = 10_000
 #: Most fixed-interface modes a link or the casing keeps by count (the low-frequency rule keeps tens; a
 #: reduction with thousands of modes is no longer a reduction).
 MAX_MODE_COUNT = 1_000
+#: Names of a hinge's three directions (:attr:`workbook.model.case.Hinge.frame`).
+HINGE_DIRECTIONS = ("radial 1", "radial 2", "axial")
 
 
 def number(item: str, name: str, value: Any, *, minimum: float = -math.inf, strictly: bool = False) -> float:
@@ -70,6 +72,23 @@ def direction(item: str, name: str, value: Any) -> tuple[float, float, float]:
     if not any(vector):
         raise CaseError(item, name, value, "a non-zero direction")
     return vector
+
+
+def per_direction(item: str, name: str, value: Any, *, minimum: float,
+                  strictly: bool) -> float | tuple[float, ...]:
+    """*value* as one number or three (one per :data:`HINGE_DIRECTIONS`), each at or above *minimum*
+    (above it if *strictly*), or a CaseError.
+
+    A bad one of three is named ``"<name>[<direction>]"``, e.g. ``"stiffness[axial]"``.
+    """
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__iter__"):
+        return number(item, name, value, minimum=minimum, strictly=strictly)
+    values = tuple(value)
+    if len(values) != 3:
+        raise CaseError(item, name, value, f"one number or three ({', '.join(HINGE_DIRECTIONS)}); "
+                                           f"{len(values)} given")
+    return tuple(number(item, f"{name}[{direction}]", v, minimum=minimum, strictly=strictly)
+                 for v, direction in zip(values, HINGE_DIRECTIONS, strict=True))
 
 
 def nonempty_name(item: str, value: Any) -> str:
