@@ -76,7 +76,7 @@ def total(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
 
 def rest_stiffness(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads) -> np.ndarray:
     """K of the rest of the scene at the state change *dq*, full coordinates."""
-    stiffness = expansion.rest.matrices(dq)[1]
+    stiffness = expansion.rest.stiffness_at(dq)
     for indices, added in loads.modal_stiffness:
         stiffness[np.ix_(indices, indices)] += added
     return stiffness
@@ -86,8 +86,7 @@ def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """M, K, D of the rest of the scene at the state change *dq*, full coordinates (M with each
     Euler-parameter body's rotation exact, :func:`turned_mass`)."""
-    damping = expansion.rest.matrices(dq)[2]
-    mass = turned_mass(expansion, dq)
+    mass, damping = turned_mass(expansion, dq), expansion.rest.matrices(dq)[2]
     q = total(expansion, dq)
     for indices, added in loads.mass:
         mass[np.ix_(indices, indices)] += added(q[indices])

@@ -100,23 +100,30 @@ class RestBlocks:
 
     def _curved(self, local: np.ndarray, weight: float) -> np.ndarray:
         """*weight* times the curvature term of K along the Euler parameters of *local* (B, b): (B, b, b)."""
-        turned = np.append(local, np.zeros((len(local), 1)), axis=1)[np.arange(len(local))[:, None], self.turning]
-        return weight * np.einsum("bijst,bs,bt->bij", self.stiffness_curvature, turned, turned)
+        blocks, width = local.shape
+        turned = np.append(local, np.zeros((blocks, 1)), axis=1)[np.arange(blocks)[:, None], self.turning]
+        pairs = (turned[:, :, None] * turned[:, None, :]).reshape(blocks, -1, 1)
+        curvature = self.stiffness_curvature.reshape(blocks, width * width, -1)
+        return weight * (curvature @ pairs).reshape(blocks, width, width)
+
+    def _full(self, blocks: np.ndarray) -> np.ndarray:
+        """The blocks (B, b, b) scattered into a full matrix (N, N)."""
+        full = np.zeros((self.size + 1, self.size + 1))
+        full[self.coordinates[:, :, None], self.coordinates[:, None, :]] = blocks
+        return full[:self.size, :self.size]
+
+    def stiffness_at(self, dq: np.ndarray) -> np.ndarray:
+        """K (N, N) at the state change *dq*: of second order in the Euler parameters, first in the rest."""
+        local = self._local(dq)
+        return self._full(self.stiffness + np.einsum("bijk,bk->bij", self.stiffness_slope, local)
+                          + self._curved(local, 0.5))
 
     def matrices(self, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """M, K, D (N, N) at the state change *dq* (first order in it; K of second order in the Euler
-        parameters)."""
+        """M, K, D (N, N) at the state change *dq* (first order in it; K as :meth:`stiffness_at`)."""
         local = self._local(dq)
-        rows, columns = self.coordinates[:, :, None], self.coordinates[:, None, :]
-        out = []
-        for matrix, slope in ((self.mass, self.mass_slope), (self.stiffness, self.stiffness_slope),
-                              (self.damping, self.damping_slope)):
-            full = np.zeros((self.size + 1, self.size + 1))
-            full[rows, columns] = matrix + np.einsum("bijk,bk->bij", slope, local)
-            out.append(full[:self.size, :self.size])
-        curved = np.zeros((self.size + 1, self.size + 1))
-        curved[rows, columns] = self._curved(local, 0.5)
-        return out[0], out[1] + curved[:self.size, :self.size], out[2]
+        mass, damping = (self._full(matrix + np.einsum("bijk,bk->bij", slope, local))
+                         for matrix, slope in ((self.mass, self.mass_slope), (self.damping, self.damping_slope)))
+        return mass, self.stiffness_at(dq), damping
 
     def force_change(self, dq: np.ndarray) -> np.ndarray:
         """The change of the rest's internal force over *dq* (N,): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""

@@ -156,8 +156,12 @@ class HingeLaw:
         loss : ndarray
             E of the loss factors: the hysteretic force is ``i E S u``, dimensionless.
         """
-        return (hinge_matrix(case, hinge, "stiffness"), hinge_matrix(case, hinge, "damping"),
-                hinge_matrix(case, hinge, "loss_factor"))
+        values = [hinge.values(name) for name in ("stiffness", "damping", "loss_factor")]
+        if all(np.ptp(value) == 0 for value in values):
+            return values[0][0] * np.eye(3), values[1][0] * np.eye(3), values[2][0] * np.eye(3)
+        frame = hinge_frame(case, hinge)
+        return frame.T @ np.diag(values[0]) @ frame, frame.T @ np.diag(values[1]) @ frame, \
+            frame.T @ np.diag(values[2]) @ frame
 
     def card_entry(self, case: Case) -> tuple[bool, str] | None:
         """The law's model-card entry (on, detail), None for none."""
