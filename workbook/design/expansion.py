@@ -320,7 +320,7 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
                 shifted.append([padded(m) for m in _rest_matrices(scene.mbs)])
             for m in range(3):
                 slopes[m][:, :, :, i] = (shifted[0][m] - shifted[1][m]) / (2 * MATRIX_STEP)
-        turning = _turning(blocks, _euler_blocks(scene), width)
+        turning = _turning(blocks, _rotation_coordinates(scene), width)
         curvature = _stiffness_curvature(scene, set_state, base, coordinates, turning, matrices[1], padded)
     finally:
         set_state(base)
@@ -329,9 +329,22 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
                       turning, curvature)
 
 
-def _turning(blocks: list[np.ndarray], euler: np.ndarray, width: int) -> np.ndarray:
-    """Each block's Euler parameters as positions in the block, padded with *width*: (B, S)."""
-    positions = [np.flatnonzero(np.isin(block, euler.ravel())) for block in blocks]
+def _rotation_coordinates(scene: Scene) -> np.ndarray:
+    """The rotation coordinates of every rigid-body node: Euler parameters and Tait-Bryan angles."""
+    mbs = scene.mbs
+    found = []
+    for node in range(mbs.systemData.NumberOfNodes()):
+        kind = str(mbs.GetNode(node)["nodeType"])
+        count = {"RigidBodyEP": 4, "RigidBodyRxyz": 3}.get(kind, 0)
+        if count:
+            start = mbs.GetNodeODE2Index(node) + 3
+            found.extend(range(start, start + count))
+    return np.array(found, dtype=int)
+
+
+def _turning(blocks: list[np.ndarray], rotations: np.ndarray, width: int) -> np.ndarray:
+    """Each block's rotation coordinates as positions in the block, padded with *width*: (B, S)."""
+    positions = [np.flatnonzero(np.isin(block, rotations)) for block in blocks]
     turning = np.full((len(blocks), max((len(p) for p in positions), default=0)), width, dtype=int)
     for k, found in enumerate(positions):
         turning[k, :len(found)] = found
