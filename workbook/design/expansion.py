@@ -332,7 +332,7 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
 def _rotation_coordinates(scene: Scene) -> np.ndarray:
     """The rotation coordinates of every rigid-body node: Euler parameters and Tait-Bryan angles."""
     mbs = scene.mbs
-    found = []
+    found: list[int] = []
     for node in range(mbs.systemData.NumberOfNodes()):
         kind = str(mbs.GetNode(node)["nodeType"])
         count = {"RigidBodyEP": 4, "RigidBodyRxyz": 3}.get(kind, 0)
