@@ -142,8 +142,13 @@ def test_infeasible_problem_names_the_conflicting_constraint(mount):
 
 @pytest.mark.slow
 def test_optimise_command_writes_a_case_mountwb_run_reproduces(mount, tmp_path, capsys):
+    from openpyxl import load_workbook
+
     from workbook.cli.main import main
+    from workbook.excel.optimise_sheet import OptimiseSheet
+    from workbook.excel.reader import read_workbook
     from workbook.model.codec import to_json
+    from workbook.studies.parametric import parameter_value
 
     out, case = tmp_path / "out", tmp_path / "coarse.json"
     case.write_text(to_json(mount.case))
@@ -159,6 +164,18 @@ def test_optimise_command_writes_a_case_mountwb_run_reproduces(mount, tmp_path, 
     for run in runs:
         for d in "xyz":
             assert reported[f"{run['name']} {d}"] == pytest.approx(run["pylon"][d]["transmissibility"], rel=1e-6)
+    # optimum.xlsx runs each excitation once, as the optimum was run: its results written into it give that T too
+    assert main(["run", str(out / "optimum.xlsx"), "--no-progress"]) == 0
+    rows = list(load_workbook(out / "optimum.xlsx")["Result efficiency"].iter_rows(min_row=3, values_only=True))
+    assert sorted(f"{row[0]} {row[3]}" for row in rows) == sorted(reported)
+    for row in rows:
+        assert reported[f"{row[0]} {row[3]}"] == pytest.approx(row[5], rel=1e-6)
+    # the optimum's Optimise sheet is the problem solved, the optimum its starting design; --pareto it cannot hold
+    book = read_workbook(out / "optimum.xlsx")
+    assert book.optimise == OptimiseSheet({"hinge_loss_factor/all": (0.01, 0.2)},
+                                          (opt.Constraint("displacement", 0.003),), {}, "worst", 1)
+    assert parameter_value(book.case, "hinge_loss_factor/all") == report["values"]["hinge_loss_factor/all"]
+    assert report["not_held"] == ["--pareto worst/LP rotor,worst/HP rotor"]
     assert main(["optimise", "--vary", "clearance=0:1e-4"]) == 2
     assert main(["optimise", str(case), "--vary", "section_scale=0.9:1.1", "--pareto"]) == 2
 
