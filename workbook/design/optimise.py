@@ -582,8 +582,8 @@ class OptimisationResult:
 
         if self.bands:
             raise UnwritableCase(f"speed bands ({', '.join(self.bands)}): a banded rotor is a sweep over its band "
-                                 "with the peaks found added, which no Excitations row holds; optimum.json holds "
-                                 "the optimum")
+                                 "(its peaks added), no longer the single-frequency excitation a band row names; "
+                                 "optimum.json holds the optimum")
         return case_workbook(self.case, [RunSpec(item.name, item.name) for item in self.case.excitations],
                              optimise=self.problem())
 
