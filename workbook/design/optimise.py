@@ -64,6 +64,8 @@ from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.processes import end_with_parent, stop_workers
 
 if TYPE_CHECKING:
+    from openpyxl import Workbook
+
     from workbook.excel.optimise_sheet import OptimiseSheet
 
 __all__ = ["Variable", "Constraint", "constraint", "variable", "variable_name", "optimise", "pareto", "OptimisationResult",
@@ -554,7 +556,8 @@ class OptimisationResult:
     def problem(self) -> OptimiseSheet:
         """The problem solved, as the optimum's Optimise sheet holds it: the variables with their ranges (a
         ``section_scale``'s divided by the scale chosen, the optimum's links the new 1), the objective, the
-        constraints, the bands and the starts."""
+        constraints, the bands and the starts; not the weights of :func:`optimise`, nor its seed, iterations or
+        section step."""
         from workbook.excel.optimise_sheet import OptimiseSheet
 
         scale = self.values.get(SECTION, 1.0)
@@ -562,7 +565,7 @@ class OptimisationResult:
                      for v in self.variables}
         return OptimiseSheet(variables, tuple(self.constraints), dict(self.bands), self.objective, self.asked_starts)
 
-    def workbook(self):
+    def workbook(self) -> Workbook:
         """The optimised case as a case workbook: a run per excitation (what :attr:`result` ran), the problem
         solved on its Optimise sheet (:meth:`problem`), so that ``mountwb optimise`` on it starts from the optimum.
 
@@ -574,7 +577,7 @@ class OptimisationResult:
         ------
         workbook.errors.UnwritableCase
             A case no case workbook holds (e.g. a mesh link), or one optimised over speed bands: a banded rotor
-            is a sweep over its band with the peaks found added, no longer the excitation the band names.
+            is a sweep over its band (its peaks added), no longer the single-frequency excitation a band row names.
         """
         from workbook.errors import UnwritableCase
         from workbook.excel.runs import RunSpec
