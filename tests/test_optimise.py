@@ -166,6 +166,7 @@ def test_optimise_command_writes_a_case_mountwb_run_reproduces(mount, tmp_path, 
             assert reported[f"{run['name']} {d}"] == pytest.approx(run["pylon"][d]["transmissibility"], rel=1e-6)
     # optimum.xlsx runs each excitation once, as the optimum was run: its results written into it give that T too
     assert main(["run", str(out / "optimum.xlsx"), "--no-progress"]) == 0
+    capsys.readouterr()
     rows = list(load_workbook(out / "optimum.xlsx")["Result efficiency"].iter_rows(min_row=3, values_only=True))
     assert sorted(f"{row[0]} {row[3]}" for row in rows) == sorted(reported)
     for row in rows:
@@ -176,6 +177,13 @@ def test_optimise_command_writes_a_case_mountwb_run_reproduces(mount, tmp_path, 
                                           (opt.Constraint("displacement", 0.003),), {}, "worst", 1)
     assert parameter_value(book.case, "hinge_loss_factor/all") == report["values"]["hinge_loss_factor/all"]
     assert report["not_held"] == ["--pareto worst/LP rotor,worst/HP rotor"]
+    # optimised again from it: the same problem, started at the optimum (its objective before is the one after)
+    assert main(["optimise", str(out / "optimum.xlsx"), "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert list(again["values"]) == ["hinge_loss_factor/all"] and len(again["starts"]) == 1
+    objective = {row["kind"]: row for row in report["table"]}["objective"]
+    assert {row["kind"]: row for row in again["table"]}["objective"]["before"] == pytest.approx(objective["after"],
+                                                                                                rel=1e-9)
     assert main(["optimise", "--vary", "clearance=0:1e-4"]) == 2
     assert main(["optimise", str(case), "--vary", "section_scale=0.9:1.1", "--pareto"]) == 2
 
