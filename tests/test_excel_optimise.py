@@ -62,6 +62,22 @@ def test_the_sheet_reads_into_the_problem(tmp_path):
         {"section_scale": (0.9, 1.1)}
 
 
+def test_a_written_problem_reads_back_to_itself(tmp_path):
+    """Every kind of row (a band and a modes_outside range included) written by case_workbook, saved and read
+    again: the same problem, in the template's columns and units."""
+    from workbook.excel.files import save_atomic
+    from workbook.excel.template import case_workbook
+
+    book = read_workbook(_with_sheet(copy_reference(tmp_path), ROWS))
+    assert book.optimise is not None and book.optimise.bands and book.optimise.starts == 2
+    written = save_atomic(case_workbook(book.case, book.runs, optimise=book.optimise), tmp_path / "written.xlsx")
+    again = read_workbook(written)
+    assert again.optimise == book.optimise and again.case == book.case
+    ws = load_workbook(written)[L.OPTIMISE.sheet]
+    assert [ws.cell(L.UNIT_ROW, col).value for col in range(3, 6)] == ["-"] * 3
+    assert [ws.cell(row, 1).value for row in range(L.FIRST_DATA_ROW, ws.max_row + 1)] == [row["kind"] for row in ROWS]
+
+
 def test_the_generated_workbooks_have_an_empty_optimise_sheet_and_older_ones_without_it_still_load(tmp_path):
     """The template's and the reference workbook's Optimise sheet: headers, units, no row (a run never
     optimises), an Instructions entry; a workbook written before the sheet existed reads to the same case."""

@@ -13,7 +13,8 @@ whether it is active, each variable), each start's end, and the optimum's
 model card; with ``section_scale`` varied, each section scale tried with
 its cost (link reductions and preparation); ``--output DIR`` writes the optimised case (``optimum.json``,
 which ``mountwb run`` runs, and ``optimum.xlsx`` when a case workbook can
-hold it), the table, the history and the plot.
+hold it, its Optimise sheet the problem solved, the options it cannot hold
+named), the table, the history and the plot.
 """
 from __future__ import annotations
 
@@ -25,13 +26,16 @@ from typing import TYPE_CHECKING, Callable
 from workbook.cli.loading import is_workbook, load_case
 from workbook.cli.params import parse_ranges
 from workbook.design.bands import BAND_POINTS, band_text
-from workbook.design.section_search import SECTION_STEP
+from workbook.design.section_search import SECTION, SECTION_STEP
 from workbook.errors import UsageError
 
 if TYPE_CHECKING:
     from workbook.excel.optimise_sheet import OptimiseSheet
 
 __all__ = ["arguments"]
+
+#: SLSQP iterations per start at most, by default.
+ITERATIONS = 60
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
@@ -62,8 +66,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="processes the starts run in (default: every core); the result is the same as with 1")
     parser.add_argument("--section-step", type=float, default=SECTION_STEP, metavar="S",
                         help=f"section_scale: the largest step between the scales tried (default {SECTION_STEP:g})")
-    parser.add_argument("--iterations", type=int, default=60, metavar="N",
-                        help="SLSQP iterations per start at most (default 60)")
+    parser.add_argument("--iterations", type=int, default=ITERATIONS, metavar="N",
+                        help=f"SLSQP iterations per start at most (default {ITERATIONS})")
     parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
                         help="also the NSGA-II front of two objectives (default worst,displacement; each worst, "
                              "worst/EXCITATION, displacement, sag or rotation)")
@@ -94,6 +98,16 @@ def _sheet(path: str | None) -> "OptimiseSheet":
     return sheet
 
 
+def _not_held(args, varied: dict, written: list) -> list[str]:
+    """The options given that the written optimum's Optimise sheet cannot hold (none: no optimum.xlsx; with
+    bands there is none, so ``--band-points`` never counts)."""
+    if not any(path.name == "optimum.xlsx" for path in written):
+        return []
+    given = (("--section-step", args.section_step if SECTION in varied else SECTION_STEP, SECTION_STEP),
+             ("--iterations", args.iterations, ITERATIONS), ("--pareto", args.pareto, None))
+    return [f"{option} {value}" for option, value, default in given if value != default]
+
+
 def run(args) -> int:
     from workbook.design.optimise import optimise
     from workbook.excel.optimise_sheet import OptimiseSheet
@@ -111,12 +125,14 @@ def run(args) -> int:
                       population=args.population, generations=args.generations, bands=bands,
                       band_points=args.band_points, workers=args.workers, section_step=args.section_step)
     written = result.write(args.output) if args.output else []
+    not_held = _not_held(args, result.values, written)
     if args.json:
         table = result.table.reset_index()
         print(json.dumps({"case": case.name, "objective": objective, "values": result.values,
                           "table": table.to_dict(orient="records"), "starts": result.starts,
                           "evaluations": result.evaluations, "seconds": result.seconds,
                           "fast_difference": result.fast_difference, "written": [str(p) for p in written],
+                          "not_held": not_held,
                           "sections": None if result.sections is None else result.sections.to_dict(orient="records")},
                          indent=1, default=float))
         return 0
@@ -143,4 +159,7 @@ def run(args) -> int:
         print("\n" + card.to_text())
     for path in written:
         print(f"written: {path}")
+    if not_held:
+        print(f"optimum.xlsx's Optimise sheet holds the problem solved but not {', '.join(not_held)}: give "
+              "them again to 'mountwb optimise optimum.xlsx'")
     return 0

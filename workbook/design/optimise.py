@@ -41,13 +41,14 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import logging
 import multiprocessing
 import signal
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import scipy.linalg as sla
@@ -62,8 +63,15 @@ from workbook.errors import InfeasibleProblem, InputError, SimulationError
 from workbook.model.case import DIRECTIONS, Case, Sweep
 from workbook.processes import end_with_parent, stop_workers
 
+if TYPE_CHECKING:
+    from openpyxl import Workbook
+
+    from workbook.excel.optimise_sheet import OptimiseSheet
+
 __all__ = ["Variable", "Constraint", "constraint", "variable", "variable_name", "optimise", "pareto", "OptimisationResult",
            "ParetoFront", "OBJECTIVES", "QUANTITIES", "MARGIN"]
+
+log = logging.getLogger(__name__)
 
 #: Objectives of :func:`optimise`.
 OBJECTIVES = ("worst", "weighted")
@@ -448,6 +456,10 @@ class OptimisationResult:
         loaded from the disk cache), the preparation's and the optimisation's
         time (s) and the designs answered; *history* and *starts* are those
         of the chosen scale.
+    bands : dict of str to (float, float)
+        The speed bands the problem judged T over, Hz.
+    asked_starts : int
+        The SLSQP starts asked for.
     """
 
     case: Case
@@ -465,6 +477,8 @@ class OptimisationResult:
     seconds: float
     pareto: ParetoFront | None = field(default=None)
     sections: Any = field(default=None)
+    bands: dict = field(default_factory=dict)
+    asked_starts: int = 1
 
     def to_pandas(self):
         """The before/after table."""
@@ -516,7 +530,6 @@ class OptimisationResult:
         """
         from workbook.errors import UnwritableCase
         from workbook.excel.files import save_atomic
-        from workbook.excel.template import case_workbook
         from workbook.model.codec import to_json
 
         folder = Path(directory)
@@ -533,11 +546,49 @@ class OptimisationResult:
             written.append(folder / "sections.csv")
             self.sections.to_csv(written[-1], index=False)
         try:
-            book = case_workbook(self.case, ())
-        except UnwritableCase:
+            book = self.workbook()
+        except UnwritableCase as error:
+            log.warning("optimum.xlsx not written: %s", error)
             return written
         written.append(save_atomic(book, folder / "optimum.xlsx"))
         return written
+
+    def problem(self) -> OptimiseSheet:
+        """The problem solved, as the optimum's Optimise sheet holds it: the variables with their ranges (a
+        ``section_scale``'s divided by the scale chosen, the optimum's links the new 1), the objective, the
+        constraints, the bands and the starts; not the weights of :func:`optimise`, nor its seed, iterations or
+        section step."""
+        from workbook.excel.optimise_sheet import OptimiseSheet
+
+        scale = self.values.get(SECTION, 1.0)
+        variables = {v.name: (v.low / scale, v.high / scale) if v.name == SECTION else (v.low, v.high)
+                     for v in self.variables}
+        return OptimiseSheet(variables, tuple(self.constraints), dict(self.bands), self.objective, self.asked_starts)
+
+    def workbook(self) -> Workbook:
+        """The optimised case as a case workbook: a run per excitation (what :attr:`result` ran), the problem
+        solved on its Optimise sheet (:meth:`problem`), so that ``mountwb optimise`` on it starts from the optimum.
+
+        Returns
+        -------
+        openpyxl.Workbook
+
+        Raises
+        ------
+        workbook.errors.UnwritableCase
+            A case no case workbook holds (e.g. a mesh link), or one optimised over speed bands: a banded rotor
+            is a sweep over its band (its peaks added), no longer the single-frequency excitation a band row names.
+        """
+        from workbook.errors import UnwritableCase
+        from workbook.excel.runs import RunSpec
+        from workbook.excel.template import case_workbook
+
+        if self.bands:
+            raise UnwritableCase(f"speed bands ({', '.join(self.bands)}): a banded rotor is a sweep over its band "
+                                 "(its peaks added), no longer the single-frequency excitation a band row names; "
+                                 "optimum.json holds the optimum")
+        return case_workbook(self.case, [RunSpec(item.name, item.name) for item in self.case.excitations],
+                             optimise=self.problem())
 
 
 def _run_start(problem: _Problem, kind: str, weights: np.ndarray, x0: np.ndarray, start: int,
@@ -764,7 +815,7 @@ def optimise(case: Case, variables: dict, objective: str = "worst", constraints=
         [{k: v for k, v in end.items() if k != "x"} for end in chosen_trial.ends], result,
         float(np.abs(exact - fast_t).max()),
         problem.evaluations + sum(trial.problem.evaluations for trial in trials if trial.problem is not problem),
-        time.perf_counter() - begin, front, sections)
+        time.perf_counter() - begin, front, sections, dict(bands or {}), starts)
 
 
 def _load_mounts(case: Case, rules: list) -> list:

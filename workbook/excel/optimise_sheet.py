@@ -10,7 +10,9 @@ One row per item (:data:`~workbook.excel.layout.OPTIMISE`), SI units:
 - ``band``: a rotor excitation's speed band (low, high, Hz);
 - ``objective``: ``worst`` or ``weighted``; ``starts``: the SLSQP starts.
 
-Each problem is reported at its cell, as every sheet's.
+Each problem is reported at its cell, as every sheet's. :func:`optimise_rows`
+writes a problem as the rows the reader reads back (the optimum
+``mountwb optimise --output`` writes carries the problem it solved).
 """
 from __future__ import annotations
 
@@ -23,7 +25,7 @@ from workbook.model.case import SINGLE_FREQUENCY_KINDS, Case
 if TYPE_CHECKING:     # the sheet reader loads openpyxl: not for a command's --help
     from workbook.excel.sheets import Record
 
-__all__ = ["OptimiseSheet", "read_optimise_sheet"]
+__all__ = ["OptimiseSheet", "read_optimise_sheet", "optimise_rows"]
 
 
 @dataclass(frozen=True)
@@ -122,3 +124,21 @@ def read_optimise_sheet(reader, records: list[Record], case: Case) -> OptimiseSh
             else:
                 given["starts"] = int(value)
     return OptimiseSheet(variables, tuple(constraints), bands, given["objective"], given["starts"])
+
+
+def optimise_rows(sheet: OptimiseSheet) -> list[dict]:
+    """The Optimise sheet's rows of the problem *sheet* (values by column key, SI units): what
+    :func:`read_optimise_sheet` reads back to *sheet*."""
+    from workbook.design.optimise import MODES_OUTSIDE
+
+    rows = [{"kind": "variable", "name": name, "low": low, "high": high} for name, (low, high) in sheet.variables.items()]
+    for rule in sheet.constraints:
+        limit = dict(zip(("low", "high"), rule.limit, strict=True)) if rule.quantity == MODES_OUTSIDE else \
+            {"value": rule.limit}
+        rows.append({"kind": "constraint", "name": rule.quantity, **limit})
+    rows += [{"kind": "band", "name": name, "low": low, "high": high} for name, (low, high) in sheet.bands.items()]
+    if sheet.objective is not None:
+        rows.append({"kind": "objective", "name": sheet.objective})
+    if sheet.starts is not None:
+        rows.append({"kind": "starts", "value": sheet.starts})
+    return rows

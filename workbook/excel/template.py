@@ -23,6 +23,7 @@ import workbook.excel.layout as L
 from flexbodies.materials import STRENGTH_FIELDS
 from workbook.errors import UnwritableCase
 from workbook.excel.files import new_file_target, save_atomic
+from workbook.excel.optimise_sheet import OptimiseSheet, optimise_rows
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.styling import print_setup
 from workbook.model import case as cm
@@ -242,8 +243,10 @@ def _frame(hinge: cm.Hinge) -> dict:
     return {**_vector("frame_radial_1", hinge.frame[0]), **_vector("frame_axial", hinge.frame[2])}
 
 
-def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> dict[str, list[dict]]:
-    """The rows of every input sheet (values in SI, by column key) for *case*."""
+def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = (),
+              optimise: OptimiseSheet | None = None) -> dict[str, list[dict]]:
+    """The rows of every input sheet (values in SI, by column key) for *case* (and the Optimise sheet's for the
+    problem *optimise*; None: no row)."""
     inertia = case.engine.inertia
     settings = {"name": case.name, "description": case.description or None,
                 **dataclasses.asdict(case.analysis), **dataclasses.asdict(case.effects)}
@@ -269,7 +272,7 @@ def case_rows(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint]
         L.CASING.sheet: _rows_for_casing(case.engine.casing),
         L.RUNS.sheet: [dataclasses.asdict(run) for run in runs],
         L.TEST_DATA.sheet: [dataclasses.asdict(point) for point in tests],
-        L.OPTIMISE.sheet: [],       # no design optimisation asked: rows are the user's
+        L.OPTIMISE.sheet: [] if optimise is None else optimise_rows(optimise),
     }
 
 
@@ -339,7 +342,8 @@ def _write_instructions(ws) -> None:
     print_setup(ws)
 
 
-def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = ()) -> Workbook:
+def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPoint] = (),
+                  optimise: OptimiseSheet | None = None) -> Workbook:
     """A case workbook: Instructions plus one sheet per input table holding *case*.
 
     Parameters
@@ -348,12 +352,14 @@ def case_workbook(case: cm.Case, runs: Iterable[RunSpec], tests: Iterable[TestPo
         Parametric links only.
     runs : iterable of RunSpec
     tests : iterable of TestPoint
+    optimise : OptimiseSheet, optional
+        The design optimisation its Optimise sheet holds (None: the sheet empty).
 
     Returns
     -------
     openpyxl.Workbook
     """
-    rows = case_rows(case, runs, tests)
+    rows = case_rows(case, runs, tests, optimise)
     workbook = Workbook()
     workbook.properties.created = _CREATED
     workbook.properties.creator = "mountwb"
