@@ -24,7 +24,7 @@ import os
 from typing import TYPE_CHECKING, Callable
 
 from workbook.cli.loading import is_workbook, load_case
-from workbook.cli.params import parse_ranges
+from workbook.cli.params import at_least_one, parse_ranges
 from workbook.design.bands import BAND_POINTS, band_text
 from workbook.design.section_search import SECTION, SECTION_STEP
 from workbook.errors import UsageError
@@ -60,9 +60,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("--band-points", type=int, default=BAND_POINTS,
                         help=f"speeds per band, evenly spaced (default {BAND_POINTS}); the peaks between them "
                              "are found as well")
-    parser.add_argument("--starts", type=int, help="SLSQP starts: the case's design, then a Latin "
+    parser.add_argument("--starts", type=at_least_one, help="SLSQP starts: the case's design, then a Latin "
                         "hypercube (default 3)")
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1, metavar="N",
+    parser.add_argument("--workers", type=at_least_one, default=os.cpu_count() or 1, metavar="N",
                         help="processes the starts run in (default: every core); the result is the same as with 1")
     parser.add_argument("--section-step", type=float, default=SECTION_STEP, metavar="S",
                         help=f"section_scale: the largest step between the scales tried (default {SECTION_STEP:g})")

@@ -52,12 +52,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="keep the rows the table in --output already holds and run only the missing ones")
 
 
+def at_least_one(text: str) -> int:
+    """An option's whole number >= 1 (processes, starts), or argparse's usage error naming what was found."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, found {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, found {value}")
+    return value
+
+
 def add_run_arguments(parser: argparse.ArgumentParser, seed_help: str) -> None:
     """Add the options of a study's rows (seed, workers, Dask, table format, rigid links, Exudyn) to *parser*."""
     from workbook.studies.sensitivity import TABLE_FORMATS
 
     parser.add_argument("--seed", type=int, default=0, help=seed_help)
-    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1,
+    parser.add_argument("--workers", type=at_least_one, default=os.cpu_count() or 1,
                        help="local processes (default: every core; 1: serial)")
     parser.add_argument("--dask", metavar="ADDRESS", help="run on the Dask scheduler at ADDRESS instead")
     parser.add_argument("--format", choices=TABLE_FORMATS, default="csv", help="table file format (csv)")
