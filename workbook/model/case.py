@@ -480,6 +480,12 @@ _SPEED = spec("Frequency; give exactly one of *frequency_hz* and *rpm*", check="
               strictly=True, optional=True, column="frequency", help="frequency (rpm accepted); empty for a sweep")
 _RPM = spec("Frequency in revolutions per minute, instead of *frequency_hz*; > 0", check="own", optional=True)
 _PHASE = spec("Phase at t = 0", unit="deg", column="phase", help="phase at t = 0 (empty: 0)")
+_IMBALANCE_POINT = spec("The rotor's imbalance plane on the engine axis", type="3 floats", check="vector3", unit="m",
+                        help="point of application on the engine")
+_AMPLITUDE = spec("Force amplitude A; give exactly one of *amplitude* and *unbalance*", unit="N", minimum=0.0,
+                  strictly=True, optional=True, help="force amplitude")
+_UNBALANCE = spec("The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
+                  help="rotating: unbalance m e instead of the amplitude ('g' = gram)")
 
 
 @documented
@@ -494,17 +500,11 @@ class RotatingForce(_OneFrequency):
     """
 
     name: str = field(metadata=_EXCITATION_NAME)
-    point: Vector3 = field(metadata=spec(
-        "The rotor's imbalance plane on the engine axis", type="3 floats", check="vector3", unit="m",
-        help="point of application on the engine"))
+    point: Vector3 = field(metadata=_IMBALANCE_POINT)
     frequency_hz: float | None = field(default=None, metadata=_SPEED)
     rpm: float | None = field(default=None, metadata=_RPM)
-    amplitude: float | None = field(default=None, metadata=spec(
-        "Force amplitude A; give exactly one of *amplitude* and *unbalance*", unit="N", minimum=0.0,
-        strictly=True, optional=True, help="force amplitude"))
-    unbalance: float | None = field(default=None, metadata=spec(
-        "The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
-        help="rotating: unbalance m e instead of the amplitude ('g' = gram)"))
+    amplitude: float | None = field(default=None, metadata=_AMPLITUDE)
+    unbalance: float | None = field(default=None, metadata=_UNBALANCE)
     axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
         "Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
         help="rotating: spin axis (empty: x)"))
@@ -584,33 +584,28 @@ class HarmonicForce(_OneFrequency):
         return ((self.point, *self.force_coefficients()),)
 
 
+@documented
 @dataclass(frozen=True)
 class ImbalancePlane:
     """One imbalance plane of a rotor: an eccentric mass at a point on the spin axis.
 
-    Parameters
-    ----------
-    point : 3 floats
-        The plane's centre on the spin axis, m.
-    unbalance, amplitude : float
-        The unbalance m e in kg m (the force is then U w^2, growing with
-        the speed) or the force amplitude in N; give exactly one (> 0).
-    phase_deg : float
-        Angular position of the eccentric mass at t = 0, degrees.
+    The unbalance gives a force growing with the speed (U w^2), the amplitude
+    a force of its own; the phase is the angular position of the eccentric
+    mass. The :class:`Imbalance` holding the plane checks it (:meth:`check`).
     """
 
-    point: Vector3
-    unbalance: float | None = None
-    amplitude: float | None = None
-    phase_deg: float = 0.0
+    point: Vector3 = field(metadata=_IMBALANCE_POINT)
+    unbalance: float | None = field(default=None, metadata=_UNBALANCE)
+    amplitude: float | None = field(default=None, metadata=_AMPLITUDE)
+    phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def check(self, item: str) -> "ImbalancePlane":
         """The plane with validated fields; *item* names it in a CaseError."""
-        if (self.amplitude is None) == (self.unbalance is None):
-            raise CaseError(item, "unbalance", self.unbalance, "either unbalance or amplitude, not both")
-        given = {name: fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True)
-                 for name in ("unbalance", "amplitude") if getattr(self, name) is not None}
-        return ImbalancePlane(fields.vector3(item, "point", self.point), phase_deg=fields.number(item, "phase_deg", self.phase_deg), **given)
+        plane = dataclasses.replace(self)
+        check_fields(plane, item)
+        if (plane.amplitude is None) == (plane.unbalance is None):
+            raise CaseError(item, "unbalance", plane.unbalance, "either unbalance or amplitude, not both")
+        return plane
 
 
 @dataclass(frozen=True)
