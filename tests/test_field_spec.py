@@ -25,6 +25,7 @@ from workbook.model.case import (
     Gravity,
     HarmonicForce,
     Hinge,
+    Imbalance,
     ImbalancePlane,
     Link,
     PointForce,
@@ -37,6 +38,7 @@ from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.reference import reference_case, reference_casing
 
 CASE = reference_case()
+PLANE = ImbalancePlane((0.2, 0.0, 0.0), unbalance=2e-3, phase_deg=90).check("plane")
 #: A valid instance of each described class, and the sheet its fields are read from.
 DESCRIBED = {
     Engine: (CASE.engine, layout.ENGINE),
@@ -52,7 +54,8 @@ DESCRIBED = {
     Gravity: (Gravity(), layout.STATIC_LOADS),
     RotatingForce: (RotatingForce("LP rotor", (0.2, 0.0, 0.0), frequency_hz=50.0, unbalance=0.01), layout.EXCITATIONS),
     HarmonicForce: (HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, rpm=3000.0), layout.EXCITATIONS),
-    ImbalancePlane: (ImbalancePlane((0.2, 0.0, 0.0), unbalance=2e-3, phase_deg=90).check("plane"), layout.EXCITATIONS),
+    ImbalancePlane: (PLANE, layout.EXCITATIONS),
+    Imbalance: (Imbalance("LP rotor", (PLANE, PLANE), rpm=3000.0), layout.EXCITATIONS),
 }
 
 

@@ -486,6 +486,8 @@ _AMPLITUDE = spec("Force amplitude A; give exactly one of *amplitude* and *unbal
                   strictly=True, optional=True, help="force amplitude")
 _UNBALANCE = spec("The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
                   help="rotating: unbalance m e instead of the amplitude ('g' = gram)")
+_SPIN_AXIS = spec("Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
+                  help="rotating: spin axis (empty: x)")
 
 
 @documented
@@ -505,9 +507,7 @@ class RotatingForce(_OneFrequency):
     rpm: float | None = field(default=None, metadata=_RPM)
     amplitude: float | None = field(default=None, metadata=_AMPLITUDE)
     unbalance: float | None = field(default=None, metadata=_UNBALANCE)
-    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
-        "Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
-        help="rotating: spin axis (empty: x)"))
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=_SPIN_AXIS)
     phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def __post_init__(self):
@@ -608,6 +608,7 @@ class ImbalancePlane:
         return plane
 
 
+@documented
 @dataclass(frozen=True)
 class Imbalance(_OneFrequency):
     """Several imbalance planes of one rotor at one speed, as a rig's rotary
@@ -619,30 +620,21 @@ class Imbalance(_OneFrequency):
     same speed about the same axis. The transmissibility refers to the sum
     of the plane force amplitudes (:attr:`force_amplitude`): the force of
     planes in phase, and never zero, also when the planes form a couple.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    planes : tuple of ImbalancePlane
-        At least one plane.
-    frequency_hz, rpm : float
-        Rotor speed; give exactly one.
-    axis : 3 floats
-        Spin axis.
     """
 
-    name: str
-    planes: tuple[ImbalancePlane, ...]
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    axis: Vector3 = (1.0, 0.0, 0.0)
+    name: str = field(metadata=_EXCITATION_NAME)
+    planes: tuple[ImbalancePlane, ...] = field(metadata=spec(
+        "At least one plane (plane k is named ``\"<name> plane <k>\"``)", type="tuple of ImbalancePlane",
+        check="own"))
+    frequency_hz: float | None = field(default=None, metadata=_SPEED)
+    rpm: float | None = field(default=None, metadata=_RPM)
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=_SPIN_AXIS)
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         fields.nonempty_name("excitation", self.name)
         _frequency(item, self.frequency_hz, self.rpm)
-        _set(self, "axis", fields.direction(item, "axis", self.axis))
+        check_fields(self, item)
         try:
             planes = tuple(self.planes)
         except TypeError:
