@@ -32,6 +32,7 @@ from workbook.model.case import (
     PointMoment,
     RotatingForce,
     Rotor,
+    Sweep,
 )
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
@@ -56,6 +57,8 @@ DESCRIBED = {
     HarmonicForce: (HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, rpm=3000.0), layout.EXCITATIONS),
     ImbalancePlane: (PLANE, layout.EXCITATIONS),
     Imbalance: (Imbalance("LP rotor", (PLANE, PLANE), rpm=3000.0), layout.EXCITATIONS),
+    Sweep: (Sweep("sweep", HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, frequency_hz=5.0),
+                  (5.0, 50.0)), layout.EXCITATIONS),
 }
 
 

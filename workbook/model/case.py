@@ -709,24 +709,22 @@ class Rotor(_OneFrequency):
 SweepSpacing = Literal["log", "linear"]
 
 
+@documented
 @dataclass(frozen=True)
 class Sweep:
     """A stepped sweep: one excitation template run at each of several frequencies.
 
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    template : RotatingForce, HarmonicForce or Imbalance
-        The excitation; its own frequency is replaced by each sweep frequency
-        (an unbalance given as m*e gives a force growing with frequency^2).
-    frequencies_hz : floats
-        The frequencies, Hz, ascending.
+    A workbook row gives it by its band (:meth:`band`): first and last
+    frequency, number of points and spacing.
     """
 
-    name: str
-    template: SingleFrequencyExcitation
-    frequencies_hz: tuple[float, ...]
+    name: str = field(metadata=_EXCITATION_NAME)
+    template: SingleFrequencyExcitation = field(metadata=spec(
+        "The excitation; its own frequency is replaced by each sweep frequency (an unbalance given as m*e gives "
+        "a force growing with frequency^2)", type="RotatingForce, HarmonicForce or Imbalance", check="own"))
+    frequencies_hz: tuple[float, ...] = field(metadata=spec(
+        f"The frequencies, ascending; at most {MAX_SWEEP_POINTS:,}", type="floats", check="own", unit="Hz",
+        minimum=0.0, strictly=True))
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
