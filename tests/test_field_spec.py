@@ -32,6 +32,7 @@ from workbook.model.case import (
     PointMoment,
     RotatingForce,
     Rotor,
+    RunUp,
     Sweep,
 )
 from workbook.model.casing import EngineCasing
@@ -59,6 +60,7 @@ DESCRIBED = {
     Imbalance: (Imbalance("LP rotor", (PLANE, PLANE), rpm=3000.0), layout.EXCITATIONS),
     Sweep: (Sweep("sweep", HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, frequency_hz=5.0),
                   (5.0, 50.0)), layout.EXCITATIONS),
+    RunUp: (RunUp("run-up", Imbalance("LP rotor", (PLANE,), rpm=600.0), (10.0, 20.0), "Hz"), layout.EXCITATIONS),
 }
 
 

@@ -774,6 +774,7 @@ SPEED_UNITS = {"rpm": 1.0 / 60.0, "Hz": 1.0}
 SpeedUnit = Literal["rpm", "Hz"]
 
 
+@documented
 @dataclass(frozen=True)
 class RunUp(Sweep):
     """A run-up: a rotor imbalance at evenly spaced speeds, its force growing as U w^2.
@@ -782,26 +783,20 @@ class RunUp(Sweep):
     given by ``unbalance``, or an :class:`Imbalance` whose planes all are),
     so that the force amplitude grows with the square of the speed, and
     whose speeds are kept in the unit they were given in.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    template : RotatingForce or Imbalance
-        The imbalance; its own speed is replaced by each run-up speed.
-    frequencies_hz : floats
-        The speeds, Hz, ascending.
-    speed_unit : {"rpm", "Hz"}
-        The unit the speeds are tabulated and plotted in.
     """
 
-    speed_unit: SpeedUnit = "rpm"
+    template: SingleFrequencyExcitation = field(metadata=spec(
+        "The imbalance, given by its unbalance; its own speed is replaced by each run-up speed",
+        type="RotatingForce or Imbalance", check="own"))
+    speed_unit: SpeedUnit = field(default="rpm", metadata=spec(
+        "The unit the speeds are tabulated and plotted in", type="str", check="choice", choices=tuple(SPEED_UNITS),
+        column="run_up", help="run-up: the sweep's speeds evenly spaced, tabulated in this unit; the force grows "
+                              "as U w^2 (give the unbalance)"))
 
     def __post_init__(self):
         super().__post_init__()
         item = f"excitation {self.name!r}"
-        if self.speed_unit not in SPEED_UNITS:
-            raise CaseError(item, "speed_unit", self.speed_unit, " or ".join(repr(u) for u in SPEED_UNITS))
+        check_fields(self, item)
         planes = (self.template.planes if isinstance(self.template, Imbalance)
                   else (self.template,) if isinstance(self.template, RotatingForce) else ())
         if not planes or any(plane.unbalance is None for plane in planes):
