@@ -33,6 +33,7 @@ from workbook.model.case import (
     RotatingForce,
     Rotor,
     RunUp,
+    Simultaneous,
     Sweep,
 )
 from workbook.model.casing import EngineCasing
@@ -61,6 +62,8 @@ DESCRIBED = {
     Sweep: (Sweep("sweep", HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, frequency_hz=5.0),
                   (5.0, 50.0)), layout.EXCITATIONS),
     RunUp: (RunUp("run-up", Imbalance("LP rotor", (PLANE,), rpm=600.0), (10.0, 20.0), "Hz"), layout.EXCITATIONS),
+    Simultaneous: (Simultaneous("both spools", (Imbalance("LP", (PLANE,), frequency_hz=50.0),
+                                                Imbalance("HP", (PLANE,), frequency_hz=200.0))), layout.EXCITATIONS),
 }
 
 

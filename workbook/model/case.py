@@ -824,6 +824,7 @@ class RunUp(Sweep):
         return np.asarray(self.frequencies_hz) / SPEED_UNITS[self.speed_unit]
 
 
+@documented
 @dataclass(frozen=True)
 class Simultaneous:
     """Several single-frequency excitations acting at once, each at its own
@@ -836,17 +837,12 @@ class Simultaneous:
     frequency from the same histories. Either way the answers are one
     result per part, named ``"<name> / <part name>"``, whose T refers to that
     part's force.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    parts : tuple of RotatingForce, HarmonicForce or Imbalance
-        At least two, at different frequencies, with different names.
     """
 
-    name: str
-    parts: tuple[SingleFrequencyExcitation, ...]
+    name: str = field(metadata=spec('Unique name, e.g. ``"both spools"``', type="str", check="own"))
+    parts: tuple[SingleFrequencyExcitation, ...] = field(metadata=spec(
+        "At least two, at different frequencies, with different names",
+        type="tuple of RotatingForce, HarmonicForce or Imbalance", check="own"))
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
