@@ -19,6 +19,7 @@ from workbook.errors import CaseError
 from workbook.excel import layout
 from workbook.model.case import (
     AnalysisSettings,
+    Case,
     Effects,
     Engine,
     ForceTransducers,
@@ -64,6 +65,7 @@ DESCRIBED = {
     RunUp: (RunUp("run-up", Imbalance("LP rotor", (PLANE,), rpm=600.0), (10.0, 20.0), "Hz"), layout.EXCITATIONS),
     Simultaneous: (Simultaneous("both spools", (Imbalance("LP", (PLANE,), frequency_hz=50.0),
                                                 Imbalance("HP", (PLANE,), frequency_hz=200.0))), layout.EXCITATIONS),
+    Case: (CASE, layout.CASE),
 }
 
 

@@ -1000,70 +1000,47 @@ class Effects:
         check_fields(self, "effects")
 
 
+@documented
 @dataclass(frozen=True)
 class Case:
-    """One mount study case.
+    """One mount study case."""
 
-    Parameters
-    ----------
-    name : str
-        Case name.
-    engine : Engine
-        The rigid engine.
-    links : tuple of Link
-        The connecting links.
-    hinges : tuple of Hinge
-        The ball hinges; a hinge may join any two bodies.
-    static_loads : tuple of PointForce, PointMoment, Gravity
-        Constant loads solved for first (the preload).
-    excitations : tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp, Simultaneous
-        Each excitation (each sweep frequency) is one run; a Simultaneous
-        excitation is one run with a result per part.
-    analysis : AnalysisSettings
-        Time step, settle and steady-state settings.
-    effects : Effects
-        The physical effects asked for.
-    description : str
-        Free text.
-    test_rig : ForceTransducers or None
-        The rig's force transducers under the pylon pins (None: the pylon
-        pins sit on rigid ground).
-    rotors : tuple of Rotor
-        Spinning rotors whose gyroscopic moments act on the engine (their
-        mass and inertia are part of ``engine``).
-    pylon : PylonModel or None
-        The flexible pylon carrying the pins (None: a rigid pylon),
-        frequency domain only: a :class:`PylonImpedance` (point dynamic
-        stiffness at the pins against frequency), a :class:`BoxBeamPylon`
-        (a clamped box beam) or a :class:`MeshPylon` (a user's solid mesh
-        clamped on its root plane). The keywords ``pylon_impedance``,
-        ``pylon_beam`` and ``pylon_mesh`` of earlier versions are
-        deprecated aliases.
-    load_cases : tuple of LoadCase
-        Named static limit load cases for the links' strength
-        (:mod:`workbook.model.load_cases`, solved by
-        :mod:`workbook.solve.load_cases`); the runs do not use them.
-    speed_spectra : tuple of SpeedSpectrum
-        The hours each rotor excitation runs at each speed, for the links'
-        Miner damage sums (:mod:`workbook.model.spectrum`, solved by
-        :mod:`workbook.solve.fatigue`); one per excitation; the runs do not
-        use them.
-    """
-
-    name: str
-    engine: Engine
-    links: tuple[Link, ...]
-    hinges: tuple[Hinge, ...]
-    static_loads: tuple[StaticLoad, ...] = ()
-    excitations: tuple[Excitation, ...] = ()
-    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
-    effects: Effects = field(default_factory=Effects)
-    description: str = ""
-    test_rig: ForceTransducers | None = None
-    rotors: tuple[Rotor, ...] = ()
-    pylon: PylonModel | None = None
-    load_cases: tuple[LoadCase, ...] = ()
-    speed_spectra: tuple[SpeedSpectrum, ...] = ()
+    name: str = field(metadata=spec("Case name", type="str", check="own"))
+    engine: Engine = field(metadata=spec("The rigid engine", type="Engine", check="own"))
+    links: tuple[Link, ...] = field(metadata=spec("The connecting links", type="tuple of Link", check="own"))
+    hinges: tuple[Hinge, ...] = field(metadata=spec(
+        "The ball hinges; a hinge may join any two bodies", type="tuple of Hinge", check="own"))
+    static_loads: tuple[StaticLoad, ...] = field(default=(), metadata=spec(
+        "Constant loads solved for first (the preload)", type="tuple of PointForce, PointMoment, Gravity",
+        check="own"))
+    excitations: tuple[Excitation, ...] = field(default=(), metadata=spec(
+        "Each excitation (each sweep frequency) is one run; a Simultaneous excitation is one run with a result "
+        "per part", type="tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp, Simultaneous",
+        check="own"))
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings, metadata=spec(
+        "Time step, settle and steady-state settings", type="AnalysisSettings", check="own"))
+    effects: Effects = field(default_factory=Effects, metadata=spec(
+        "The physical effects asked for", type="Effects", check="own"))
+    description: str = field(default="", metadata=spec("Free text", type="str", check="own"))
+    test_rig: ForceTransducers | None = field(default=None, metadata=spec(
+        "The rig's force transducers under the pylon pins (None: the pylon pins sit on rigid ground)",
+        type="ForceTransducers", check="own", optional=True))
+    rotors: tuple[Rotor, ...] = field(default=(), metadata=spec(
+        "Spinning rotors whose gyroscopic moments act on the engine (their mass and inertia are part of "
+        "``engine``)", type="tuple of Rotor", check="own"))
+    pylon: PylonModel | None = field(default=None, metadata=spec(
+        "The flexible pylon carrying the pins (None: a rigid pylon), frequency domain only: a "
+        ":class:`PylonImpedance` (point dynamic stiffness at the pins against frequency), a "
+        ":class:`BoxBeamPylon` (a clamped box beam) or a :class:`MeshPylon` (a user's solid mesh clamped on its "
+        "root plane). The keywords ``pylon_impedance``, ``pylon_beam`` and ``pylon_mesh`` of earlier versions "
+        "are deprecated aliases", type="PylonModel", check="own", optional=True))
+    load_cases: tuple[LoadCase, ...] = field(default=(), metadata=spec(
+        "Named static limit load cases for the links' strength (:mod:`workbook.model.load_cases`, solved by "
+        ":mod:`workbook.solve.load_cases`); the runs do not use them", type="tuple of LoadCase", check="own"))
+    speed_spectra: tuple[SpeedSpectrum, ...] = field(default=(), metadata=spec(
+        "The hours each rotor excitation runs at each speed, for the links' Miner damage sums "
+        "(:mod:`workbook.model.spectrum`, solved by :mod:`workbook.solve.fatigue`); one per excitation; the runs "
+        "do not use them", type="tuple of SpeedSpectrum", check="own"))
 
     def __post_init__(self):
         fields.nonempty_name("case", self.name)
