@@ -19,23 +19,30 @@ from workbook.errors import CaseError
 from workbook.excel import layout
 from workbook.model.case import (
     AnalysisSettings,
+    Case,
     Effects,
     Engine,
     ForceTransducers,
     Gravity,
     HarmonicForce,
     Hinge,
+    Imbalance,
+    ImbalancePlane,
     Link,
     PointForce,
     PointMoment,
     RotatingForce,
     Rotor,
+    RunUp,
+    Simultaneous,
+    Sweep,
 )
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.reference import reference_case, reference_casing
 
 CASE = reference_case()
+PLANE = ImbalancePlane((0.2, 0.0, 0.0), unbalance=2e-3, phase_deg=90).check("plane")
 #: A valid instance of each described class, and the sheet its fields are read from.
 DESCRIBED = {
     Engine: (CASE.engine, layout.ENGINE),
@@ -51,7 +58,21 @@ DESCRIBED = {
     Gravity: (Gravity(), layout.STATIC_LOADS),
     RotatingForce: (RotatingForce("LP rotor", (0.2, 0.0, 0.0), frequency_hz=50.0, unbalance=0.01), layout.EXCITATIONS),
     HarmonicForce: (HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, rpm=3000.0), layout.EXCITATIONS),
+    ImbalancePlane: (PLANE, layout.EXCITATIONS),
+    Imbalance: (Imbalance("LP rotor", (PLANE, PLANE), rpm=3000.0), layout.EXCITATIONS),
+    Sweep: (Sweep("sweep", HarmonicForce("shaker", (0.2, 0.0, 0.0), (0.0, 0.0, 1.0), 1e3, frequency_hz=5.0),
+                  (5.0, 50.0)), layout.EXCITATIONS),
+    RunUp: (RunUp("run-up", Imbalance("LP rotor", (PLANE,), rpm=600.0), (10.0, 20.0), "Hz"), layout.EXCITATIONS),
+    Simultaneous: (Simultaneous("both spools", (Imbalance("LP", (PLANE,), frequency_hz=50.0),
+                                                Imbalance("HP", (PLANE,), frequency_hz=200.0))), layout.EXCITATIONS),
+    Case: (CASE, layout.CASE),
 }
+
+
+def _replaced(valid, **changes):
+    """*valid* with *changes*, checked (an imbalance plane is checked by the imbalance holding it)."""
+    changed = dataclasses.replace(valid, **changes)
+    return changed.check("excitation 'LP rotor' plane 1") if isinstance(changed, ImbalancePlane) else changed
 
 
 def _specs(cls) -> list[tuple[str, FieldSpec]]:
@@ -72,14 +93,14 @@ def test_a_value_below_the_bound_is_refused_naming_the_field_and_the_bound(cls, 
     valid, _ = DESCRIBED[cls]
     below = described.minimum - 1.0
     with pytest.raises(CaseError) as refused:
-        dataclasses.replace(valid, **{name: _at(described, below)})
+        _replaced(valid, **{name: _at(described, below)})
     assert f"field '{name}'" in str(refused.value) and described.bound in str(refused.value)
     at_bound = _at(described, described.minimum)
     if described.strictly:
         with pytest.raises(CaseError):
-            dataclasses.replace(valid, **{name: at_bound})
+            _replaced(valid, **{name: at_bound})
     else:
-        assert dataclasses.replace(valid, **{name: at_bound}) is not None
+        assert _replaced(valid, **{name: at_bound}) is not None
 
 
 @pytest.mark.parametrize("cls, name, described", [b for b in BOUNDED if b[2].check == "per_direction"],
@@ -87,7 +108,7 @@ def test_a_value_below_the_bound_is_refused_naming_the_field_and_the_bound(cls, 
 def test_a_bad_one_of_three_per_direction_values_is_named_by_its_direction(cls, name, described):
     valid, _ = DESCRIBED[cls]
     with pytest.raises(CaseError, match=rf"field '{name}\[axial\]'.*a number {described.bound}"):
-        dataclasses.replace(valid, **{name: (1.0, 1.0, described.minimum - 1.0)})
+        _replaced(valid, **{name: (1.0, 1.0, described.minimum - 1.0)})
 
 
 @pytest.mark.parametrize("cls, name, described", [(cls, name, described) for cls in DESCRIBED
@@ -98,10 +119,10 @@ def test_a_choice_or_flag_takes_only_its_values(cls, name, described):
     valid, _ = DESCRIBED[cls]
     expected = " or ".join(map(repr, described.choices)) if described.choices else "True or False"
     with pytest.raises(CaseError) as refused:
-        dataclasses.replace(valid, **{name: "maybe"})
+        _replaced(valid, **{name: "maybe"})
     assert str(refused.value).endswith(f"field '{name}': found 'maybe', expected {expected}")
     for value in described.choices or (True, False):
-        assert getattr(dataclasses.replace(valid, **{name: value}), name) == value
+        assert getattr(_replaced(valid, **{name: value}), name) == value
 
 
 @pytest.mark.parametrize("cls", DESCRIBED, ids=lambda c: c.__name__)

@@ -32,6 +32,7 @@ from workbook.model.case import (
     PointMoment,
     RotatingForce,
     Rotor,
+    RunUp,
 )
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import field_spec
@@ -318,9 +319,7 @@ EXCITATIONS = Table("Excitations", help="rotor imbalances and harmonic forces; a
     _num("sweep_to", "sweep to", "Hz", help="sweep: last frequency"),
     Column("sweep_points", "sweep points", "integer", DIMENSIONLESS, help="sweep: number of frequencies"),
     Column("sweep_spacing", "sweep spacing", "choice", choices=("log", "linear"), help="sweep: spacing"),
-    Column("run_up", "run-up", "choice", choices=("rpm", "Hz"),
-           help="run-up: the sweep's speeds evenly spaced, tabulated in this unit; the force grows as U w^2 "
-                "(give the unbalance)"),
+    *_field(RunUp, "speed_unit", "run-up"),
 ))
 
 LOAD_CASES = Table("Load cases", optional=True,

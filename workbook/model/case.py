@@ -480,6 +480,14 @@ _SPEED = spec("Frequency; give exactly one of *frequency_hz* and *rpm*", check="
               strictly=True, optional=True, column="frequency", help="frequency (rpm accepted); empty for a sweep")
 _RPM = spec("Frequency in revolutions per minute, instead of *frequency_hz*; > 0", check="own", optional=True)
 _PHASE = spec("Phase at t = 0", unit="deg", column="phase", help="phase at t = 0 (empty: 0)")
+_IMBALANCE_POINT = spec("The rotor's imbalance plane on the engine axis", type="3 floats", check="vector3", unit="m",
+                        help="point of application on the engine")
+_AMPLITUDE = spec("Force amplitude A; give exactly one of *amplitude* and *unbalance*", unit="N", minimum=0.0,
+                  strictly=True, optional=True, help="force amplitude")
+_UNBALANCE = spec("The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
+                  help="rotating: unbalance m e instead of the amplitude ('g' = gram)")
+_SPIN_AXIS = spec("Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
+                  help="rotating: spin axis (empty: x)")
 
 
 @documented
@@ -494,20 +502,12 @@ class RotatingForce(_OneFrequency):
     """
 
     name: str = field(metadata=_EXCITATION_NAME)
-    point: Vector3 = field(metadata=spec(
-        "The rotor's imbalance plane on the engine axis", type="3 floats", check="vector3", unit="m",
-        help="point of application on the engine"))
+    point: Vector3 = field(metadata=_IMBALANCE_POINT)
     frequency_hz: float | None = field(default=None, metadata=_SPEED)
     rpm: float | None = field(default=None, metadata=_RPM)
-    amplitude: float | None = field(default=None, metadata=spec(
-        "Force amplitude A; give exactly one of *amplitude* and *unbalance*", unit="N", minimum=0.0,
-        strictly=True, optional=True, help="force amplitude"))
-    unbalance: float | None = field(default=None, metadata=spec(
-        "The unbalance m*e (then A = m e w^2)", unit="kg*m", minimum=0.0, strictly=True, optional=True,
-        help="rotating: unbalance m e instead of the amplitude ('g' = gram)"))
-    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=spec(
-        "Spin axis (not necessarily unit length)", type="3 floats", check="direction", unit=DIMENSIONLESS,
-        help="rotating: spin axis (empty: x)"))
+    amplitude: float | None = field(default=None, metadata=_AMPLITUDE)
+    unbalance: float | None = field(default=None, metadata=_UNBALANCE)
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=_SPIN_AXIS)
     phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def __post_init__(self):
@@ -584,35 +584,31 @@ class HarmonicForce(_OneFrequency):
         return ((self.point, *self.force_coefficients()),)
 
 
+@documented
 @dataclass(frozen=True)
 class ImbalancePlane:
     """One imbalance plane of a rotor: an eccentric mass at a point on the spin axis.
 
-    Parameters
-    ----------
-    point : 3 floats
-        The plane's centre on the spin axis, m.
-    unbalance, amplitude : float
-        The unbalance m e in kg m (the force is then U w^2, growing with
-        the speed) or the force amplitude in N; give exactly one (> 0).
-    phase_deg : float
-        Angular position of the eccentric mass at t = 0, degrees.
+    The unbalance gives a force growing with the speed (U w^2), the amplitude
+    a force of its own; the phase is the angular position of the eccentric
+    mass. The :class:`Imbalance` holding the plane checks it (:meth:`check`).
     """
 
-    point: Vector3
-    unbalance: float | None = None
-    amplitude: float | None = None
-    phase_deg: float = 0.0
+    point: Vector3 = field(metadata=_IMBALANCE_POINT)
+    unbalance: float | None = field(default=None, metadata=_UNBALANCE)
+    amplitude: float | None = field(default=None, metadata=_AMPLITUDE)
+    phase_deg: float = field(default=0.0, metadata=_PHASE)
 
     def check(self, item: str) -> "ImbalancePlane":
         """The plane with validated fields; *item* names it in a CaseError."""
-        if (self.amplitude is None) == (self.unbalance is None):
-            raise CaseError(item, "unbalance", self.unbalance, "either unbalance or amplitude, not both")
-        given = {name: fields.number(item, name, getattr(self, name), minimum=0.0, strictly=True)
-                 for name in ("unbalance", "amplitude") if getattr(self, name) is not None}
-        return ImbalancePlane(fields.vector3(item, "point", self.point), phase_deg=fields.number(item, "phase_deg", self.phase_deg), **given)
+        plane = dataclasses.replace(self)
+        check_fields(plane, item)
+        if (plane.amplitude is None) == (plane.unbalance is None):
+            raise CaseError(item, "unbalance", plane.unbalance, "either unbalance or amplitude, not both")
+        return plane
 
 
+@documented
 @dataclass(frozen=True)
 class Imbalance(_OneFrequency):
     """Several imbalance planes of one rotor at one speed, as a rig's rotary
@@ -624,30 +620,21 @@ class Imbalance(_OneFrequency):
     same speed about the same axis. The transmissibility refers to the sum
     of the plane force amplitudes (:attr:`force_amplitude`): the force of
     planes in phase, and never zero, also when the planes form a couple.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    planes : tuple of ImbalancePlane
-        At least one plane.
-    frequency_hz, rpm : float
-        Rotor speed; give exactly one.
-    axis : 3 floats
-        Spin axis.
     """
 
-    name: str
-    planes: tuple[ImbalancePlane, ...]
-    frequency_hz: float | None = None
-    rpm: float | None = None
-    axis: Vector3 = (1.0, 0.0, 0.0)
+    name: str = field(metadata=_EXCITATION_NAME)
+    planes: tuple[ImbalancePlane, ...] = field(metadata=spec(
+        "At least one plane (plane k is named ``\"<name> plane <k>\"``)", type="tuple of ImbalancePlane",
+        check="own"))
+    frequency_hz: float | None = field(default=None, metadata=_SPEED)
+    rpm: float | None = field(default=None, metadata=_RPM)
+    axis: Vector3 = field(default=(1.0, 0.0, 0.0), metadata=_SPIN_AXIS)
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
         fields.nonempty_name("excitation", self.name)
         _frequency(item, self.frequency_hz, self.rpm)
-        _set(self, "axis", fields.direction(item, "axis", self.axis))
+        check_fields(self, item)
         try:
             planes = tuple(self.planes)
         except TypeError:
@@ -722,24 +709,22 @@ class Rotor(_OneFrequency):
 SweepSpacing = Literal["log", "linear"]
 
 
+@documented
 @dataclass(frozen=True)
 class Sweep:
     """A stepped sweep: one excitation template run at each of several frequencies.
 
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    template : RotatingForce, HarmonicForce or Imbalance
-        The excitation; its own frequency is replaced by each sweep frequency
-        (an unbalance given as m*e gives a force growing with frequency^2).
-    frequencies_hz : floats
-        The frequencies, Hz, ascending.
+    A workbook row gives it by its band (:meth:`band`): first and last
+    frequency, number of points and spacing.
     """
 
-    name: str
-    template: SingleFrequencyExcitation
-    frequencies_hz: tuple[float, ...]
+    name: str = field(metadata=_EXCITATION_NAME)
+    template: SingleFrequencyExcitation = field(metadata=spec(
+        "The excitation; its own frequency is replaced by each sweep frequency (an unbalance given as m*e gives "
+        "a force growing with frequency^2)", type="RotatingForce, HarmonicForce or Imbalance", check="own"))
+    frequencies_hz: tuple[float, ...] = field(metadata=spec(
+        f"The frequencies, ascending; at most {MAX_SWEEP_POINTS:,}", type="floats", check="own", unit="Hz",
+        minimum=0.0, strictly=True))
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
@@ -789,6 +774,7 @@ SPEED_UNITS = {"rpm": 1.0 / 60.0, "Hz": 1.0}
 SpeedUnit = Literal["rpm", "Hz"]
 
 
+@documented
 @dataclass(frozen=True)
 class RunUp(Sweep):
     """A run-up: a rotor imbalance at evenly spaced speeds, its force growing as U w^2.
@@ -797,26 +783,20 @@ class RunUp(Sweep):
     given by ``unbalance``, or an :class:`Imbalance` whose planes all are),
     so that the force amplitude grows with the square of the speed, and
     whose speeds are kept in the unit they were given in.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    template : RotatingForce or Imbalance
-        The imbalance; its own speed is replaced by each run-up speed.
-    frequencies_hz : floats
-        The speeds, Hz, ascending.
-    speed_unit : {"rpm", "Hz"}
-        The unit the speeds are tabulated and plotted in.
     """
 
-    speed_unit: SpeedUnit = "rpm"
+    template: SingleFrequencyExcitation = field(metadata=spec(
+        "The imbalance, given by its unbalance; its own speed is replaced by each run-up speed",
+        type="RotatingForce or Imbalance", check="own"))
+    speed_unit: SpeedUnit = field(default="rpm", metadata=spec(
+        "The unit the speeds are tabulated and plotted in", type="str", check="choice", choices=tuple(SPEED_UNITS),
+        column="run_up", help="run-up: the sweep's speeds evenly spaced, tabulated in this unit; the force grows "
+                              "as U w^2 (give the unbalance)"))
 
     def __post_init__(self):
         super().__post_init__()
         item = f"excitation {self.name!r}"
-        if self.speed_unit not in SPEED_UNITS:
-            raise CaseError(item, "speed_unit", self.speed_unit, " or ".join(repr(u) for u in SPEED_UNITS))
+        check_fields(self, item)
         planes = (self.template.planes if isinstance(self.template, Imbalance)
                   else (self.template,) if isinstance(self.template, RotatingForce) else ())
         if not planes or any(plane.unbalance is None for plane in planes):
@@ -844,6 +824,7 @@ class RunUp(Sweep):
         return np.asarray(self.frequencies_hz) / SPEED_UNITS[self.speed_unit]
 
 
+@documented
 @dataclass(frozen=True)
 class Simultaneous:
     """Several single-frequency excitations acting at once, each at its own
@@ -856,17 +837,12 @@ class Simultaneous:
     frequency from the same histories. Either way the answers are one
     result per part, named ``"<name> / <part name>"``, whose T refers to that
     part's force.
-
-    Parameters
-    ----------
-    name : str
-        Unique name.
-    parts : tuple of RotatingForce, HarmonicForce or Imbalance
-        At least two, at different frequencies, with different names.
     """
 
-    name: str
-    parts: tuple[SingleFrequencyExcitation, ...]
+    name: str = field(metadata=spec('Unique name, e.g. ``"both spools"``', type="str", check="own"))
+    parts: tuple[SingleFrequencyExcitation, ...] = field(metadata=spec(
+        "At least two, at different frequencies, with different names",
+        type="tuple of RotatingForce, HarmonicForce or Imbalance", check="own"))
 
     def __post_init__(self):
         item = f"excitation {self.name!r}"
@@ -1024,70 +1000,47 @@ class Effects:
         check_fields(self, "effects")
 
 
+@documented
 @dataclass(frozen=True)
 class Case:
-    """One mount study case.
+    """One mount study case."""
 
-    Parameters
-    ----------
-    name : str
-        Case name.
-    engine : Engine
-        The rigid engine.
-    links : tuple of Link
-        The connecting links.
-    hinges : tuple of Hinge
-        The ball hinges; a hinge may join any two bodies.
-    static_loads : tuple of PointForce, PointMoment, Gravity
-        Constant loads solved for first (the preload).
-    excitations : tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp, Simultaneous
-        Each excitation (each sweep frequency) is one run; a Simultaneous
-        excitation is one run with a result per part.
-    analysis : AnalysisSettings
-        Time step, settle and steady-state settings.
-    effects : Effects
-        The physical effects asked for.
-    description : str
-        Free text.
-    test_rig : ForceTransducers or None
-        The rig's force transducers under the pylon pins (None: the pylon
-        pins sit on rigid ground).
-    rotors : tuple of Rotor
-        Spinning rotors whose gyroscopic moments act on the engine (their
-        mass and inertia are part of ``engine``).
-    pylon : PylonModel or None
-        The flexible pylon carrying the pins (None: a rigid pylon),
-        frequency domain only: a :class:`PylonImpedance` (point dynamic
-        stiffness at the pins against frequency), a :class:`BoxBeamPylon`
-        (a clamped box beam) or a :class:`MeshPylon` (a user's solid mesh
-        clamped on its root plane). The keywords ``pylon_impedance``,
-        ``pylon_beam`` and ``pylon_mesh`` of earlier versions are
-        deprecated aliases.
-    load_cases : tuple of LoadCase
-        Named static limit load cases for the links' strength
-        (:mod:`workbook.model.load_cases`, solved by
-        :mod:`workbook.solve.load_cases`); the runs do not use them.
-    speed_spectra : tuple of SpeedSpectrum
-        The hours each rotor excitation runs at each speed, for the links'
-        Miner damage sums (:mod:`workbook.model.spectrum`, solved by
-        :mod:`workbook.solve.fatigue`); one per excitation; the runs do not
-        use them.
-    """
-
-    name: str
-    engine: Engine
-    links: tuple[Link, ...]
-    hinges: tuple[Hinge, ...]
-    static_loads: tuple[StaticLoad, ...] = ()
-    excitations: tuple[Excitation, ...] = ()
-    analysis: AnalysisSettings = field(default_factory=AnalysisSettings)
-    effects: Effects = field(default_factory=Effects)
-    description: str = ""
-    test_rig: ForceTransducers | None = None
-    rotors: tuple[Rotor, ...] = ()
-    pylon: PylonModel | None = None
-    load_cases: tuple[LoadCase, ...] = ()
-    speed_spectra: tuple[SpeedSpectrum, ...] = ()
+    name: str = field(metadata=spec("Case name", type="str", check="own"))
+    engine: Engine = field(metadata=spec("The rigid engine", type="Engine", check="own"))
+    links: tuple[Link, ...] = field(metadata=spec("The connecting links", type="tuple of Link", check="own"))
+    hinges: tuple[Hinge, ...] = field(metadata=spec(
+        "The ball hinges; a hinge may join any two bodies", type="tuple of Hinge", check="own"))
+    static_loads: tuple[StaticLoad, ...] = field(default=(), metadata=spec(
+        "Constant loads solved for first (the preload)", type="tuple of PointForce, PointMoment, Gravity",
+        check="own"))
+    excitations: tuple[Excitation, ...] = field(default=(), metadata=spec(
+        "Each excitation (each sweep frequency) is one run; a Simultaneous excitation is one run with a result "
+        "per part", type="tuple of RotatingForce, HarmonicForce, Imbalance, Sweep, RunUp, Simultaneous",
+        check="own"))
+    analysis: AnalysisSettings = field(default_factory=AnalysisSettings, metadata=spec(
+        "Time step, settle and steady-state settings", type="AnalysisSettings", check="own"))
+    effects: Effects = field(default_factory=Effects, metadata=spec(
+        "The physical effects asked for", type="Effects", check="own"))
+    description: str = field(default="", metadata=spec("Free text", type="str", check="own"))
+    test_rig: ForceTransducers | None = field(default=None, metadata=spec(
+        "The rig's force transducers under the pylon pins (None: the pylon pins sit on rigid ground)",
+        type="ForceTransducers", check="own", optional=True))
+    rotors: tuple[Rotor, ...] = field(default=(), metadata=spec(
+        "Spinning rotors whose gyroscopic moments act on the engine (their mass and inertia are part of "
+        "``engine``)", type="tuple of Rotor", check="own"))
+    pylon: PylonModel | None = field(default=None, metadata=spec(
+        "The flexible pylon carrying the pins (None: a rigid pylon), frequency domain only: a "
+        ":class:`PylonImpedance` (point dynamic stiffness at the pins against frequency), a "
+        ":class:`BoxBeamPylon` (a clamped box beam) or a :class:`MeshPylon` (a user's solid mesh clamped on its "
+        "root plane). The keywords ``pylon_impedance``, ``pylon_beam`` and ``pylon_mesh`` of earlier versions "
+        "are deprecated aliases", type="PylonModel", check="own", optional=True))
+    load_cases: tuple[LoadCase, ...] = field(default=(), metadata=spec(
+        "Named static limit load cases for the links' strength (:mod:`workbook.model.load_cases`, solved by "
+        ":mod:`workbook.solve.load_cases`); the runs do not use them", type="tuple of LoadCase", check="own"))
+    speed_spectra: tuple[SpeedSpectrum, ...] = field(default=(), metadata=spec(
+        "The hours each rotor excitation runs at each speed, for the links' Miner damage sums "
+        "(:mod:`workbook.model.spectrum`, solved by :mod:`workbook.solve.fatigue`); one per excitation; the runs "
+        "do not use them", type="tuple of SpeedSpectrum", check="own"))
 
     def __post_init__(self):
         fields.nonempty_name("case", self.name)
