@@ -39,6 +39,7 @@ from workbook.model.case import (
 )
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
+from workbook.model.load_cases import LoadCase
 from workbook.model.reference import reference_case, reference_casing
 
 CASE = reference_case()
@@ -66,6 +67,7 @@ DESCRIBED = {
     Simultaneous: (Simultaneous("both spools", (Imbalance("LP", (PLANE,), frequency_hz=50.0),
                                                 Imbalance("HP", (PLANE,), frequency_hz=200.0))), layout.EXCITATIONS),
     Case: (CASE, layout.CASE),
+    LoadCase: (LoadCase("take-off", thrust=110e3, torque=30e3, thrust_point=(1, 0, 0)), layout.LOAD_CASES),
 }
 
 
