@@ -41,6 +41,7 @@ from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.load_cases import LoadCase
 from workbook.model.reference import reference_case, reference_casing
+from workbook.model.spectrum import SpeedBand, SpeedSpectrum
 
 CASE = reference_case()
 PLANE = ImbalancePlane((0.2, 0.0, 0.0), unbalance=2e-3, phase_deg=90).check("plane")
@@ -68,6 +69,8 @@ DESCRIBED = {
                                                 Imbalance("HP", (PLANE,), frequency_hz=200.0))), layout.EXCITATIONS),
     Case: (CASE, layout.CASE),
     LoadCase: (LoadCase("take-off", thrust=110e3, torque=30e3, thrust_point=(1, 0, 0)), layout.LOAD_CASES),
+    SpeedBand: (SpeedBand(150, 15, 25), layout.SPEED_SPECTRUM),
+    SpeedSpectrum: (SpeedSpectrum("LP rotor", (SpeedBand(150, 15, 25),)), layout.SPEED_SPECTRUM),
 }
 
 

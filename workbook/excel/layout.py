@@ -37,6 +37,7 @@ from workbook.model.case import (
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import field_spec
 from workbook.model.load_cases import LoadCase
+from workbook.model.spectrum import SpeedBand
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -346,9 +347,9 @@ SPEED_SPECTRUM = Table("Speed spectrum", optional=True,
                        columns=(
     Column("excitation", "excitation", "text", required=True,
            help="a rotor excitation (rows of the same excitation make its spectrum)"),
-    _num("speed_hz", "speed", "Hz", unit="rpm", required=True, help="the speed, or the band's lower end (Hz accepted)"),
-    _num("to_hz", "to speed", "Hz", unit="rpm", help="the band's upper end (empty: one speed)"),
-    _num("hours", "hours", "h", required=True, help="time at the speed or in the band, >= 0"),
+    *_field(SpeedBand, "speed_hz", "speed", unit="rpm", required=True),
+    *_field(SpeedBand, "to_hz", "to speed", unit="rpm"),
+    *_field(SpeedBand, "hours", "hours", required=True),
 ))
 
 ROTORS = Table("Rotors", optional=True,
