@@ -42,10 +42,12 @@ from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
 from workbook.model.load_cases import LoadCase
 from workbook.model.pylon_beam import BoxBeamPylon
+from workbook.model.pylon_mesh import MeshPylon
 from workbook.model.reference import reference_case, reference_casing
 from workbook.model.spectrum import SpeedBand, SpeedSpectrum
 
 CASE = reference_case()
+ALUMINIUM = Material("aluminium", 70e9, 0.33, 2800.0)
 PLANE = ImbalancePlane((0.2, 0.0, 0.0), unbalance=2e-3, phase_deg=90).check("plane")
 #: A valid instance of each described class, and the sheet its fields are read from (None: it has none).
 DESCRIBED = {
@@ -73,8 +75,8 @@ DESCRIBED = {
     LoadCase: (LoadCase("take-off", thrust=110e3, torque=30e3, thrust_point=(1, 0, 0)), layout.LOAD_CASES),
     SpeedBand: (SpeedBand(150, 15, 25), layout.SPEED_SPECTRUM),
     SpeedSpectrum: (SpeedSpectrum("LP rotor", (SpeedBand(150, 15, 25),)), layout.SPEED_SPECTRUM),
-    BoxBeamPylon: (BoxBeamPylon((0, 0, 3), (0, 0, 0), 0.3, 0.5, 0.01, Material("aluminium", 70e9, 0.33, 2800.0),
-                                up=(1, 0, 0)), None),
+    BoxBeamPylon: (BoxBeamPylon((0, 0, 3), (0, 0, 0), 0.3, 0.5, 0.01, ALUMINIUM, up=(1, 0, 0)), None),
+    MeshPylon: (MeshPylon("pylon.msh", (0, 0, 3), (0, 0, 1), (0, 1, 0), 0.012, ALUMINIUM, scale=1e-3), None),
 }
 
 
