@@ -15,6 +15,7 @@ import math
 import pytest
 from numpydoc.docscrape import NumpyDocString
 
+from flexbodies.materials import Material
 from workbook.errors import CaseError
 from workbook.excel import layout
 from workbook.model.case import (
@@ -39,11 +40,16 @@ from workbook.model.case import (
 )
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import FieldSpec, field_spec
+from workbook.model.load_cases import LoadCase
+from workbook.model.pylon_beam import BoxBeamPylon
+from workbook.model.pylon_mesh import MeshPylon
 from workbook.model.reference import reference_case, reference_casing
+from workbook.model.spectrum import SpeedBand, SpeedSpectrum
 
 CASE = reference_case()
+ALUMINIUM = Material("aluminium", 70e9, 0.33, 2800.0)
 PLANE = ImbalancePlane((0.2, 0.0, 0.0), unbalance=2e-3, phase_deg=90).check("plane")
-#: A valid instance of each described class, and the sheet its fields are read from.
+#: A valid instance of each described class, and the sheet its fields are read from (None: it has none).
 DESCRIBED = {
     Engine: (CASE.engine, layout.ENGINE),
     Link: (CASE.links[0], layout.LINKS),
@@ -66,6 +72,11 @@ DESCRIBED = {
     Simultaneous: (Simultaneous("both spools", (Imbalance("LP", (PLANE,), frequency_hz=50.0),
                                                 Imbalance("HP", (PLANE,), frequency_hz=200.0))), layout.EXCITATIONS),
     Case: (CASE, layout.CASE),
+    LoadCase: (LoadCase("take-off", thrust=110e3, torque=30e3, thrust_point=(1, 0, 0)), layout.LOAD_CASES),
+    SpeedBand: (SpeedBand(150, 15, 25), layout.SPEED_SPECTRUM),
+    SpeedSpectrum: (SpeedSpectrum("LP rotor", (SpeedBand(150, 15, 25),)), layout.SPEED_SPECTRUM),
+    BoxBeamPylon: (BoxBeamPylon((0, 0, 3), (0, 0, 0), 0.3, 0.5, 0.01, ALUMINIUM, up=(1, 0, 0)), None),
+    MeshPylon: (MeshPylon("pylon.msh", (0, 0, 3), (0, 0, 1), (0, 1, 0), 0.012, ALUMINIUM, scale=1e-3), None),
 }
 
 

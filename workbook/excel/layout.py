@@ -36,6 +36,8 @@ from workbook.model.case import (
 )
 from workbook.model.casing import EngineCasing
 from workbook.model.field_spec import field_spec
+from workbook.model.load_cases import LoadCase
+from workbook.model.spectrum import SpeedBand
 from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["Column", "Table", "TABLES", "CASE", "ENGINE", "LINKS", "HINGES", "STATIC_LOADS",
@@ -328,15 +330,14 @@ LOAD_CASES = Table("Load cases", optional=True,
                    columns=(
     Column("name", "name", "text", required=True, help="unique load case name"),
     Column("description", "description", "text", help="free text: where the numbers come from"),
-    _num("thrust", "thrust", "N", unit="kN", help="thrust along +x (negative: reverse thrust) (empty: 0)"),
-    *_xyz("thrust_point", "thrust point", "m", help="where the thrust acts (empty: the engine's CG)"),
-    *_xyz("load_factors", "load factor", DIMENSIONLESS,
-          help="load factor in g on every body; empty: 0 in x and y, -1 in z (1 g level flight)"),
-    _num("torque", "torque", "N*m", unit="kN*m", help="engine torque about +x (empty: 0)"),
+    *_field(LoadCase, "thrust", "thrust", unit="kN"),
+    *_field(LoadCase, "thrust_point", "thrust point"),
+    *_field(LoadCase, "load_factors", "load factor"),
+    *_field(LoadCase, "torque", "torque", unit="kN*m"),
     *_xyz("force", "force", "N", help="an extra point force on the engine"),
     *_xyz("force_point", "force point", "m", help="point of the extra force"),
     *_xyz("moment", "moment", "N*m", help="an extra moment on the engine"),
-    _num("factor_of_safety", "factor of safety", help="ultimate over limit load, >= 1 (empty: 1.5)"),
+    *_field(LoadCase, "factor_of_safety", "factor of safety"),
     Column("without_link", "fail-safe link", "text", help="fail-safe: the link removed for this load case"),
 ))
 
@@ -346,9 +347,9 @@ SPEED_SPECTRUM = Table("Speed spectrum", optional=True,
                        columns=(
     Column("excitation", "excitation", "text", required=True,
            help="a rotor excitation (rows of the same excitation make its spectrum)"),
-    _num("speed_hz", "speed", "Hz", unit="rpm", required=True, help="the speed, or the band's lower end (Hz accepted)"),
-    _num("to_hz", "to speed", "Hz", unit="rpm", help="the band's upper end (empty: one speed)"),
-    _num("hours", "hours", "h", required=True, help="time at the speed or in the band, >= 0"),
+    *_field(SpeedBand, "speed_hz", "speed", unit="rpm", required=True),
+    *_field(SpeedBand, "to_hz", "to speed", unit="rpm"),
+    *_field(SpeedBand, "hours", "hours", required=True),
 ))
 
 ROTORS = Table("Rotors", optional=True,

@@ -12,10 +12,12 @@ case's: x heading, y lateral, z up.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from workbook.errors import CaseError
 from workbook.model import fields
+from workbook.model.field_spec import check_fields, documented, spec
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["LoadCase", "STANDARD_GRAVITY", "DEFAULT_FACTOR_OF_SAFETY", "reference_load_cases"]
 
@@ -29,55 +31,44 @@ def _set(obj, name, value) -> None:
     object.__setattr__(obj, name, value)
 
 
+@documented
 @dataclass(frozen=True)
 class LoadCase:
-    """A named static limit load case.
+    """A named static limit load case."""
 
-    Parameters
-    ----------
-    name : str
-    thrust : float
-        Engine thrust along +x (negative: reverse thrust), N, acting at
-        ``thrust_point``.
-    load_factors : 3 floats
-        Load factors ``(n_x, n_y, n_z)`` in g: every body (engine and links)
-        carries its mass times ``g0 n``; ``(0, 0, -1)`` is the 1 g weight of
-        level flight, ``(0, 0, -2.5)`` a 2.5 g pull-up.
-    torque : float
-        Engine torque about +x on the engine, N m.
-    forces : tuple of PointForce
-        Further point forces on the engine, N at m.
-    moments : tuple of PointMoment
-        Further moments on the engine, N m.
-    factor_of_safety : float
-        Ultimate load over limit load (>= 1), dimensionless.
-    without_link : str or None
-        Fail-safe: the link removed, with its hinges, for this load case.
-    thrust_point : 3 floats or None
-        Where the thrust acts, m (None: the engine's centre of gravity).
-    description : str
-        Free text: where the numbers come from.
-    """
-
-    name: str
-    thrust: float = 0.0
-    load_factors: tuple = (0.0, 0.0, -1.0)
-    torque: float = 0.0
-    forces: tuple = ()
-    moments: tuple = ()
-    factor_of_safety: float = DEFAULT_FACTOR_OF_SAFETY
-    without_link: str | None = None
-    thrust_point: tuple | None = None
-    description: str = ""
+    name: str = field(metadata=spec("Unique name", type="str", check="own"))
+    thrust: float = field(default=0.0, metadata=spec(
+        "Engine thrust along +x (negative: reverse thrust), acting at *thrust_point*", unit="N",
+        help="thrust along +x (negative: reverse thrust) (empty: 0)"))
+    load_factors: tuple = field(default=(0.0, 0.0, -1.0), metadata=spec(
+        "Load factors ``(n_x, n_y, n_z)`` in g: every body (engine and links) carries its mass times ``g0 n``; "
+        "``(0, 0, -1)`` is the 1 g weight of level flight, ``(0, 0, -2.5)`` a 2.5 g pull-up",
+        type="3 floats", check="vector3", unit=DIMENSIONLESS,
+        help="load factor in g on every body; empty: 0 in x and y, -1 in z (1 g level flight)"))
+    torque: float = field(default=0.0, metadata=spec("Engine torque about +x on the engine", unit="N*m",
+                                                     help="engine torque about +x (empty: 0)"))
+    forces: tuple = field(default=(), metadata=spec("Further point forces on the engine, N at m",
+                                                    type="tuple of PointForce", check="own"))
+    moments: tuple = field(default=(), metadata=spec("Further moments on the engine, N m",
+                                                     type="tuple of PointMoment", check="own"))
+    factor_of_safety: float = field(default=DEFAULT_FACTOR_OF_SAFETY, metadata=spec(
+        "Ultimate load over limit load", check="own", unit=DIMENSIONLESS, minimum=1.0,
+        help="ultimate over limit load, >= 1 (empty: 1.5)"))
+    without_link: str | None = field(default=None, metadata=spec(
+        "Fail-safe: the link removed, with its hinges, for this load case", type="str", check="own",
+        optional=True))
+    thrust_point: tuple | None = field(default=None, metadata=spec(
+        "Where the thrust acts (None: the engine's centre of gravity)", type="3 floats", check="vector3",
+        unit="m", optional=True, help="where the thrust acts (empty: the engine's CG)"))
+    description: str = field(default="", metadata=spec("Free text: where the numbers come from", type="str",
+                                                       check="own"))
 
     def __post_init__(self):
         from workbook.model.case import PointForce, PointMoment
 
         fields.nonempty_name("load case", self.name)
         item = f"load case {self.name!r}"
-        _set(self, "thrust", fields.number(item, "thrust", self.thrust))
-        _set(self, "load_factors", fields.vector3(item, "load_factors", self.load_factors))
-        _set(self, "torque", fields.number(item, "torque", self.torque))
+        check_fields(self, item)
         fos = fields.number(item, "factor_of_safety", self.factor_of_safety)
         if fos < 1.0:
             raise CaseError(item, "factor_of_safety", self.factor_of_safety, "a factor of safety >= 1")
@@ -90,8 +81,6 @@ class LoadCase:
             _set(self, name, items)
         if self.without_link is not None and not (isinstance(self.without_link, str) and self.without_link.strip()):
             raise CaseError(item, "without_link", self.without_link, "a link name or None")
-        if self.thrust_point is not None:
-            _set(self, "thrust_point", fields.vector3(item, "thrust_point", self.thrust_point))
 
     def check(self, links) -> None:
         """Refuse a fail-safe link that is not one of *links* (names), naming the load case."""

@@ -20,17 +20,17 @@ four-pole set closes it in its compliance form
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import numpy as np
 
 from flexbodies.materials import Material
 from workbook.errors import CaseError
-from workbook.model.fields import positive_number, vector3
+from workbook.model.field_spec import check_fields, documented, spec
 from workbook.model.pylon import Pin, PinDynamics, PylonModel, PylonStructure
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["BoxBeamPylon", "SectionProperties", "BeamModel", "beam_model"]
 
@@ -59,65 +59,47 @@ class SectionProperties:
     torsion_constant: float
 
 
+@documented
 @dataclass(frozen=True)
 class BoxBeamPylon(PylonModel):
-    """A box-beam pylon clamped at its root (a :class:`~workbook.model.pylon.PylonModel`).
-
-    Parameters
-    ----------
-    root, tip : 3 floats
-        Ends of the beam axis, m; clamped at *root*.
-    width, height : float
-        Outer dimensions of the box, m; *height* along *up* (made
-        normal to the axis), *width* normal to both.
-    wall : float
-        Wall thickness, m (less than half of width and height).
-    material : flexbodies.Material
-    loss_factor : float
-        Structural loss factor eta: stiffness ``K (1 + i eta)``, >= 0.
-    up : 3 floats
-        Direction of the height, not along the axis (default +z).
-    elements : int
-        Beam elements over the length, at least; stations at the pins are
-        added.
-    name : str
-    """
+    """A box-beam pylon clamped at its root (a :class:`~workbook.model.pylon.PylonModel`)."""
 
     effect: ClassVar[str] = "flexible pylon (box beam)"
     noun: ClassVar[str] = "pylon beam"
     legacy_field: ClassVar[str] = "pylon_beam"
     time_domain_note: ClassVar[str] = "the box beam is built as the pylon's compliance in the frequency domain"
 
-    root: tuple
-    tip: tuple
-    width: float
-    height: float
-    wall: float
-    material: Material
-    loss_factor: float = 0.02
-    up: tuple = (0.0, 0.0, 1.0)
-    elements: int = 40
-    name: str = "box-beam pylon"
+    root: tuple = field(metadata=spec("End of the beam axis where it is clamped", type="3 floats", check="vector3",
+                                      unit="m"))
+    tip: tuple = field(metadata=spec("Free end of the beam axis, other than *root*", type="3 floats",
+                                     check="vector3", unit="m"))
+    width: float = field(metadata=spec("Outer width of the box, normal to the axis and to *up*", unit="m",
+                                       minimum=0.0, strictly=True))
+    height: float = field(metadata=spec("Outer height of the box, along *up* (made normal to the axis)", unit="m",
+                                        minimum=0.0, strictly=True))
+    wall: float = field(metadata=spec("Wall thickness, less than half of *width* and *height*", unit="m",
+                                      minimum=0.0, strictly=True))
+    material: Material = field(metadata=spec("Material of the box", type="flexbodies.Material", check="own"))
+    loss_factor: float = field(default=0.02, metadata=spec(
+        "Structural loss factor eta: stiffness ``K (1 + i eta)``", unit=DIMENSIONLESS, minimum=0.0))
+    up: tuple = field(default=(0.0, 0.0, 1.0), metadata=spec(
+        "Direction of the height, not along the axis (default +z)", type="3 floats", check="vector3"))
+    elements: int = field(default=40, metadata=spec(
+        "Beam elements over the length, at least (stations at the pins are added)", type="int", check="own",
+        minimum=1.0))
+    name: str = field(default="box-beam pylon", metadata=spec("Its name in messages", type="str", check="own"))
 
     def __post_init__(self):
         item = f"pylon beam {self.name!r}"
-        set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
-        for name in ("root", "tip", "up"):
-            set_(name, vector3(item, name, getattr(self, name)))
-        for name in ("width", "height", "wall"):
-            set_(name, positive_number(item, name, getattr(self, name)))
+        check_fields(self, item)
         if self.wall >= min(self.width, self.height) / 2:
             raise CaseError(item, "wall", self.wall, f"less than half the width and height "
                                                      f"({min(self.width, self.height) / 2:g} m)")
         if not isinstance(self.material, Material):
             raise CaseError(item, "material", self.material, "a Material")
-        loss = float(self.loss_factor) if not isinstance(self.loss_factor, bool) else math.nan
-        if not (math.isfinite(loss) and loss >= 0):
-            raise CaseError(item, "loss_factor", self.loss_factor, "a number >= 0")
-        set_("loss_factor", loss)
         if isinstance(self.elements, bool) or int(self.elements) != self.elements or self.elements < 1:
             raise CaseError(item, "elements", self.elements, "a whole number >= 1")
-        set_("elements", int(self.elements))
+        object.__setattr__(self, "elements", int(self.elements))
         if self.length == 0:
             raise CaseError(item, "tip", self.tip, "a point other than the root")
         axis = np.subtract(self.tip, self.root) / self.length

@@ -15,85 +15,58 @@ whose compliance closes the four-pole set as the box beam's does.
 """
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import ClassVar
-
-import numpy as np
 
 from flexbodies.materials import Material
 from flexbodies.pylon_reduction import PylonMeshModel, reduce_pylon
 from workbook.errors import CaseError
-from workbook.model.fields import positive_number, vector3
+from workbook.model.field_spec import check_fields, documented, spec
 from workbook.model.pylon import Pin, PinDynamics, PylonModel, PylonStructure
+from workbook.model.units import DIMENSIONLESS
 
 __all__ = ["MeshPylon", "mesh_pylon_model"]
 
 
+@documented
 @dataclass(frozen=True)
 class MeshPylon(PylonModel):
-    """A pylon from a user's solid mesh, clamped on its root plane (a :class:`~workbook.model.pylon.PylonModel`).
-
-    Parameters
-    ----------
-    path : str
-        Mesh file (``.msh``, ``.inp``, ``.vtu``, ...; quadratic tetrahedra
-        preferred), coordinates in the case's axes times ``scale``.
-    root_point, root_normal : 3 floats
-        A point of the root plane (m) and its normal: every mesh node within
-        ``root_tolerance`` of the plane is clamped.
-    bore_axis : 3 floats
-        Direction of the pin bores' axes.
-    bore_radius : float
-        Radius of the pin bores, m.
-    material : flexbodies.Material
-    loss_factor : float
-        Structural loss factor of the pylon's material (stiffness ``K (1 + i eta)``).
-    scale : float
-        Factor from the file's units to m (1e-3 for a file in mm).
-    root_tolerance : float
-        Distance from the root plane within which a node is clamped, m.
-    name : str
-    """
+    """A pylon from a user's solid mesh, clamped on its root plane (a :class:`~workbook.model.pylon.PylonModel`)."""
 
     effect: ClassVar[str] = "flexible pylon (mesh)"
     noun: ClassVar[str] = "pylon mesh"
     legacy_field: ClassVar[str] = "pylon_mesh"
     time_domain_note: ClassVar[str] = "the mesh is reduced to the pylon's compliance in the frequency domain"
 
-    path: str
-    root_point: tuple
-    root_normal: tuple
-    bore_axis: tuple
-    bore_radius: float
-    material: Material
-    loss_factor: float = 0.02
-    scale: float = 1.0
-    root_tolerance: float = 1e-6
-    name: str = "mesh pylon"
+    path: str = field(metadata=spec(
+        "Mesh file (``.msh``, ``.inp``, ``.vtu``, ...; quadratic tetrahedra preferred), coordinates in the case's "
+        "axes times *scale*", type="str", check="own"))
+    root_point: tuple = field(metadata=spec("A point of the root plane", type="3 floats", check="vector3", unit="m"))
+    root_normal: tuple = field(metadata=spec(
+        "Normal of the root plane: every mesh node within *root_tolerance* of the plane is clamped",
+        type="3 floats", check="direction"))
+    bore_axis: tuple = field(metadata=spec("Direction of the pin bores' axes", type="3 floats", check="direction"))
+    bore_radius: float = field(metadata=spec("Radius of the pin bores", unit="m", minimum=0.0, strictly=True))
+    material: Material = field(metadata=spec("Material of the pylon", type="flexbodies.Material", check="own"))
+    loss_factor: float = field(default=0.02, metadata=spec(
+        "Structural loss factor of the pylon's material (stiffness ``K (1 + i eta)``)", unit=DIMENSIONLESS,
+        minimum=0.0))
+    scale: float = field(default=1.0, metadata=spec(
+        "Factor from the file's units to m (1e-3 for a file in mm)", unit=DIMENSIONLESS, minimum=0.0, strictly=True))
+    root_tolerance: float = field(default=1e-6, metadata=spec(
+        "Distance from the root plane within which a node is clamped", unit="m", minimum=0.0, strictly=True))
+    name: str = field(default="mesh pylon", metadata=spec("Its name in messages", type="str", check="own"))
 
     def __post_init__(self):
         item = f"pylon mesh {self.name!r}"
-        set_ = lambda name, value: object.__setattr__(self, name, value)  # noqa: E731
         if not isinstance(self.path, (str, Path)) or not str(self.path):
             raise CaseError(item, "path", self.path, "the path of a mesh file")
-        set_("path", str(self.path))
-        for name in ("root_point", "root_normal", "bore_axis"):
-            set_(name, vector3(item, name, getattr(self, name)))
-        for name in ("root_normal", "bore_axis"):
-            if not np.linalg.norm(getattr(self, name)) > 0:
-                raise CaseError(item, name, getattr(self, name), "a non-zero direction")
-        for name in ("bore_radius", "scale", "root_tolerance"):
-            set_(name, positive_number(item, name, getattr(self, name)))
+        object.__setattr__(self, "path", str(self.path))
+        check_fields(self, item)
         if not isinstance(self.material, Material):
             raise CaseError(item, "material", self.material, "a Material")
-        loss = float(self.loss_factor) if isinstance(self.loss_factor, (int, float)) and not isinstance(
-            self.loss_factor, bool) else math.nan
-        if not (math.isfinite(loss) and loss >= 0):
-            raise CaseError(item, "loss_factor", self.loss_factor, "a number >= 0")
-        set_("loss_factor", loss)
 
     def describe(self) -> str:
         """One line for the model card."""

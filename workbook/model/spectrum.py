@@ -15,10 +15,11 @@ run-up, its speeds bound the spectrum's.
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from workbook.errors import CaseError
 from workbook.model import fields
+from workbook.model.field_spec import check_fields, documented, spec
 
 __all__ = ["SpeedBand", "SpeedSpectrum", "BAND_POINTS", "SECONDS_PER_HOUR", "check_speed_spectra",
            "reference_speed_spectra"]
@@ -34,33 +35,24 @@ def _set(obj, name, value) -> None:
     object.__setattr__(obj, name, value)
 
 
+@documented
 @dataclass(frozen=True)
 class SpeedBand:
-    """Hours at one rotor speed, or spread evenly over a band of speeds.
+    """Hours at one rotor speed, or spread evenly over a band of speeds."""
 
-    Parameters
-    ----------
-    hours : float
-        Time at the speed (or in the band), h (>= 0).
-    speed_hz : float
-        The speed, or the band's lower end, Hz (> 0).
-    to_hz : float or None
-        The band's upper end, Hz (> speed_hz); None: one speed.
-    """
-
-    hours: float
-    speed_hz: float
-    to_hz: float | None = None
+    hours: float = field(metadata=spec("Time at the speed (or in the band)", unit="h", minimum=0.0,
+                                       help="time at the speed or in the band, >= 0"))
+    speed_hz: float = field(metadata=spec("The speed, or the band's lower end", unit="Hz", minimum=0.0,
+                                          strictly=True, help="the speed, or the band's lower end (Hz accepted)"))
+    to_hz: float | None = field(default=None, metadata=spec(
+        "The band's upper end, above *speed_hz* (None: one speed)", unit="Hz", minimum=0.0, strictly=True,
+        optional=True, help="the band's upper end (empty: one speed)"))
 
     def __post_init__(self):
         item = "speed band"
-        _set(self, "hours", fields.number(item, "hours", self.hours, minimum=0.0))
-        _set(self, "speed_hz", fields.positive_number(item, "speed_hz", self.speed_hz))
-        if self.to_hz is not None:
-            to_hz = fields.positive_number(item, "to_hz", self.to_hz)
-            if to_hz <= self.speed_hz:
-                raise CaseError(item, "to_hz", self.to_hz, f"a speed above the band's lower end ({self.speed_hz:g} Hz)")
-            _set(self, "to_hz", to_hz)
+        check_fields(self, item)
+        if self.to_hz is not None and self.to_hz <= self.speed_hz:
+            raise CaseError(item, "to_hz", self.to_hz, f"a speed above the band's lower end ({self.speed_hz:g} Hz)")
 
     def points(self) -> tuple[tuple[float, float], ...]:
         """``(speed Hz, hours)`` at which the band is solved (see the module)."""
@@ -70,21 +62,16 @@ class SpeedBand:
         return tuple((self.speed_hz + (k + 0.5) * width, self.hours / BAND_POINTS) for k in range(BAND_POINTS))
 
 
+@documented
 @dataclass(frozen=True)
 class SpeedSpectrum:
-    """The hours one rotor excitation runs at each speed.
+    """The hours one rotor excitation runs at each speed."""
 
-    Parameters
-    ----------
-    excitation : str
-        The name of a rotor excitation of the case (not a simultaneous one:
-        give each of its rotors a spectrum of its own excitation).
-    bands : tuple of SpeedBand
-        At least one, with more than zero hours in all.
-    """
-
-    excitation: str
-    bands: tuple[SpeedBand, ...]
+    excitation: str = field(metadata=spec(
+        "The name of a rotor excitation of the case (not a simultaneous one: give each of its rotors a spectrum "
+        "of its own excitation)", type="str", check="own"))
+    bands: tuple[SpeedBand, ...] = field(metadata=spec("At least one, with more than zero hours in all",
+                                                       type="tuple of SpeedBand", check="own"))
 
     def __post_init__(self):
         fields.nonempty_name("speed spectrum", self.excitation)
