@@ -86,7 +86,7 @@ def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """M, K, D of the rest of the scene at the state change *dq*, full coordinates (M with each
     Euler-parameter body's rotation exact, :func:`turned_mass`)."""
-    mass, damping = turned_mass(expansion, dq), expansion.rest.matrices(dq)[2]
+    mass, damping = turned_mass(expansion, dq), expansion.rest.damping_at(dq)
     q = total(expansion, dq)
     for indices, added in loads.mass:
         mass[np.ix_(indices, indices)] += added(q[indices])
@@ -121,11 +121,11 @@ def turned_mass(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
     """
     euler = expansion.euler_blocks
     if not len(euler):
-        return expansion.rest.matrices(dq)[0]
+        return expansion.rest.mass_at(dq)
     nodes = np.concatenate([euler[:, :1] - 3 + np.arange(3), euler], axis=1)      # (E, 7): position, parameters
     unturned = dq.copy()
     unturned[nodes] = 0.0
-    mass = expansion.rest.matrices(unturned)[0]
+    mass = expansion.rest.mass_at(unturned)
     at = [total(expansion, change)[euler] for change in (np.zeros_like(dq), dq)]
     (base_rotation, base_local), (rotation, local) = (_rotation(theta / np.linalg.norm(theta, axis=1)[:, None])
                                                       for theta in at)

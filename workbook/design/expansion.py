@@ -118,12 +118,13 @@ class RestBlocks:
         return self._full(self.stiffness + np.einsum("bijk,bk->bij", self.stiffness_slope, local)
                           + self._curved(local, 0.5))
 
-    def matrices(self, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """M, K, D (N, N) at the state change *dq* (first order in it; K as :meth:`stiffness_at`)."""
-        local = self._local(dq)
-        mass, damping = (self._full(matrix + np.einsum("bijk,bk->bij", slope, local))
-                         for matrix, slope in ((self.mass, self.mass_slope), (self.damping, self.damping_slope)))
-        return mass, self.stiffness_at(dq), damping
+    def mass_at(self, dq: np.ndarray) -> np.ndarray:
+        """M (N, N) at the state change *dq*, of first order in it."""
+        return self._full(self.mass + np.einsum("bijk,bk->bij", self.mass_slope, self._local(dq)))
+
+    def damping_at(self, dq: np.ndarray) -> np.ndarray:
+        """D (N, N) at the state change *dq*, of first order in it."""
+        return self._full(self.damping + np.einsum("bijk,bk->bij", self.damping_slope, self._local(dq)))
 
     def force_change(self, dq: np.ndarray) -> np.ndarray:
         """The change of the rest's internal force over *dq* (N,): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""

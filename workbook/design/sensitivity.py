@@ -35,7 +35,7 @@ import scipy.linalg as sla
 from workbook.design.assembly import (
     ChannelSprings,
     projection,
-    rest_matrices,
+    rest_stiffness,
     tangent_stiffness,
     total,
     without_normal,
@@ -277,9 +277,8 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
     for dq, tensions, loads in solution.state.passes:
         at = channels.state(total(expansion, dq))
         q = total(expansion, dq)
-        _, rest_stiffness, _ = rest_matrices(expansion, dq, loads)
         basis = projection(expansion, dq)
-        factor = sla.lu_factor(basis.both(tangent_stiffness(expansion, dq, rest_stiffness, base, at)),
+        factor = sla.lu_factor(basis.both(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), base, at)),
                                check_finite=False)
         jacobian = channels.outputs(at, base.stiffness)
         for j, change in enumerate(changes):
