@@ -118,23 +118,32 @@ class LinkStiffening:
         product = np.einsum("ick,icl->kl", nodal, (self.scalar @ nodal.reshape(n, -1)).reshape(n, 3, -1))
         return 0.5 * (product + product.T)
 
-    def pinned_hz(self, tension: float, count: int = 2) -> np.ndarray:
+    def pinned_hz(self, tension, count: int = 2) -> np.ndarray:
         """Lowest pinned-pinned frequencies under an axial tension, Hz.
 
         Parameters
         ----------
-        tension : float
-            Axial force, N (negative: compression).
+        tension : float or ndarray
+            Axial force, N (negative: compression); an array gives the
+            frequencies at each of its tensions.
         count : int
 
         Returns
         -------
-        ndarray, shape (count,)
+        ndarray, shape (..., count)
             Frequencies, Hz; a mode past its buckling load has a negative
             squared frequency, returned as a negative number.
         """
-        lam = sla.eigh(self.pinned_stiffness + tension * self.pinned_geometric, self.pinned_mass,
-                       eigvals_only=True, subset_by_index=[0, count - 1])
+        tension = np.asarray(tension, dtype=float)
+        if tension.ndim == 0:
+            lam = sla.eigh(self.pinned_stiffness + tension * self.pinned_geometric, self.pinned_mass,
+                           eigvals_only=True, subset_by_index=[0, count - 1])
+        else:       # one symmetric pencil per tension, whitened by M = L L^T
+            factor = np.linalg.cholesky(self.pinned_mass)
+            stiffness, geometric = (sla.solve_triangular(factor, sla.solve_triangular(factor, m, lower=True).T,
+                                                         lower=True) for m in (self.pinned_stiffness,
+                                                                               self.pinned_geometric))
+            lam = np.linalg.eigvalsh(stiffness + tension[..., None, None] * geometric)[..., :count]
         return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
 
     def first_mode_shift(self, tension: float) -> float:

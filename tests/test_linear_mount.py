@@ -6,7 +6,7 @@ import pytest
 
 from workbook import run_case
 from workbook.design.linear_mount import LinearMount
-from workbook.errors import OutsideDesignModel
+from workbook.errors import OutsideDesignModel, UnstablePreloadError
 from workbook.model.reference import reference_case
 
 pytestmark = pytest.mark.slow
@@ -61,6 +61,35 @@ def test_engine_mass_and_excitation_amplitude(mount):
     excitations = tuple(dataclasses.replace(e, amplitude=2.0 * e.amplitude) for e in case.excitations)
     for t_error, hinge_error in _compare(mount, dataclasses.replace(case, engine=engine, excitations=excitations)):
         assert t_error < 5e-6 and hinge_error < 1e-5
+
+
+def test_many_designs_at_once_are_each_design_alone(mount):
+    """A batch mixing hinge designs, a heavier engine under larger excitations, a change the mount cannot follow
+    and a design with no stable preload: each answer is that design's alone, the heavier one is the pipeline's,
+    and the two it cannot answer have their errors in their places."""
+    case = mount.case
+    rng = np.random.default_rng(7)
+    heavier = dataclasses.replace(case, engine=dataclasses.replace(case.engine, mass=1.2 * case.engine.mass),
+                                  excitations=tuple(dataclasses.replace(e, amplitude=3.0 * e.amplitude)
+                                                    for e in case.excitations))
+    moved = dataclasses.replace(case, engine=dataclasses.replace(case.engine, center_of_mass=(-0.5, 0.0, -0.03)))
+    sinking = dataclasses.replace(case, engine=dataclasses.replace(case.engine, mass=300 * case.engine.mass))
+    batch = [_design(case, rng), moved, heavier, sinking, _design(case, rng)]
+    answers = mount.evaluate_many(batch)
+    assert isinstance(answers[1], OutsideDesignModel)
+    assert isinstance(answers[3], UnstablePreloadError) and "no stable equilibrium" in str(answers[3])
+    for k in (0, 2, 4):
+        alone = mount.evaluate(batch[k])
+        for together, single in zip(answers[k].result.runs, alone.result.runs, strict=True):
+            assert _normwise(together.transmissibility, single.transmissibility) < 1e-10
+            for name, amplitude in single.hinge_amplitudes.items():
+                assert _normwise(together.hinge_amplitudes[name], amplitude) < 1e-10
+        for item, forces in alone.static_hinge_forces.items():
+            for name, force in forces.items():
+                assert _normwise(answers[k].static_hinge_forces[item][name], force) < 1e-10
+    exact = run_case(heavier)
+    for fast, e in zip(answers[2].result.runs, exact.runs, strict=True):
+        assert _normwise(fast.transmissibility, e.transmissibility) < 5e-6
 
 
 def test_a_change_it_cannot_follow_is_named(mount):

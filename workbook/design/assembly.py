@@ -2,8 +2,9 @@
 
 The arithmetic of :mod:`workbook.design.linear_mount`, on plain arrays:
 
-- :func:`static_state`: Newton on the preload equilibrium in the
-  independent coordinates (Euler parameters renormalised);
+- :func:`static_state`: Newton (with its tangent kept while it serves) on
+  the preload equilibrium in the independent coordinates (Euler parameters
+  renormalised);
 - :func:`tangent_stiffness`, :func:`rest_matrices` and :func:`projection`:
   the linearisation at a state, projected on the independent coordinates.
 
@@ -11,6 +12,9 @@ A channel with stiffness S (3x3, N/m) has the potential ``d^T S d / 2``:
 generalised force ``J^T S d`` and tangent stiffness
 ``J^T S J + sum_k (S d)_k H_k``; its force output is ``sign S d`` with the
 sign of Exudyn's ``Force`` output.
+
+Every function takes one state, ``dq`` of shape (N,), or one per design,
+shape (B, N), with the design-dependent arguments (springs, loads) likewise.
 """
 from __future__ import annotations
 
@@ -21,17 +25,19 @@ import numpy as np
 from workbook.design.channel_set import ChannelState
 from workbook.design.expansion import SceneExpansion
 
-__all__ = ["ChannelSprings", "StateLoads", "Projection", "total", "rest_stiffness", "rest_matrices", "turned_mass", "static_residual",
-           "normal_components", "without_normal", "tangent_stiffness", "static_state", "projection",
-           "NEWTON_TOLERANCE", "NEWTON_STEPS"]
+__all__ = ["ChannelSprings", "AddedRigidMass", "StateLoads", "Projection", "total", "rest_stiffness",
+           "rest_matrices", "turned_mass", "static_residual", "normal_components", "without_normal",
+           "tangent_stiffness", "static_state", "StaticSolution", "solve_each", "projection", "NEWTON_TOLERANCE",
+           "CHORD_STEPS"]
 
-#: Newton on the preload ends when the error it leaves is below this (relative to the state change):
-#: when the last update is below its square root (quadratic convergence leaves an error of order its square).
+#: The preload solve ends when the error it leaves is below this (relative to the state change).
 NEWTON_TOLERANCE = 1e-10
 #: Smallest state change the tolerance is relative to (m, rad, modal coordinates).
 STATE_SCALE = 1e-3
-#: Most Newton steps of one preload solve.
-NEWTON_STEPS = 20
+#: Most steps of one preload solve.
+CHORD_STEPS = 40
+#: A design's tangent stiffness is renewed when its updates shrink by less than this factor per step.
+RENEWAL_RATE = 0.1
 
 
 @dataclass(frozen=True)
@@ -49,6 +55,51 @@ class ChannelSprings:
     damping: np.ndarray
     structural: np.ndarray
 
+    def take(self, rows: np.ndarray | int) -> "ChannelSprings":
+        """The designs *rows* of springs given per design (leading axis; an index: one design without it)."""
+        return ChannelSprings(self.stiffness[rows], self.damping[rows], self.structural[rows])
+
+
+@dataclass(frozen=True)
+class AddedRigidMass:
+    """Mass and inertia added to a rigid body whose node has Tait-Bryan (Rxyz) angles, per design.
+
+    Attributes
+    ----------
+    coordinates : ndarray of int, shape (6,)
+        The node's position and angles among the full coordinates.
+    mass : ndarray, shape (...)
+        kg.
+    inertia : ndarray, shape (..., 3, 3)
+        About the centre of gravity, body axes, kg m^2.
+    """
+
+    coordinates: np.ndarray
+    mass: np.ndarray
+    inertia: np.ndarray
+
+    def matrix(self, q: np.ndarray) -> np.ndarray:
+        """The added M (..., 6, 6) at the node's total coordinates *q* (..., 6)."""
+        rotation = _angular_velocity_map(q[..., 3:6])
+        block = np.zeros(q.shape[:-1] + (6, 6))
+        block[..., :3, :3] = np.asarray(self.mass)[..., None, None] * np.eye(3)
+        block[..., 3:, 3:] = rotation.swapaxes(-1, -2) @ self.inertia @ rotation
+        return block
+
+    def take(self, rows: np.ndarray | int) -> "AddedRigidMass":
+        """The designs *rows*."""
+        return AddedRigidMass(self.coordinates, self.mass[rows], self.inertia[rows])
+
+
+def _angular_velocity_map(angles: np.ndarray) -> np.ndarray:
+    """``G`` of Exudyn's Tait-Bryan (Rxyz) angles (..., 3): body angular velocity = G @ angle rates, (..., 3, 3)."""
+    b, c = angles[..., 1], angles[..., 2]
+    out = np.zeros(angles.shape[:-1] + (3, 3))
+    out[..., 0, 0], out[..., 0, 1] = np.cos(b) * np.cos(c), np.sin(c)
+    out[..., 1, 0], out[..., 1, 1] = -np.cos(b) * np.sin(c), np.cos(c)
+    out[..., 2, 0], out[..., 2, 2] = np.sin(b), 1.0
+    return out
+
 
 @dataclass(frozen=True)
 class StateLoads:
@@ -57,16 +108,22 @@ class StateLoads:
     Attributes
     ----------
     modal_stiffness : list of (ndarray of int, ndarray)
-        Added stiffness on modal coordinates: (indices, matrix) per stiffened link.
-    mass : list of (ndarray of int, callable)
-        Added mass on coordinates: (indices, ``f(q) -> matrix``).
-    force : ndarray, shape (N,)
+        Added stiffness on modal coordinates: (indices, matrix (..., m, m)) per stiffened link.
+    mass : list of AddedRigidMass
+        Added rigid-body mass.
+    force : ndarray, shape (..., N)
         Added applied force (e.g. the weight of added engine mass), N.
     """
 
     modal_stiffness: list
     mass: list
     force: np.ndarray
+
+    def take(self, rows: np.ndarray | int) -> "StateLoads":
+        """The designs *rows* of loads given per design (leading axis; an index: one design without it)."""
+        return StateLoads([(indices, added[rows] if added.ndim == 3 else added)
+                           for indices, added in self.modal_stiffness],
+                          [added.take(rows) for added in self.mass], self.force[rows])
 
 
 def total(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
@@ -75,34 +132,34 @@ def total(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
 
 
 def rest_stiffness(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads) -> np.ndarray:
-    """K of the rest of the scene at the state change *dq*, full coordinates."""
+    """K of the rest of the scene at the state change *dq* (..., N), full coordinates (..., N, N)."""
     stiffness = expansion.rest.stiffness_at(dq)
     for indices, added in loads.modal_stiffness:
-        stiffness[np.ix_(indices, indices)] += added
+        stiffness[..., indices[:, None], indices] += added
     return stiffness
 
 
 def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """M, K, D of the rest of the scene at the state change *dq*, full coordinates (M with each
-    Euler-parameter body's rotation exact, :func:`turned_mass`)."""
+    """M, K, D of the rest of the scene at the state change *dq* (..., N), full coordinates (..., N, N) (M with
+    each Euler-parameter body's rotation exact, :func:`turned_mass`)."""
     mass, damping = turned_mass(expansion, dq), expansion.rest.damping_at(dq)
     q = total(expansion, dq)
-    for indices, added in loads.mass:
-        mass[np.ix_(indices, indices)] += added(q[indices])
+    for added in loads.mass:
+        indices = added.coordinates
+        mass[..., indices[:, None], indices] += added.matrix(q[..., indices])
     return mass, rest_stiffness(expansion, dq, loads), damping
 
 
 def _rotation(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A (E, 3, 3) and the local ``G`` (E, 3, 4) of unit Euler parameters *theta* (E, 4), as Exudyn's
-    rigid-body nodes have them: body angular velocity ``G theta'``, global vector ``A v`` of a local v."""
-    p0, pv = theta[:, 0], theta[:, 1:]
-    skew = np.zeros((len(theta), 3, 3))
-    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -pv[:, 2], pv[:, 1], -pv[:, 0]
-    skew -= skew.transpose(0, 2, 1)
-    rotation = (2 * p0 ** 2 - 1)[:, None, None] * np.eye(3) + 2 * (np.einsum("ei,ej->eij", pv, pv)
-                                                                  + p0[:, None, None] * skew)
-    local = 2 * np.concatenate([-pv[:, :, None], p0[:, None, None] * np.eye(3) - skew], axis=2)
+    """A (..., E, 3, 3) and the local ``G`` (..., E, 3, 4) of unit Euler parameters *theta* (..., E, 4), as
+    Exudyn's rigid-body nodes have them: body angular velocity ``G theta'``, global vector ``A v`` of a local v."""
+    p0, pv = theta[..., 0, None, None], theta[..., 1:]
+    skew = np.zeros(theta.shape[:-1] + (3, 3))
+    skew[..., 0, 1], skew[..., 0, 2], skew[..., 1, 2] = -pv[..., 2], pv[..., 1], -pv[..., 0]
+    skew -= skew.swapaxes(-1, -2)
+    rotation = (2 * p0 ** 2 - 1) * np.eye(3) + 2 * (pv[..., :, None] * pv[..., None, :] + p0 * skew)
+    local = 2 * np.concatenate([-pv[..., :, None], p0 * np.eye(3) - skew], axis=-1)
     return rotation, local
 
 
@@ -124,23 +181,24 @@ def turned_mass(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
         return expansion.rest.mass_at(dq)
     nodes = np.concatenate([euler[:, :1] - 3 + np.arange(3), euler], axis=1)      # (E, 7): position, parameters
     unturned = dq.copy()
-    unturned[nodes] = 0.0
+    unturned[..., nodes] = 0.0
     mass = expansion.rest.mass_at(unturned)
-    at = [total(expansion, change)[euler] for change in (np.zeros_like(dq), dq)]
-    (base_rotation, base_local), (rotation, local) = (_rotation(theta / np.linalg.norm(theta, axis=1)[:, None])
+    at = [total(expansion, change)[..., euler] for change in (np.zeros_like(dq), dq)]
+    (base_rotation, base_local), (rotation, local) = (_rotation(theta / np.linalg.norm(theta, axis=-1)[..., None])
                                                       for theta in at)
-    turn = np.zeros((len(euler), 7, 7))
-    turn[:, :3, :3] = base_rotation @ rotation.transpose(0, 2, 1)
-    turn[:, 3:, 3:] = base_local.transpose(0, 2, 1) @ local / 4
-    for index, block in zip(nodes, turn, strict=True):
-        mass[:, index] = mass[:, index] @ block
-        mass[index, :] = block.T @ mass[index, :]
+    turn = np.zeros(dq.shape[:-1] + (len(euler), 7, 7))
+    turn[..., :3, :3] = base_rotation @ rotation.swapaxes(-1, -2)
+    turn[..., 3:, 3:] = base_local.swapaxes(-1, -2) @ local / 4
+    for k, index in enumerate(nodes):
+        block = turn[..., k, :, :]
+        mass[..., :, index] = mass[..., :, index] @ block
+        mass[..., index, :] = block.swapaxes(-1, -2) @ mass[..., index, :]
     return mass
 
 
 def normal_components(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarray
                       ) -> tuple[np.ndarray, np.ndarray]:
-    """Per Euler-parameter node: its unit parameters (E, 4) and ``theta . force / |theta|`` (E,).
+    """Per Euler-parameter node: its unit parameters (..., E, 4) and ``theta . force / |theta|`` (..., E).
 
     Exudyn applies a force to such a node through ``G^T``, which has no
     component along the parameters themselves; the true Jacobian of a
@@ -148,22 +206,22 @@ def normal_components(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarr
     force) and its derivative, ``-(theta . f) / |theta|^2`` on the tangent
     directions (added to the stiffness): the same linearisation as Exudyn's.
     """
-    theta = total(expansion, dq)[expansion.euler_blocks]
-    norm = np.linalg.norm(theta, axis=1)
-    return theta / norm[:, None], np.einsum("ei,ei->e", theta, force[expansion.euler_blocks]) / norm
+    theta = total(expansion, dq)[..., expansion.euler_blocks]
+    norm = np.linalg.norm(theta, axis=-1)
+    return theta / norm[..., None], np.einsum("...ei,...ei->...e", theta, force[..., expansion.euler_blocks]) / norm
 
 
 def without_normal(expansion: SceneExpansion, dq: np.ndarray, force: np.ndarray) -> np.ndarray:
-    """*force* (N,) with its normal components on the Euler parameters removed (:func:`normal_components`)."""
+    """*force* (..., N) with its normal components on the Euler parameters removed (:func:`normal_components`)."""
     unit, normal = normal_components(expansion, dq, force)
     out = force.copy()
-    out[expansion.euler_blocks] -= normal[:, None] * unit
+    out[..., expansion.euler_blocks] -= normal[..., None] * unit
     return out
 
 
 def static_residual(expansion: SceneExpansion, dq: np.ndarray, springs: ChannelSprings, base_force: np.ndarray,
                     loads: StateLoads, state: ChannelState) -> np.ndarray:
-    """Internal minus applied generalised force at the state change *dq*, full coordinates.
+    """Internal minus applied generalised force at the state change *dq* (..., N), full coordinates.
 
     *base_force* is the rest's internal force at the prepared state (minus the
     channels' there). The rest's force grows with its stiffness at the mid
@@ -171,7 +229,7 @@ def static_residual(expansion: SceneExpansion, dq: np.ndarray, springs: ChannelS
     residual = base_force - loads.force + expansion.rest.force_change(dq)
     q = total(expansion, dq)
     for indices, added in loads.modal_stiffness:
-        residual[indices] += added @ q[indices]
+        residual[..., indices] += (added @ q[..., indices, None])[..., 0]
     return residual + without_normal(expansion, dq, expansion.channels.force(state, springs.stiffness))
 
 
@@ -182,15 +240,15 @@ def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarra
     channels = expansion.channels
     stiffness = rest + channels.matrix(state, springs.stiffness, stiffness=springs.stiffness)
     _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
-    theta = total(expansion, dq)[expansion.euler_blocks]
+    theta = total(expansion, dq)[..., expansion.euler_blocks]
     diagonal = expansion.euler_blocks
-    stiffness[diagonal, diagonal] -= (normal / np.linalg.norm(theta, axis=1))[:, None]
+    stiffness[..., diagonal, diagonal] -= (normal / np.linalg.norm(theta, axis=-1))[..., None]
     return stiffness
 
 
 @dataclass(frozen=True)
 class Projection:
-    """The null space of the Euler-parameter constraints at a state: ``q = B x``.
+    """The null space of the Euler-parameter constraints at a state (or one per design): ``q = B x``.
 
     B keeps the free coordinates as they are and gives each Euler-parameter
     node three tangent directions; it is applied block by block, never formed.
@@ -201,8 +259,8 @@ class Projection:
         The coordinates that are independent as they are.
     euler : ndarray of int, shape (E, 4)
         Each Euler-parameter node's coordinates.
-    tangents : ndarray, shape (E, 4, 3)
-        Each node's orthonormal tangent basis.
+    tangents : ndarray, shape (..., E, 4, 3)
+        Each node's orthonormal tangent basis (leading axes: designs).
     size : int
         N, the full coordinates.
     """
@@ -212,67 +270,172 @@ class Projection:
     tangents: np.ndarray
     size: int
 
+    @property
+    def _batch(self) -> tuple:
+        return self.tangents.shape[:-3]
+
     def expand(self, independent: np.ndarray) -> np.ndarray:
-        """``B @ independent`` (first axis: the f + 3 E independent coordinates)."""
+        """``B @ independent`` of vectors (..., f + 3 E): (..., N)."""
         count = len(self.free)
-        full = np.zeros((self.size,) + independent.shape[1:], dtype=independent.dtype)
-        full[self.free] = independent[:count]
-        nodes = independent[count:].reshape((len(self.euler), 3) + independent.shape[1:])
-        full[self.euler] = np.einsum("eki,ei...->ek...", self.tangents, nodes)
+        full = np.zeros(independent.shape[:-1] + (self.size,), dtype=independent.dtype)
+        full[..., self.free] = independent[..., :count]
+        nodes = independent[..., count:].reshape(independent.shape[:-1] + (len(self.euler), 3, 1))
+        full[..., self.euler] = (self.tangents @ nodes)[..., 0]
         return full
 
     def columns(self, matrix: np.ndarray) -> np.ndarray:
-        """``matrix @ B``."""
-        nodes = np.einsum("mek,eki->mei", matrix[:, self.euler], self.tangents)
-        return np.concatenate([matrix[:, self.free], nodes.reshape(len(matrix), -1)], axis=1)
+        """``matrix @ B`` of matrices (..., r, N): (..., r, f + 3 E)."""
+        on_nodes = np.moveaxis(matrix[..., self.euler], -3, -2)          # (..., E, r, 4)
+        nodes = np.moveaxis(on_nodes @ self.tangents, -3, -2)             # (..., r, E, 3)
+        return np.concatenate([matrix[..., self.free], nodes.reshape(nodes.shape[:-2] + (-1,))], axis=-1)
 
     def rows(self, matrix: np.ndarray) -> np.ndarray:
-        """``B.T @ matrix`` for a matrix (or vector) with the full coordinates as rows."""
-        nodes = np.einsum("eki,ek...->ei...", self.tangents, matrix[self.euler])
-        return np.concatenate([matrix[self.free], nodes.reshape((-1,) + matrix.shape[1:])], axis=0)
+        """``B.T @ matrix`` of a vector (design axes + (N,)) or matrix (design axes + (N, k))."""
+        batch = self._batch
+        trailing = matrix.shape[len(batch) + 1:]
+        flat = matrix.reshape(batch + (self.size, -1))
+        nodes = self.tangents.swapaxes(-1, -2) @ flat[..., self.euler, :]     # (..., E, 3, k)
+        out = np.concatenate([flat[..., self.free, :], nodes.reshape(batch + (-1, flat.shape[-1]))], axis=-2)
+        return out.reshape(batch + (-1,) + trailing)
 
     def both(self, matrix: np.ndarray) -> np.ndarray:
-        """``B.T @ matrix @ B``."""
+        """``B.T @ matrix @ B`` of matrices (..., N, N)."""
         return self.rows(self.columns(matrix))
 
 
 def projection(expansion: SceneExpansion, dq: np.ndarray) -> Projection:
-    """The independent coordinates at the state change *dq*."""
+    """The independent coordinates at the state change *dq* (..., N)."""
     q = total(expansion, dq)
     euler = expansion.euler_blocks
-    t0, t1, t2, t3 = (q[euler] / np.linalg.norm(q[euler], axis=1)[:, None]).T
+    unit = q[..., euler] / np.linalg.norm(q[..., euler], axis=-1)[..., None]
+    t0, t1, t2, t3 = np.moveaxis(unit, -1, 0)
     # an orthonormal basis (4, 3) of the directions normal to the unit parameters, per node
-    tangents = np.stack([np.stack([-t1, t0, t3, -t2], axis=1), np.stack([-t2, -t3, t0, t1], axis=1),
-                         np.stack([-t3, t2, -t1, t0], axis=1)], axis=2)
-    return Projection(expansion.free, euler, tangents, len(q))
+    tangents = np.stack([np.stack([-t1, t0, t3, -t2], axis=-1), np.stack([-t2, -t3, t0, t1], axis=-1),
+                         np.stack([-t3, t2, -t1, t0], axis=-1)], axis=-1)
+    return Projection(expansion.free, euler, tangents, q.shape[-1])
 
 
 def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force: np.ndarray, loads: StateLoads,
-                 start: np.ndarray) -> tuple[np.ndarray, int]:
-    """The preload equilibrium's state change from the prepared state, by Newton from *start*.
+                 start: np.ndarray, inverse: np.ndarray | None = None) -> "StaticSolution":
+    """The preload equilibrium's state change from the prepared state of each design, from *start*.
+
+    Newton with its tangent stiffness kept while it serves (a chord
+    iteration): the tangent at the start is inverted once, and a design's
+    tangent is renewed at its current state only when its updates shrink by
+    less than :data:`RENEWAL_RATE` per step. A design has converged when the
+    error its updates leave (``rate / (1 - rate)`` times the last update) is
+    below :data:`NEWTON_TOLERANCE` of its state change.
+
+    Parameters
+    ----------
+    springs, loads
+        Per design (leading axis B).
+    start : ndarray, shape (B, N)
+    inverse : ndarray, shape (B, n, n), optional
+        Inverses of projected tangent stiffnesses to start with (e.g. a
+        previous solve's, :attr:`StaticSolution.inverse`); else the tangent
+        at *start*.
+    """
+    dq = start.copy()
+    count = len(dq)
+    steps = np.zeros(count, dtype=int)
+    failures: dict[int, str] = {}
+    inverse = _tangent_inverse(expansion, springs, loads, dq, failures) if inverse is None else inverse.copy()
+    last = np.full(count, np.inf)
+    active = np.array([k for k in range(count) if k not in failures], dtype=int)
+    for step in range(1, CHORD_STEPS + 1):
+        part, part_springs, part_loads = dq[active], springs.take(active), loads.take(active)
+        state = expansion.channels.state(total(expansion, part), second=False)
+        basis = projection(expansion, part)
+        residual = basis.rows(static_residual(expansion, part, part_springs, base_force, part_loads, state))
+        full_update = basis.expand(-(inverse[active] @ residual[..., None])[..., 0])
+        q = total(expansion, part + full_update)
+        q[..., expansion.euler_blocks] /= np.linalg.norm(q[..., expansion.euler_blocks], axis=-1)[..., None]
+        moved = q - expansion.reference - expansion.state
+        dq[active] = moved
+        size = np.abs(full_update).max(axis=-1) / np.maximum(np.abs(moved).max(axis=-1), STATE_SCALE)
+        known = np.isfinite(last[active])
+        rate = np.where(known, size / np.where(known, last[active], 1.0), np.inf)
+        last[active] = size
+        shrinking = rate < 1.0
+        left = np.full(len(rate), np.inf)                 # the error the updates leave
+        left[shrinking] = rate[shrinking] * size[shrinking] / (1.0 - rate[shrinking])
+        converged = (size <= NEWTON_TOLERANCE) | (left <= NEWTON_TOLERANCE)
+        steps[active[converged]] = step
+        active = active[~converged]
+        renew = active[known[~converged] & (rate[~converged] > RENEWAL_RATE)]
+        if len(renew):
+            found: dict[int, str] = {}
+            inverse[renew] = _tangent_inverse(expansion, springs.take(renew), loads.take(renew), dq[renew], found)
+            failures.update({int(renew[k]): reason for k, reason in found.items()})
+            last[renew] = np.inf
+            active = np.array([k for k in active if k not in failures], dtype=int)
+        if not len(active):
+            break
+    for k in active:
+        failures[int(k)] = f"the preload did not converge in {CHORD_STEPS} steps"
+    return StaticSolution(dq, steps, failures, inverse)
+
+
+@dataclass(frozen=True)
+class StaticSolution:
+    """The preload equilibria of B designs (:func:`static_state`).
+
+    Attributes
+    ----------
+    dq : ndarray, shape (B, N)
+    steps : ndarray of int, shape (B,)
+        Steps each design took.
+    failures : dict of int to str
+        The designs whose tangent stiffness was singular or that did not
+        converge, with the reason (their rows of *dq* mean nothing).
+    inverse : ndarray, shape (B, n, n)
+        The inverse tangent stiffnesses last used.
+    """
+
+    dq: np.ndarray
+    steps: np.ndarray
+    failures: dict
+    inverse: np.ndarray
+
+
+def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: StateLoads, dq: np.ndarray,
+                     failures: dict) -> np.ndarray:
+    """The inverse projected tangent stiffness at *dq* (B, N) per design, (B, n, n); a singular one is noted
+    in *failures* (its inverse is zero)."""
+    state = expansion.channels.state(total(expansion, dq))
+    basis = projection(expansion, dq)
+    tangent = basis.both(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), springs, state))
+    inverse, singular = solve_each(tangent, np.broadcast_to(np.eye(tangent.shape[-1]), tangent.shape))
+    for k in np.flatnonzero(singular):
+        failures[int(k)] = "its tangent stiffness is singular"
+    return inverse
+
+
+def solve_each(matrices: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``matrices[k] x[k] = right[k]`` for every k, and which matrices are singular (their x is zero).
+
+    Parameters
+    ----------
+    matrices : ndarray, shape (B, n, n)
+    right : ndarray, shape (B, n) or (B, n, m)
 
     Returns
     -------
-    dq : ndarray, shape (N,)
-    steps : int
-        Newton steps taken.
-
-    Raises
-    ------
-    numpy.linalg.LinAlgError
-        The projected tangent stiffness is singular or Newton did not converge.
+    x : ndarray, shape of *right*
+    singular : ndarray of bool, shape (B,)
     """
-    dq = start.copy()
-    for step in range(1, NEWTON_STEPS + 1):
-        state = expansion.channels.state(total(expansion, dq))
-        basis = projection(expansion, dq)
-        stiffness = basis.both(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), springs, state))
-        residual = basis.rows(static_residual(expansion, dq, springs, base_force, loads, state))
-        update = np.linalg.solve(stiffness, -residual)
-        full_update = basis.expand(update)
-        q = total(expansion, dq + full_update)
-        q[expansion.euler_blocks] /= np.linalg.norm(q[expansion.euler_blocks], axis=1)[:, None]
-        dq = q - expansion.reference - expansion.state
-        if np.abs(full_update).max() <= np.sqrt(NEWTON_TOLERANCE) * max(np.abs(dq).max(), STATE_SCALE):
-            return dq, step
-    raise np.linalg.LinAlgError(f"the preload did not converge in {NEWTON_STEPS} Newton steps")
+    vector = right.ndim == 2
+    try:
+        solution = np.linalg.solve(matrices, right[..., None] if vector else right)
+        solution = solution[..., 0] if vector else solution
+        return solution, np.asarray(~np.isfinite(solution).reshape(len(matrices), -1).all(axis=-1))
+    except np.linalg.LinAlgError:                 # one of them at least: find which
+        solution = np.zeros(right.shape, dtype=np.result_type(matrices, right))
+        singular = np.zeros(len(matrices), dtype=bool)
+        for k, (matrix, vector) in enumerate(zip(matrices, right, strict=True)):
+            try:
+                solution[k] = np.linalg.solve(matrix, vector)
+            except np.linalg.LinAlgError:
+                singular[k] = True
+        return solution, np.asarray(singular | ~np.isfinite(solution).reshape(len(matrices), -1).all(axis=-1))

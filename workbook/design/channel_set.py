@@ -24,15 +24,15 @@ _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 
 @dataclass(frozen=True)
 class ChannelState:
-    """The channels at one state.
+    """The channels at one state (or one per design: leading axes).
 
     Attributes
     ----------
-    separation : ndarray, shape (C, 3)
+    separation : ndarray, shape (..., C, 3)
         d of every channel, m.
-    jacobian : ndarray, shape (2 C, 3, M)
+    jacobian : ndarray, shape (..., 2 C, 3, M)
         Each marker's position Jacobian on its padded coordinates.
-    hessian : ndarray, shape (2 C, 3, M, M), or None
+    hessian : ndarray, shape (..., 2 C, 3, M, M), or None
         None when not asked for.
     """
 
@@ -92,109 +92,138 @@ class ChannelSet:
         return len(self.coordinates) // 2
 
     def state(self, q: np.ndarray, *, second: bool = True) -> ChannelState:
-        """Separations, Jacobians and (with *second*) Hessians at the total coordinates *q* (N,)."""
-        values = np.append(q, 0.0)[self.coordinates]
+        """Separations, Jacobians and (with *second*) Hessians at the total coordinates *q* (..., N):
+        any leading axes are designs, answered at once."""
+        batch = q.shape[:-1]
+        count = int(np.prod(batch, dtype=int))
         points, width = self.coordinates.shape
-        position = np.zeros((points, 3))
-        jacobian = np.zeros((points, 3, width))
-        hessian = np.zeros((points, 3, width, width)) if second else None
-        ground, free = self.kinds["ground"], self.kinds["none"]
-        position[ground] = self.local[ground]
+        values = np.concatenate([q.reshape(count, -1), np.zeros((count, 1))], axis=1)[:, self.coordinates]
+        values = values.reshape(count * points, width)
+        local = np.tile(self.local, (count, 1))
+        modal = np.tile(self.modal, (count, 1, 1))
+        offsets = points * np.arange(count)[:, None]
+        kinds = {kind: (offsets + index).ravel() for kind, index in self.kinds.items()}
+        position = np.zeros((count * points, 3))
+        jacobian = np.zeros((count * points, 3, width))
+        hessian = np.zeros((count * points, 3, width, width)) if second else None
+        ground, free = kinds["ground"], kinds["none"]
+        position[ground] = local[ground]
         jacobian[:, :, :3] = np.eye(3)
         jacobian[ground] = 0.0
-        position[free] = values[free, :3] + self.local[free]
-        self._euler(values, position, jacobian, hessian)
-        self._rxyz(values, position, jacobian, hessian)
-        return ChannelState(position[1::2] - position[0::2], jacobian, hessian)
-
-    def _euler(self, values, position, jacobian, hessian) -> None:
-        index = self.kinds["euler"]
-        if not len(index):
-            return
-        modes = self.modal.shape[2]
-        shapes = self.modal[index]
-        w = self.local[index] + np.einsum("pak,pk->pa", shapes, values[index, 7:7 + modes])
-        e = values[index, 3:7]
-        a = np.einsum("abij,pj->pabi", EULER, e)                 # A = I + a . e
-        rotation = np.eye(3) + np.einsum("pabi,pi->pab", a, e)
-        position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
-        jacobian[index, :, 3:7] = 2 * np.einsum("pabi,pb->pai", a, w)
-        jacobian[index, :, 7:7 + modes] = rotation @ shapes
-        if hessian is None:
-            return
-        hessian[index, :, 3:7, 3:7] = 2 * np.einsum("abij,pb->paij", EULER, w)
-        mixed = 2 * np.einsum("pabi,pbk->paik", a, shapes)
-        hessian[index, :, 3:7, 7:7 + modes] = mixed
-        hessian[index, :, 7:7 + modes, 3:7] = mixed.transpose(0, 1, 3, 2)
-
-    def _rxyz(self, values, position, jacobian, hessian) -> None:
-        index = self.kinds["rxyz"]
-        if not len(index):
-            return
-        modes = self.modal.shape[2]
-        shapes = self.modal[index]
-        w = self.local[index] + np.einsum("pak,pk->pa", shapes, values[index, 6:6 + modes])
-        x, y, z = np.moveaxis(_axis_derivatives(values[index, 3:6]), 1, 0)   # (p, order, 3, 3) each
-
-        def product(orders: tuple[int, int, int]) -> np.ndarray:
-            # d^i R_x d^j R_y d^k R_z of the derivative orders (i, j, k)
-            return x[:, orders[0]] @ y[:, orders[1]] @ z[:, orders[2]]
-
-        rotation = product((0, 0, 0))
-        firsts = np.stack([product((1, 0, 0)), product((0, 1, 0)), product((0, 0, 1))], axis=1)
-        position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
-        jacobian[index, :, 3:6] = np.einsum("piab,pb->pai", firsts, w)
-        jacobian[index, :, 6:6 + modes] = rotation @ shapes
-        if hessian is None:
-            return
-        for i in range(3):
-            for j in range(i, 3):
-                orders = tuple(int(k == i) + int(k == j) for k in range(3))
-                second = np.einsum("pab,pb->pa", product(orders), w)  # type: ignore[arg-type]
-                hessian[index, :, 3 + i, 3 + j] = hessian[index, :, 3 + j, 3 + i] = second
-        mixed = np.einsum("piab,pbk->paik", firsts, shapes)
-        hessian[index, :, 3:6, 6:6 + modes] = mixed
-        hessian[index, :, 6:6 + modes, 3:6] = mixed.transpose(0, 1, 3, 2)
+        position[free] = values[free, :3] + local[free]
+        _euler(values, local, modal, kinds["euler"], position, jacobian, hessian)
+        _rxyz(values, local, modal, kinds["rxyz"], position, jacobian, hessian)
+        position = position.reshape(batch + (points, 3))
+        return ChannelState(position[..., 1::2, :] - position[..., 0::2, :],
+                            jacobian.reshape(batch + (points, 3, width)),
+                            None if hessian is None else hessian.reshape(batch + (points, 3, width, width)))
 
     def force(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
-        """``sum_c J_c^T S_c d_c`` (N,) for the springs *stiffness* (C, 3, 3), N/m."""
-        on_points = self._on_points(np.einsum("cab,cb->ca", stiffness, state.separation))
-        generalised = np.einsum("pam,pa->pm", state.jacobian, on_points)
-        return np.bincount(self.coordinates.ravel(), generalised.ravel(), self.size + 1)[:self.size]
+        """``sum_c J_c^T S_c d_c`` (..., N) for the springs *stiffness* (..., C, 3, 3), N/m."""
+        on_points = _on_points(np.einsum("...cab,...cb->...ca", stiffness, state.separation))
+        generalised = np.einsum("...pam,...pa->...pm", state.jacobian, on_points)
+        flat = generalised.reshape(generalised.shape[:-2] + (-1,))
+        return _scatter(self.coordinates.ravel(), flat, self.size + 1)[..., :self.size]
 
     def matrix(self, state: ChannelState, springs: np.ndarray, *, stiffness: np.ndarray | None = None) -> np.ndarray:
-        """``sum_c J_c^T S_c J_c`` (N, N) of the matrices *springs* (C, 3, 3); with *stiffness*, also
+        """``sum_c J_c^T S_c J_c`` (..., N, N) of the matrices *springs* (..., C, 3, 3); with *stiffness*, also
         ``sum_c (S_c d_c) . H_c`` of those springs (the tangent stiffness)."""
         jacobian = self._channel_jacobians(state)
-        blocks = np.einsum("csan,ctam->cstnm", jacobian, np.einsum("cab,ctbm->ctam", springs, jacobian))
+        weighted = np.einsum("...cab,...ctbm->...ctam", springs, jacobian)
+        blocks = np.einsum("...csan,...ctam->...cstnm", jacobian, weighted)
         rows = self.coordinates.reshape(self.count, 2, 1, -1, 1)
         columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
-        index, values = [(rows * (self.size + 1) + columns).ravel()], [blocks.ravel()]
+        index = [np.broadcast_to(rows * (self.size + 1) + columns, blocks.shape[-5:]).ravel()]
+        values = [blocks.reshape(blocks.shape[:-5] + (-1,))]
         if stiffness is not None:
             assert state.hessian is not None, "the tangent stiffness needs the Hessians"
-            on_points = self._on_points(np.einsum("cab,cb->ca", stiffness, state.separation))
+            on_points = _on_points(np.einsum("...cab,...cb->...ca", stiffness, state.separation))
             own = self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]
             index.append(own.ravel())
-            values.append(np.einsum("pa,pamn->pmn", on_points, state.hessian).ravel())
-        full = np.bincount(np.concatenate(index), np.concatenate(values), (self.size + 1) ** 2)
-        return full.reshape(self.size + 1, self.size + 1)[:self.size, :self.size]
+            curvature = np.einsum("...pa,...pamn->...pmn", on_points, state.hessian)
+            values.append(curvature.reshape(curvature.shape[:-3] + (-1,)))
+        batch = np.broadcast_shapes(*(v.shape[:-1] for v in values))
+        full = _scatter(np.concatenate(index), np.concatenate([np.broadcast_to(v, batch + v.shape[-1:])
+                                                               for v in values], axis=-1), (self.size + 1) ** 2)
+        return full.reshape(batch + (self.size + 1, self.size + 1))[..., :self.size, :self.size]
 
     def outputs(self, state: ChannelState, springs: np.ndarray) -> np.ndarray:
-        """``S_c J_c`` of every channel stacked: shape (3 C, N)."""
-        product = np.einsum("cab,ctbm->ctam", springs, self._channel_jacobians(state))
+        """``S_c J_c`` of every channel stacked: shape (..., 3 C, N)."""
+        product = np.einsum("...cab,...ctbm->...ctam", springs, self._channel_jacobians(state))
         rows = 3 * np.arange(self.count).reshape(-1, 1, 1, 1) + np.arange(3).reshape(1, 1, 3, 1)
         columns = self.coordinates.reshape(self.count, 2, 1, -1)
-        index = (rows * (self.size + 1) + columns).ravel()
-        full = np.bincount(index, product.ravel(), 3 * self.count * (self.size + 1))
-        return full.reshape(3 * self.count, self.size + 1)[:, :self.size]
-
-    def _on_points(self, channel_force: np.ndarray) -> np.ndarray:
-        """A force per channel (C, 3) as the force on each marker's Jacobian row (2 C, 3)."""
-        return (channel_force[:, None, :] * _SIGNS[None, :, None]).reshape(-1, 3)
+        index = np.broadcast_to(rows * (self.size + 1) + columns, product.shape[-4:]).ravel()
+        full = _scatter(index, product.reshape(product.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
+        return full.reshape(product.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
 
     def _channel_jacobians(self, state: ChannelState) -> np.ndarray:
-        """Each channel's two marker Jacobians with the sign of d: shape (C, 2, 3, M)."""
-        return state.jacobian.reshape(self.count, 2, 3, -1) * _SIGNS[None, :, None, None]
+        """Each channel's two marker Jacobians with the sign of d: shape (..., C, 2, 3, M)."""
+        jacobian = state.jacobian
+        return jacobian.reshape(jacobian.shape[:-3] + (self.count, 2, 3, -1)) * _SIGNS[:, None, None]
+
+
+def _on_points(channel_force: np.ndarray) -> np.ndarray:
+    """A force per channel (..., C, 3) as the force on each marker's Jacobian row (..., 2 C, 3)."""
+    return (channel_force[..., :, None, :] * _SIGNS[:, None]).reshape(channel_force.shape[:-2] + (-1, 3))
+
+
+def _scatter(index: np.ndarray, values: np.ndarray, length: int) -> np.ndarray:
+    """Sums of *values* (..., K) at the positions *index* (K,) in [0, length): shape (..., length)."""
+    batch = values.shape[:-1]
+    count = int(np.prod(batch, dtype=int))
+    flat = (index[None, :] + length * np.arange(count)[:, None]).ravel()
+    return np.bincount(flat, values.reshape(-1), count * length).reshape(batch + (length,))
+
+
+def _euler(values, local, modal, index, position, jacobian, hessian) -> None:
+    """Euler-parameter points *index* of the flat point arrays: their position, Jacobian and Hessian in place."""
+    if not len(index):
+        return
+    modes = modal.shape[2]
+    shapes = modal[index]
+    w = local[index] + np.einsum("pak,pk->pa", shapes, values[index, 7:7 + modes])
+    e = values[index, 3:7]
+    a = np.einsum("abij,pj->pabi", EULER, e)                 # A = I + a . e
+    rotation = np.eye(3) + np.einsum("pabi,pi->pab", a, e)
+    position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
+    jacobian[index, :, 3:7] = 2 * np.einsum("pabi,pb->pai", a, w)
+    jacobian[index, :, 7:7 + modes] = rotation @ shapes
+    if hessian is None:
+        return
+    hessian[index, :, 3:7, 3:7] = 2 * np.einsum("abij,pb->paij", EULER, w)
+    mixed = 2 * np.einsum("pabi,pbk->paik", a, shapes)
+    hessian[index, :, 3:7, 7:7 + modes] = mixed
+    hessian[index, :, 7:7 + modes, 3:7] = mixed.transpose(0, 1, 3, 2)
+
+
+def _rxyz(values, local, modal, index, position, jacobian, hessian) -> None:
+    """Tait-Bryan points *index* of the flat point arrays: their position, Jacobian and Hessian in place."""
+    if not len(index):
+        return
+    modes = modal.shape[2]
+    shapes = modal[index]
+    w = local[index] + np.einsum("pak,pk->pa", shapes, values[index, 6:6 + modes])
+    x, y, z = np.moveaxis(_axis_derivatives(values[index, 3:6]), 1, 0)   # (p, order, 3, 3) each
+
+    def product(orders: tuple[int, int, int]) -> np.ndarray:
+        # d^i R_x d^j R_y d^k R_z of the derivative orders (i, j, k)
+        return x[:, orders[0]] @ y[:, orders[1]] @ z[:, orders[2]]
+
+    rotation = product((0, 0, 0))
+    firsts = np.stack([product((1, 0, 0)), product((0, 1, 0)), product((0, 0, 1))], axis=1)
+    position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
+    jacobian[index, :, 3:6] = np.einsum("piab,pb->pai", firsts, w)
+    jacobian[index, :, 6:6 + modes] = rotation @ shapes
+    if hessian is None:
+        return
+    for i in range(3):
+        for j in range(i, 3):
+            orders = tuple(int(k == i) + int(k == j) for k in range(3))
+            second = np.einsum("pab,pb->pa", product(orders), w)  # type: ignore[arg-type]
+            hessian[index, :, 3 + i, 3 + j] = hessian[index, :, 3 + j, 3 + i] = second
+    mixed = np.einsum("piab,pbk->paik", firsts, shapes)
+    hessian[index, :, 3:6, 6:6 + modes] = mixed
+    hessian[index, :, 6:6 + modes, 3:6] = mixed.transpose(0, 1, 3, 2)
 
 
 def _axis_derivatives(angles: np.ndarray) -> np.ndarray:

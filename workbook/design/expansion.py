@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from workbook.design.channel_set import ChannelSet
-from workbook.design.kinematics import identify
+from workbook.design.kinematics import PointKinematics, identify
 from workbook.errors import OutsideDesignModel, SimulationError
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
@@ -96,43 +96,52 @@ class RestBlocks:
     stiffness_curvature: np.ndarray
 
     def _local(self, dq: np.ndarray) -> np.ndarray:
-        return np.append(dq, 0.0)[self.coordinates]
+        """*dq* (..., N) per block: (..., B, b)."""
+        return np.concatenate([dq, np.zeros(dq.shape[:-1] + (1,))], axis=-1)[..., self.coordinates]
 
     def _curved(self, local: np.ndarray, weight: float) -> np.ndarray:
-        """*weight* times the curvature term of K along the Euler parameters of *local* (B, b): (B, b, b)."""
-        blocks, width = local.shape
-        turned = np.append(local, np.zeros((blocks, 1)), axis=1)[np.arange(blocks)[:, None], self.turning]
-        pairs = (turned[:, :, None] * turned[:, None, :]).reshape(blocks, -1, 1)
+        """*weight* times the curvature term of K along the Euler parameters of *local* (..., B, b): (..., B, b, b)."""
+        blocks, width = self.coordinates.shape
+        padded = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
+        turned = padded[..., np.arange(blocks)[:, None], self.turning]
+        pairs = (turned[..., :, None] * turned[..., None, :]).reshape(local.shape[:-2] + (blocks, -1, 1))
         curvature = self.stiffness_curvature.reshape(blocks, width * width, -1)
-        return weight * (curvature @ pairs).reshape(blocks, width, width)
+        return weight * (curvature @ pairs).reshape(local.shape[:-2] + (blocks, width, width))
 
     def _full(self, blocks: np.ndarray) -> np.ndarray:
-        """The blocks (B, b, b) scattered into a full matrix (N, N)."""
-        full = np.zeros((self.size + 1, self.size + 1))
-        full[self.coordinates[:, :, None], self.coordinates[:, None, :]] = blocks
-        return full[:self.size, :self.size]
+        """The blocks (..., B, b, b) scattered into a full matrix (..., N, N)."""
+        full = np.zeros(blocks.shape[:-3] + (self.size + 1, self.size + 1))
+        full[..., self.coordinates[:, :, None], self.coordinates[:, None, :]] = blocks
+        return full[..., :self.size, :self.size]
+
+    def _sloped(self, matrix: np.ndarray, slope: np.ndarray, local: np.ndarray, weight: float = 1.0) -> np.ndarray:
+        """``matrix + weight slope . local`` per block: (..., B, b, b)."""
+        blocks, width = self.coordinates.shape
+        change = slope.reshape(blocks, width * width, width) @ local[..., None]
+        return matrix + weight * change.reshape(local.shape[:-2] + (blocks, width, width))
 
     def stiffness_at(self, dq: np.ndarray) -> np.ndarray:
-        """K (N, N) at the state change *dq*: of second order in the Euler parameters, first in the rest."""
+        """K (..., N, N) at the state change *dq* (..., N): of second order in the Euler parameters, first in
+        the rest."""
         local = self._local(dq)
-        return self._full(self.stiffness + np.einsum("bijk,bk->bij", self.stiffness_slope, local)
-                          + self._curved(local, 0.5))
+        return self._full(self._sloped(self.stiffness, self.stiffness_slope, local) + self._curved(local, 0.5))
 
     def mass_at(self, dq: np.ndarray) -> np.ndarray:
-        """M (N, N) at the state change *dq*, of first order in it."""
-        return self._full(self.mass + np.einsum("bijk,bk->bij", self.mass_slope, self._local(dq)))
+        """M (..., N, N) at the state change *dq* (..., N), of first order in it."""
+        return self._full(self._sloped(self.mass, self.mass_slope, self._local(dq)))
 
     def damping_at(self, dq: np.ndarray) -> np.ndarray:
-        """D (N, N) at the state change *dq*, of first order in it."""
-        return self._full(self.damping + np.einsum("bijk,bk->bij", self.damping_slope, self._local(dq)))
+        """D (..., N, N) at the state change *dq* (..., N), of first order in it."""
+        return self._full(self._sloped(self.damping, self.damping_slope, self._local(dq)))
 
     def force_change(self, dq: np.ndarray) -> np.ndarray:
-        """The change of the rest's internal force over *dq* (N,): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""
+        """The change of the rest's internal force over *dq* (..., N): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""
         local = self._local(dq)
-        stiffness = self.stiffness + 0.5 * np.einsum("bijk,bk->bij", self.stiffness_slope, local) \
-            + self._curved(local, 1.0 / 6.0)
-        change = np.einsum("bij,bj->bi", stiffness, local)
-        return np.bincount(self.coordinates.ravel(), change.ravel(), self.size + 1)[:self.size]
+        stiffness = self._sloped(self.stiffness, self.stiffness_slope, local, 0.5) + self._curved(local, 1.0 / 6.0)
+        change = (stiffness @ local[..., None])[..., 0]
+        out = np.zeros(dq.shape[:-1] + (self.size + 1,))
+        out[..., self.coordinates] = change           # each coordinate is in one block; the padding goes to N
+        return out[..., :self.size]
 
 
 @dataclass(frozen=True)
@@ -170,6 +179,13 @@ class SceneExpansion:
     def free(self) -> np.ndarray:
         """The coordinates that are not Euler parameters (independent as they are)."""
         return np.setdiff1d(np.arange(len(self.state)), self.euler_blocks.ravel())
+
+    @functools.cached_property
+    def point_set(self) -> ChannelSet:
+        """The excitation points as channels from the ground (at the origin) to each point, in the order of
+        :attr:`points`: a channel's Jacobian is its point's."""
+        ground = PointKinematics(np.zeros(0, dtype=int), "none", np.zeros(3), np.zeros((3, 0)))
+        return ChannelSet.of([(ground, point) for point in self.points.values()], len(self.state))
 
 
 def _marker_coordinates(mbs, marker: int) -> np.ndarray:

@@ -28,26 +28,28 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.answers.results import ExcitationResult, MountResult
 from workbook.design.assembly import (
+    AddedRigidMass,
     ChannelSprings,
     Projection,
     StateLoads,
     projection,
     rest_matrices,
+    solve_each,
     static_state,
     tangent_stiffness,
     total,
     without_normal,
 )
 from workbook.design.expansion import SceneExpansion, expand_scene
-from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, UnstablePreloadError
+from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, SimulationError, UnstablePreloadError
 from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, SingleFrequencyExcitation, Sweep
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.harmonic import point_phasors
@@ -60,9 +62,17 @@ __all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "chann
            "keeps_casing_modes"]
 
 
-def channel_springs(case: Case, channels: list[str]) -> ChannelSprings:
+def hinge_frames(case: Case) -> dict:
+    """Each hinge's frame (:func:`~workbook.scene.hinge_law_base.hinge_frame`) by its name."""
+    from workbook.scene.hinge_law_base import hinge_frame
+
+    return {hinge.name: hinge_frame(case, hinge) for hinge in case.hinges}
+
+
+def channel_springs(case: Case, channels: list[str], frames: dict | None = None) -> ChannelSprings:
     """The springs of the force channels *channels* of *case*: the hinges' as their laws give them
-    (:meth:`~workbook.scene.hinge_law_base.HingeLaw.matrices`), then the transducers' along the global axes."""
+    (:meth:`~workbook.scene.hinge_law_base.HingeLaw.matrices`, in the hinges' *frames* when given), then the
+    transducers' along the global axes."""
     from workbook.scene.hinge_laws import law_of
 
     hinge_loss, _ = loss_factors(case)
@@ -75,7 +85,7 @@ def channel_springs(case: Case, channels: list[str]) -> ChannelSprings:
             assert rig is not None
             springs[0, k], springs[1, k] = np.diag(rig.stiffness), np.diag(rig.damping)
             continue
-        stiffness, damping, loss = law_of(case, hinge).matrices(case, hinge)
+        stiffness, damping, loss = law_of(case, hinge).matrices(case, hinge, None if frames is None else frames[name])
         springs[0, k] = stiffness
         if case.effects.hinge_damping:
             springs[1, k] = damping
@@ -156,6 +166,7 @@ class _Item:
     compression: np.ndarray            # (links, channels, 3): link compression per channel force
     links: list                        # _FlexibleLink, in the case's order of the assessed links
     engine: np.ndarray                 # the engine's full coordinates
+    flexible_positions: list           # the positions of *links* among the case's links
     points: list                       # excitation points of the item's excitations
     warnings: list
     modes: list
@@ -189,21 +200,36 @@ class DesignAnswer:
     engine_static: dict = field(default_factory=dict)
 
 
-def _normalised(case: Case, base: Case) -> Case:
-    """*case* with every field a design may change set to *base*'s."""
-    hinges = tuple(dataclasses.replace(h, stiffness=b.stiffness, damping=b.damping, loss_factor=b.loss_factor)
-                   for h, b in zip(case.hinges, base.hinges, strict=True)) \
-        if [h.name for h in case.hinges] == [b.name for b in base.hinges] else case.hinges
-    casing = case.engine.casing
-    if casing is not None and base.engine.casing is not None:
-        casing = dataclasses.replace(casing, material=dataclasses.replace(
-            casing.material, youngs_modulus=base.engine.casing.material.youngs_modulus))
-    engine = dataclasses.replace(case.engine, mass=base.engine.mass, inertia=base.engine.inertia, casing=casing)
-    rig = case.test_rig
-    if rig is not None and base.test_rig is not None:
-        rig = dataclasses.replace(rig, stiffness=base.test_rig.stiffness, damping=base.test_rig.damping)
-    return dataclasses.replace(case, name=base.name, hinges=hinges, engine=engine, test_rig=rig,
-                               excitations=base.excitations)
+def _same_except(one, other, changes: dict) -> bool:
+    """Whether the dataclasses *one* and *other* are equal but in the fields named in *changes*; a name that
+    maps to a dict compares those fields' own fields likewise (None: the field is free)."""
+    if one is other:
+        return True
+    if type(one) is not type(other):
+        return False
+    for item in dataclasses.fields(one):
+        mine, theirs = getattr(one, item.name), getattr(other, item.name)
+        if item.name not in changes:
+            if not (mine is theirs or mine == theirs):
+                return False
+        elif changes[item.name] is not None and not (
+                (mine is None and theirs is None) or (mine is not None and theirs is not None
+                                                      and _same_except(mine, theirs, changes[item.name]))):
+            return False
+    return True
+
+
+#: What a design may change, by field (module text); the excitations are checked on their own.
+_DESIGN_CHANGES = {"name": None, "excitations": None, "hinges": None,
+                   "engine": {"mass": None, "inertia": None, "casing": {"material": {"youngs_modulus": None}}},
+                   "test_rig": {"stiffness": None, "damping": None}}
+_HINGE_CHANGES = {"stiffness": None, "damping": None, "loss_factor": None}
+
+
+def _follows(case: Case, base: Case) -> bool:
+    """Whether *case* differs from *base* only in what a design may change (not checking the excitations)."""
+    return _same_except(case, base, _DESIGN_CHANGES) and len(case.hinges) == len(base.hinges) and all(
+        _same_except(hinge, other, _HINGE_CHANGES) for hinge, other in zip(case.hinges, base.hinges, strict=True))
 
 
 class LinearMount:
@@ -220,6 +246,7 @@ class LinearMount:
         self.pylon = pylon
         self._cards = cards
         self._preloads = preloads
+        self._frames = hinge_frames(case)
 
     @classmethod
     def prepare(cls, case: Case) -> "LinearMount":
@@ -265,7 +292,7 @@ class LinearMount:
         """Raise :class:`OutsideDesignModel` unless *case* differs from the prepared case only in what
         a design may change (see the module text)."""
         base = self.case
-        if _normalised(case, base) != base:
+        if not _follows(case, base):
             raise OutsideDesignModel(case.name, "a change beyond hinge springs, transducer springs, engine mass "
                                      "properties, the casing's modulus and excitation frequencies and amplitudes")
         if [type(e) for e in case.excitations] != [type(e) for e in base.excitations] or \
@@ -300,22 +327,68 @@ class LinearMount:
             The design buckles a link, loses its stability under the preload,
             or is excited on an undamped resonance.
         """
+        answer = self.evaluate_many([case])[0]
+        if isinstance(answer, Exception):
+            raise answer
+        return answer
+
+    def evaluate_many(self, cases: Sequence[Case]) -> list[DesignAnswer | SimulationError]:
+        """Answer many designs at once (NumPy on all of them together: much faster per design).
+
+        Returns
+        -------
+        list of DesignAnswer or SimulationError
+            In the order of *cases*; a design :meth:`evaluate` would raise for
+            (:class:`OutsideDesignModel`, a buckled link, no stable preload,
+            an undamped resonance) has its error in its place. Each answer's
+            ``seconds`` is its share of the batch's wall time.
+        """
         start = time.perf_counter()
-        return self.answer(case, self.solve_items(case), start)
+        outcomes: list = [None] * len(cases)
+        rows = []
+        for k, case in enumerate(cases):
+            try:
+                self.check(case)
+                rows.append(k)
+            except OutsideDesignModel as error:
+                outcomes[k] = error
+        if rows:
+            designs = self._designs([cases[k] for k in rows])
+            runs: list[list] = [[] for _ in rows]
+            static: list[dict] = [{} for _ in rows]
+            engine: list[dict] = [{} for _ in rows]
+            failed: dict[int, SimulationError] = {}
+            for position, item in enumerate(self.case.excitations):
+                solved = _solve_item(designs, self.items[item.name])
+                failed = {**solved.failures, **failed}
+                for k, answered in enumerate(self._item_runs(designs, position, solved.prepared, solved.model,
+                                                             solved.rows, solved.failures)):
+                    if isinstance(answered, SimulationError):
+                        failed.setdefault(k, answered)
+                        continue
+                    runs[k].extend(answered)
+                    static[k][item.name] = dict(zip(self.channels, solved.state.forces[k], strict=True))
+                    engine[k][item.name] = (solved.prepared.expansion.state + solved.state.dq[k])[solved.prepared.engine]
+            share = (time.perf_counter() - start) / len(cases)
+            for k, row in enumerate(rows):
+                outcomes[row] = failed[k] if k in failed else DesignAnswer(
+                    MountResult(cases[row].name, runs[k]), static[k], share, engine[k])
+        return outcomes
 
     def answer(self, case: Case, solutions: list["ItemSolution"], start: float) -> DesignAnswer:
         """The answers of the design *case* from its solved items (:meth:`solve_items`), begun at *start*
         (``time.perf_counter()``)."""
+        designs = self._designs([case])
         runs, static, engine = [], {}, {}
-        for item, solution in zip(case.excitations, solutions, strict=True):
+        for position, (item, solution) in enumerate(zip(case.excitations, solutions, strict=True)):
             static[item.name] = dict(zip(self.channels, solution.state.forces, strict=True))
             engine[item.name] = solution.engine_static
-            for excitation in points_of(item):
-                run = _answer(case, solution.prepared, solution.model, excitation, self.channels, self.pylon)
-                run.model_card, run.preload = self._cards.get(run.name), self._preloads.get(run.name)
-                runs.append(run)
-        result = MountResult(case.name, runs)
-        return DesignAnswer(result, static, time.perf_counter() - start, engine)
+            answered = self._item_runs(designs, position, solution.prepared, solution.model.stacked(),
+                                       np.zeros(1, dtype=int), {})[0]
+            if isinstance(answered, SimulationError):
+                raise answered
+            runs.extend(answered)
+        return DesignAnswer(MountResult(case.name, runs), static, time.perf_counter() - start, engine)
 
     def solve_items(self, case: Case) -> list["ItemSolution"]:
         """The preload and the linear model of every excitation item of the design *case*.
@@ -325,13 +398,70 @@ class LinearMount:
         As :meth:`evaluate`.
         """
         self.check(case)
-        springs = channel_springs(case, self.channels)
+        designs = self._designs([case])
         solutions = []
         for item in case.excitations:
-            prepared = self.items[item.name]
-            state = _solve_state(case, prepared, springs)
-            solutions.append(ItemSolution(prepared, springs, state, linear_model(case, prepared, springs, state)))
+            solved = _solve_item(designs, self.items[item.name], keep_passes=True)
+            if solved.failures:
+                raise solved.failures[0]
+            solutions.append(solved.design(0))
         return solutions
+
+    def _designs(self, cases: list[Case]) -> "_Designs":
+        """The fields of *cases* (checked) the evaluation takes, stacked."""
+        base = self.case.engine
+        springs = [channel_springs(case, self.channels, self._frames) for case in cases]
+        casing = next(iter(self.items.values())).casing
+        return _Designs(
+            cases, ChannelSprings(*(np.stack([getattr(s, name) for s in springs])
+                                    for name in ("stiffness", "damping", "structural"))),
+            np.array([case.engine.mass - base.mass for case in cases], dtype=float),
+            np.array([case.engine.inertia_matrix - base.inertia_matrix for case in cases], dtype=float),
+            np.array([1.0 if casing is None else casing.scale(case) for case in cases]))
+
+    def _item_runs(self, designs: "_Designs", position: int, prepared: _Item, model: "_Harmonic", solved: np.ndarray,
+                   failures: dict) -> list:
+        """Per design, its excitation results of the item at *position* (the designs' own excitations), or the
+        error that stopped it.
+
+        *model* holds the linear models of the designs *solved* (sorted positions among *designs*); *failures*
+        the errors of the others."""
+        results: list = [[] for _ in range(designs.count)]
+        excitations = [points_of(case.excitations[position]) for case in designs.cases]
+        pylon = [self.channels.index(name) for name in self.pylon]
+        for point in range(max(len(e) for e in excitations)):
+            rows = np.array([k for k, e in enumerate(excitations) if len(e) > point and k not in failures],
+                            dtype=int)
+            if not len(rows):
+                continue
+            chosen = [excitations[k][point] for k in rows]
+            omega = 2 * np.pi * np.array([e.frequency for e in chosen])
+            models = model.take(np.searchsorted(solved, rows))
+            loads = np.stack([models.load(e, k) for k, e in enumerate(chosen)])
+            motion, singular = solve_each(models.dynamic(omega), loads)
+            forces = (models.output(omega) @ motion[..., None])[..., 0].reshape(len(rows), -1, 3)
+            for k, row in enumerate(rows):
+                excitation = chosen[k]
+                if singular[k]:
+                    results[row] = ResonanceError(
+                        f"{designs.cases[row].name} / {excitation.name}: the design is excited on an undamped "
+                        f"resonance at {excitation.frequency:g} Hz")
+                    continue
+                if isinstance(results[row], SimulationError):
+                    continue
+                run = ExcitationResult(
+                    name=excitation.name, frequency_hz=excitation.frequency,
+                    excitation_amplitude=excitation.force_amplitude,
+                    pylon_amplitude=np.abs(forces[k, pylon].sum(axis=0)),
+                    hinge_amplitudes=dict(zip(self.channels, np.abs(forces[k]), strict=True)),
+                    pylon_hinges=list(self.pylon), steady_change=0.0,
+                    steady_tolerance=designs.cases[row].analysis.steady_tolerance,
+                    warnings=list(prepared.warnings))
+                run.model_card, run.preload = self._cards.get(run.name), self._preloads.get(run.name)
+                results[row].append(run)
+        for k, error in failures.items():
+            results[k] = error
+        return results
 
 
 def points_of(item) -> tuple:
@@ -448,7 +578,8 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
             stressed[link.name] = StressedLink(
                 link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
                 np.ascontiguousarray(shapes.transpose(1, 0, 2)), np.linalg.norm(shapes, ord=2, axis=(1, 2)))
-    return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine, points, warnings,
+    return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine,
+                 [names.index(link.name) for link in flexible], points, warnings,
                  prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed,
                  _prepared_casing(case, scene))
 
@@ -469,123 +600,199 @@ def _prepared_casing(case: Case, scene: Scene) -> _Casing | None:
 
 
 @dataclass(frozen=True)
+class _Designs:
+    """The fields of B designs (checked against the prepared case) that the evaluation takes, stacked."""
+
+    cases: list
+    springs: ChannelSprings            # (B, C, 3, 3) each
+    added_mass: np.ndarray             # (B,) engine mass minus the prepared one, kg
+    added_inertia: np.ndarray          # (B, 3, 3) likewise, kg m^2
+    casing_scale: np.ndarray           # (B,) E / E_0 of a flexible casing (1 without)
+
+    @property
+    def count(self) -> int:
+        return len(self.cases)
+
+    def take(self, rows: np.ndarray) -> "_Designs":
+        """The designs *rows*."""
+        return _Designs([self.cases[k] for k in rows], self.springs.take(rows), self.added_mass[rows],
+                        self.added_inertia[rows], self.casing_scale[rows])
+
+
+@dataclass(frozen=True)
 class _State:
-    """A design's preloaded state."""
+    """Preloaded states: of one design, or of several (leading axis)."""
 
-    dq: np.ndarray
-    tensions: dict             # used in K_r + P K_G,r per flexible link (0: not stiffened)
-    forces: np.ndarray         # (channels, 3) static channel forces, N
+    dq: np.ndarray             # (..., N)
+    tensions: np.ndarray       # (..., L) per flexible link, used in K_r + P K_G,r (0: not stiffened)
+    stiffened: np.ndarray      # (..., L) bool: the stress-stiffening passes chose the link
+    forces: np.ndarray         # (..., C, 3) static channel forces, N
     loads: StateLoads
-    passes: tuple = ()         # (dq, tensions, loads) of each preload solve, the last being this state's
+    passes: tuple = ()         # (dq, stiffened, loads) of each preload solve of one design, the last its state's
+
+    def take(self, rows) -> "_State":
+        """The designs *rows* (an index: one design without its axis)."""
+        return _State(self.dq[rows], self.tensions[rows], self.stiffened[rows], self.forces[rows],
+                      self.loads.take(rows))
 
 
-def _engine_rotation_map(angles: np.ndarray) -> np.ndarray:
-    """``G`` of Exudyn's Tait-Bryan (Rxyz) angles: body angular velocity = G @ angle rates."""
-    _, b, c = angles
-    return np.array([[np.cos(b) * np.cos(c), np.sin(c), 0.0],
-                     [-np.cos(b) * np.sin(c), np.cos(c), 0.0],
-                     [np.sin(b), 0.0, 1.0]])
-
-
-def _state_loads(case: Case, prepared: _Item, tensions: dict) -> StateLoads:
-    base = prepared.base_engine
-    added_mass = case.engine.mass - base.mass
-    added_inertia = case.engine.inertia_matrix - base.inertia_matrix
-    force = np.zeros(prepared.size)
+def _state_loads(designs: _Designs, prepared: _Item, tensions: np.ndarray) -> StateLoads:
+    """What the designs change in the rest of the scene, with the links' *tensions* (B, L) in their stiffness."""
+    force = np.zeros((designs.count, prepared.size))
     mass = []
-    if added_mass or np.any(added_inertia):
-        def engine_mass(q: np.ndarray) -> np.ndarray:
-            rotation = _engine_rotation_map(q[3:6])
-            block = np.zeros((6, 6))
-            block[:3, :3] = added_mass * np.eye(3)
-            block[3:, 3:] = rotation.T @ added_inertia @ rotation
-            return block
-        mass.append((prepared.engine, engine_mass))
+    if np.any(designs.added_mass) or np.any(designs.added_inertia):
+        mass.append(AddedRigidMass(prepared.engine, designs.added_mass, designs.added_inertia))
+        case = designs.cases[0]
         if case.effects.preload:
             for load in case.static_loads:
                 if isinstance(load, Gravity):
-                    force[prepared.engine[:3]] += added_mass * np.asarray(load.acceleration)
-    modal = [(link.modal, (tensions.get(link.name, 0.0) - link.base_tension) * link.geometric)
-             for link in prepared.links if tensions.get(link.name, 0.0) != link.base_tension]
+                    force[:, prepared.engine[:3]] += designs.added_mass[:, None] * np.asarray(load.acceleration)
+    modal = [(link.modal, (tensions[:, k] - link.base_tension)[:, None, None] * link.geometric)
+             for k, link in enumerate(prepared.links) if np.any(tensions[:, k] != link.base_tension)]
     casing = prepared.casing
-    if casing is not None and casing.scale(case) != 1.0:
-        modal.append((casing.modal, (casing.scale(case) - 1.0) * casing.stiffness))
+    if casing is not None and np.any(designs.casing_scale != 1.0):
+        modal.append((casing.modal, (designs.casing_scale - 1.0)[:, None, None] * casing.stiffness))
     return StateLoads(modal, mass, force)
-
 
 
 def _channel_forces(prepared: _Item, springs: ChannelSprings, dq: np.ndarray) -> np.ndarray:
     separation = prepared.expansion.channels.state(total(prepared.expansion, dq), second=False).separation
-    return prepared.sign * np.einsum("cab,cb->ca", springs.stiffness, separation)
+    return prepared.sign * np.einsum("...cab,...cb->...ca", springs.stiffness, separation)
 
 
-def _solve_state(case: Case, prepared: _Item, springs: ChannelSprings) -> _State:
-    """The design's preload with the stress-stiffening passes of the Exudyn pipeline."""
+@dataclass(frozen=True)
+class _SolvedItem:
+    """An excitation item solved for B designs."""
+
+    prepared: _Item
+    designs: _Designs
+    state: _State              # of every design (the rows of failed ones mean nothing)
+    model: _Harmonic           # of the designs *rows*
+    rows: np.ndarray           # the designs solved, sorted
+    failures: dict             # design -> SimulationError of the others
+    passes: list               # (rows, dq, tensions, stiffened) of each preload solve, when kept
+
+    def design(self, k: int) -> "ItemSolution":
+        """Design *k* alone (solved)."""
+        passes = []
+        for rows, dq, tensions, stiffened in self.passes:
+            position = np.flatnonzero(rows == k)
+            if len(position):
+                p = int(position[0])
+                loads = _state_loads(self.designs.take(np.array([k])), self.prepared, tensions[p][None]).take(0)
+                passes.append((dq[p], stiffened[p], loads))
+        state = dataclasses.replace(self.state.take(k), passes=tuple(passes))
+        return ItemSolution(self.prepared, self.designs.springs.take(k), state,
+                            self.model.take(int(np.searchsorted(self.rows, k))))
+
+
+def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False) -> _SolvedItem:
+    """The designs' preloads with the stress-stiffening passes of the Exudyn pipeline, and their linear models."""
     from workbook.solve.stress_stiffening import AUTO_SHIFT, MAX_PASSES, TENSION_TOLERANCE
 
-    def solve(tensions: dict, start: np.ndarray) -> tuple[np.ndarray, np.ndarray, StateLoads]:
-        loads = _state_loads(case, prepared, tensions)
-        try:
-            dq, _ = static_state(prepared.expansion, springs, prepared.base_force, loads, start)
-        except np.linalg.LinAlgError as error:
-            raise UnstablePreloadError(f"{case.name}: the design's preload has no stable equilibrium ({error})",
-                                       []) from None
-        passes.append((dq, tensions, loads))
-        return dq, _channel_forces(prepared, springs, dq), loads
-
+    count, links = designs.count, prepared.links
+    dq = np.zeros((count, prepared.size))
+    tensions = np.zeros((count, len(links)))
+    stiffened = np.zeros((count, len(links)), dtype=bool)
+    forces = np.zeros((count, prepared.compression.shape[1], 3))
+    failures: dict[int, SimulationError] = {}
     passes: list = []
-    dq, forces, loads = solve({}, np.zeros(prepared.size))
-    tensions: dict = {}
-    if prepared.links:
-        names = [link.name for link in case.links]
-        compression = dict(zip(names, np.einsum("lcx,cx->l", prepared.compression, forces), strict=True))
-        chosen = []
-        for link in prepared.links:
-            tension = -compression[link.name]
-            unloaded = link.unloaded_hz
-            if -tension >= link.stiffening.buckling_load:
-                raise BucklingError(case.name, link.name, -tension, link.stiffening.buckling_load, unloaded)
-            shift = abs(float(link.stiffening.pinned_hz(tension, 1)[0]) / unloaded - 1.0)
-            if case.effects.stress_stiffening == "on" or shift > AUTO_SHIFT:
-                chosen.append(link.name)
-            tensions[link.name] = tension
-        used = {name: tensions[name] for name in chosen}
-        while chosen and len(passes) <= MAX_PASSES:
-            dq, forces, loads = solve(used, dq)
-            new = dict(zip(names, -np.einsum("lcx,cx->l", prepared.compression, forces), strict=True))
-            change = max(abs(new[name] - used[name]) for name in chosen) / max(abs(used[name]) for name in chosen)
-            if change <= TENSION_TOLERANCE or len(passes) > MAX_PASSES:
-                break
-            used = {name: new[name] for name in chosen}
-        tensions = used
-    return _State(dq, tensions, forces, loads, tuple(passes))
+    inverses: list[np.ndarray] = []           # each design's inverse tangent stiffness, kept between passes
+
+    def solve(rows: np.ndarray) -> np.ndarray:
+        """Solve the designs *rows* from their current state and tensions; the ones that solved."""
+        loads = _state_loads(designs.take(rows), prepared, tensions[rows])
+        solution = static_state(prepared.expansion, designs.springs.take(rows), prepared.base_force, loads, dq[rows],
+                                inverses[0][rows] if inverses else None)
+        for k, reason in solution.failures.items():
+            failures[int(rows[k])] = UnstablePreloadError(
+                f"{designs.cases[rows[k]].name}: the design's preload has no stable equilibrium ({reason})", [])
+        dq[rows] = solution.dq
+        forces[rows] = _channel_forces(prepared, designs.springs.take(rows), solution.dq)
+        if keep_passes:
+            passes.append((rows, solution.dq, tensions[rows].copy(), stiffened[rows].copy()))
+        if inverses:
+            inverses[0][rows] = solution.inverse
+        else:
+            inverses.append(solution.inverse)
+        return np.delete(rows, list(solution.failures))
+
+    def link_tensions(rows: np.ndarray) -> np.ndarray:
+        return -np.einsum("lcx,bcx->bl", prepared.compression, forces[rows])[:, prepared.flexible_positions]
+
+    rows = solve(np.arange(count))
+    if links and len(rows):
+        found = link_tensions(rows)
+        setting = designs.cases[0].effects.stress_stiffening
+        for k, link in enumerate(links):
+            for j in np.flatnonzero(-found[:, k] >= link.stiffening.buckling_load):
+                failures.setdefault(int(rows[j]), BucklingError(designs.cases[rows[j]].name, link.name, -found[j, k],
+                                                                link.stiffening.buckling_load, link.unloaded_hz))
+            shift = np.abs(link.stiffening.pinned_hz(found[:, k], 1)[:, 0] / link.unloaded_hz - 1.0)
+            stiffened[rows, k] = setting == "on" or shift > AUTO_SHIFT
+        alive = np.array([k not in failures for k in rows], dtype=bool)
+        rows, found = rows[alive], found[alive]
+        tensions[rows] = np.where(stiffened[rows], found, 0.0)
+        active = rows[stiffened[rows].any(axis=1)]
+        solves = 1
+        while len(active) and solves <= MAX_PASSES:
+            active = solve(active)
+            solves += 1
+            new, used, chosen = link_tensions(active), tensions[active], stiffened[active]
+            change = np.where(chosen, np.abs(new - used), 0.0).max(axis=1) / np.where(chosen, np.abs(used), 0.0).max(axis=1)
+            going = ~((change <= TENSION_TOLERANCE) | (solves > MAX_PASSES))
+            tensions[active[going]] = np.where(chosen, new, 0.0)[going]
+            active = active[going]
+    solved = np.array(sorted(set(range(count)) - set(failures)), dtype=int)
+    state = _State(dq, tensions, stiffened, forces, _state_loads(designs, prepared, tensions))
+    part = designs.take(solved)
+    model = linear_model(prepared, part.springs, state.take(solved), part.casing_scale)
+    return _SolvedItem(prepared, designs, state, model, solved, failures, passes)
 
 
 @dataclass(frozen=True)
 class _Harmonic:
-    """The projected linear model at a state: ``Z = K - w^2 M + i (w D + H)``, outputs ``C_k + i (C_h + w C_d)``."""
+    """The projected linear models at states: ``Z = K - w^2 M + i (w D + H)``, outputs ``C_k + i (C_h + w C_d)``;
+    of one design, or of several (leading axis)."""
 
     mass: np.ndarray
     stiffness: np.ndarray
     damping: np.ndarray
     structural: np.ndarray
-    outputs: tuple              # C_k, C_d, C_h, shape (3 c, n) each
+    outputs: tuple              # C_k, C_d, C_h, shape (..., 3 c, n) each
     basis: Projection
-    inputs: dict                # point -> (n, 3)
+    inputs: dict                # point -> (..., n, 3)
 
-    def dynamic(self, omega: float) -> np.ndarray:
-        """Z at the circular frequency *omega* (rad/s), shape (n, n)."""
-        return self.stiffness - omega ** 2 * self.mass + 1j * (omega * self.damping + self.structural)
+    def dynamic(self, omega) -> np.ndarray:
+        """Z at the circular frequency *omega* (rad/s; one per design: shape (...)), shape (..., n, n)."""
+        w = np.asarray(omega, dtype=float)[..., None, None]
+        return self.stiffness - w ** 2 * self.mass + 1j * (w * self.damping + self.structural)
 
-    def output(self, omega: float) -> np.ndarray:
-        """The channel force phasors per motion phasor at *omega*, shape (3 C, n)."""
+    def output(self, omega) -> np.ndarray:
+        """The channel force phasors per motion phasor at *omega* (rad/s, as :meth:`dynamic`), shape (..., 3 C, n)."""
         stiffness_output, damping_output, structural_output = self.outputs
-        return stiffness_output + 1j * (structural_output + omega * damping_output)
+        return stiffness_output + 1j * (structural_output + np.asarray(omega, dtype=float)[..., None, None]
+                                        * damping_output)
 
-    def load(self, excitation: SingleFrequencyExcitation) -> np.ndarray:
-        """The generalised force phasor of *excitation*, shape (n,)."""
-        return sum(self.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))] @ phasor
-                   for p, phasor in point_phasors(excitation))
+    def load(self, excitation: SingleFrequencyExcitation, design: int | None = None) -> np.ndarray:
+        """The generalised force phasor of *excitation* (of the design *design* of several), shape (n,)."""
+        total_load = np.zeros(self.mass.shape[-1], dtype=complex)
+        for p, phasor in point_phasors(excitation):
+            inputs = self.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))]
+            total_load += (inputs if design is None else inputs[design]) @ phasor
+        return total_load
+
+    def take(self, rows) -> "_Harmonic":
+        """The designs *rows* (an index: one design without its axis)."""
+        basis = self.basis
+        return _Harmonic(self.mass[rows], self.stiffness[rows], self.damping[rows], self.structural[rows],
+                         tuple(o[rows] for o in self.outputs),
+                         Projection(basis.free, basis.euler, basis.tangents[rows], basis.size),
+                         {key: value[rows] for key, value in self.inputs.items()})
+
+    def stacked(self) -> "_Harmonic":
+        """One design's model as a batch of one."""
+        return self.take(np.newaxis)
 
 
 @dataclass(frozen=True)
@@ -604,8 +811,9 @@ class ItemSolution:
         return (self.prepared.expansion.state + self.state.dq)[self.prepared.engine]
 
 
-def linear_model(case: Case, prepared: _Item, springs: ChannelSprings, state: _State) -> _Harmonic:
-    """The projected linear model of the item *prepared* at the preloaded *state*."""
+def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing_scale) -> _Harmonic:
+    """The projected linear model of the item *prepared* at the preloaded *state* (of one design or several,
+    with their *springs* and casing moduli *casing_scale*, E / E_0)."""
     expansion, dq = prepared.expansion, state.dq
     channels = expansion.channels
     at = channels.state(total(expansion, dq))
@@ -615,38 +823,20 @@ def linear_model(case: Case, prepared: _Item, springs: ChannelSprings, state: _S
     structural = prepared.sign * channels.matrix(at, springs.structural)
     outputs = [prepared.sign * channels.outputs(at, spring)
                for spring in (springs.stiffness, springs.damping, springs.structural)]
-    for link in prepared.links:
-        added = (state.tensions.get(link.name, 0.0) - link.base_tension) * link.geometric
-        block = np.ix_(link.modal, link.modal)
+    for k, link in enumerate(prepared.links):
+        added = (state.tensions[..., k] - link.base_tension)[..., None, None] * link.geometric
+        block = (..., link.modal[:, None], link.modal)
         damping[block] += link.stiffness_damping * added
         structural[block] += link.loss_factor * (link.reduced_stiffness + added)
     casing = prepared.casing
     if casing is not None:
-        damping[np.ix_(casing.modal, casing.modal)] += (np.sqrt(casing.scale(case)) - 1.0) * casing.damping
+        damping[..., casing.modal[:, None], casing.modal] += \
+            (np.sqrt(np.asarray(casing_scale, dtype=float)) - 1.0)[..., None, None] * casing.damping
     basis = projection(expansion, dq)
-    inputs = {}
-    q = total(expansion, dq)
-    for key, point in expansion.points.items():
-        _, jacobian, _ = point.expand(q[point.coordinates])
-        full = np.zeros((prepared.size, 3))
-        full[point.coordinates] = jacobian.T
-        inputs[key] = basis.rows(full)
+    points = expansion.point_set
+    jacobians = points.outputs(points.state(total(expansion, dq), second=False),
+                               np.broadcast_to(np.eye(3), (points.count, 3, 3)))
+    inputs = {key: basis.rows(jacobians[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2))
+              for k, key in enumerate(expansion.points)}
     return _Harmonic(basis.both(mass), basis.both(stiffness), basis.both(damping), basis.both(structural),
                      tuple(basis.columns(o) for o in outputs), basis, inputs)
-
-
-def _answer(case: Case, prepared: _Item, model: _Harmonic, excitation: SingleFrequencyExcitation,
-            channels: list[str], pylon: list[str]) -> ExcitationResult:
-    omega = 2 * np.pi * excitation.frequency
-    try:
-        motion = sla.solve(model.dynamic(omega), model.load(excitation), check_finite=False)
-    except (np.linalg.LinAlgError, sla.LinAlgWarning) as error:
-        raise ResonanceError(f"{case.name} / {excitation.name}: the design is excited on an undamped resonance at "
-                             f"{excitation.frequency:g} Hz ({error})") from None
-    forces = (model.output(omega) @ motion).reshape(-1, 3)
-    amplitudes = dict(zip(channels, np.abs(forces), strict=True))
-    pylon_force = forces[[channels.index(name) for name in pylon]].sum(axis=0)
-    return ExcitationResult(
-        name=excitation.name, frequency_hz=excitation.frequency, excitation_amplitude=excitation.force_amplitude,
-        pylon_amplitude=np.abs(pylon_force), hinge_amplitudes=amplitudes, pylon_hinges=list(pylon),
-        steady_change=0.0, steady_tolerance=case.analysis.steady_tolerance, warnings=list(prepared.warnings))

@@ -265,7 +265,6 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
     prepared, base = solution.prepared, solution.springs
     expansion = prepared.expansion
     channels = expansion.channels
-    names = [link.name for link in case.links]
     gravity = np.zeros(prepared.size)
     if case.effects.preload:
         for load in case.static_loads:
@@ -274,7 +273,7 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
     d_tension = [np.zeros(len(prepared.links)) for _ in changes]
     d_state = [np.zeros(prepared.size) for _ in changes]
     d_forces: list = [None for _ in changes]
-    for dq, tensions, loads in solution.state.passes:
+    for dq, stiffened, loads in solution.state.passes:
         at = channels.state(total(expansion, dq))
         q = total(expansion, dq)
         basis = projection(expansion, dq)
@@ -285,8 +284,7 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
             springs = change.springs
             if d_forces[j] is not None:
                 by_link = -np.einsum("lcx,cx->l", prepared.compression, d_forces[j])
-                d_tension[j] = np.array([by_link[names.index(link.name)] if link.name in tensions else 0.0
-                                         for link in prepared.links])
+                d_tension[j] = np.where(stiffened, by_link[prepared.flexible_positions], 0.0)
             residual = without_normal(expansion, dq, channels.force(at, springs.stiffness)) - change.mass * gravity
             for link, tension in zip(prepared.links, d_tension[j], strict=True):
                 residual[link.modal] += tension * (link.geometric @ q[link.modal])
@@ -308,7 +306,8 @@ def _model_change(case: Case, solution: ItemSolution, change: _Change, state_cha
     d_state, d_tension = state_change
     # along the state change: a forward difference of the whole linear model
     step = STATE_STEP / max(np.abs(d_state).max(), 1e-300)
-    moved = linear_model(case, prepared, solution.springs, dataclasses.replace(state, dq=state.dq + step * d_state))
+    scale = 1.0 if prepared.casing is None else prepared.casing.scale(case)
+    moved = linear_model(prepared, solution.springs, dataclasses.replace(state, dq=state.dq + step * d_state), scale)
     basis = model.basis
     at = expansion.channels.state(total(expansion, state.dq))
     channels = expansion.channels

@@ -236,7 +236,7 @@ class Link:
     def eye_at(self, point: Vector3) -> str | None:
         """Return ``"a"`` or ``"b"`` if *point* is that eye's centre, else None."""
         for eye, end in (("a", self.end_a), ("b", self.end_b)):
-            if np.linalg.norm(np.subtract(point, end)) <= POINT_TOLERANCE:
+            if math.dist(point, end) <= POINT_TOLERANCE:
                 return eye
         return None
 
@@ -318,11 +318,14 @@ class Hinge:
     @property
     def isotropic(self) -> bool:
         """True if stiffness, damping and loss factor are each the same in every direction."""
-        return all(np.ptp(self.values(name)) == 0 for name in ("stiffness", "damping", "loss_factor"))
+        return all(isinstance(value, float) or len(set(value)) == 1
+                   for value in (self.stiffness, self.damping, self.loss_factor))
 
     def values(self, name: str) -> np.ndarray:
         """*name* (``"stiffness"``, ``"damping"`` or ``"loss_factor"``) per hinge direction, shape (3,)."""
-        return np.broadcast_to(np.asarray(getattr(self, name), dtype=float), (3,)).copy()
+        value = getattr(self, name)
+        return np.full(3, value) if isinstance(value, float) else np.broadcast_to(
+            np.asarray(value, dtype=float), (3,)).copy()
 
     @property
     def largest_stiffness(self) -> float:

@@ -144,8 +144,10 @@ class HingeLaw:
         return stiffness * np.asarray(displacement, dtype=float) \
             + (damping + np.asarray(loss_time, dtype=float) * stiffness) * np.asarray(velocity, dtype=float)
 
-    def matrices(self, case: Case, hinge: Hinge) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The law as the frequency domain's linear models take it, global coordinates, shape (3, 3) each.
+    def matrices(self, case: Case, hinge: Hinge, frame: np.ndarray | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The law as the frequency domain's linear models take it, global coordinates, shape (3, 3) each
+        (*frame*: the hinge's :func:`hinge_frame`, found here when not given).
 
         Returns
         -------
@@ -157,9 +159,9 @@ class HingeLaw:
             E of the loss factors: the hysteretic force is ``i E S u``, dimensionless.
         """
         values = [hinge.values(name) for name in ("stiffness", "damping", "loss_factor")]
-        if all(np.ptp(value) == 0 for value in values):
+        if hinge.isotropic:
             return values[0][0] * np.eye(3), values[1][0] * np.eye(3), values[2][0] * np.eye(3)
-        frame = hinge_frame(case, hinge)
+        frame = hinge_frame(case, hinge) if frame is None else frame
         return frame.T @ np.diag(values[0]) @ frame, frame.T @ np.diag(values[1]) @ frame, \
             frame.T @ np.diag(values[2]) @ frame
 

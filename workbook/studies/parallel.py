@@ -54,8 +54,8 @@ from workbook.processes import end_with_parent, stop_workers
 if TYPE_CHECKING:
     from workbook.design.linear_mount import LinearMount
 
-__all__ = ["RowOutcome", "prepare", "prepare_design_model", "run_row", "run_rows", "SERIAL", "ROWS_PER_WORKER",
-           "NUMPY_PATH", "EXUDYN_PATH"]
+__all__ = ["RowOutcome", "prepare", "prepare_design_model", "run_row", "run_batch", "batches", "run_rows", "SERIAL",
+           "ROWS_PER_WORKER", "BATCH_ROWS", "NUMPY_PATH", "EXUDYN_PATH"]
 
 log = logging.getLogger(__name__)
 
@@ -68,6 +68,8 @@ ROWS_PER_WORKER = 200
 #: Rows per worker in one chunk when the study has a prepared linear mount: its NumPy rows gather no
 #: memory (the bound is for Exudyn's runs), and each fresh pool costs seconds of start-up.
 DESIGN_ROWS_PER_WORKER = 5000
+#: Rows the prepared linear mount answers together, in one NumPy batch (one task of a worker).
+BATCH_ROWS = 100
 #: The row was answered by the prepared linear mount in NumPy.
 NUMPY_PATH = "NumPy"
 #: The row was answered by the Exudyn pipeline.
@@ -198,28 +200,63 @@ def run_row(index: int, case: Case, design_model: LinearMount | None = None) -> 
     KeyboardInterrupt
         Ctrl-C or SIGTERM (also when Exudyn wrapped it in an error of its own).
     """
+    return run_batch([(index, case)], design_model)[0]
+
+
+def run_batch(rows: list[tuple[int, Case]], design_model: LinearMount | None = None) -> list[RowOutcome]:
+    """Run several rows (``(index, case)``) as :func:`run_row` does, the ones the prepared linear mount follows
+    together (:meth:`~workbook.LinearMount.evaluate_many`: NumPy on all of them at once); never raises but for
+    an interrupt.
+
+    Returns
+    -------
+    list of RowOutcome
+        In the order of *rows*; the wall time of a row answered in NumPy is its share of the batch's.
+    """
     from threadpoolctl import threadpool_limits
 
+    model = _design_model if design_model is None else design_model
+    with threadpool_limits(limits=1):
+        if model is None:
+            return [_exudyn_row(index, case) for index, case in rows]
+        start = time.perf_counter()
+        try:
+            answers = model.evaluate_many([case for _, case in rows])
+        except Exception as error:
+            interrupt = interruption(error)
+            if interrupt is not None:
+                raise interrupt from None
+            share = (time.perf_counter() - start) / len(rows)
+            return [dataclasses.replace(_failed(index, error, share), path=NUMPY_PATH) for index, _ in rows]
+        share = (time.perf_counter() - start) / len(rows)
+        outcomes = []
+        for (index, case), answer in zip(rows, answers, strict=True):
+            if isinstance(answer, OutsideDesignModel):      # a change the prepared mount does not follow
+                outcomes.append(_exudyn_row(index, case))
+            elif isinstance(answer, Exception):
+                outcomes.append(dataclasses.replace(_failed(index, answer, share), path=NUMPY_PATH))
+            else:
+                outcomes.append(_outcome(index, answer.result, share, NUMPY_PATH))
+        return outcomes
+
+
+def _exudyn_row(index: int, case: Case) -> RowOutcome:
+    """One row through :func:`workbook.run_case` (BLAS limits set by the caller)."""
     from workbook.solve.pipeline import run_case
 
     start = time.perf_counter()
-    path = EXUDYN_PATH
-    model = _design_model if design_model is None else design_model
     try:
-        with threadpool_limits(limits=1):
-            result = None
-            if model is not None:
-                try:
-                    result, path = model.evaluate(case).result, NUMPY_PATH
-                except OutsideDesignModel:      # a change the prepared mount does not follow
-                    pass
-            if result is None:
-                result = run_case(case)
+        result = run_case(case)
     except Exception as error:
         interrupt = interruption(error)
         if interrupt is not None:
             raise interrupt from None
-        return dataclasses.replace(_failed(index, error, time.perf_counter() - start), path=path)
+        return dataclasses.replace(_failed(index, error, time.perf_counter() - start), path=EXUDYN_PATH)
+    return _outcome(index, result, time.perf_counter() - start, EXUDYN_PATH)
+
+
+def _outcome(index: int, result, wall_time: float, path: str) -> RowOutcome:
+    """The outcome of a row answered with *result* (a MountResult)."""
     runs = []
     for run in result.runs:
         t = run.transmissibility
@@ -227,7 +264,21 @@ def run_row(index: int, case: Case, design_model: LinearMount | None = None) -> 
                      **{f"T {d}": float(v) for d, v in zip(DIRECTIONS, t, strict=True)},
                      **{f"eta % {d}": float(v) for d, v in zip(DIRECTIONS, efficiency(t), strict=True)},
                      "steady": run.steady})
-    return RowOutcome(index, runs, wall_time=time.perf_counter() - start, path=path)
+    return RowOutcome(index, runs, wall_time=wall_time, path=path)
+
+
+def batches(pending: dict, design_model: LinearMount | None, size: int | None = None) -> list[list[tuple[int, Case]]]:
+    """The rows *pending* (index to case) in the batches they run in: the rows *design_model* follows
+    :data:`BATCH_ROWS` (or *size*) at a time, every other row alone."""
+    size = BATCH_ROWS if size is None else size
+    together: list[tuple[int, Case]] = []
+    out: list[list[tuple[int, Case]]] = []
+    for index, case in pending.items():
+        if design_model is not None and design_model.follows(case):
+            together.append((index, case))
+        else:
+            out.append([(index, case)])
+    return [together[k:k + size] for k in range(0, len(together), size)] + out
 
 
 def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: str | None = None,
@@ -285,15 +336,17 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
             done(item)
         else:
             pending[index] = item
+    work = batches(pending, design_model)
     if dask is not None:
         _run_dask(pending, dask, done, design_model)
-    elif workers <= SERIAL or len(pending) <= 1:
+    elif workers <= SERIAL or len(work) <= 1:
         with _signals_seen() as seen, _using(design_model):
-            for index, case in pending.items():
-                outcome = run_row(index, case)
-                if seen:        # a signal a library swallowed during the row: its outcome is dropped, --resume reruns it
+            for batch in work:
+                answered = run_batch(batch)
+                if seen:        # a signal a library swallowed during the rows: their outcomes are dropped, --resume reruns them
                     raise Terminated() if signal.SIGTERM in seen else KeyboardInterrupt()
-                done(outcome)
+                for outcome in answered:
+                    done(outcome)
     else:
         chunk = rows_per_worker if design_model is None else max(rows_per_worker, DESIGN_ROWS_PER_WORKER)
         _run_processes(pending, workers, done, chunk, design_model)
@@ -357,10 +410,11 @@ def _worker_init(started, design_model: LinearMount | None) -> None:
     end_with_parent()
 
 
-def _reported_row(index: int, case: Case) -> RowOutcome:
+def _reported_batch(batch: list[tuple[int, Case]]) -> list[RowOutcome]:
     assert _started is not None
-    _started.put((index, os.getpid()))
-    return run_row(index, case)
+    for index, _ in batch:
+        _started.put((index, os.getpid()))
+    return run_batch(batch)
 
 
 def _death(exitcode: int | None) -> str:
@@ -403,14 +457,16 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
             pids[index] = pid
 
     try:
-        futures = {pool.submit(_reported_row, index, case): index for index, case in pending.items()}
+        size = max(1, min(BATCH_ROWS, -(-len(pending) // (2 * workers))))       # at least two batches per worker
+        futures = {pool.submit(_reported_batch, batch): batch for batch in batches(pending, design_model, size)}
         processes.update(set(multiprocessing.active_children()) - before)  # to read their exit codes later
         for future in as_completed(futures):
             processes.update(set(multiprocessing.active_children()) - before)
             try:
-                done(future.result())
+                for outcome in future.result():
+                    done(outcome)
             except BrokenProcessPool:
-                broken[futures[future]] = pending[futures[future]]
+                broken.update(futures[future])
             read_started()
     except BaseException:
         processes.update(set(multiprocessing.active_children()) - before)
@@ -458,10 +514,13 @@ def _run_dask(pending: dict, address: str, done: Callable, design_model: LinearM
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
         # the prepared mount goes to every worker once; each task gets it by reference
         model = None if design_model is None else client.scatter(design_model, broadcast=True)
-        futures = client.map(run_row, list(pending), list(pending.values()), design_model=model, pure=False)
-        rows = {future.key: index for future, index in zip(futures, pending, strict=True)}
+        work = batches(pending, design_model)
+        futures = client.map(run_batch, work, design_model=model, pure=False)
+        rows = {future.key: batch for future, batch in zip(futures, work, strict=True)}
         for future in dask_completed(futures):
             try:
-                done(future.result())
-            except Exception as error:  # e.g. KilledWorker: Dask gave up on the row's worker
-                done(_failed(rows[future.key], error))
+                outcomes = future.result()
+            except Exception as error:  # e.g. KilledWorker: Dask gave up on the batch's worker
+                outcomes = [_failed(index, error) for index, _ in rows[future.key]]
+            for outcome in outcomes:
+                done(outcome)
