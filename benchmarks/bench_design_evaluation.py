@@ -7,7 +7,10 @@ forces; the difference of T for designs far from the prepared one (every
 hinge's stiffness scaled by :data:`FAR_FACTORS`) with the engine's static
 sag there; then the median time of the derivatives of T and the hinge forces
 with respect to five parameters by the direct method and by central
-differences of whole evaluations, and their largest difference. Run with
+differences of whole evaluations, and their largest difference. Last, the
+time per design of :data:`BATCH` designs answered together
+(``LinearMount.evaluate_many``) against the same designs one at a time, in
+:data:`REPEATS` alternating rounds, and the largest difference between them. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
 import dataclasses
@@ -22,6 +25,9 @@ from workbook.design.sensitivity import difference_sensitivity
 
 #: Scale factors of every hinge's stiffness for the designs far from the prepared one.
 FAR_FACTORS = (0.25, 0.5, 2.0, 20.0, 80.0)
+#: Designs answered together, and rounds of the batch against one at a time.
+BATCH = 100
+REPEATS = 3
 PARAMETERS = ("hinge_stiffness/front", "hinge_stiffness/rear/axial", "hinge_loss_factor/thrust", "engine_mass",
               "hinge_damping/all")
 
@@ -83,6 +89,33 @@ def main(count: int = 5) -> None:
         difference = max(np.abs(f.transmissibility - e.transmissibility).max() / e.transmissibility.max()
                          for f, e in zip(answer.result.runs, exact.runs, strict=True))
         print(f"{factor:>8g}{1e3 * sag:>16.2f}{difference:>14.1e}")
+    _batch(case, mount, rng)
+
+
+def _batch(case, mount, rng) -> None:
+    """Designs answered together against one at a time: median time per design, and their largest difference."""
+    designs = [dataclasses.replace(case, hinges=tuple(
+        dataclasses.replace(h, stiffness=tuple(h.values("stiffness") * rng.uniform(1.0, 4.0, 3)),
+                            loss_factor=float(rng.uniform(0.02, 0.1))) for h in case.hinges))
+        for _ in range(BATCH)]
+    alone_times, together_times, difference = [], [], 0.0
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        alone = [mount.evaluate(design) for design in designs]
+        alone_times.append((time.perf_counter() - start) / BATCH)
+        start = time.perf_counter()
+        together = mount.evaluate_many(designs)
+        together_times.append((time.perf_counter() - start) / BATCH)
+        for one, many in zip(alone, together, strict=True):
+            for a, b in zip(one.result.runs, many.result.runs, strict=True):
+                difference = max(difference, np.abs(a.transmissibility - b.transmissibility).max()
+                                 / a.transmissibility.max())
+    one, many = statistics.median(alone_times), statistics.median(together_times)
+    print(f"\n{BATCH} hinge designs (stiffness and loss factor), both rotors, {REPEATS} rounds")
+    print(f"{'evaluation':<24}{'median s/design':>16}{'designs/s':>11}")
+    print(f"{'one at a time':<24}{one:>16.4f}{1 / one:>11.1f}")
+    print(f"{'together':<24}{many:>16.4f}{1 / many:>11.1f}")
+    print(f"speed-up {one / many:.1f}x; largest difference of T {difference:.1e}")
 
 
 if __name__ == "__main__":

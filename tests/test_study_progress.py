@@ -85,5 +85,22 @@ def test_the_table_file_is_written_at_most_every_interval_and_completely_on_flus
     table.flush()                     # nothing new: the file is left alone
     assert path.stat().st_mtime_ns == stamp
     monkeypatch.setattr(sensitivity, "WRITE_INTERVAL", 0.0)
+    monkeypatch.setattr(sensitivity, "WRITE_SHARE", 0.0)
     table.add(_outcome(1))
     assert list(pd.read_csv(path)["row"]) == [0, 1, 2] and table.kept == 3
+
+
+def test_a_table_that_takes_long_to_write_is_written_less_often(tmp_path, monkeypatch):
+    """The next write waits WRITE_SHARE times the last write's own time: however large the table grows, writing
+    it takes at most a share of the study."""
+    monkeypatch.setattr(sensitivity, "WRITE_INTERVAL", 0.0)
+    monkeypatch.setattr(sensitivity, "WRITE_SHARE", 1e9)
+    rows = tuple({"hinge_stiffness": 1e7 * (i + 1)} for i in range(3))
+    path = tmp_path / "study.csv"
+    table = StudyTable(path, rows)
+    table.add(_outcome(0))            # the first write: it took some time, so ...
+    table.add(_outcome(1))            # ... the next row waits far longer than the interval
+    assert list(pd.read_csv(path)["row"]) == [0] and table.kept == 1
+    monkeypatch.setattr(sensitivity, "WRITE_SHARE", 0.0)
+    table.add(_outcome(2))
+    assert list(pd.read_csv(path)["row"]) == [0, 1, 2]

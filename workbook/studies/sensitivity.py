@@ -8,7 +8,8 @@ table row with its error and no answers).
 While a study runs, :class:`StudyTable` keeps its table file up to date:
 the whole table is written to a temporary file and renamed over the old
 one, so the file never holds half of a row. It is written when a row
-finishes at least :data:`WRITE_INTERVAL` s after the last write (a long
+finishes at least :data:`WRITE_INTERVAL` s after the last write, and at
+least :data:`WRITE_SHARE` times the last write's own time after it (a long
 study does not spend its time rewriting a growing table), and once more by
 :meth:`StudyTable.flush` at the end or on an interrupt: an interrupted
 study keeps every finished row, a study killed outright (SIGKILL) those of
@@ -30,7 +31,7 @@ from workbook.studies.parallel import RowOutcome
 from workbook.studies.parametric import parameter
 
 __all__ = ["study_frame", "plot_sensitivity", "write_study", "TABLE_FORMATS", "StudyTable", "table_path",
-           "new_study_table", "STUDY_STEM", "read_finished", "WRITE_INTERVAL"]
+           "new_study_table", "STUDY_STEM", "read_finished", "WRITE_INTERVAL", "WRITE_SHARE"]
 
 TableFormat = Literal["csv", "parquet"]
 #: File formats of the study table.
@@ -39,6 +40,9 @@ TABLE_FORMATS: tuple[TableFormat, ...] = get_args(TableFormat)
 #: after every row, a long study's growing table would cost more than its rows
 #: (docs/reliability.md, ``benchmarks/bench_study_table.py``).
 WRITE_INTERVAL = 2.0
+#: Rows wait for the next write at least this many times the last write's time: writing takes a tenth of a
+#: study's time at most, however long its table grows.
+WRITE_SHARE = 10.0
 #: Columns of a row's wall time, how it was answered (:data:`workbook.studies.parallel.NUMPY_PATH` or
 #: ``EXUDYN_PATH``), its status and error.
 TAIL = ("wall time s", "path", "status", "error")
@@ -162,20 +166,22 @@ class StudyTable:
         #: Rows the table file holds.
         self.kept = len(self.outcomes)
         self._written_at = -math.inf
+        self._write_seconds = 0.0
 
     def add(self, outcome: RowOutcome) -> None:
-        """Take a finished row; write the table file if the last write is :data:`WRITE_INTERVAL` s old."""
+        """Take a finished row; write the table file if the last write is old enough (module text)."""
         self.outcomes[outcome.index] = outcome
-        if time.monotonic() - self._written_at >= WRITE_INTERVAL:
+        if time.monotonic() - self._written_at >= max(WRITE_INTERVAL, WRITE_SHARE * self._write_seconds):
             self.flush()
 
     def flush(self) -> None:
         """Write every row taken so far to the table file (if any is not there yet)."""
         if self.kept == len(self.outcomes):
             return
-        count = len(self.outcomes)
+        count, start = len(self.outcomes), time.monotonic()
         _write_table(self.to_pandas(), self.path)
         self.kept, self._written_at = count, time.monotonic()
+        self._write_seconds = self._written_at - start
 
     def to_pandas(self):
         """The table of the rows finished so far, in row order."""
