@@ -120,27 +120,28 @@ class ChannelSet:
 
     def force(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
         """``sum_c J_c^T S_c d_c`` (..., N) for the springs *stiffness* (..., C, 3, 3), N/m."""
-        on_points = _on_points(np.einsum("...cab,...cb->...ca", stiffness, state.separation))
-        generalised = np.einsum("...pam,...pa->...pm", state.jacobian, on_points)
-        flat = generalised.reshape(generalised.shape[:-2] + (-1,))
+        on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
+        generalised = on_points[..., None, :] @ state.jacobian                 # (..., 2 C, 1, M)
+        flat = generalised.reshape(generalised.shape[:-3] + (-1,))
         return _scatter(self.coordinates.ravel(), flat, self.size + 1)[..., :self.size]
 
     def matrix(self, state: ChannelState, springs: np.ndarray, *, stiffness: np.ndarray | None = None) -> np.ndarray:
         """``sum_c J_c^T S_c J_c`` (..., N, N) of the matrices *springs* (..., C, 3, 3); with *stiffness*, also
         ``sum_c (S_c d_c) . H_c`` of those springs (the tangent stiffness)."""
         jacobian = self._channel_jacobians(state)
-        weighted = np.einsum("...cab,...ctbm->...ctam", springs, jacobian)
-        blocks = np.einsum("...csan,...ctam->...cstnm", jacobian, weighted)
+        weighted = springs[..., None, :, :] @ jacobian                          # (..., C, 2, 3, M)
+        blocks = jacobian.swapaxes(-1, -2)[..., :, None, :, :] @ weighted[..., None, :, :, :]
         rows = self.coordinates.reshape(self.count, 2, 1, -1, 1)
         columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
         index = [np.broadcast_to(rows * (self.size + 1) + columns, blocks.shape[-5:]).ravel()]
         values = [blocks.reshape(blocks.shape[:-5] + (-1,))]
         if stiffness is not None:
             assert state.hessian is not None, "the tangent stiffness needs the Hessians"
-            on_points = _on_points(np.einsum("...cab,...cb->...ca", stiffness, state.separation))
+            on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
             own = self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]
             index.append(own.ravel())
-            curvature = np.einsum("...pa,...pamn->...pmn", on_points, state.hessian)
+            hessian = state.hessian
+            curvature = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))   # (..., 2 C, 1, M M)
             values.append(curvature.reshape(curvature.shape[:-3] + (-1,)))
         batch = np.broadcast_shapes(*(v.shape[:-1] for v in values))
         full = _scatter(np.concatenate(index), np.concatenate([np.broadcast_to(v, batch + v.shape[-1:])
@@ -149,7 +150,7 @@ class ChannelSet:
 
     def outputs(self, state: ChannelState, springs: np.ndarray) -> np.ndarray:
         """``S_c J_c`` of every channel stacked: shape (..., 3 C, N)."""
-        product = np.einsum("...cab,...ctbm->...ctam", springs, self._channel_jacobians(state))
+        product = springs[..., None, :, :] @ self._channel_jacobians(state)       # (..., C, 2, 3, M)
         rows = 3 * np.arange(self.count).reshape(-1, 1, 1, 1) + np.arange(3).reshape(1, 1, 3, 1)
         columns = self.coordinates.reshape(self.count, 2, 1, -1)
         index = np.broadcast_to(rows * (self.size + 1) + columns, product.shape[-4:]).ravel()
