@@ -20,6 +20,8 @@ from workbook.design.kinematics import EULER, PointKinematics
 __all__ = ["ChannelSet", "ChannelState"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
+_EULER_ROWS = EULER.reshape(36, 4)                                # (a b i, j)
+_EULER_BY_B = EULER.transpose(1, 0, 2, 3).reshape(3, 48)          # (b, a i j)
 
 
 @dataclass(frozen=True)
@@ -182,17 +184,17 @@ def _euler(values, local, modal, index, position, jacobian, hessian) -> None:
         return
     modes = modal.shape[2]
     shapes = modal[index]
-    w = local[index] + np.einsum("pak,pk->pa", shapes, values[index, 7:7 + modes])
+    w = local[index] + (shapes @ values[index, 7:7 + modes, None])[..., 0]
     e = values[index, 3:7]
-    a = np.einsum("abij,pj->pabi", EULER, e)                 # A = I + a . e
-    rotation = np.eye(3) + np.einsum("pabi,pi->pab", a, e)
-    position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
-    jacobian[index, :, 3:7] = 2 * np.einsum("pabi,pb->pai", a, w)
+    a = (e @ _EULER_ROWS.T).reshape(-1, 3, 3, 4)              # A = I + a . e
+    rotation = np.eye(3) + (a @ e[:, None, :, None])[..., 0]
+    position[index] = values[index, :3] + (rotation @ w[..., None])[..., 0]
+    jacobian[index, :, 3:7] = 2 * (w[:, None, None, :] @ a)[:, :, 0, :]
     jacobian[index, :, 7:7 + modes] = rotation @ shapes
     if hessian is None:
         return
-    hessian[index, :, 3:7, 3:7] = 2 * np.einsum("abij,pb->paij", EULER, w)
-    mixed = 2 * np.einsum("pabi,pbk->paik", a, shapes)
+    hessian[index, :, 3:7, 3:7] = 2 * (w @ _EULER_BY_B).reshape(-1, 3, 4, 4)
+    mixed = 2 * (a.swapaxes(-1, -2) @ shapes[:, None, :, :])
     hessian[index, :, 3:7, 7:7 + modes] = mixed
     hessian[index, :, 7:7 + modes, 3:7] = mixed.transpose(0, 1, 3, 2)
 

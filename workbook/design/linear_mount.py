@@ -437,7 +437,9 @@ class LinearMount:
             chosen = [excitations[k][point] for k in rows]
             omega = 2 * np.pi * np.array([e.frequency for e in chosen])
             models = model.take(np.searchsorted(solved, rows))
-            loads = np.stack([models.load(e, k) for k, e in enumerate(chosen)])
+            phasors: dict = {}                   # the designs of a study mostly share their excitations
+            loads = np.stack([models.load(e, k, phasors.setdefault(id(e), point_phasors(e)))
+                              for k, e in enumerate(chosen)])
             motion, singular = solve_each(models.dynamic(omega), loads)
             forces = (models.output(omega) @ motion[..., None])[..., 0].reshape(len(rows), -1, 3)
             for k, row in enumerate(rows):
@@ -774,10 +776,11 @@ class _Harmonic:
         return stiffness_output + 1j * (structural_output + np.asarray(omega, dtype=float)[..., None, None]
                                         * damping_output)
 
-    def load(self, excitation: SingleFrequencyExcitation, design: int | None = None) -> np.ndarray:
-        """The generalised force phasor of *excitation* (of the design *design* of several), shape (n,)."""
+    def load(self, excitation: SingleFrequencyExcitation, design: int | None = None, phasors=None) -> np.ndarray:
+        """The generalised force phasor of *excitation* (of the design *design* of several; *phasors*: its
+        :func:`~workbook.solve.harmonic.point_phasors` when known), shape (n,)."""
         total_load = np.zeros(self.mass.shape[-1], dtype=complex)
-        for p, phasor in point_phasors(excitation):
+        for p, phasor in point_phasors(excitation) if phasors is None else phasors:
             inputs = self.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))]
             total_load += (inputs if design is None else inputs[design]) @ phasor
         return total_load

@@ -162,8 +162,7 @@ class HingeLaw:
         if hinge.isotropic:
             return values[0][0] * np.eye(3), values[1][0] * np.eye(3), values[2][0] * np.eye(3)
         frame = hinge_frame(case, hinge) if frame is None else frame
-        return frame.T @ np.diag(values[0]) @ frame, frame.T @ np.diag(values[1]) @ frame, \
-            frame.T @ np.diag(values[2]) @ frame
+        return (frame.T * values[0]) @ frame, (frame.T * values[1]) @ frame, (frame.T * values[2]) @ frame
 
     def card_entry(self, case: Case) -> tuple[bool, str] | None:
         """The law's model-card entry (on, detail), None for none."""
