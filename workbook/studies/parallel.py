@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING, Callable
 from workbook.answers.isolation import efficiency
 from workbook.errors import OutsideDesignModel, Terminated, interruption
 from workbook.model.case import DIRECTIONS, Case
-from workbook.processes import end_with_parent, stop_workers
+from workbook.processes import end_with_parent, loosen_allocator, stop_workers
 
 if TYPE_CHECKING:
     from workbook.design.linear_mount import LinearMount
@@ -512,6 +512,7 @@ def _run_dask(pending: dict, address: str, done: Callable, design_model: LinearM
     with Client(address) as client:
         if cache:  # the workers load the reductions made here (a shared folder on a real cluster)
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
+        client.run(loosen_allocator)    # Dask's own setting slows NumPy's large temporaries (workbook.processes)
         # the prepared mount goes to every worker once; each task gets it by reference
         model = None if design_model is None else client.scatter(design_model, broadcast=True)
         work = batches(pending, design_model)
