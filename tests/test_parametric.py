@@ -139,3 +139,24 @@ def test_a_section_too_wide_for_the_eyes_is_a_case_error_of_its_row(base):
     cases = study_cases(base, ({"section_scale": 1.0}, {"section_scale": 2.0}))
     assert cases[0].links[0].model == base.links[0].model
     assert isinstance(cases[1], CaseError) and "shank width" in str(cases[1])
+
+
+def test_a_long_study_prints_the_ends_of_its_table_and_writes_every_row(base, tmp_path, capsys):
+    """70 rows on the fast path: the table printed is its first and last 30 rows with a line saying where the
+    rest is; the table file holds every row, and the rows answered in NumPy equal the batch's own answers."""
+    from workbook.cli.params import PRINTED_ROWS
+    from workbook.design.linear_mount import LinearMount
+
+    case_file = tmp_path / "case.json"
+    case_file.write_text(to_json(base))
+    argv = ["study", "params", str(case_file), "--output", str(tmp_path / "out"), "--workers", "1",
+            "--vary=hinge_stiffness=1e7:4e7", "--vary=hinge_loss_factor=0.02:0.08", "--lhs", "70"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert f"(the first and last {PRINTED_ROWS // 2} of 70 table rows; all of them in" in out
+    assert len(out.splitlines()) < PRINTED_ROWS + 15
+    table = pd.read_csv(tmp_path / "out" / "parameter-study.csv")
+    assert list(table["row"]) == list(range(70)) and set(table["path"]) == {"NumPy"}
+    rows = latin_hypercube({"hinge_stiffness": (1e7, 4e7), "hinge_loss_factor": (0.02, 0.08)}, 70, seed=0)
+    answers = LinearMount.prepare(base).evaluate_many(study_cases(base, rows))
+    np.testing.assert_allclose(table["T z"], [a.result.runs[0].transmissibility[2] for a in answers], rtol=1e-9)

@@ -207,6 +207,10 @@ def run_table(args, case, table, resume: str) -> list:
     return outcomes
 
 
+#: Most table rows printed; a longer table prints its first and last halves of them (the file has every row).
+PRINTED_ROWS = 60
+
+
 def run_parameter_study(args) -> int:
     """Run ``study params``; print the table, a summary line and the files written.
 
@@ -237,7 +241,10 @@ def run_parameter_study(args) -> int:
     print(f"{case.name}: {len(rows)} study rows{kept} on {where}", file=sys.stderr)
     outcomes = run_table(args, case, table, "--resume runs the rest")
     frame = table.to_pandas()
-    print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}"))
+    print(frame.drop(columns="error").to_string(index=False, float_format=lambda v: f"{v:.5g}",
+                                                max_rows=PRINTED_ROWS))
+    if len(frame) > PRINTED_ROWS:
+        print(f"(the first and last {PRINTED_ROWS // 2} of {len(frame)} table rows; all of them in {path})")
     failed = [outcome for outcome in outcomes if outcome.status != "ok"]
     for outcome in failed:
         print(f"row {outcome.index} failed: {outcome.error}")
