@@ -162,3 +162,42 @@ def test_invariants_are_exudyns(fe_model):
                                    err_msg=key)
     for key in ("massMatrixReduced", "stiffnessMatrixReduced"):
         assert np.array_equal(ours[key] == 0, exudyns[key] == 0), f"{key}: other entries rounded to zero"
+
+
+def test_side_by_side_eigen_solves_agree_with_one_at_a_time(fe_model):
+    """The three eigen-solves of a link run side by side with their solves shared in blocks give the
+    frequencies and modes of the solves one at a time, and the same bits however the threads run."""
+    from flexbodies.interior import InteriorSolver
+
+    coupled = couple(fe_model, "RBE2")
+    solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+
+    def fixed():
+        solver._fixed = None  # the eigen-solve, not the modes kept from the last
+        return solver.fixed_interface_modes(6)
+
+    alone = [solver.free_free_frequencies(6), solver.mounted_frequencies(3), fixed()]
+    together = solver.side_by_side(lambda: solver.free_free_frequencies(6), lambda: solver.mounted_frequencies(3), fixed)
+    again = solver.side_by_side(lambda: solver.free_free_frequencies(6), lambda: solver.mounted_frequencies(3), fixed)
+    for one, shared in zip(alone[:2] + [alone[2][0]], together[:2] + [together[2][0]], strict=True):
+        np.testing.assert_allclose(shared, one, rtol=1e-12)
+    modes, shared_modes = alone[2][1], together[2][1]
+    np.testing.assert_allclose(np.abs(np.einsum("ij,ij->j", modes, coupled.mass @ shared_modes)), 1.0, rtol=1e-9)
+    for first, second in zip(together[:2] + list(together[2]), again[:2] + list(again[2]), strict=True):
+        assert np.array_equal(first, second)
+
+
+def test_a_failing_side_by_side_task_does_not_hold_the_others(fe_model):
+    from flexbodies.interior import InteriorSolver
+
+    coupled = couple(fe_model, "RBE2")
+    solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+
+    def failing():
+        solver.solve_plain(np.ones(len(solver.interior)))
+        raise RuntimeError("task failed")
+
+    with pytest.raises(RuntimeError, match="task failed"):
+        solver.side_by_side(lambda: solver.mounted_frequencies(3), failing)
+    mounted, _ = solver.side_by_side(lambda: solver.mounted_frequencies(3), lambda: None)
+    np.testing.assert_allclose(mounted, solver.mounted_frequencies(3), rtol=1e-12)
