@@ -30,8 +30,9 @@ compressed, as before) and a reload from the process's memory.
 (both rotors, an empty cache each time, a fresh process each time) of this
 tree, and with ``--before REV`` of the package as it was at git revision
 REV too, the two alternating, and checks that both print the same
-isolation table. It prints the median wall times side by side and the
-load average before and after.
+isolation table. It prints the median wall and CPU times (the run's
+processes' user and system time, which another load on the machine
+disturbs less) side by side and the load average before and after.
 
 Run::
 
@@ -276,18 +277,21 @@ def warm_links(repeats: int) -> None:
     print(f"  from the process's memory:     {memory_s:.4f} s")
 
 
-def _cold_run(tree: str) -> tuple[float, str]:
-    """Wall time of one cold ``mountwb run`` of the package in *tree*, s, and its isolation table."""
+def _cold_run(tree: str) -> tuple[float, float, str]:
+    """Wall and CPU time (its processes' user and system time) of one cold ``mountwb run`` of the package
+    in *tree*, s, and its isolation table."""
     import shutil
     import tempfile
 
     cache = tempfile.mkdtemp(prefix="bench-cold-")
     env = dict(os.environ, MOUNTWB_CACHE=cache, PYTHONPATH=tree)
     try:
-        start = time.perf_counter()
+        used, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
         output = subprocess.run([sys.executable, "-m", "workbook.cli.main", "run", "--no-progress"], check=True,
                                 capture_output=True, text=True, env=env, cwd=tree).stdout
-        return time.perf_counter() - start, output.split("Model card")[0]
+        wall, now = time.perf_counter() - start, resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = now.ru_utime + now.ru_stime - used.ru_utime - used.ru_stime
+        return wall, cpu, output.split("Model card")[0]
     finally:
         shutil.rmtree(cache, ignore_errors=True)
 
@@ -308,23 +312,29 @@ def cold_runs(repeats: int, before: str | None) -> None:
         trees = {f"before ({before})": folder, **trees}
     load = os.getloadavg()
     times: dict = {name: [] for name in trees}
+    cpu: dict = {name: [] for name in trees}
     tables = {}
     try:
         for _ in range(repeats):
             for name, tree in trees.items():
-                seconds, tables[name] = _cold_run(tree)
+                seconds, used, tables[name] = _cold_run(tree)
                 times[name].append(seconds)
+                cpu[name].append(used)
     finally:
         if before is not None:
             shutil.rmtree(trees[f"before ({before})"], ignore_errors=True)
     print(f"Cold `mountwb run` of the reference mount (empty cache, both rotors), median of {repeats}, "
           f"1 BLAS thread, {os.cpu_count()} cores; load average {load[0]:.2f} before, {os.getloadavg()[0]:.2f} after")
+    print(f"  {'':24s} {'wall':>8s} {'CPU':>8s}   (wall of each run)")
     for name, values in times.items():
-        print(f"  {name:24s} {statistics.median(values):6.2f} s   ({', '.join(f'{v:.2f}' for v in values)})")
+        print(f"  {name:24s} {statistics.median(values):6.2f} s {statistics.median(cpu[name]):6.2f} s   "
+              f"({', '.join(f'{v:.2f}' for v in values)})")
     if before is not None:
         old, new = (statistics.median(values) for values in times.values())
+        old_cpu, new_cpu = (statistics.median(values) for values in cpu.values())
         same = len(set(tables.values())) == 1
-        print(f"  speed-up {old / new:.2f}x; isolation tables {'identical' if same else 'DIFFER'}")
+        print(f"  speed-up {old / new:.2f}x wall, {old_cpu / new_cpu:.2f}x CPU; isolation tables "
+              f"{'identical' if same else 'DIFFER'}")
 
 
 def main(argv=None):
