@@ -15,6 +15,7 @@ theirs (:class:`LockstepSolves`).
 """
 from __future__ import annotations
 
+import copy
 import threading
 
 import numpy as np
@@ -136,34 +137,55 @@ class LockstepSolves:
         self._asked: dict = {}
         self._answers: dict = {}
         self._round = 0
+        self._stopped: BaseException | None = None
         self._changed = threading.Condition()
 
     def solve(self, task: int, rhs: np.ndarray) -> np.ndarray:
         """Task *task*'s next plain solve (see ``solve_plain`` of :func:`factorize`'s factor)."""
         with self._changed:
+            if self._stopped is not None:
+                raise copy.copy(self._stopped)
             self._asked[task] = np.asarray(rhs, dtype=float)
             ticket = self._round
             self._solve_round()
             while self._round == ticket:
                 self._changed.wait()
-            return self._answers.pop(task)
+            answer = self._answers.pop(task)
+        if isinstance(answer, BaseException):
+            raise answer
+        return answer
 
     def finished(self, task: int) -> None:
-        """Task *task* asks no more solves."""
+        """Task *task* asks no more solves (a task interrupted while it waited withdraws its solve)."""
         with self._changed:
             self._running.discard(task)
+            self._asked.pop(task, None)
             self._solve_round()
 
+    def stop(self, reason: BaseException) -> None:
+        """Every solve asked from now on, or waiting, raises a copy of *reason* (what stopped one task,
+        e.g. an interrupt), so that the other tasks end at once."""
+        with self._changed:
+            self._stopped = reason
+            self._answers.update((task, copy.copy(reason)) for task in self._asked)
+            self._asked.clear()
+            self._round += 1
+            self._changed.notify_all()
+
     def _solve_round(self) -> None:
-        """Solve the round once every running task has asked (the caller holds the lock)."""
+        """Solve the round once every running task has asked (the caller holds the lock); a failed
+        block solve is every asking task's error."""
         if not self._asked or set(self._asked) != self._running:
             return
         tasks = sorted(self._asked)
-        if len(tasks) == 1:
-            self._answers[tasks[0]] = self._factor.solve_plain(self._asked[tasks[0]])
-        else:
-            block = self._factor.solve_plain(np.column_stack([self._asked[task] for task in tasks]))
-            self._answers.update((task, block[:, column].copy()) for column, task in enumerate(tasks))
+        try:
+            if len(tasks) == 1:
+                self._answers[tasks[0]] = self._factor.solve_plain(self._asked[tasks[0]])
+            else:
+                block = self._factor.solve_plain(np.column_stack([self._asked[task] for task in tasks]))
+                self._answers.update((task, block[:, column].copy()) for column, task in enumerate(tasks))
+        except Exception as error:  # noqa: BLE001 - handed to each task of the round, which raises it
+            self._answers.update((task, error) for task in tasks)
         self._asked.clear()
         self._round += 1
         self._changed.notify_all()

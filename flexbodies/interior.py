@@ -96,7 +96,9 @@ class InteriorSolver:
         Each task is a callable of no arguments; their plain solves (the
         Lanczos iterations) are made one block solve per round
         (:class:`~flexbodies.eigen.LockstepSolves`), so the results do not
-        depend on the threads' timing. A task must not call this method itself.
+        depend on the threads' timing. The first task runs in this thread:
+        when it raises (an interrupt too), the others stop at their next
+        solve. A task must not call this method itself.
 
         Returns
         -------
@@ -115,7 +117,11 @@ class InteriorSolver:
 
         with ThreadPoolExecutor(max_workers=max(len(tasks) - 1, 1), thread_name_prefix="interior solves") as pool:
             others = [pool.submit(run, index) for index in range(1, len(tasks))]
-            first = run(0)
+            try:
+                first = run(0)
+            except BaseException as error:  # an interrupt, or a failure: the others stop at their next solve
+                shared.stop(error)
+                raise
             return [first, *(other.result() for other in others)]
 
     @property

@@ -192,12 +192,26 @@ def test_a_failing_side_by_side_task_does_not_hold_the_others(fe_model):
 
     coupled = couple(fe_model, "RBE2")
     solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+    ended = []
 
     def failing():
         solver.solve_plain(np.ones(len(solver.interior)))
         raise RuntimeError("task failed")
 
-    with pytest.raises(RuntimeError, match="task failed"):
-        solver.side_by_side(lambda: solver.mounted_frequencies(3), failing)
-    mounted, _ = solver.side_by_side(lambda: solver.mounted_frequencies(3), lambda: None)
-    np.testing.assert_allclose(mounted, solver.mounted_frequencies(3), rtol=1e-12)
+    def mounted():
+        ended.append(solver.mounted_frequencies(3))
+        return ended[-1]
+
+    with pytest.raises(RuntimeError, match="task failed"):  # a task in a thread: the others run on
+        solver.side_by_side(mounted, failing)
+    assert len(ended) == 1
+
+    def interrupted():
+        solver.solve_plain(np.ones(len(solver.interior)))
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):  # the first task, in this thread: the others stop at their next solve
+        solver.side_by_side(interrupted, mounted)
+    assert len(ended) == 1
+    again, _ = solver.side_by_side(mounted, lambda: None)
+    np.testing.assert_allclose(again, ended[0], rtol=1e-12)
