@@ -47,6 +47,20 @@ _TOLERANCE = 1e-8
 _VECTORS_MOUNTED = 12
 
 
+def _arpack_is_reentrant() -> bool:
+    """Whether eigen-solves may run in threads side by side: SciPy's Fortran ARPACK (before its C
+    translation) serialises them behind one process-wide lock, on which they would wait for each
+    other's shared solves for ever."""
+    try:
+        from scipy.sparse.linalg._eigen.arpack import arpack
+    except ImportError:
+        return False
+    return not hasattr(arpack, "_ARPACK_LOCK")
+
+
+_ARPACK_REENTRANT = _arpack_is_reentrant()
+
+
 class InteriorSolver:
     """One factorisation of a coupled link's interior stiffness, and what it solves.
 
@@ -98,13 +112,16 @@ class InteriorSolver:
         (:class:`~flexbodies.eigen.LockstepSolves`), so the results do not
         depend on the threads' timing. The first task runs in this thread:
         when it raises (an interrupt too), the others stop at their next
-        solve. A task must not call this method itself.
+        solve. A task must not call this method itself. With a SciPy whose
+        ARPACK is not reentrant the tasks run one after the other.
 
         Returns
         -------
         list
             The tasks' results, in order.
         """
+        if not _ARPACK_REENTRANT:
+            return [task() for task in tasks]
         shared = LockstepSolves(self.factor, len(tasks))
 
         def run(index: int):
