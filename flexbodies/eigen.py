@@ -7,23 +7,14 @@ ordering is METIS's nested dissection of the matrix's graph, one vertex per
 node (the DOF of a node share their pattern). On the reference links it gives
 the fill of SuperLU's minimum-degree ordering (within 2 %), but ordering and
 factorisation take 0.45 to 0.75 of its time and a solve 0.7 to 0.8.
-
-A block solve of several right-hand sides costs little more than one (on
-the reference thrust rod, two cost 1.1 and three 1.6 times one), so the
-Lanczos runs of one factorisation that run side by side in threads share
-theirs (:class:`LockstepSolves`).
 """
 from __future__ import annotations
-
-import copy
-import threading
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-__all__ = ["factorize", "nested_dissection", "natural_frequencies", "free_dofs", "lowest_modes", "start_vector",
-           "LockstepSolves"]
+__all__ = ["factorize", "nested_dissection", "natural_frequencies", "free_dofs", "lowest_modes", "start_vector"]
 
 
 #: Relative residual below which a solve is not refined.
@@ -107,88 +98,11 @@ class _Factor:
         return x
 
     def solve_plain(self, rhs: np.ndarray) -> np.ndarray:
-        """Solve for one vector (or each column of a matrix), without refinement (what an eigen-solver's
-        operator needs)."""
+        """Solve for one vector, without refinement (what an eigen-solver's operator needs)."""
         return self._solved(np.asarray(rhs, dtype=float))
 
     def as_operator(self) -> spla.LinearOperator:
         return spla.LinearOperator(self.shape, matvec=self.solve_plain, dtype=float)
-
-
-class LockstepSolves:
-    """The single-vector solves of tasks running side by side in threads, one block solve per round.
-
-    Round ``r`` holds the ``r``-th solve of every task still running, in task
-    order: each task waits for the others' (or their end), and the last to
-    ask solves them all at once. Which solves share a block, and so every
-    result, does not depend on how the threads are scheduled.
-
-    Parameters
-    ----------
-    factor
-        A factorisation from :func:`factorize`.
-    tasks : int
-        Number of tasks; each calls :meth:`finished` when it ends, however it ends.
-    """
-
-    def __init__(self, factor: _Factor, tasks: int):
-        self._factor = factor
-        self._running = set(range(tasks))
-        self._asked: dict = {}
-        self._answers: dict = {}
-        self._round = 0
-        self._stopped: BaseException | None = None
-        self._changed = threading.Condition()
-
-    def solve(self, task: int, rhs: np.ndarray) -> np.ndarray:
-        """Task *task*'s next plain solve (see ``solve_plain`` of :func:`factorize`'s factor)."""
-        with self._changed:
-            if self._stopped is not None:
-                raise copy.copy(self._stopped)
-            self._asked[task] = np.asarray(rhs, dtype=float)
-            ticket = self._round
-            self._solve_round()
-            while self._round == ticket:
-                self._changed.wait()
-            answer = self._answers.pop(task)
-        if isinstance(answer, BaseException):
-            raise answer
-        return answer
-
-    def finished(self, task: int) -> None:
-        """Task *task* asks no more solves (a task interrupted while it waited withdraws its solve)."""
-        with self._changed:
-            self._running.discard(task)
-            self._asked.pop(task, None)
-            self._solve_round()
-
-    def stop(self, reason: BaseException) -> None:
-        """Every solve asked from now on, or waiting, raises a copy of *reason* (what stopped one task,
-        e.g. an interrupt), so that the other tasks end at once."""
-        with self._changed:
-            self._stopped = reason
-            self._answers.update((task, copy.copy(reason)) for task in self._asked)
-            self._asked.clear()
-            self._round += 1
-            self._changed.notify_all()
-
-    def _solve_round(self) -> None:
-        """Solve the round once every running task has asked (the caller holds the lock); a failed
-        block solve is every asking task's error."""
-        if not self._asked or set(self._asked) != self._running:
-            return
-        tasks = sorted(self._asked)
-        try:
-            if len(tasks) == 1:
-                self._answers[tasks[0]] = self._factor.solve_plain(self._asked[tasks[0]])
-            else:
-                block = self._factor.solve_plain(np.column_stack([self._asked[task] for task in tasks]))
-                self._answers.update((task, block[:, column].copy()) for column, task in enumerate(tasks))
-        except Exception as error:  # noqa: BLE001 - handed to each task of the round, which raises it
-            self._answers.update((task, error) for task in tasks)
-        self._asked.clear()
-        self._round += 1
-        self._changed.notify_all()
 
 
 def factorize(matrix: sp.spmatrix) -> _Factor:
@@ -232,8 +146,7 @@ def lowest_modes(stiffness, mass, count: int, sigma: float, factor=None, *, tol:
     sigma : float
         Shift, (rad/s)^2.
     factor : optional
-        A factorisation of ``K - sigma M`` from :func:`factorize`, to reuse (or any object whose
-        ``as_operator()`` applies its inverse).
+        A factorisation of ``K - sigma M`` from :func:`factorize`, to reuse.
     tol : float
         Lanczos's relative accuracy of the eigenvalues (0: machine precision).
     ncv : int, optional

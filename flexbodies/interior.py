@@ -15,23 +15,16 @@ In coupled coordinates ``q = [interior, masters]`` the interior stiffness
   elastic modes.
 
 Each eigenproblem then runs shift-invert Lanczos on the full coupled model:
-the frequencies are those of the FE model, not of a reduced one. The
-eigenproblems that are independent run side by side
-(:meth:`InteriorSolver.side_by_side`), their solves in shared blocks
-(:class:`~flexbodies.eigen.LockstepSolves`).
+the frequencies are those of the FE model, not of a reduced one.
 """
 from __future__ import annotations
-
-import threading
-from concurrent.futures import ThreadPoolExecutor
-from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .eigen import LockstepSolves, factorize, lowest_modes, start_vector
+from .eigen import factorize, lowest_modes, start_vector
 from .frequencies import mounted_constraint_basis
 from .interfaces import rigid_motion_rows
 
@@ -45,20 +38,6 @@ _TOLERANCE = 1e-8
 #: Lanczos vectors between restarts for the 3 mounted modes. With the shift at 0 they converge in one
 #: short cycle; ARPACK's default of 20 vectors took 21 solves on every reference link, 12 vectors 13.
 _VECTORS_MOUNTED = 12
-
-
-def _arpack_is_reentrant() -> bool:
-    """Whether eigen-solves may run in threads side by side: SciPy's Fortran ARPACK (before its C
-    translation) serialises them behind one process-wide lock, on which they would wait for each
-    other's shared solves for ever."""
-    try:
-        from scipy.sparse.linalg._eigen.arpack import arpack
-    except ImportError:
-        return False
-    return not hasattr(arpack, "_ARPACK_LOCK")
-
-
-_ARPACK_REENTRANT = _arpack_is_reentrant()
 
 
 class InteriorSolver:
@@ -93,67 +72,14 @@ class InteriorSolver:
         #: Condensed (Guyan) boundary stiffness, symmetrised.
         self.condensed = 0.5 * (condensed + condensed.T)
         self._fixed = None  # the largest set of fixed-interface modes computed so far
-        self._lockstep = threading.local()  # a side-by-side task's route to the shared solves
-
-    def solve_plain(self, rhs: np.ndarray) -> np.ndarray:
-        """``K_ii^-1 rhs`` without refinement; in a task of :meth:`side_by_side`, in that task's turn."""
-        route = getattr(self._lockstep, "route", None)
-        return self.factor.solve_plain(rhs) if route is None else route(rhs)
-
-    def as_operator(self) -> spla.LinearOperator:
-        """:meth:`solve_plain` as ARPACK's ``OPinv``."""
-        return spla.LinearOperator(self.K_ii.shape, matvec=self.solve_plain, dtype=float)
-
-    def side_by_side(self, *tasks: Callable) -> list:
-        """Run tasks that use this solver side by side, in threads, their solves shared.
-
-        Each task is a callable of no arguments; their plain solves (the
-        Lanczos iterations) are made one block solve per round
-        (:class:`~flexbodies.eigen.LockstepSolves`), so the results do not
-        depend on the threads' timing. The first task runs in this thread:
-        when it raises (an interrupt too), the others stop at their next
-        solve. A task must not call this method itself. With a SciPy whose
-        ARPACK is not reentrant the tasks run one after the other.
-
-        Returns
-        -------
-        list
-            The tasks' results, in order.
-        """
-        if not _ARPACK_REENTRANT:
-            return [task() for task in tasks]
-        shared = LockstepSolves(self.factor, len(tasks))
-
-        def run(index: int):
-            self._lockstep.route = lambda rhs: shared.solve(index, rhs)
-            try:
-                return tasks[index]()
-            finally:
-                self._lockstep.route = None
-                shared.finished(index)
-
-        with ThreadPoolExecutor(max_workers=max(len(tasks) - 1, 1), thread_name_prefix="interior solves") as pool:
-            others = [pool.submit(run, index) for index in range(1, len(tasks))]
-            try:
-                first = run(0)
-            except BaseException as error:  # an interrupt, or a failure: the others stop at their next solve
-                shared.stop(error)
-                raise
-            return [first, *(other.result() for other in others)]
 
     @property
     def n_q(self) -> int:
         return self.stiffness.shape[0]
 
-    def reference_frequencies(self, alongside: Callable | None = None) -> dict:
-        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz.
-
-        The two eigen-solves run side by side (:meth:`side_by_side`), with
-        *alongside* (another task of this solver, its result dropped) when given.
-        """
-        tasks = [lambda: self.free_free_frequencies(6), lambda: self.mounted_frequencies(3)]
-        free_free, mounted, *_ = self.side_by_side(*tasks, *([alongside] if alongside is not None else []))
-        return {"free_free_hz": free_free, "mounted_hz": mounted}
+    def reference_frequencies(self) -> dict:
+        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz."""
+        return {"free_free_hz": self.free_free_frequencies(6), "mounted_hz": self.mounted_frequencies(3)}
 
     def static_modes(self) -> np.ndarray:
         """Static modes in coupled coordinates, shape (n_q, n_masters): unit value at one master DOF."""
@@ -170,7 +96,7 @@ class InteriorSolver:
         reduction ask for them in turn).
         """
         if self._fixed is None or len(self._fixed[0]) < count:
-            freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, self, tol=_TOLERANCE,
+            freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, self.factor, tol=_TOLERANCE,
                                       ncv=2 * count + 5)
             vectors = np.zeros((self.n_q, phi.shape[1]))
             vectors[self.interior] = phi
@@ -187,7 +113,7 @@ class InteriorSolver:
 
         def solve(f):
             f = np.asarray(f, dtype=float)
-            y = self.solve_plain(f[:n_i])
+            y = self.factor.solve_plain(f[:n_i])
             r = sla.cho_solve(schur, f[n_i:] - coupling.T @ y)
             return np.concatenate([y + psi_n @ r, r])
 
