@@ -15,15 +15,9 @@ In coupled coordinates ``q = [interior, masters]`` the interior stiffness
   elastic modes.
 
 Each eigenproblem then runs shift-invert Lanczos on the full coupled model:
-the frequencies are those of the FE model, not of a reduced one. The
-eigen-solves only read the factorisation, and SuperLU's solves and ARPACK
-let other threads run meanwhile, so independent ones can run side by side
-(:meth:`InteriorSolver.reference_frequencies`).
+the frequencies are those of the FE model, not of a reduced one.
 """
 from __future__ import annotations
-
-from concurrent.futures import ThreadPoolExecutor
-from typing import Callable
 
 import numpy as np
 import scipy.linalg as sla
@@ -83,20 +77,9 @@ class InteriorSolver:
     def n_q(self) -> int:
         return self.stiffness.shape[0]
 
-    def reference_frequencies(self, alongside: Callable[[], object] | None = None) -> dict:
-        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz.
-
-        The two eigen-solves run side by side, the mounted one in a thread,
-        and so does *alongside* when given (another task of this solver, e.g.
-        the stress stiffening's eigen-solve; its result is dropped, its error raised).
-        """
-        with ThreadPoolExecutor(max_workers=2, thread_name_prefix="interior eigen-solve") as pool:
-            others = [pool.submit(task) for task in ([alongside] if alongside is not None else [])]
-            mounted = pool.submit(self.mounted_frequencies, 3)
-            free_free = self.free_free_frequencies(6)
-            for other in others:
-                other.result()
-            return {"free_free_hz": free_free, "mounted_hz": mounted.result()}
+    def reference_frequencies(self) -> dict:
+        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz."""
+        return {"free_free_hz": self.free_free_frequencies(6), "mounted_hz": self.mounted_frequencies(3)}
 
     def static_modes(self) -> np.ndarray:
         """Static modes in coupled coordinates, shape (n_q, n_masters): unit value at one master DOF."""

@@ -279,20 +279,15 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         start = time.perf_counter()
         solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
         timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
-
-        def stiffen():
+        if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
             start = time.perf_counter()
             save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
                             cache_dir=cache_dir)
             timings["stiffening_seconds"] = time.perf_counter() - start
-
-        stiffen_now = stiffen if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir) else None
         if frequencies is None:
             start = time.perf_counter()
-            frequencies = solver.reference_frequencies(alongside=stiffen_now)  # the three eigen-solves side by side
+            frequencies = solver.reference_frequencies()
             timings["frequency_seconds"] = time.perf_counter() - start
-        elif stiffen_now is not None:
-            stiffen_now()
         return coupled, solver, frequencies, timings
 
     return cached_reductions(model.fingerprint(), _decider(modes), excitations_hz, prepare, cache_dir=cache_dir,

@@ -162,25 +162,3 @@ def test_invariants_are_exudyns(fe_model):
                                    err_msg=key)
     for key in ("massMatrixReduced", "stiffnessMatrixReduced"):
         assert np.array_equal(ours[key] == 0, exudyns[key] == 0), f"{key}: other entries rounded to zero"
-
-
-def test_reference_frequencies_side_by_side_are_those_one_at_a_time(fe_model):
-    """The mounted, free-free and another eigen-solve of one factorisation run side by side in threads
-    give the bits they give one at a time; an error of the task run alongside is raised."""
-    from flexbodies.interior import InteriorSolver
-
-    coupled = couple(fe_model, "RBE2")
-    solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
-    alone = {"free_free_hz": solver.free_free_frequencies(6), "mounted_hz": solver.mounted_frequencies(3)}
-    fixed_hz, _ = solver.fixed_interface_modes(6)
-    solver._fixed = None  # the alongside task solves again
-    together = solver.reference_frequencies(alongside=lambda: solver.fixed_interface_modes(6))
-    for name, values in alone.items():
-        assert np.array_equal(together[name], values), name
-    assert np.array_equal(solver.fixed_interface_modes(6)[0], fixed_hz)
-
-    def failing():
-        raise RuntimeError("alongside failed")
-
-    with pytest.raises(RuntimeError, match="alongside failed"):
-        solver.reference_frequencies(alongside=failing)
