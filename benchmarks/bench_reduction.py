@@ -26,12 +26,21 @@ repeats and the largest relative difference of every frequency.
 verifying its file (uncompressed, as stored, and the same arrays
 compressed, as before) and a reload from the process's memory.
 
+``--cold`` times the whole cold ``mountwb run`` of the reference mount
+(both rotors, an empty cache each time, a fresh process each time) of this
+tree, and with ``--before REV`` of the package as it was at git revision
+REV too, the two alternating, and checks that both print the same
+isolation table. It prints the median wall and CPU times (the run's
+processes' user and system time, which another load on the machine
+disturbs less) side by side and the load average before and after.
+
 Run::
 
     python benchmarks/bench_reduction.py                 # 14, 10 and 7 mm
     python benchmarks/bench_reduction.py --sizes 10 5 --repeats 3 --exudyn
     python benchmarks/bench_reduction.py --reference --repeats 3
     python benchmarks/bench_reduction.py --warm --repeats 5
+    python benchmarks/bench_reduction.py --cold --before HEAD~3 --repeats 3
 """
 from __future__ import annotations
 
@@ -268,6 +277,66 @@ def warm_links(repeats: int) -> None:
     print(f"  from the process's memory:     {memory_s:.4f} s")
 
 
+def _cold_run(tree: str) -> tuple[float, float, str]:
+    """Wall and CPU time (its processes' user and system time) of one cold ``mountwb run`` of the package
+    in *tree*, s, and its isolation table."""
+    import shutil
+    import tempfile
+
+    cache = tempfile.mkdtemp(prefix="bench-cold-")
+    env = dict(os.environ, MOUNTWB_CACHE=cache, PYTHONPATH=tree)
+    try:
+        used, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+        output = subprocess.run([sys.executable, "-m", "workbook.cli.main", "run", "--no-progress"], check=True,
+                                capture_output=True, text=True, env=env, cwd=tree).stdout
+        wall, now = time.perf_counter() - start, resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = now.ru_utime + now.ru_stime - used.ru_utime - used.ru_stime
+        return wall, cpu, output.split("Model card")[0]
+    finally:
+        shutil.rmtree(cache, ignore_errors=True)
+
+
+def cold_runs(repeats: int, before: str | None) -> None:
+    """The cold run of the reference mount, this tree and (``before``) a git revision, alternating."""
+    import shutil
+    import tempfile
+    from pathlib import Path
+
+    root = str(Path(__file__).resolve().parents[1])
+    trees = {"now": root}
+    if before is not None:
+        folder = tempfile.mkdtemp(prefix="bench-before-")
+        archive = subprocess.run(["git", "-C", root, "archive", before, "flexbodies", "workbook"], check=True,
+                                 capture_output=True).stdout
+        subprocess.run(["tar", "-x", "-C", folder], input=archive, check=True)
+        trees = {f"before ({before})": folder, **trees}
+    load = os.getloadavg()
+    times: dict = {name: [] for name in trees}
+    cpu: dict = {name: [] for name in trees}
+    tables = {}
+    try:
+        for _ in range(repeats):
+            for name, tree in trees.items():
+                seconds, used, tables[name] = _cold_run(tree)
+                times[name].append(seconds)
+                cpu[name].append(used)
+    finally:
+        if before is not None:
+            shutil.rmtree(trees[f"before ({before})"], ignore_errors=True)
+    print(f"Cold `mountwb run` of the reference mount (empty cache, both rotors), median of {repeats}, "
+          f"1 BLAS thread, {os.cpu_count()} cores; load average {load[0]:.2f} before, {os.getloadavg()[0]:.2f} after")
+    print(f"  {'':24s} {'wall':>8s} {'CPU':>8s}   (wall of each run)")
+    for name, values in times.items():
+        print(f"  {name:24s} {statistics.median(values):6.2f} s {statistics.median(cpu[name]):6.2f} s   "
+              f"({', '.join(f'{v:.2f}' for v in values)})")
+    if before is not None:
+        old, new = (statistics.median(values) for values in times.values())
+        old_cpu, new_cpu = (statistics.median(values) for values in cpu.values())
+        same = len(set(tables.values())) == 1
+        print(f"  speed-up {old / new:.2f}x wall, {old_cpu / new_cpu:.2f}x CPU; isolation tables "
+              f"{'identical' if same else 'DIFFER'}")
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=float, nargs="+", default=[14.0, 10.0, 7.0], help="element sizes, mm")
@@ -276,10 +345,15 @@ def main(argv=None):
     parser.add_argument("--reference", action="store_true",
                         help="cold reduction of the reference mount's links, before and now")
     parser.add_argument("--warm", action="store_true", help="loading the reference mount's reduced links")
+    parser.add_argument("--cold", action="store_true", help="the whole cold `mountwb run` of the reference mount")
+    parser.add_argument("--before", metavar="REV", help="with --cold: also time the package at git revision REV")
     parser.add_argument("--one", type=float, help=argparse.SUPPRESS)  # a single size, in this process
     args = parser.parse_args(argv)
     if args.warm:
         warm_links(args.repeats)
+        return
+    if args.cold:
+        cold_runs(args.repeats, args.before)
         return
     if args.reference:
         reference_links(args.repeats)
