@@ -135,6 +135,8 @@ def rest_stiffness(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads)
     """K of the rest of the scene at the state change *dq* (..., N), full coordinates (..., N, N)."""
     stiffness = expansion.rest.stiffness_at(dq)
     for indices, added in loads.modal_stiffness:
+        if added.ndim > stiffness.ndim:           # one state for designs of their own loads
+            stiffness = np.repeat(stiffness[None], len(added), axis=0)
         stiffness[..., indices[:, None], indices] += added
     return stiffness
 
@@ -402,10 +404,14 @@ class StaticSolution:
 def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: StateLoads, dq: np.ndarray,
                      failures: dict) -> np.ndarray:
     """The inverse projected tangent stiffness at *dq* (B, N) per design, (B, n, n); a singular one is noted
-    in *failures* (its inverse is zero)."""
-    state = expansion.channels.state(total(expansion, dq))
-    basis = projection(expansion, dq)
-    tangent = basis.both(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), springs, state))
+    in *failures* (its inverse is zero). Designs all at the prepared state share its kinematics."""
+    at = dq[0] if not dq.any() else dq
+    state = expansion.channels.state(total(expansion, at))
+    basis = projection(expansion, at)
+    basis = Projection(basis.free, basis.euler, np.broadcast_to(basis.tangents, dq.shape[:-1] + basis.tangents.shape[-3:]),
+                       basis.size)
+    full = tangent_stiffness(expansion, at, rest_stiffness(expansion, at, loads), springs, state)
+    tangent = basis.both(np.broadcast_to(full, dq.shape[:-1] + full.shape[-2:]))
     inverse, singular = solve_each(tangent, np.broadcast_to(np.eye(tangent.shape[-1]), tangent.shape))
     for k in np.flatnonzero(singular):
         failures[int(k)] = "its tangent stiffness is singular"
