@@ -132,23 +132,24 @@ class ChannelSet:
         ``sum_c (S_c d_c) . H_c`` of those springs (the tangent stiffness)."""
         jacobian = self._channel_jacobians(state)
         weighted = springs[..., None, :, :] @ jacobian                          # (..., C, 2, 3, M)
-        blocks = jacobian.swapaxes(-1, -2)[..., :, None, :, :] @ weighted[..., None, :, :, :]
-        rows = self.coordinates.reshape(self.count, 2, 1, -1, 1)
-        columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
-        index = [np.broadcast_to(rows * (self.size + 1) + columns, blocks.shape[-5:]).ravel()]
-        values = [blocks.reshape(blocks.shape[:-5] + (-1,))]
-        if stiffness is not None:
+        blocks = jacobian.swapaxes(-1, -2)[..., :, None, :, :] @ weighted[..., None, :, :, :]   # (..., C, 2, 2, M, M)
+        if stiffness is not None:       # each marker's curvature joins its own diagonal block
             assert state.hessian is not None, "the tangent stiffness needs the Hessians"
             on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
-            own = self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]
-            index.append(own.ravel())
             hessian = state.hessian
             curvature = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))   # (..., 2 C, 1, M M)
-            values.append(curvature.reshape(curvature.shape[:-3] + (-1,)))
-        batch = np.broadcast_shapes(*(v.shape[:-1] for v in values))
-        full = _scatter(np.concatenate(index), np.concatenate([np.broadcast_to(v, batch + v.shape[-1:])
-                                                               for v in values], axis=-1), (self.size + 1) ** 2)
-        return full.reshape(batch + (self.size + 1, self.size + 1))[..., :self.size, :self.size]
+            width = hessian.shape[-1]
+            curvature = curvature.reshape(curvature.shape[:-3] + (self.count, 2, width, width))
+            batch = np.broadcast_shapes(blocks.shape[:-5], curvature.shape[:-4])
+            if blocks.shape[:-5] != batch:
+                blocks = np.broadcast_to(blocks, batch + blocks.shape[-5:]).copy()
+            for side in range(2):
+                blocks[..., side, side, :, :] += curvature[..., side, :, :]
+        rows = self.coordinates.reshape(self.count, 2, 1, -1, 1)
+        columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
+        index = np.broadcast_to(rows * (self.size + 1) + columns, blocks.shape[-5:]).ravel()
+        full = _scatter(index, blocks.reshape(blocks.shape[:-5] + (-1,)), (self.size + 1) ** 2)
+        return full.reshape(blocks.shape[:-5] + (self.size + 1, self.size + 1))[..., :self.size, :self.size]
 
     def outputs(self, state: ChannelState, springs: np.ndarray) -> np.ndarray:
         """``S_c J_c`` of every channel stacked: shape (..., 3 C, N)."""

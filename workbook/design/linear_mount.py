@@ -207,16 +207,26 @@ def _same_except(one, other, changes: dict) -> bool:
         return True
     if type(one) is not type(other):
         return False
-    for item in dataclasses.fields(one):
-        mine, theirs = getattr(one, item.name), getattr(other, item.name)
-        if item.name not in changes:
+    for name in _field_names(type(one)):
+        mine, theirs = getattr(one, name), getattr(other, name)
+        if name not in changes:
             if not (mine is theirs or mine == theirs):
                 return False
-        elif changes[item.name] is not None and not (
+        elif changes[name] is not None and not (
                 (mine is None and theirs is None) or (mine is not None and theirs is not None
-                                                      and _same_except(mine, theirs, changes[item.name]))):
+                                                      and _same_except(mine, theirs, changes[name]))):
             return False
     return True
+
+
+_FIELD_NAMES: dict[type, tuple[str, ...]] = {}
+
+
+def _field_names(kind: type) -> tuple[str, ...]:
+    """The field names of the dataclass *kind*."""
+    if kind not in _FIELD_NAMES:
+        _FIELD_NAMES[kind] = tuple(item.name for item in dataclasses.fields(kind))
+    return _FIELD_NAMES[kind]
 
 
 #: What a design may change, by field (module text); the excitations are checked on their own.
@@ -298,7 +308,9 @@ class LinearMount:
         if [type(e) for e in case.excitations] != [type(e) for e in base.excitations] or \
                 [e.name for e in case.excitations] != [e.name for e in base.excitations]:
             raise OutsideDesignModel(case.name, "other excitations")
-        for item in case.excitations:
+        for item, base_item in zip(case.excitations, base.excitations, strict=True):
+            if item is base_item:                 # the prepared excitation itself (a study's rows share it)
+                continue
             prepared = self.items[item.name]
             for excitation in points_of(item):
                 for point, _ in point_phasors(excitation):

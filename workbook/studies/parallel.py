@@ -336,12 +336,11 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
             done(item)
         else:
             pending[index] = item
-    work = batches(pending, design_model)
     if dask is not None:
         _run_dask(pending, dask, done, design_model)
-    elif workers <= SERIAL or len(work) <= 1:
+    elif workers <= SERIAL or len(pending) <= 1 or (design_model is not None and len(pending) <= BATCH_ROWS):
         with _signals_seen() as seen, _using(design_model):
-            for batch in work:
+            for batch in batches(pending, design_model):
                 answered = run_batch(batch)
                 if seen:        # a signal a library swallowed during the rows: their outcomes are dropped, --resume reruns them
                     raise Terminated() if signal.SIGTERM in seen else KeyboardInterrupt()
