@@ -37,6 +37,7 @@ link's modes costs a few sparse products.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 from collections import OrderedDict
@@ -139,12 +140,16 @@ class LinkStiffening:
             lam = sla.eigh(self.pinned_stiffness + tension * self.pinned_geometric, self.pinned_mass,
                            eigvals_only=True, subset_by_index=[0, count - 1])
         else:       # one symmetric pencil per tension, whitened by M = L L^T
-            factor = np.linalg.cholesky(self.pinned_mass)
-            stiffness, geometric = (sla.solve_triangular(factor, sla.solve_triangular(factor, m, lower=True).T,
-                                                         lower=True) for m in (self.pinned_stiffness,
-                                                                               self.pinned_geometric))
+            stiffness, geometric = self._whitened
             lam = np.linalg.eigvalsh(stiffness + tension[..., None, None] * geometric)[..., :count]
         return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
+
+    @functools.cached_property
+    def _whitened(self) -> tuple[np.ndarray, np.ndarray]:
+        """``L^-1 K L^-T`` and ``L^-1 G L^-T`` of the pinned-pinned model, ``M = L L^T``."""
+        factor = np.linalg.cholesky(self.pinned_mass)
+        return tuple(sla.solve_triangular(factor, sla.solve_triangular(factor, m, lower=True).T, lower=True)
+                     for m in (self.pinned_stiffness, self.pinned_geometric))
 
     def first_mode_shift(self, tension: float) -> float:
         """Relative change of the first pinned-pinned frequency under *tension* (N); -1 at buckling."""

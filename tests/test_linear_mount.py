@@ -65,7 +65,8 @@ def test_engine_mass_and_excitation_amplitude(mount):
 
 def test_many_designs_at_once_are_each_design_alone(mount):
     """A batch mixing hinge designs, a heavier engine under larger excitations, a change the mount cannot follow
-    and a design with no stable preload: each answer is that design's alone, the heavier one is the pipeline's,
+    and a design with no stable preload: each answer is that design's alone (to the preload solves' tolerance:
+    one design is solved by Newton, designs together by the chord iteration), the heavier one is the pipeline's,
     and the two it cannot answer have their errors in their places."""
     case = mount.case
     rng = np.random.default_rng(7)
@@ -81,12 +82,12 @@ def test_many_designs_at_once_are_each_design_alone(mount):
     for k in (0, 2, 4):
         alone = mount.evaluate(batch[k])
         for together, single in zip(answers[k].result.runs, alone.result.runs, strict=True):
-            assert _normwise(together.transmissibility, single.transmissibility) < 1e-10
+            assert _normwise(together.transmissibility, single.transmissibility) < 1e-8
             for name, amplitude in single.hinge_amplitudes.items():
-                assert _normwise(together.hinge_amplitudes[name], amplitude) < 1e-10
+                assert _normwise(together.hinge_amplitudes[name], amplitude) < 1e-8
         for item, forces in alone.static_hinge_forces.items():
             for name, force in forces.items():
-                assert _normwise(answers[k].static_hinge_forces[item][name], force) < 1e-10
+                assert _normwise(answers[k].static_hinge_forces[item][name], force) < 1e-8
     exact = run_case(heavier)
     for fast, e in zip(answers[2].result.runs, exact.runs, strict=True):
         assert _normwise(fast.transmissibility, e.transmissibility) < 5e-6

@@ -318,15 +318,21 @@ def projection(expansion: SceneExpansion, dq: np.ndarray) -> Projection:
 
 
 def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force: np.ndarray, loads: StateLoads,
-                 start: np.ndarray, inverse: np.ndarray | None = None) -> "StaticSolution":
+                 start: np.ndarray, inverse: np.ndarray | None = None, *,
+                 keep_tangent: bool = True) -> "StaticSolution":
     """The preload equilibrium's state change from the prepared state of each design, from *start*.
 
-    Newton with its tangent stiffness kept while it serves (a chord
-    iteration): the tangent at the start is inverted once, and a design's
-    tangent is renewed at its current state only when its updates shrink by
-    less than :data:`RENEWAL_RATE` per step. A design has converged when the
-    error its updates leave (``rate / (1 - rate)`` times the last update) is
-    below :data:`NEWTON_TOLERANCE` of its state change.
+    With *keep_tangent*, Newton with its tangent stiffness kept while it
+    serves (a chord iteration, for designs together: the tangent's inversion
+    is their larger cost): the tangent at the start is inverted once, and a
+    design's tangent is renewed at its current state only when its updates
+    shrink by less than :data:`RENEWAL_RATE` per step; a design has converged
+    when the error its updates leave (``rate / (1 - rate)`` times the last
+    update) is below :data:`NEWTON_TOLERANCE` of its state change. Without,
+    Newton with a tangent per step (for one design, whose cost is mostly
+    NumPy's per call: fewer steps win), converged when an update is below
+    the square root of the tolerance (quadratic convergence leaves an error
+    of the order of its square).
 
     Parameters
     ----------
@@ -334,23 +340,33 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         Per design (leading axis B).
     start : ndarray, shape (B, N)
     inverse : ndarray, shape (B, n, n), optional
-        Inverses of projected tangent stiffnesses to start with (e.g. a
-        previous solve's, :attr:`StaticSolution.inverse`); else the tangent
-        at *start*.
+        With *keep_tangent*: inverses of projected tangent stiffnesses to
+        start with (e.g. a previous solve's, :attr:`StaticSolution.inverse`);
+        else the tangent at *start*.
     """
     dq = start.copy()
     count = len(dq)
     steps = np.zeros(count, dtype=int)
     failures: dict[int, str] = {}
-    inverse = _tangent_inverse(expansion, springs, loads, dq, failures) if inverse is None else inverse.copy()
+    if keep_tangent:
+        inverse = _tangent_inverse(expansion, springs, loads, dq, failures) if inverse is None else inverse.copy()
     last = np.full(count, np.inf)
     active = np.array([k for k in range(count) if k not in failures], dtype=int)
     for step in range(1, CHORD_STEPS + 1):
         part, part_springs, part_loads = dq[active], springs.take(active), loads.take(active)
-        state = expansion.channels.state(total(expansion, part), second=False)
+        state = expansion.channels.state(total(expansion, part), second=not keep_tangent)
         basis = projection(expansion, part)
         residual = basis.rows(static_residual(expansion, part, part_springs, base_force, part_loads, state))
-        full_update = basis.expand(-(inverse[active] @ residual[..., None])[..., 0])
+        if keep_tangent:
+            assert inverse is not None
+            update = -(inverse[active] @ residual[..., None])[..., 0]
+        else:
+            tangent = basis.both(tangent_stiffness(expansion, part, rest_stiffness(expansion, part, part_loads),
+                                                   part_springs, state))
+            update, singular = solve_each(tangent, -residual)
+            for k in np.flatnonzero(singular):
+                failures[int(active[k])] = "its tangent stiffness is singular"
+        full_update = basis.expand(update)
         q = total(expansion, part + full_update)
         q[..., expansion.euler_blocks] /= np.linalg.norm(q[..., expansion.euler_blocks], axis=-1)[..., None]
         moved = q - expansion.reference - expansion.state
@@ -362,11 +378,14 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         shrinking = rate < 1.0
         left = np.full(len(rate), np.inf)                 # the error the updates leave
         left[shrinking] = rate[shrinking] * size[shrinking] / (1.0 - rate[shrinking])
-        converged = (size <= NEWTON_TOLERANCE) | (left <= NEWTON_TOLERANCE)
+        converged = (size <= np.sqrt(NEWTON_TOLERANCE)) if not keep_tangent else \
+            (size <= NEWTON_TOLERANCE) | (left <= NEWTON_TOLERANCE)
         steps[active[converged]] = step
-        active = active[~converged]
-        renew = active[known[~converged] & (rate[~converged] > RENEWAL_RATE)]
+        going = ~converged & np.array([int(k) not in failures for k in active], dtype=bool)
+        renew = active[going & known & (rate > RENEWAL_RATE)] if keep_tangent else np.zeros(0, dtype=int)
+        active = active[going]
         if len(renew):
+            assert inverse is not None
             found: dict[int, str] = {}
             inverse[renew] = _tangent_inverse(expansion, springs.take(renew), loads.take(renew), dq[renew], found)
             failures.update({int(renew[k]): reason for k, reason in found.items()})
@@ -391,14 +410,14 @@ class StaticSolution:
     failures : dict of int to str
         The designs whose tangent stiffness was singular or that did not
         converge, with the reason (their rows of *dq* mean nothing).
-    inverse : ndarray, shape (B, n, n)
-        The inverse tangent stiffnesses last used.
+    inverse : ndarray, shape (B, n, n), or None
+        The inverse tangent stiffnesses last used (None: a tangent per step).
     """
 
     dq: np.ndarray
     steps: np.ndarray
     failures: dict
-    inverse: np.ndarray
+    inverse: np.ndarray | None
 
 
 def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: StateLoads, dq: np.ndarray,

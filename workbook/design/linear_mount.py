@@ -717,7 +717,7 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
         """Solve the designs *rows* from their current state and tensions; the ones that solved."""
         loads = _state_loads(designs.take(rows), prepared, tensions[rows])
         solution = static_state(prepared.expansion, designs.springs.take(rows), prepared.base_force, loads, dq[rows],
-                                inverses[0][rows] if inverses else None)
+                                inverses[0][rows] if inverses else None, keep_tangent=count > 1)
         for k, reason in solution.failures.items():
             failures[int(rows[k])] = UnstablePreloadError(
                 f"{designs.cases[rows[k]].name}: the design's preload has no stable equilibrium ({reason})", [])
@@ -725,9 +725,9 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
         forces[rows] = _channel_forces(prepared, designs.springs.take(rows), solution.dq)
         if keep_passes:
             passes.append((rows, solution.dq, tensions[rows].copy(), stiffened[rows].copy()))
-        if inverses:
+        if solution.inverse is not None and inverses:
             inverses[0][rows] = solution.inverse
-        else:
+        elif solution.inverse is not None:
             inverses.append(solution.inverse)
         return np.delete(rows, list(solution.failures))
 
