@@ -9,8 +9,9 @@ sag there; then the median time of the derivatives of T and the hinge forces
 with respect to five parameters by the direct method and by central
 differences of whole evaluations, and their largest difference. Last, the
 time per design of :data:`BATCH` designs answered together
-(``LinearMount.evaluate_many``) against the same designs one at a time, in
-:data:`REPEATS` alternating rounds, and the largest difference between them. Run with
+(``LinearMount.evaluate_many``, in the parameter studies' batches of
+``BATCH_ROWS``) against the same designs one at a time, in :data:`REPEATS`
+alternating rounds, and the largest difference between them. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
 import dataclasses
@@ -22,11 +23,12 @@ import numpy as np
 
 import workbook as wb
 from workbook.design.sensitivity import difference_sensitivity
+from workbook.studies.parallel import BATCH_ROWS
 
 #: Scale factors of every hinge's stiffness for the designs far from the prepared one.
 FAR_FACTORS = (0.25, 0.5, 2.0, 20.0, 80.0)
 #: Designs answered together, and rounds of the batch against one at a time.
-BATCH = 100
+BATCH = 128
 REPEATS = 3
 PARAMETERS = ("hinge_stiffness/front", "hinge_stiffness/rear/axial", "hinge_loss_factor/thrust", "engine_mass",
               "hinge_damping/all")
@@ -104,14 +106,15 @@ def _batch(case, mount, rng) -> None:
         alone = [mount.evaluate(design) for design in designs]
         alone_times.append((time.perf_counter() - start) / BATCH)
         start = time.perf_counter()
-        together = mount.evaluate_many(designs)
+        together = [answer for k in range(0, BATCH, BATCH_ROWS) for answer in mount.evaluate_many(designs[k:k + BATCH_ROWS])]
         together_times.append((time.perf_counter() - start) / BATCH)
         for one, many in zip(alone, together, strict=True):
             for a, b in zip(one.result.runs, many.result.runs, strict=True):
                 difference = max(difference, np.abs(a.transmissibility - b.transmissibility).max()
                                  / a.transmissibility.max())
     one, many = statistics.median(alone_times), statistics.median(together_times)
-    print(f"\n{BATCH} hinge designs (stiffness and loss factor), both rotors, {REPEATS} rounds")
+    print(f"\n{BATCH} hinge designs (stiffness and loss factor), both rotors, {REPEATS} rounds; together: "
+          f"{BATCH_ROWS} at a time")
     print(f"{'evaluation':<24}{'median s/design':>16}{'designs/s':>11}")
     print(f"{'one at a time':<24}{one:>16.4f}{1 / one:>11.1f}")
     print(f"{'together':<24}{many:>16.4f}{1 / many:>11.1f}")
