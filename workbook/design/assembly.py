@@ -28,14 +28,14 @@ from workbook.design.expansion import SceneExpansion
 __all__ = ["ChannelSprings", "AddedRigidMass", "StateLoads", "Projection", "total", "rest_stiffness",
            "rest_matrices", "turned_mass", "static_residual", "normal_components", "without_normal",
            "tangent_stiffness", "static_state", "StaticSolution", "solve_each", "projection", "NEWTON_TOLERANCE",
-           "CHORD_STEPS"]
+           "PRELOAD_STEPS", "RENEWAL_RATE"]
 
 #: The preload solve ends when the error it leaves is below this (relative to the state change).
 NEWTON_TOLERANCE = 1e-10
 #: Smallest state change the tolerance is relative to (m, rad, modal coordinates).
 STATE_SCALE = 1e-3
 #: Most steps of one preload solve.
-CHORD_STEPS = 40
+PRELOAD_STEPS = 40
 #: A design's tangent stiffness is renewed when its updates shrink by less than this factor per step.
 RENEWAL_RATE = 0.1
 
@@ -352,7 +352,7 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         inverse = _tangent_inverse(expansion, springs, loads, dq, failures) if inverse is None else inverse.copy()
     last = np.full(count, np.inf)
     active = np.array([k for k in range(count) if k not in failures], dtype=int)
-    for step in range(1, CHORD_STEPS + 1):
+    for step in range(1, PRELOAD_STEPS + 1):
         part, part_springs, part_loads = dq[active], springs.take(active), loads.take(active)
         state = expansion.channels.state(total(expansion, part), second=not keep_tangent)
         basis = projection(expansion, part)
@@ -394,7 +394,7 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         if not len(active):
             break
     for k in active:
-        failures[int(k)] = f"the preload did not converge in {CHORD_STEPS} steps"
+        failures[int(k)] = f"the preload did not converge in {PRELOAD_STEPS} steps"
     return StaticSolution(dq, steps, failures, inverse)
 
 

@@ -189,7 +189,7 @@ class DesignAnswer:
     static_hinge_forces : dict of str to dict of str to ndarray
         Per excitation item, the preload force of every channel, N.
     seconds : float
-        Wall time of the evaluation, s.
+        Wall time of the evaluation (of designs answered together, its share of theirs), s.
     engine_static : dict of str to ndarray
         Per excitation item, :attr:`ItemSolution.engine_static`.
     """

@@ -4,10 +4,13 @@ The parent first builds every row's case and reduces every distinct link
 model once (:func:`prepare`), so the disk cache of :mod:`flexbodies`
 (``$MOUNTWB_CACHE``, which workers must share) holds every reduction before
 a run starts: workers only load, and no two processes ever write the same
-cache file. The same function, :func:`run_row`, then runs one row anywhere;
-it never raises for a row's own trouble: a failing row comes back with its
-error while the others complete. Results are the same whichever way they
-ran (BLAS is single-threaded inside every run).
+cache file. The same function, :func:`run_batch`, then runs a batch of rows
+anywhere (:func:`batches`: the rows the study's prepared linear mount
+follows, :data:`BATCH_ROWS` at a time, answered together in NumPy; every
+other row alone, through Exudyn); it never raises for a row's own trouble: a
+failing row comes back with its error while the others complete. Results
+are the same whichever way they ran, to the preload solve's tolerance (BLAS
+is single-threaded inside every run).
 
 Local processes run the rows in chunks of ``workers * rows_per_worker``
 rows, each chunk in a fresh pool that is shut down before the next starts:
