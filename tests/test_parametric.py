@@ -94,7 +94,9 @@ def test_hinge_parameters_by_group_and_direction(base):
 
 def test_processes_equal_serial_and_failing_rows_are_reported(base, rows, serial):
     processes = study_frame(rows, run_rows(study_cases(base, rows), workers=2))
-    pd.testing.assert_frame_equal(_answers(processes), _answers(serial), check_exact=True)
+    # the same to round-off, not bit for bit: NumPy's reductions round by the memory alignment of their data,
+    # which differs between a fresh worker process and one that has run before
+    pd.testing.assert_frame_equal(_answers(processes), _answers(serial), check_exact=False, rtol=1e-10, atol=1e-14)
     by_row = serial.set_index("row")
     for index, row in enumerate(rows):
         status, error = by_row.loc[index, "status"], by_row.loc[index, "error"]
@@ -109,7 +111,8 @@ def test_processes_equal_serial_and_failing_rows_are_reported(base, rows, serial
     # the row with the reference values is the reference case's own answer
     direct = run_case(base).runs[0].transmissibility
     reference_row = ok[ok["hinge_stiffness"] == HINGE_STIFFNESS]
-    np.testing.assert_array_equal(reference_row[["T x", "T y", "T z"]].to_numpy()[0], direct)
+    np.testing.assert_allclose(reference_row[["T x", "T y", "T z"]].to_numpy()[0], direct, rtol=0.0,
+                               atol=1e-12 * np.abs(direct).max())
     # stiffer hinges pass more heading force to the pylon at 59 Hz
     assert np.all(np.diff(ok["T x"].to_numpy()) > 0)
 
@@ -127,8 +130,9 @@ def test_dask_cluster_equals_local(base, rows, serial, tmp_path):
     table = pd.read_csv(tmp_path / "out" / "parameter-study.csv")
     expected = _answers(serial)
     for column in expected:
-        if expected[column].dtype.kind == "f":
-            np.testing.assert_array_equal(table[column].to_numpy(float), expected[column].to_numpy(float))
+        if expected[column].dtype.kind == "f":     # to round-off, as local processes
+            np.testing.assert_allclose(table[column].to_numpy(float), expected[column].to_numpy(float), rtol=1e-10,
+                                       atol=1e-14)
         else:
             assert list(table[column].fillna("").astype(str)) == list(expected[column].fillna("").astype(str))
     assert (tmp_path / "out" / "parameter-study.png").stat().st_size > 10_000
