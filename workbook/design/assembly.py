@@ -276,6 +276,10 @@ class Projection:
     def _batch(self) -> tuple:
         return self.tangents.shape[:-3]
 
+    def take(self, rows) -> "Projection":
+        """The designs *rows* (an index: one design without its axis)."""
+        return Projection(self.free, self.euler, self.tangents[rows], self.size)
+
     def expand(self, independent: np.ndarray) -> np.ndarray:
         """``B @ independent`` of vectors (..., f + 3 E): (..., N)."""
         count = len(self.free)

@@ -373,7 +373,7 @@ class LinearMount:
             for position, item in enumerate(self.case.excitations):
                 solved = _solve_item(designs, self.items[item.name])
                 failed = {**solved.failures, **failed}
-                for k, answered in enumerate(self._item_runs(designs, position, solved.prepared, solved.model,
+                for k, answered in enumerate(self._item_runs(designs.cases, position, solved.prepared, solved.model,
                                                              solved.rows, solved.failures)):
                     if isinstance(answered, SimulationError):
                         failed.setdefault(k, answered)
@@ -390,12 +390,11 @@ class LinearMount:
     def answer(self, case: Case, solutions: list["ItemSolution"], start: float) -> DesignAnswer:
         """The answers of the design *case* from its solved items (:meth:`solve_items`), begun at *start*
         (``time.perf_counter()``)."""
-        designs = self._designs([case])
         runs, static, engine = [], {}, {}
         for position, (item, solution) in enumerate(zip(case.excitations, solutions, strict=True)):
             static[item.name] = dict(zip(self.channels, solution.state.forces, strict=True))
             engine[item.name] = solution.engine_static
-            answered = self._item_runs(designs, position, solution.prepared, solution.model.stacked(),
+            answered = self._item_runs([case], position, solution.prepared, solution.model.stacked(),
                                        np.zeros(1, dtype=int), {})[0]
             if isinstance(answered, SimulationError):
                 raise answered
@@ -431,15 +430,15 @@ class LinearMount:
             np.array([case.engine.inertia_matrix - base.inertia_matrix for case in cases], dtype=float),
             np.array([1.0 if casing is None else casing.scale(case) for case in cases]))
 
-    def _item_runs(self, designs: "_Designs", position: int, prepared: _Item, model: "_Harmonic", solved: np.ndarray,
+    def _item_runs(self, cases: list[Case], position: int, prepared: _Item, model: "_Harmonic", solved: np.ndarray,
                    failures: dict) -> list:
-        """Per design, its excitation results of the item at *position* (the designs' own excitations), or the
+        """Per design *cases*, its excitation results of the item at *position* (its own excitations), or the
         error that stopped it.
 
         *model* holds the linear models of the designs *solved* (sorted positions among *designs*); *failures*
         the errors of the others."""
-        results: list = [[] for _ in range(designs.count)]
-        excitations = [points_of(case.excitations[position]) for case in designs.cases]
+        results: list = [[] for _ in cases]
+        excitations = [points_of(case.excitations[position]) for case in cases]
         pylon = [self.channels.index(name) for name in self.pylon]
         for point in range(max(len(e) for e in excitations)):
             rows = np.array([k for k, e in enumerate(excitations) if len(e) > point and k not in failures],
@@ -458,7 +457,7 @@ class LinearMount:
                 excitation = chosen[k]
                 if singular[k]:
                     results[row] = ResonanceError(
-                        f"{designs.cases[row].name} / {excitation.name}: the design is excited on an undamped "
+                        f"{cases[row].name} / {excitation.name}: the design is excited on an undamped "
                         f"resonance at {excitation.frequency:g} Hz")
                     continue
                 if isinstance(results[row], SimulationError):
@@ -469,7 +468,7 @@ class LinearMount:
                     pylon_amplitude=np.abs(forces[k, pylon].sum(axis=0)),
                     hinge_amplitudes=dict(zip(self.channels, np.abs(forces[k]), strict=True)),
                     pylon_hinges=list(self.pylon), steady_change=0.0,
-                    steady_tolerance=designs.cases[row].analysis.steady_tolerance,
+                    steady_tolerance=cases[row].analysis.steady_tolerance,
                     warnings=list(prepared.warnings))
                 run.model_card, run.preload = self._cards.get(run.name), self._preloads.get(run.name)
                 results[row].append(run)
@@ -799,10 +798,8 @@ class _Harmonic:
 
     def take(self, rows) -> "_Harmonic":
         """The designs *rows* (an index: one design without its axis)."""
-        basis = self.basis
         return _Harmonic(self.mass[rows], self.stiffness[rows], self.damping[rows], self.structural[rows],
-                         tuple(o[rows] for o in self.outputs),
-                         Projection(basis.free, basis.euler, basis.tangents[rows], basis.size),
+                         tuple(o[rows] for o in self.outputs), self.basis.take(rows),
                          {key: value[rows] for key, value in self.inputs.items()})
 
     def stacked(self) -> "_Harmonic":
