@@ -135,3 +135,39 @@ def test_design_derivatives_equal_differences_of_evaluations(mount):
         assert _normwise(direct.hinge_gradient[..., j], differences.hinge_gradient[..., j]) < 1e-5
     assert np.all(np.abs(direct.gradient).max(axis=(0, 1)) > 0)
     assert direct.to_pandas().shape == (6, 5)
+
+
+@pytest.mark.parametrize("hinge_damping", [True, False])
+def test_springs_of_designs_together_are_the_hinge_laws(hinge_damping):
+    """The springs of designs together are each hinge law's own matrices, design by design: hinges
+    anisotropic in their frames, isotropic ones, and without hinge damping neither damping nor loss."""
+    from workbook.design.linear_mount import designs_springs, hinge_frames
+    from workbook.scene.hinge_laws import law_of
+
+    base = reference_case()
+    base = dataclasses.replace(base, effects=dataclasses.replace(base.effects, hinge_damping=hinge_damping))
+    rng = np.random.default_rng(5)
+    designs = []
+    for _ in range(3):
+        hinges = []
+        for k, hinge in enumerate(base.hinges):
+            if k % 2:
+                hinge = dataclasses.replace(hinge, stiffness=tuple(rng.uniform(1e7, 1e8, 3)),
+                                            damping=tuple(rng.uniform(0.0, 500.0, 3)),
+                                            loss_factor=tuple(rng.uniform(0.0, 0.1, 3)))
+            else:
+                hinge = dataclasses.replace(hinge, stiffness=float(rng.uniform(1e7, 1e8)),
+                                            damping=float(rng.uniform(0.0, 500.0)), loss_factor=0.05)
+            hinges.append(hinge)
+        designs.append(dataclasses.replace(base, hinges=tuple(hinges)))
+    names = [hinge.name for hinge in base.hinges]
+    springs = designs_springs(designs, names, hinge_frames(base))
+    for b, case in enumerate(designs):
+        for c, hinge in enumerate(case.hinges):
+            stiffness, damping, loss = law_of(case, hinge).matrices(case, hinge)
+            scale = np.abs(stiffness).max()
+            assert np.abs(springs.stiffness[b, c] - stiffness).max() <= 1e-12 * scale
+            expected_damping = damping if hinge_damping else np.zeros((3, 3))
+            expected_structural = loss @ stiffness if hinge_damping else np.zeros((3, 3))
+            assert np.abs(springs.damping[b, c] - expected_damping).max() <= 1e-12 * max(np.abs(damping).max(), 1.0)
+            assert np.abs(springs.structural[b, c] - expected_structural).max() <= 1e-12 * scale

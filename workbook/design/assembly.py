@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workbook.design.channel_set import ChannelState
+from workbook.design.channel_set import ChannelState, spring_matrix
 from workbook.design.expansion import SceneExpansion
 
 __all__ = ["ChannelSprings", "AddedRigidMass", "StateLoads", "Projection", "total", "rest_stiffness",
@@ -235,17 +235,22 @@ def static_residual(expansion: SceneExpansion, dq: np.ndarray, springs: ChannelS
     return residual + without_normal(expansion, dq, expansion.channels.force(state, springs.stiffness))
 
 
-def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarray,
-                      springs: ChannelSprings, state: ChannelState) -> np.ndarray:
-    """The rest's stiffness plus every channel's ``J^T S J + (S d) . H``, full coordinates, with
-    Exudyn's term of the normal force components (:func:`normal_components`)."""
+def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarray, springs: ChannelSprings,
+                      state: ChannelState, basis: "Projection", jacobian: np.ndarray) -> np.ndarray:
+    """The tangent stiffness projected on the independent coordinates *basis*, (..., n, n).
+
+    ``B^T`` (the rest's stiffness *rest* plus every channel's ``(S d) . H``
+    and Exudyn's term of the normal force components,
+    :func:`normal_components`) ``B``, plus every channel's ``J^T S J`` on
+    the projected channel Jacobians *jacobian* (..., 3 C, n).
+    """
     channels = expansion.channels
-    stiffness = rest + channels.matrix(state, springs.stiffness, stiffness=springs.stiffness)
+    curved = rest + channels.curvature(state, springs.stiffness)
     _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
     theta = total(expansion, dq)[..., expansion.euler_blocks]
     diagonal = expansion.euler_blocks
-    stiffness[..., diagonal, diagonal] -= (normal / np.linalg.norm(theta, axis=-1))[..., None]
-    return stiffness
+    curved[..., diagonal, diagonal] -= (normal / np.linalg.norm(theta, axis=-1))[..., None]
+    return basis.both(curved) + spring_matrix(springs.stiffness, jacobian)
 
 
 @dataclass(frozen=True)
@@ -308,6 +313,14 @@ class Projection:
         """``B.T @ matrix @ B`` of matrices (..., N, N)."""
         return self.rows(self.columns(matrix))
 
+    def place(self, indices: np.ndarray) -> np.ndarray:
+        """The positions among the independent coordinates of the free full coordinates *indices*."""
+        lookup = np.full(self.size, -1)
+        lookup[self.free] = np.arange(len(self.free))
+        placed = lookup[indices]
+        assert (placed >= 0).all(), "coordinates of Euler parameters have no independent position"
+        return placed
+
 
 def projection(expansion: SceneExpansion, dq: np.ndarray) -> Projection:
     """The independent coordinates at the state change *dq* (..., N)."""
@@ -365,8 +378,8 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
             assert inverse is not None
             update = -(inverse[active] @ residual[..., None])[..., 0]
         else:
-            tangent = basis.both(tangent_stiffness(expansion, part, rest_stiffness(expansion, part, part_loads),
-                                                   part_springs, state))
+            tangent = tangent_stiffness(expansion, part, rest_stiffness(expansion, part, part_loads), part_springs,
+                                        state, basis, basis.columns(expansion.channels.jacobian(state)))
             update, singular = solve_each(tangent, -residual)
             for k in np.flatnonzero(singular):
                 failures[int(active[k])] = "its tangent stiffness is singular"
@@ -431,10 +444,12 @@ def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: 
     at = dq[0] if not dq.any() else dq
     state = expansion.channels.state(total(expansion, at))
     basis = projection(expansion, at)
+    jacobian = basis.columns(expansion.channels.jacobian(state))
     basis = Projection(basis.free, basis.euler, np.broadcast_to(basis.tangents, dq.shape[:-1] + basis.tangents.shape[-3:]),
                        basis.size)
-    full = tangent_stiffness(expansion, at, rest_stiffness(expansion, at, loads), springs, state)
-    tangent = basis.both(np.broadcast_to(full, dq.shape[:-1] + full.shape[-2:]))
+    rest = rest_stiffness(expansion, at, loads)
+    rest = np.broadcast_to(rest, dq.shape[:-1] + rest.shape[-2:])
+    tangent = tangent_stiffness(expansion, at, rest, springs, state, basis, jacobian)
     inverse, singular = solve_each(tangent, np.broadcast_to(np.eye(tangent.shape[-1]), tangent.shape))
     for k in np.flatnonzero(singular):
         failures[int(k)] = "its tangent stiffness is singular"

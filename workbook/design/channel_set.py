@@ -1,13 +1,15 @@
 """Every force channel's marker kinematics at once, and the channels' force, stiffness and outputs.
 
-The batched form of :class:`~workbook.design.expansion.ChannelGeometry`:
-the two marker points of every channel are evaluated together, kind by
+The two marker points of every channel are evaluated together, kind by
 kind (:mod:`workbook.design.kinematics`), on coordinates padded to one
 length with a spare coordinate (index N, always zero) that collects the
 padding. A channel with stiffness S (3x3) adds ``J^T S d`` to the
 generalised force, ``J^T S J + (S d) . H`` to the tangent stiffness and
-``S J`` to its force output; the sums over channels are scattered into the
-full coordinates by one ``bincount`` each.
+``S J`` to its force output. The channels' Jacobians J (3 rows each) and
+the curvature terms are scattered into the full coordinates by one
+``bincount`` each; the products with the springs (:func:`spring_rows`,
+:func:`spring_matrix`) are then formed on J as it is, or on J projected on
+the independent coordinates (fewer columns, no N x N scatter).
 """
 from __future__ import annotations
 
@@ -17,7 +19,7 @@ import numpy as np
 
 from workbook.design.kinematics import EULER, PointKinematics
 
-__all__ = ["ChannelSet", "ChannelState"]
+__all__ = ["ChannelSet", "ChannelState", "spring_rows", "spring_matrix"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 _EULER_ROWS = EULER.reshape(36, 4)                                # (a b i, j)
@@ -127,43 +129,44 @@ class ChannelSet:
         flat = generalised.reshape(generalised.shape[:-3] + (-1,))
         return _scatter(self.coordinates.ravel(), flat, self.size + 1)[..., :self.size]
 
-    def matrix(self, state: ChannelState, springs: np.ndarray, *, stiffness: np.ndarray | None = None) -> np.ndarray:
-        """``sum_c J_c^T S_c J_c`` (..., N, N) of the matrices *springs* (..., C, 3, 3); with *stiffness*, also
-        ``sum_c (S_c d_c) . H_c`` of those springs (the tangent stiffness)."""
-        jacobian = self._channel_jacobians(state)
-        weighted = springs[..., None, :, :] @ jacobian                          # (..., C, 2, 3, M)
-        blocks = jacobian.swapaxes(-1, -2)[..., :, None, :, :] @ weighted[..., None, :, :, :]   # (..., C, 2, 2, M, M)
-        if stiffness is not None:       # each marker's curvature joins its own diagonal block
-            assert state.hessian is not None, "the tangent stiffness needs the Hessians"
-            on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
-            hessian = state.hessian
-            curvature = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))   # (..., 2 C, 1, M M)
-            width = hessian.shape[-1]
-            curvature = curvature.reshape(curvature.shape[:-3] + (self.count, 2, width, width))
-            batch = np.broadcast_shapes(blocks.shape[:-5], curvature.shape[:-4])
-            if blocks.shape[:-5] != batch:
-                blocks = np.broadcast_to(blocks, batch + blocks.shape[-5:]).copy()
-            for side in range(2):
-                blocks[..., side, side, :, :] += curvature[..., side, :, :]
-        rows = self.coordinates.reshape(self.count, 2, 1, -1, 1)
-        columns = self.coordinates.reshape(self.count, 1, 2, 1, -1)
-        index = np.broadcast_to(rows * (self.size + 1) + columns, blocks.shape[-5:]).ravel()
-        full = _scatter(index, blocks.reshape(blocks.shape[:-5] + (-1,)), (self.size + 1) ** 2)
-        return full.reshape(blocks.shape[:-5] + (self.size + 1, self.size + 1))[..., :self.size, :self.size]
-
-    def outputs(self, state: ChannelState, springs: np.ndarray) -> np.ndarray:
-        """``S_c J_c`` of every channel stacked: shape (..., 3 C, N)."""
-        product = springs[..., None, :, :] @ self._channel_jacobians(state)       # (..., C, 2, 3, M)
+    def jacobian(self, state: ChannelState) -> np.ndarray:
+        """The Jacobians of the separations d of every channel stacked, ``J_c``: shape (..., 3 C, N)."""
+        jacobian = self._channel_jacobians(state)                                # (..., C, 2, 3, M)
         rows = 3 * np.arange(self.count).reshape(-1, 1, 1, 1) + np.arange(3).reshape(1, 1, 3, 1)
         columns = self.coordinates.reshape(self.count, 2, 1, -1)
-        index = np.broadcast_to(rows * (self.size + 1) + columns, product.shape[-4:]).ravel()
-        full = _scatter(index, product.reshape(product.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
-        return full.reshape(product.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
+        index = np.broadcast_to(rows * (self.size + 1) + columns, jacobian.shape[-4:]).ravel()
+        full = _scatter(index, jacobian.reshape(jacobian.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
+        return full.reshape(jacobian.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
+
+    def curvature(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
+        """``sum_c (S_c d_c) . H_c`` (..., N, N) of the springs *stiffness* (..., C, 3, 3): the tangent
+        stiffness's term of the markers' curvature."""
+        assert state.hessian is not None, "the curvature needs the Hessians"
+        on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
+        hessian = state.hessian
+        curvature = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))   # (..., 2 C, 1, M M)
+        index = (self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]).ravel()
+        full = _scatter(index, curvature.reshape(curvature.shape[:-3] + (-1,)), (self.size + 1) ** 2)
+        return full.reshape(curvature.shape[:-3] + (self.size + 1, self.size + 1))[..., :self.size, :self.size]
 
     def _channel_jacobians(self, state: ChannelState) -> np.ndarray:
         """Each channel's two marker Jacobians with the sign of d: shape (..., C, 2, 3, M)."""
         jacobian = state.jacobian
         return jacobian.reshape(jacobian.shape[:-3] + (self.count, 2, 3, -1)) * _SIGNS[:, None, None]
+
+
+def spring_rows(springs: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
+    """``S_c J_c`` of every channel stacked, (..., 3 C, n), of the springs *springs* (..., C, 3, 3) and the
+    channels' Jacobians *jacobian* (..., 3 C, n) (:meth:`ChannelSet.jacobian`, or projected)."""
+    rows = jacobian.reshape(jacobian.shape[:-2] + (-1, 3, jacobian.shape[-1]))
+    product = springs @ rows
+    return product.reshape(product.shape[:-3] + (-1, jacobian.shape[-1]))
+
+
+def spring_matrix(springs: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
+    """``sum_c J_c^T S_c J_c`` (..., n, n) of the springs *springs* (..., C, 3, 3) and the channels'
+    Jacobians *jacobian* (..., 3 C, n), as :func:`spring_rows`."""
+    return jacobian.swapaxes(-1, -2) @ spring_rows(springs, jacobian)
 
 
 def _on_points(channel_force: np.ndarray) -> np.ndarray:

@@ -48,6 +48,7 @@ from workbook.design.assembly import (
     total,
     without_normal,
 )
+from workbook.design.channel_set import spring_matrix, spring_rows
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, SimulationError, UnstablePreloadError
 from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, SingleFrequencyExcitation, Sweep
@@ -73,25 +74,42 @@ def channel_springs(case: Case, channels: list[str], frames: dict | None = None)
     """The springs of the force channels *channels* of *case*: the hinges' as their laws give them
     (:meth:`~workbook.scene.hinge_law_base.HingeLaw.matrices`, in the hinges' *frames* when given), then the
     transducers' along the global axes."""
-    from workbook.scene.hinge_laws import law_of
+    return designs_springs([case], channels, hinge_frames(case) if frames is None else frames).take(0)
 
-    hinge_loss, _ = loss_factors(case)
-    by_name = {hinge.name: hinge for hinge in case.hinges}
-    springs = np.zeros((3, len(channels), 3, 3))        # stiffness, damping, loss factors
-    for k, name in enumerate(channels):
-        hinge = by_name.get(name)
-        if hinge is None:
-            rig = case.test_rig
-            assert rig is not None
-            springs[0, k], springs[1, k] = np.diag(rig.stiffness), np.diag(rig.damping)
-            continue
-        stiffness, damping, loss = law_of(case, hinge).matrices(case, hinge, None if frames is None else frames[name])
-        springs[0, k] = stiffness
-        if case.effects.hinge_damping:
-            springs[1, k] = damping
-        if name in hinge_loss:
-            springs[2, k] = loss
-    return ChannelSprings(springs[0], springs[1], springs[2] @ springs[0])
+
+def designs_springs(cases: list[Case], channels: list[str], frames: dict) -> ChannelSprings:
+    """:func:`channel_springs` of the designs *cases* at once (springs of shape (B, C, 3, 3)), whose hinges
+    and transducers sit where the hinges' *frames* (by name) say.
+
+    The laws' :meth:`~workbook.scene.hinge_law_base.HingeLaw.matrices`, for all designs together: a hinge
+    isotropic in stiffness, damping and loss factor has them times the identity, any other ``R^T diag R``
+    in its frame R.
+    """
+    effects = cases[0].effects
+    hinge_names = {hinge.name for hinge in cases[0].hinges}
+    values = np.zeros((len(cases), len(channels), 3, 3))          # design, channel, quantity, direction
+    transducers = np.zeros((len(cases), len(channels), 2, 3))      # stiffness and damping per global axis
+    for b, case in enumerate(cases):
+        by_name = {hinge.name: hinge for hinge in case.hinges}
+        for k, name in enumerate(channels):
+            hinge = by_name.get(name)
+            if hinge is None:
+                rig = case.test_rig
+                assert rig is not None
+                transducers[b, k] = rig.stiffness, rig.damping
+                continue
+            values[b, k] = [value if isinstance(value, tuple) else (value, value, value)
+                            for value in (hinge.stiffness, hinge.damping, hinge.loss_factor)]
+    isotropic = (values == values[..., :1]).all(axis=(-1, -2))
+    if not effects.hinge_damping:
+        values[..., 1:, :] = 0.0
+    rotation = np.array([frames[name] if name in hinge_names else np.eye(3) for name in channels])  # (C, 3, 3)
+    turned = (rotation.swapaxes(-1, -2)[:, None] * values[..., None, :]) @ rotation[:, None]         # (B, C, 3, 3, 3)
+    turned = np.where(isotropic[..., None, None, None], values[..., :1, None] * np.eye(3), turned)
+    is_hinge = np.array([name in hinge_names for name in channels])[:, None, None]
+    stiffness = np.where(is_hinge, turned[:, :, 0], transducers[:, :, 0, :, None] * np.eye(3))
+    damping = np.where(is_hinge, turned[:, :, 1], transducers[:, :, 1, :, None] * np.eye(3))
+    return ChannelSprings(stiffness, damping, np.where(is_hinge, turned[:, :, 2], 0.0) @ stiffness)
 
 
 @dataclass(frozen=True)
@@ -421,11 +439,9 @@ class LinearMount:
     def _designs(self, cases: list[Case]) -> "_Designs":
         """The fields of *cases* (checked) the evaluation takes, stacked."""
         base = self.case.engine
-        springs = [channel_springs(case, self.channels, self._frames) for case in cases]
         casing = next(iter(self.items.values())).casing
         return _Designs(
-            cases, ChannelSprings(*(np.stack([getattr(s, name) for s in springs])
-                                    for name in ("stiffness", "damping", "structural"))),
+            cases, designs_springs(cases, self.channels, self._frames),
             np.array([case.engine.mass - base.mass for case in cases], dtype=float),
             np.array([case.engine.inertia_matrix - base.inertia_matrix for case in cases], dtype=float),
             np.array([1.0 if casing is None else casing.scale(case) for case in cases]))
@@ -449,8 +465,10 @@ class LinearMount:
             omega = 2 * np.pi * np.array([e.frequency for e in chosen])
             models = model.take(np.searchsorted(solved, rows))
             phasors: dict = {}                   # the designs of a study mostly share their excitations
-            loads = np.stack([models.load(e, k, phasors.setdefault(id(e), point_phasors(e)))
-                              for k, e in enumerate(chosen)])
+            for e in chosen:
+                if id(e) not in phasors:
+                    phasors[id(e)] = point_phasors(e)
+            loads = np.stack([models.load(e, k, phasors[id(e)]) for k, e in enumerate(chosen)])
             motion, singular = solve_each(models.dynamic(omega), loads)
             forces = (models.output(omega) @ motion[..., None])[..., 0].reshape(len(rows), -1, 3)
             for k, row in enumerate(rows):
@@ -829,26 +847,25 @@ def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing
     expansion, dq = prepared.expansion, state.dq
     channels = expansion.channels
     at = channels.state(total(expansion, dq))
+    basis = projection(expansion, dq)
+    jacobian = basis.columns(channels.jacobian(at))
     mass, rest_stiffness, damping = rest_matrices(expansion, dq, state.loads)
-    stiffness = tangent_stiffness(expansion, dq, rest_stiffness, springs, at)
-    damping += channels.matrix(at, springs.damping)
-    structural = prepared.sign * channels.matrix(at, springs.structural)
-    outputs = [prepared.sign * channels.outputs(at, spring)
-               for spring in (springs.stiffness, springs.damping, springs.structural)]
+    stiffness = tangent_stiffness(expansion, dq, rest_stiffness, springs, at, basis, jacobian)
+    structural = prepared.sign * spring_matrix(springs.structural, jacobian)
+    outputs = tuple(prepared.sign * spring_rows(spring, jacobian)
+                    for spring in (springs.stiffness, springs.damping, springs.structural))
     for k, link in enumerate(prepared.links):
         added = (state.tensions[..., k] - link.base_tension)[..., None, None] * link.geometric
-        block = (..., link.modal[:, None], link.modal)
-        damping[block] += link.stiffness_damping * added
-        structural[block] += link.loss_factor * (link.reduced_stiffness + added)
+        damping[..., link.modal[:, None], link.modal] += link.stiffness_damping * added
+        modal = basis.place(link.modal)
+        structural[..., modal[:, None], modal] += link.loss_factor * (link.reduced_stiffness + added)
     casing = prepared.casing
     if casing is not None:
         damping[..., casing.modal[:, None], casing.modal] += \
             (np.sqrt(np.asarray(casing_scale, dtype=float)) - 1.0)[..., None, None] * casing.damping
-    basis = projection(expansion, dq)
+    damping = basis.both(damping) + spring_matrix(springs.damping, jacobian)
     points = expansion.point_set
-    jacobians = points.outputs(points.state(total(expansion, dq), second=False),
-                               np.broadcast_to(np.eye(3), (points.count, 3, 3)))
+    jacobians = points.jacobian(points.state(total(expansion, dq), second=False))
     inputs = {key: basis.rows(jacobians[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2))
               for k, key in enumerate(expansion.points)}
-    return _Harmonic(basis.both(mass), basis.both(stiffness), basis.both(damping), basis.both(structural),
-                     tuple(basis.columns(o) for o in outputs), basis, inputs)
+    return _Harmonic(basis.both(mass), stiffness, damping, structural, outputs, basis, inputs)

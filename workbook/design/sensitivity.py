@@ -40,6 +40,7 @@ from workbook.design.assembly import (
     total,
     without_normal,
 )
+from workbook.design.channel_set import spring_matrix, spring_rows
 from workbook.design.linear_mount import DesignAnswer, ItemSolution, LinearMount, linear_model, points_of
 from workbook.model.case import DIRECTIONS, Case, Gravity
 
@@ -277,9 +278,10 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
         at = channels.state(total(expansion, dq))
         q = total(expansion, dq)
         basis = projection(expansion, dq)
-        factor = sla.lu_factor(basis.both(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), base, at)),
-                               check_finite=False)
-        jacobian = channels.outputs(at, base.stiffness)
+        jacobian = channels.jacobian(at)
+        factor = sla.lu_factor(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), base, at, basis,
+                                                 basis.columns(jacobian)), check_finite=False)
+        jacobian = spring_rows(base.stiffness, jacobian)
         for j, change in enumerate(changes):
             springs = change.springs
             if d_forces[j] is not None:
@@ -311,9 +313,10 @@ def _model_change(case: Case, solution: ItemSolution, change: _Change, state_cha
     basis = model.basis
     at = expansion.channels.state(total(expansion, state.dq))
     channels = expansion.channels
-    stiffness = basis.both(tangent_stiffness(expansion, state.dq, np.zeros((prepared.size,) * 2), springs, at))
-    damping = basis.both(channels.matrix(at, springs.damping))
-    structural = prepared.sign * basis.both(channels.matrix(at, springs.structural))
+    jacobian = basis.columns(channels.jacobian(at))
+    stiffness = tangent_stiffness(expansion, state.dq, np.zeros((prepared.size,) * 2), springs, at, basis, jacobian)
+    damping = spring_matrix(springs.damping, jacobian)
+    structural = prepared.sign * spring_matrix(springs.structural, jacobian)
     engine_mass = np.zeros((prepared.size,) * 2)
     engine_mass[prepared.engine[:3], prepared.engine[:3]] = mass
     added_mass = basis.both(engine_mass)
@@ -334,7 +337,7 @@ def _model_change(case: Case, solution: ItemSolution, change: _Change, state_cha
         stiffness = stiffness + basis.both(full)
         full[block] = change.modulus / (2.0 * np.sqrt(casing.scale(case)) * casing.modulus) * casing.damping
         damping = damping + basis.both(full)
-    outputs = tuple(basis.columns(prepared.sign * channels.outputs(at, spring))
+    outputs = tuple(prepared.sign * spring_rows(spring, jacobian)
                     for spring in (springs.stiffness, springs.damping, springs.structural))
 
     def along(field: str):
