@@ -296,9 +296,7 @@ class Projection:
 
     def columns(self, matrix: np.ndarray) -> np.ndarray:
         """``matrix @ B`` of matrices (..., r, N): (..., r, f + 3 E)."""
-        on_nodes = np.moveaxis(matrix[..., self.euler], -3, -2)          # (..., E, r, 4)
-        nodes = np.moveaxis(on_nodes @ self.tangents, -3, -2)             # (..., r, E, 3)
-        return np.concatenate([matrix[..., self.free], nodes.reshape(nodes.shape[:-2] + (-1,))], axis=-1)
+        return self.rows(matrix.swapaxes(-1, -2)).swapaxes(-1, -2)     # gathering rows is the faster
 
     def rows(self, matrix: np.ndarray) -> np.ndarray:
         """``B.T @ matrix`` of a vector (design axes + (N,)) or matrix (design axes + (N, k))."""
