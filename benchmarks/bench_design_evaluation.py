@@ -11,7 +11,11 @@ differences of whole evaluations, and their largest difference. Last, the
 time per design of :data:`BATCH` designs answered together
 (``LinearMount.evaluate_many``, in the parameter studies' batches of
 ``BATCH_ROWS``) against the same designs one at a time, in :data:`REPEATS`
-alternating rounds, and the largest difference between them. Run with
+alternating rounds, and the largest difference between them; and beside
+them the floor of this way of evaluating: the LAPACK solves alone that a
+design needs together with others (per rotor, the inverse of its tangent
+stiffness and one complex solve of its dynamic stiffness, of the size of
+its independent coordinates), timed on matrices of those sizes. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
 import dataclasses
@@ -113,12 +117,33 @@ def _batch(case, mount, rng) -> None:
                 difference = max(difference, np.abs(a.transmissibility - b.transmissibility).max()
                                  / a.transmissibility.max())
     one, many = statistics.median(alone_times), statistics.median(together_times)
+    floor = _solves_alone(mount)
     print(f"\n{BATCH} hinge designs (stiffness and loss factor), both rotors, {REPEATS} rounds; together: "
           f"{BATCH_ROWS} at a time")
     print(f"{'evaluation':<24}{'median s/design':>16}{'designs/s':>11}")
     print(f"{'one at a time':<24}{one:>16.4f}{1 / one:>11.1f}")
     print(f"{'together':<24}{many:>16.4f}{1 / many:>11.1f}")
+    print(f"{'its LAPACK solves alone':<24}{floor:>16.4f}{1 / floor:>11.1f}")
     print(f"speed-up {one / many:.1f}x; largest difference of T {difference:.1e}")
+
+
+def _solves_alone(mount) -> float:
+    """Median time per design of the LAPACK solves of :data:`BATCH_ROWS` designs together, s."""
+    rng = np.random.default_rng(2)
+    times = []
+    for _ in range(REPEATS):
+        total = 0.0
+        for item in mount.items.values():
+            size = len(item.expansion.free) + 3 * len(item.expansion.euler_blocks)
+            stiffness = rng.standard_normal((BATCH_ROWS, size, size)) + size * np.eye(size)
+            dynamic = stiffness + 1j * rng.standard_normal((BATCH_ROWS, size, size))
+            load = rng.standard_normal((BATCH_ROWS, size, 1)) + 0j
+            start = time.perf_counter()
+            np.linalg.solve(stiffness, np.broadcast_to(np.eye(size), stiffness.shape))
+            np.linalg.solve(dynamic, load)
+            total += time.perf_counter() - start
+        times.append(total / BATCH_ROWS)
+    return statistics.median(times)
 
 
 if __name__ == "__main__":
