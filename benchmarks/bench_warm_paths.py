@@ -52,6 +52,38 @@ single solves of three Lanczos runs (fixed-interface modes, 30 solves, the
 fewest of the ``ncv`` tried; free-free, 21; mounted, 13), 1.7 s assembly,
 1.2 s meshing, 1.5 s geometric stiffness, 0.55 s stress operator and shapes.
 
+The warm paths since (issue 25, "warm paths that feel instant": only the
+command's own module imported, the geometric stiffness projected once per
+reduction, a workbook's result tables made once, a table's number cells
+sharing their column's style, the checksum without copies), with
+``--before ca25197 --repeats 11 --cold-repeats 1`` (ca25197: before these
+changes; load average 3 to 4 from other work), wall time and in brackets
+CPU time (the cold run's single repeat says little)::
+
+    | what                                                    | before                | now                   | target |
+    | warm `mountwb run`                                      | 1.46 s (CPU 1.38 s)   | 1.46 s (CPU 1.41 s)   | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.89 s (CPU 4.73 s)   | 4.69 s (CPU 4.55 s)   | 2 s    |
+    | cold `mountwb run` (empty cache), 1 repeat              | 21.40 s (CPU 20.74 s) | 18.71 s (CPU 18.40 s) | 6 s    |
+
+The warm run's change is within the load's noise (about 0.05 s of CPU
+time: the other commands' modules); the workbook with its report takes
+0.2 s less. Neither meets its target. Where the warm run's time goes
+(``python -X importtime`` and cProfile of one run, load about 2): imports
+about 0.5 s, of which ``scipy.linalg`` 0.23 to 0.30 s (SciPy's array-API
+layer copies NumPy's namespace, which imports ``numpy.f2py``, 0.09 to
+0.12 s, and ``numpy.testing``, 0.03 s; every SciPy module the run needs
+brings it) and Exudyn 0.05 s; under cProfile, for the two rotors, the four
+cached reductions read and verified (36 MB) 0.14 s, the scene built four
+times (before and after the stress stiffening) 0.17 s, the preload solved
+and checked four times 0.24 s, the harmonic models' central differences
+0.13 s (22,000 Exudyn output reads). The workbook
+adds pandas and openpyxl (0.55 s of imports) and the hinge-force sheet
+(13,000 cells, built and saved by openpyxl: most of the 1.4 s the results'
+write takes under cProfile). Answering the two rotors in two processes (a
+fork after the links are loaded) was tried and dropped: at a load average
+of 4 it was slower (0.90 s against 0.84 s for the two rotors' run, medians
+of 10 processes each).
+
 Run from the repository's root::
 
     python benchmarks/bench_warm_paths.py [--repeats 5] [--cold-repeats 3] [--before REV]
