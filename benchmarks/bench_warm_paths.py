@@ -1,7 +1,10 @@
 """Warm paths: the wall time of the commands a user runs most, now and (optionally) before, side by side.
 
 Measured, each the median of its repeats, every repeat a new process of
-this source tree (``python -m workbook.cli.main``):
+this source tree (``python -m workbook.cli.main``): the wall time, and the
+CPU time (user and system) of that process with the processes it waited
+for (a report's picture process), which the load of other work changes far
+less than the wall time:
 
 - ``mountwb run`` with the reduction cache filled (both rotors of the
   reference mount);
@@ -49,6 +52,38 @@ single solves of three Lanczos runs (fixed-interface modes, 30 solves, the
 fewest of the ``ncv`` tried; free-free, 21; mounted, 13), 1.7 s assembly,
 1.2 s meshing, 1.5 s geometric stiffness, 0.55 s stress operator and shapes.
 
+The warm paths since (issue 25, "warm paths that feel instant": only the
+command's own module imported, the geometric stiffness projected once per
+reduction, a workbook's result tables made once, a table's number cells
+sharing their column's style, the checksum without copies), with
+``--before ca25197 --repeats 11 --cold-repeats 1`` (ca25197: before these
+changes; load average 3 to 4 from other work), wall time and in brackets
+CPU time (the cold run's single repeat says little)::
+
+    | what                                                    | before                | now                   | target |
+    | warm `mountwb run`                                      | 1.46 s (CPU 1.38 s)   | 1.46 s (CPU 1.41 s)   | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.89 s (CPU 4.73 s)   | 4.69 s (CPU 4.55 s)   | 2 s    |
+    | cold `mountwb run` (empty cache), 1 repeat              | 21.40 s (CPU 20.74 s) | 18.71 s (CPU 18.40 s) | 6 s    |
+
+The warm run's change is within the load's noise (about 0.05 s of CPU
+time: the other commands' modules); the workbook with its report takes
+0.2 s less. Neither meets its target. Where the warm run's time goes
+(``python -X importtime`` and cProfile of one run, load about 2): imports
+about 0.5 s, of which ``scipy.linalg`` 0.23 to 0.30 s (SciPy's array-API
+layer copies NumPy's namespace, which imports ``numpy.f2py``, 0.09 to
+0.12 s, and ``numpy.testing``, 0.03 s; every SciPy module the run needs
+brings it) and Exudyn 0.05 s; under cProfile, for the two rotors, the four
+cached reductions read and verified (36 MB) 0.14 s, the scene built four
+times (before and after the stress stiffening) 0.17 s, the preload solved
+and checked four times 0.24 s, the harmonic models' central differences
+0.13 s (22,000 Exudyn output reads). The workbook
+adds pandas and openpyxl (0.55 s of imports) and the hinge-force sheet
+(13,000 cells, built and saved by openpyxl: most of the 1.4 s the results'
+write takes under cProfile). Answering the two rotors in two processes (a
+fork after the links are loaded) was tried and dropped: at a load average
+of 4 it was slower (0.90 s against 0.84 s for the two rotors' run, medians
+of 10 processes each).
+
 Run from the repository's root::
 
     python benchmarks/bench_warm_paths.py [--repeats 5] [--cold-repeats 3] [--before REV]
@@ -57,6 +92,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import resource
 import shutil
 import statistics
 import subprocess
@@ -86,12 +122,18 @@ def _environment(tree: Path, cache: Path, pycache: Path) -> dict:
     return env
 
 
-def _command(tree: Path, args: list[str], cache: Path, pycache: Path, cwd: Path) -> float:
-    """Wall time of one ``mountwb ARGS`` process of the source tree *tree*, s."""
-    start = time.perf_counter()
+def _cpu_of_children() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def _command(tree: Path, args: list[str], cache: Path, pycache: Path, cwd: Path) -> tuple[float, float]:
+    """Wall time and CPU time (user and system, with the processes it waited for) of one ``mountwb ARGS``
+    process of the source tree *tree*, s."""
+    start, cpu = time.perf_counter(), _cpu_of_children()
     subprocess.run([sys.executable, "-m", "workbook.cli.main", *args, "--no-progress"], check=True, cwd=cwd,
                    env=_environment(tree, cache, pycache), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    return time.perf_counter() - start
+    return time.perf_counter() - start, _cpu_of_children() - cpu
 
 
 def _imported(tree: Path, cache: Path, pycache: Path, cwd: Path) -> list[str]:
@@ -101,7 +143,7 @@ def _imported(tree: Path, cache: Path, pycache: Path, cwd: Path) -> list[str]:
     return done.stdout.rpartition("MODULES")[2].split()
 
 
-def _workbook_run(tree: Path, cache: Path, pycache: Path, folder: Path, label: str) -> float:
+def _workbook_run(tree: Path, cache: Path, pycache: Path, folder: Path, label: str) -> tuple[float, float]:
     copy = folder / f"reference-{label}.xlsx"
     shutil.copy(ROOT / "cases" / "reference.xlsx", copy)
     report = folder / f"report-{label}.xlsx"
@@ -110,10 +152,11 @@ def _workbook_run(tree: Path, cache: Path, pycache: Path, folder: Path, label: s
 
 
 def measure(trees: dict[str, Path], repeats: int, cold_repeats: int, folder: Path) -> dict:
-    """Median wall times per tree: warm run, warm workbook with report, cold run; and the warm run's imports."""
+    """Median wall and CPU times per tree: warm run, warm workbook with report, cold run; and the warm run's imports."""
     pycache = folder / "pycache"
     caches = {name: folder / f"cache-{name}" for name in trees}
-    times: dict[str, dict[str, list[float]]] = {name: {"warm": [], "report": [], "cold": []} for name in trees}
+    times: dict[str, dict[str, list[tuple[float, float]]]] = {name: {"warm": [], "report": [], "cold": []}
+                                                              for name in trees}
     for name, tree in trees.items():   # fill the caches and the compiled modules; the first workbook run
         _command(tree, ["run"], caches[name], pycache, folder)
         _workbook_run(tree, caches[name], pycache, folder, f"{name}-first")
@@ -126,7 +169,8 @@ def measure(trees: dict[str, Path], repeats: int, cold_repeats: int, folder: Pat
             empty = folder / f"cold-{name}-{i}"
             times[name]["cold"].append(_command(tree, ["run"], empty, pycache, folder))
             shutil.rmtree(empty, ignore_errors=True)
-    return {name: {**{what: statistics.median(values) for what, values in times[name].items()},
+    return {name: {**{what: (statistics.median(wall for wall, _ in values), statistics.median(cpu for _, cpu in values))
+                      for what, values in times[name].items()},
                    "imports": _imported(trees[name], caches[name], pycache, folder)} for name in trees}
 
 
@@ -153,7 +197,7 @@ def main(argv=None):
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     load = os.getloadavg()[0]
-    print(f"Reference mount, medians of new processes, 1 BLAS thread, {os.cpu_count()} cores, "
+    print(f"Reference mount, medians of new processes (wall, CPU), 1 BLAS thread, {os.cpu_count()} cores, "
           f"load average {load:.1f} at the end (targets: an idle machine)")
     names = list(results)
     print("| what | " + " | ".join(names) + " | target | met (now) |")
@@ -162,8 +206,8 @@ def main(argv=None):
             ("warm `mountwb run cases/reference.xlsx --report r.xlsx` (second run)", "report", args.repeats, 2.0),
             ("cold `mountwb run` (empty cache)", "cold", args.cold_repeats, 6.0)]
     for what, key, repeats, target in rows:
-        values = " | ".join(f"{results[name][key]:.2f} s" for name in names)
-        met = "yes" if results["now"][key] <= target else "no"
+        values = " | ".join(f"{results[name][key][0]:.2f} s (CPU {results[name][key][1]:.2f} s)" for name in names)
+        met = "yes" if results["now"][key][0] <= target else "no"
         print(f"| {what}, {repeats} repeats | {values} | <= {target:g} s | {met} |")
     imports = " | ".join(", ".join(results[name]["imports"]) or "none" for name in names)
     print(f"| packages of {', '.join(NOT_NEEDED)} the warm run imports | {imports} | none | "

@@ -398,6 +398,24 @@ def save_stiffening(model, stiffening: LinkStiffening, *, cache_dir=None) -> Pat
     return path
 
 
+#: (id of a geometric stiffness, id of a mode basis) -> (the two, ``K_G,r``), most recent last: the links that
+#: share a reduction (a mount's left and right links), the stiffening passes and the runs of one process
+#: project it once. The entry holds both inputs, so their ids stay theirs while it is kept.
+_projections: OrderedDict = OrderedDict()
+
+
+def _projection(stiffening: LinkStiffening, basis: np.ndarray) -> np.ndarray:
+    """``stiffening.project(basis)``, computed once per pair of objects (the result is not to be changed)."""
+    key = (id(stiffening.scalar), id(basis))
+    kept = _projections.get(key)
+    if kept is None:
+        kept = _projections[key] = (stiffening.scalar, basis, stiffening.project(basis))
+        while len(_projections) > MEMORY_ENTRIES:
+            _projections.popitem(last=False)
+    _projections.move_to_end(key)
+    return kept[2]
+
+
 def stiffened(link: ReducedBody, stiffening: LinkStiffening, tension: float) -> ReducedBody:
     """The reduced link with its modal stiffness under an axial tension: ``K_r + P K_G,r``.
 
@@ -419,5 +437,5 @@ def stiffened(link: ReducedBody, stiffening: LinkStiffening, tension: float) -> 
                          f"stiffness {stiffening.scalar.shape[0]}: they were meshed differently")
     ffrf = dict(link.ffrf)
     ffrf["stiffnessMatrixReduced"] = (np.asarray(link.ffrf["stiffnessMatrixReduced"])
-                                      + tension * stiffening.project(link.mode_basis))
+                                      + tension * _projection(stiffening, link.mode_basis))
     return dataclasses.replace(link, ffrf=ffrf, info={**link.info, "axial_tension_N": float(tension)})

@@ -187,7 +187,7 @@ def _checksum(arrays: dict) -> str:
         digest.update(key.encode())
         digest.update(str(value.dtype).encode())
         digest.update(str(value.shape).encode())
-        digest.update(value.tobytes())
+        digest.update(value.reshape(-1).view(np.uint8).data)   # its bytes, as tobytes() gives them, without a copy
     return digest.hexdigest()
 
 

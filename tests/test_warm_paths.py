@@ -1,4 +1,5 @@
-"""Warm paths stay fast: a command imports only what it uses, a workbook is read once, units need no pint.
+"""Warm paths stay fast: a command imports only what it uses (no other command's module), a workbook is read
+once, units need no pint.
 
 The guards of issue 25's "warm paths that feel instant": ``mountwb run`` on
 a JSON case (or the reference mount) loads neither pandas nor pint,
@@ -9,6 +10,8 @@ reader opened.
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import os
 import random
@@ -65,6 +68,30 @@ def test_help_the_cache_listing_and_a_workbook_check_load_no_numerics(tmp_path):
         done = subprocess.run([sys.executable, "-c", probe, *args], env=env, capture_output=True, text=True, timeout=120)
         assert done.returncode == 0, done.stderr
         assert done.stdout.rpartition("MODULES")[2].split() == [], args
+
+
+def test_a_command_imports_the_module_of_no_other_command(tmp_path):
+    """``mountwb cache info`` builds its own parser only: no other command's module is imported; without a
+    command every parser is built, each with its handler."""
+    from workbook.cli.main import COMMANDS, build_parser
+
+    env = dict(os.environ, MOUNTWB_CACHE=str(tmp_path / "cache"), PYTHONPATH=str(ROOT))
+    probe = ("import sys\nfrom workbook.cli.main import main\nmain(['cache', 'info'])\n"
+             "print('MODULES', *sorted(m for m in sys.modules if m.startswith('workbook.cli.')))")
+    done = subprocess.run([sys.executable, "-c", probe], env=env, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.rpartition("MODULES")[2].split() == ["workbook.cli.cache", "workbook.cli.main"]
+
+    def help_text(parser, name):
+        text = io.StringIO()
+        with contextlib.redirect_stdout(text), pytest.raises(SystemExit):
+            parser.parse_args([name, "--help"])
+        return text.getvalue()
+
+    every, run_only = build_parser(), build_parser("run")
+    for name in COMMANDS:
+        same = help_text(every, name) == help_text(run_only, name)
+        assert same == (name == "run"), name      # the other commands' arguments are added only to the full parser
 
 
 @pytest.mark.slow  # the links are reduced first (an empty cache)

@@ -17,6 +17,7 @@ whose path the line gives.
 from __future__ import annotations
 
 import argparse
+import importlib
 import logging
 import os
 import signal
@@ -24,55 +25,71 @@ import sys
 import tempfile
 import time
 import traceback
+from typing import Callable
 
 from threadpoolctl import threadpool_limits
 
 from workbook.answers.saving import recording_writes
-from workbook.cli import cache, campbell, four_pole, layout, links, loads, optimise, rig, run, run_up, stress, study, update, workbooks
 from workbook.errors import MountwbError, SimulationError, Terminated, exit_code, interruption
 
 __all__ = ["main", "COMMANDS", "build_parser"]
 
-#: name -> (help, function adding the arguments and returning the handler)
+#: name -> (help, ``module:function`` of :mod:`workbook.cli` adding the command's arguments and returning its
+#: handler); a command's module is imported only when that command is run or its parser built.
 COMMANDS = {
-    "run": ("run a case and print the isolation-efficiency table and the model card", run.arguments),
+    "run": ("run a case and print the isolation-efficiency table and the model card", "run:arguments"),
     "links": ("per link: FE size, frequencies free-free and as mounted, modes kept and why, cost, cache hit",
-              links.arguments),
-    "layout": ("draw a case's layout (side, front and top views) as a PNG", layout.arguments),
+              "links:arguments"),
+    "layout": ("draw a case's layout (side, front and top views) as a PNG", "layout:arguments"),
     "check": ("check a case workbook (.xlsx) and list every problem; nothing is run or written",
-              workbooks.check_arguments),
+              "workbooks:check_arguments"),
     "template": ("write the case template workbook (or, with --reference, the reference case)",
-                 workbooks.template_arguments),
+                 "workbooks:template_arguments"),
     "study": ("studies of a case: 'accuracy' (accuracy against time) or 'params' (a parameter study)",
-              study.arguments),
+              "study:arguments"),
     "rig": ("measured rig records: measured T and eta, the validation table against simulation, "
-            "synthetic records", rig.arguments),
+            "synthetic records", "rig:arguments"),
     "update": ("model updating: fit hinge, transducer and engine parameters to rig records by least squares "
-               "(fitted values, standard errors, correlation, error before and after)", update.arguments),
+               "(fitted values, standard errors, correlation, error before and after)", "update:arguments"),
     "run-up": ("a rotor imbalance over a speed range (force U w^2): pylon force and T per direction against speed, "
-               "the mounted modes marked", run_up.arguments),
-    "four-pole": ("the mount's four-pole parameters (dynamic stiffness) against frequency", four_pole.arguments),
+               "the mounted modes marked", "run_up:arguments"),
+    "four-pole": ("the mount's four-pole parameters (dynamic stiffness) against frequency", "four_pole:arguments"),
     "campbell": ("the Campbell diagram: mounted modes against rotor speed, gyroscopic whirl, critical speeds",
-                 campbell.arguments),
+                 "campbell:arguments"),
     "loads": ("limit load cases: hinge and link forces, engine displacement, link stresses and margins of safety",
-              loads.arguments),
+              "loads:arguments"),
     "stress": ("link strength: the load cases' static margins, then per rotor excitation the dynamic stress on the "
-               "preload and the fatigue factors (Goodman, Gerber); --vtu writes the stress fields", stress.arguments),
+               "preload and the fatigue factors (Goodman, Gerber); --vtu writes the stress fields",
+               "stress:arguments"),
     "optimise": ("optimise the design on the fast linear mount: the worst T (dB) or a weighted mean within static "
                  "displacement and mode-band constraints; before/after table, the optimised case, a Pareto front",
-                 optimise.arguments),
-    "cache": ("the store of reduced bodies: info, verify (keys and checksums), clear", cache.arguments),
+                 "optimise:arguments"),
+    "cache": ("the store of reduced bodies: info, verify (keys and checksums), clear", "cache:arguments"),
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
+def _configure(name: str) -> Callable[[argparse.ArgumentParser], Callable]:
+    """The function of command *name* that adds its arguments to its parser and returns its handler."""
+    module, _, function = COMMANDS[name][1].partition(":")
+    return getattr(importlib.import_module(f"workbook.cli.{module}"), function)
+
+
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser of ``mountwb``: every command's, or with *command* only that command's arguments (the
+    others are listed with their help, their modules not imported)."""
     parser = argparse.ArgumentParser(prog="mountwb", description="Engine mount vibration isolation workbook")
     parser.add_argument("-v", "--verbose", action="count", default=0, help="more log output (-v, -vv)")
     commands = parser.add_subparsers(dest="command", required=True)
-    for name, (help_text, configure) in COMMANDS.items():
-        command = commands.add_parser(name, help=help_text, description=help_text)
-        command.set_defaults(handler=configure(command))
+    for name, (help_text, _) in COMMANDS.items():
+        subparser = commands.add_parser(name, help=help_text, description=help_text)
+        if command is None or name == command:
+            subparser.set_defaults(handler=_configure(name)(subparser))
     return parser
+
+
+def _command_of(argv: list[str]) -> str | None:
+    """The command *argv* names (its first word that is no option: ``-v`` takes no value), or None."""
+    return next((word for word in argv if not word.startswith("-")), None)
 
 
 def _terminate(signum, frame):
@@ -143,7 +160,8 @@ def main(argv: list[str] | None = None) -> int:
 def _main(argv: list[str] | None) -> int:
     # Multithreaded BLAS made the small dense solves of a run many times slower on 2 cores.
     threadpool_limits(limits=1)
-    args = build_parser().parse_args(argv)
+    words = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(_command_of(words)).parse_args(words)
     level = {0: logging.WARNING, 1: logging.INFO}.get(args.verbose, logging.DEBUG)
     logging.basicConfig(level=level, format="%(levelname)s %(name)s: %(message)s")
     with recording_writes() as written:
@@ -156,7 +174,7 @@ def _main(argv: list[str] | None) -> int:
             if not isinstance(error, Exception):
                 raise
             if not isinstance(error, (MountwbError, OSError)):
-                return _internal_error(args.command, error, sys.argv[1:] if argv is None else list(argv))
+                return _internal_error(args.command, error, words)
             trouble = "numerical trouble: " if isinstance(error, SimulationError) else ""
             print(f"mountwb {args.command}: {trouble}{error}", file=sys.stderr)
             return exit_code(error)

@@ -77,10 +77,10 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
                              "transfer dynamic stiffness per direction (as mountwb four-pole with its defaults)")
 
 
-def _print_summary(runs) -> None:
-    from workbook.excel.writer import result_frames
-
-    frame = result_frames(runs)["efficiency"]
+def _print_summary(runs, frames: dict) -> None:
+    """Print the efficiency table of *runs* (their result tables *frames*, :func:`~workbook.excel.writer.result_frames`)
+    and their warnings."""
+    frame = frames["efficiency"].copy()
     frame["frequency Hz"] = frame["frequency Hz"].map("{:.6g}".format)
     table = frame.pivot_table(index=["run", "point", "frequency Hz"], columns="direction", values="eta %",
                               sort=False)
@@ -165,7 +165,7 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     from workbook.errors import SimulationError
     from workbook.excel.execute import run_book
     from workbook.excel.report import write_report
-    from workbook.excel.writer import write_results
+    from workbook.excel.writer import result_frames, write_results
     from workbook.solve.pipeline import report_four_pole
 
     runs, failures = run_book(book, selected, progress=progress)
@@ -184,10 +184,11 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
         return EXIT_TROUBLE
     if pictures is not None:
         pictures.draw(runs)
-    _print_summary(runs)
+    frames = result_frames(runs, book.tests)
+    _print_summary(runs, frames)
     try:
         outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened, loads=loads,
-                                fatigue=fatigue)
+                                fatigue=fatigue, frames=frames)
     except OSError as error:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import textwrap
 
+from openpyxl.cell.cell import Cell
 from openpyxl.chart import Series
 from openpyxl.styles import Alignment, Font, PatternFill
 from openpyxl.utils import get_column_letter
@@ -147,7 +148,8 @@ def write_frame(ws, frame, top: int = 1, fill: PatternFill | None = None, quanti
 
     The header is bold (on *fill*), frozen and repeated on every printed
     page; each column is as wide as its header and its texts; a missing
-    value is an empty cell.
+    value is an empty cell. The rows below *top* are to be empty: the table's
+    rows are appended after its header.
 
     Parameters
     ----------
@@ -164,13 +166,21 @@ def write_frame(ws, frame, top: int = 1, fill: PatternFill | None = None, quanti
             cell.fill = fill
         texts = [str(v) for v in frame[name] if isinstance(v, str)]
         ws.column_dimensions[get_column_letter(col)].width = max([11, len(str(name)) + 2, *(len(t) + 2 for t in texts)])
-    for row, values in enumerate(frame.itertuples(index=False), start=top + 1):
-        for col, value in enumerate(values, start=1):
+    # a column's number cells share the style of its first (setting each cell's format looks it up again: the
+    # most of the time of a long table)
+    styles: list = [None] * len(formats)
+    for values in frame.itertuples(index=False):
+        cells = []
+        for col, value in enumerate(values):
             if isinstance(value, float) and not pd.notna(value):
                 value = None
             elif hasattr(value, "item"):
                 value = value.item()
-            cell = ws.cell(row, col, value)
-            if formats[col - 1] is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
-                cell.number_format = formats[col - 1]
+            number = formats[col] is not None and isinstance(value, (int, float)) and not isinstance(value, bool)
+            cell = Cell(ws, value=value, style_array=styles[col] if number else None)
+            if number and styles[col] is None:
+                cell.number_format = formats[col]
+                styles[col] = cell._style
+            cells.append(cell)
+        ws.append(cells)
     print_setup(ws, header_rows=top)

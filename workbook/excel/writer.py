@@ -402,7 +402,7 @@ def _cached_formula_values(path: Path, workbook, values=None) -> dict[int, dict[
 
 
 def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = (), *,
-                  opened=None, loads=None, fatigue=None) -> WriteOutcome:
+                  opened=None, loads=None, fatigue=None, frames: dict | None = None) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
     Parameters
@@ -420,6 +420,8 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         The solved load cases (:func:`~workbook.excel.loads_sheet.loads_frame`): the loads sheet.
     fatigue : pandas.DataFrame, optional
         The links' fatigue (:func:`~workbook.excel.fatigue_sheet.fatigue_frame`): the fatigue sheet.
+    frames : dict of str to pandas.DataFrame, optional
+        ``result_frames(runs, tests)`` when the caller has them already.
 
     Returns
     -------
@@ -427,7 +429,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     """
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
-    frames = result_frames(runs, tests)
+    frames = result_frames(runs, tests) if frames is None else frames
     titles = result_sheet_names(frames, loads, fatigue)
     with held(path):
         reason, workbook, values = _reason_not_to_overwrite(path, sha256, titles, opened)
