@@ -34,7 +34,7 @@ work), medians of 5 (cold: 3)::
     | cold `mountwb run` (empty cache)                        | 10.62 s | 9.85 s | 6 s    |
     | unneeded packages the warm run imports                  | meshio, pandas, skfem | none | none |
 
-The cold path since (issue 25, item 5), with ``--before 95f7844 --repeats 3
+The cold path since (the reductions' changes), with ``--before 95f7844 --repeats 3
 --cold-repeats 5`` (95f7844: before the residual mass shared by a link's
 decisions and the nested-dissection ordering; load average 3.3 to 4 from
 other work, so every time is longer than on the quieter machine above)::
@@ -52,7 +52,7 @@ single solves of three Lanczos runs (fixed-interface modes, 30 solves, the
 fewest of the ``ncv`` tried; free-free, 21; mounted, 13), 1.7 s assembly,
 1.2 s meshing, 1.5 s geometric stiffness, 0.55 s stress operator and shapes.
 
-The warm paths since (issue 25, "warm paths that feel instant": only the
+The warm paths since (only the
 command's own module imported, the geometric stiffness projected once per
 reduction, a workbook's result tables made once, a table's number cells
 sharing their column's style, the checksum without copies), with

@@ -1,7 +1,7 @@
 """Warm paths stay fast: a command imports only what it uses (no other command's module), a workbook is read
 once, units need no pint.
 
-The guards of issue 25's "warm paths that feel instant": ``mountwb run`` on
+The guards of the warm paths: ``mountwb run`` on
 a JSON case (or the reference mount) loads neither pandas nor pint,
 matplotlib, openpyxl, scikit-fem, meshio or gmsh; its tables, printed
 without pandas, are pandas' own text; the factors of the unit table are
