@@ -63,6 +63,10 @@ _DEFAULT_RELATIVE_TOLERANCE = 1e-3
 #: function times a curved surface element).
 _SURFACE_INTORDER = 4
 
+#: The connectivity a scikit-fem mesh finds on first use (faces, edges and their maps to the elements):
+#: it depends on the elements alone, so a moved copy of a mesh takes the original's.
+_CONNECTIVITY = ("_facets", "_t2f", "_f2t", "_edges", "_t2e", "_f2e")
+
 _GMSH_LOCK = threading.Lock()
 
 
@@ -609,6 +613,9 @@ def surface_basis(mesh, facets: np.ndarray) -> tuple:
     """
     origin = mesh.doflocs[:, np.unique(mesh.facets[:, facets])].mean(axis=1)
     moved = mesh.translated(-origin)
+    for name in _CONNECTIVITY:  # moving does not change them: found once, not again for every bore
+        if name in vars(mesh):
+            setattr(moved, name, getattr(mesh, name))
     return skfem.FacetBasis(moved, moved.elem(), facets=facets, intorder=_SURFACE_INTORDER), origin
 
 
