@@ -55,19 +55,21 @@ fewest of the ``ncv`` tried; free-free, 21; mounted, 13), 1.7 s assembly,
 The warm paths since (only the
 command's own module imported, the geometric stiffness projected once per
 reduction, a workbook's result tables made once, a table's number cells
-sharing their column's style, the checksum without copies), with
-``--before ca25197 --repeats 11 --cold-repeats 1`` (ca25197: before these
-changes; load average 3 to 4 from other work), wall time and in brackets
-CPU time (the cold run's single repeat says little)::
+sharing their column's style, the checksum without copies; for the cold
+run also the bores' meshes sharing their connectivity), with
+``--before ca25197 --repeats 7 --cold-repeats 3`` (ca25197: before these
+changes; load average 1.3 to 1.4, the machine otherwise quiet), wall time
+and in brackets CPU time (all the run's processes)::
 
     | what                                                    | before                | now                   | target |
-    | warm `mountwb run`                                      | 1.46 s (CPU 1.38 s)   | 1.46 s (CPU 1.41 s)   | 1 s    |
-    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 4.89 s (CPU 4.73 s)   | 4.69 s (CPU 4.55 s)   | 2 s    |
-    | cold `mountwb run` (empty cache), 1 repeat              | 21.40 s (CPU 20.74 s) | 18.71 s (CPU 18.40 s) | 6 s    |
+    | warm `mountwb run`                                      | 1.44 s (CPU 1.43 s)   | 1.33 s (CPU 1.32 s)   | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx` | 3.46 s (CPU 4.53 s)   | 3.59 s (CPU 4.58 s)   | 2 s    |
+    | cold `mountwb run` (empty cache)                        | 12.20 s (CPU 18.02 s) | 10.89 s (CPU 16.61 s) | 6 s    |
 
-The warm run's change is within the load's noise (about 0.05 s of CPU
-time: the other commands' modules); the workbook with its report takes
-0.2 s less. Neither meets its target. Where the warm run's time goes
+The warm run takes 0.1 s less (the other commands' modules it no longer
+imports), the workbook with its report the same within the noise; neither
+meets its target. The cold run's CPU time, 16.6 s on two cores, bounds it
+above 8 s whatever the layout of its processes. Where the warm run's time goes
 (``python -X importtime`` and cProfile of one run, load about 2): imports
 about 0.5 s, of which ``scipy.linalg`` 0.23 to 0.30 s (SciPy's array-API
 layer copies NumPy's namespace, which imports ``numpy.f2py``, 0.09 to
