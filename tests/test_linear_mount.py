@@ -171,3 +171,50 @@ def test_springs_of_designs_together_are_the_hinge_laws(hinge_damping):
             expected_structural = loss @ stiffness if hinge_damping else np.zeros((3, 3))
             assert np.abs(springs.damping[b, c] - expected_damping).max() <= 1e-12 * max(np.abs(damping).max(), 1.0)
             assert np.abs(springs.structural[b, c] - expected_structural).max() <= 1e-12 * scale
+
+
+def _dense_blocks(matrix, slope, local, weight=1.0):
+    """``matrix + weight slope . local`` per block and state, from the dense slope (B, b, b, b)."""
+    return matrix + weight * np.einsum("kijl,dkl->dkij", slope, local)
+
+
+def _full(rest, blocks, size):
+    """The blocks (states, B, b, b) of *rest* added into full matrices (states, N, N)."""
+    out = np.zeros((len(blocks), size + 1, size + 1))
+    for d in range(len(blocks)):
+        for k, coordinates in enumerate(rest.coordinates):
+            out[d][np.ix_(coordinates, coordinates)] += blocks[d, k]
+    return out[:, :size, :size]
+
+
+def test_sparse_slopes_are_the_dense_expansion(mount):
+    """The rest's M, K, D and force change from the sparse slope operators equal the dense expansion of
+    the stored slopes and curvature (``M + M' dq``, ``K + K' dq + K'' dq dq / 2``, ``(K + K' dq / 2 +
+    K'' dq dq / 6) dq``), for several states at once and one alone."""
+    rng = np.random.default_rng(7)
+    for item in mount.items.values():
+        rest = item.expansion.rest
+        size = len(item.expansion.state)
+        dq = 1e-3 * rng.standard_normal((3, size))
+        local = np.concatenate([dq, np.zeros((3, 1))], axis=1)[:, rest.coordinates]          # (3, B, b)
+        padded = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
+        turned = padded[:, np.arange(len(rest.coordinates))[:, None], rest.turning]           # (3, B, S)
+        curvature = np.einsum("kijst,dks,dkt->dkij", rest.stiffness_curvature, turned, turned)
+        expected = {
+            "mass": _full(rest, _dense_blocks(rest.mass, rest.mass_slope, local), size),
+            "damping": _full(rest, _dense_blocks(rest.damping, rest.damping_slope, local), size),
+            "stiffness": _full(rest, _dense_blocks(rest.stiffness, rest.stiffness_slope, local) + 0.5 * curvature,
+                               size),
+        }
+        for name, matrices in expected.items():
+            got = getattr(rest, f"{name}_at")(dq)
+            assert np.abs(got - matrices).max() <= 1e-12 * np.abs(matrices).max(), name
+            alone = getattr(rest, f"{name}_at")(dq[1])
+            assert np.abs(alone - matrices[1]).max() <= 1e-12 * np.abs(matrices).max(), name
+        secant = _dense_blocks(rest.stiffness, rest.stiffness_slope, local, 0.5) + curvature / 6.0
+        change = np.zeros((3, size + 1))
+        np.add.at(change, (np.arange(3)[:, None, None], rest.coordinates[None]),
+                  np.einsum("dkij,dkj->dki", secant, local))
+        got = rest.force_change(dq)
+        assert np.abs(got - change[:, :size]).max() <= 1e-12 * np.abs(change).max()
+        assert np.abs(got).max() > 0.0
