@@ -278,10 +278,10 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
         at = channels.state(total(expansion, dq))
         q = total(expansion, dq)
         basis = projection(expansion, dq)
-        jacobian = channels.jacobian(at)
+        channel_jacobian = channels.jacobian(at)
         factor = sla.lu_factor(tangent_stiffness(expansion, dq, rest_stiffness(expansion, dq, loads), base, at, basis,
-                                                 basis.columns(jacobian)), check_finite=False)
-        jacobian = spring_rows(base.stiffness, jacobian)
+                                                 basis.columns(channel_jacobian)), check_finite=False)
+        force_rows = spring_rows(base.stiffness, channel_jacobian)       # the channel forces per state change
         for j, change in enumerate(changes):
             springs = change.springs
             if d_forces[j] is not None:
@@ -294,7 +294,7 @@ def _state_changes(case: Case, solution: ItemSolution, changes: list) -> list[tu
             residual[modal] += casing @ q[modal]
             d_state[j] = basis.expand(sla.lu_solve(factor, -basis.rows(residual), check_finite=False))
             d_forces[j] = prepared.sign * (np.einsum("cab,cb->ca", springs.stiffness, at.separation)
-                                           + (jacobian @ d_state[j]).reshape(-1, 3))
+                                           + (force_rows @ d_state[j]).reshape(-1, 3))
     return list(zip(d_state, d_tension, strict=True))
 
 
