@@ -13,9 +13,10 @@ time per design of :data:`BATCH` designs answered together
 ``BATCH_ROWS``) against the same designs one at a time, in :data:`REPEATS`
 alternating rounds, and the largest difference between them; and beside
 them the floor of this way of evaluating: the LAPACK solves alone that a
-design needs together with others (per rotor, the inverse of its tangent
-stiffness and one complex solve of its dynamic stiffness, of the size of
-its independent coordinates), timed on matrices of those sizes. Run with
+design needs together with others (per rotor, the chord's solve of the size
+of its channels' coordinates and one complex solve of its dynamic
+stiffness, of the size of its independent coordinates), timed on matrices of
+those sizes. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
 import dataclasses
@@ -135,11 +136,13 @@ def _solves_alone(mount) -> float:
         total = 0.0
         for item in mount.items.values():
             size = len(item.expansion.free) + 3 * len(item.expansion.euler_blocks)
-            stiffness = rng.standard_normal((BATCH_ROWS, size, size)) + size * np.eye(size)
-            dynamic = stiffness + 1j * rng.standard_normal((BATCH_ROWS, size, size))
+            channels = 3 * len(mount.channels)
+            chord = rng.standard_normal((BATCH_ROWS, channels, channels)) + channels * np.eye(channels)
+            dynamic = rng.standard_normal((BATCH_ROWS, size, size)) + size * np.eye(size) \
+                + 1j * rng.standard_normal((BATCH_ROWS, size, size))
             load = rng.standard_normal((BATCH_ROWS, size, 1)) + 0j
             start = time.perf_counter()
-            np.linalg.solve(stiffness, np.broadcast_to(np.eye(size), stiffness.shape))
+            np.linalg.solve(chord, chord)
             np.linalg.solve(dynamic, load)
             total += time.perf_counter() - start
         times.append(total / BATCH_ROWS)

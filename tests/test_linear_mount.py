@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from workbook import run_case
+from workbook.design.equilibrium import ChordStiffness
 from workbook.design.linear_mount import LinearMount
 from workbook.errors import OutsideDesignModel, UnstablePreloadError
 from workbook.model.reference import reference_case
@@ -218,3 +219,30 @@ def test_sparse_slopes_are_the_dense_expansion(mount):
         got = rest.force_change(dq)
         assert np.abs(got - change[:, :size]).max() <= 1e-12 * np.abs(change).max()
         assert np.abs(got).max() > 0.0
+
+
+def test_chord_is_the_prepared_tangent_with_each_designs_springs(mount):
+    """The chord iteration's matrix of designs together, solved by the Woodbury identity, is the prepared
+    tangent plus every channel's ``J_c^T (S_c - S_0,c) J_c`` on the prepared Jacobian, summed here channel by
+    channel and solved densely; a design whose chord was renewed is solved with its own inverse."""
+    rng = np.random.default_rng(3)
+    designs = mount._designs([_design(mount.case, rng) for _ in range(3)])
+    for item in mount.items.values():
+        prepared = item.tangent
+        size = len(prepared.inverse)
+        chord = ChordStiffness.of(prepared, designs.springs)
+        residual = rng.standard_normal((3, size))
+        channels = prepared.jacobian.reshape(-1, 3, size)
+        expected = []
+        for k in range(3):
+            matrix = np.linalg.inv(prepared.inverse)
+            for jacobian, change in zip(channels, designs.springs.stiffness[k] - prepared.springs, strict=True):
+                matrix = matrix + jacobian.T @ change @ jacobian
+            expected.append(np.linalg.solve(matrix, residual[k]))
+        got = chord.solve(np.arange(3), residual)
+        assert np.abs(got - expected).max() <= 1e-9 * np.abs(expected).max()
+        own = rng.standard_normal((size, size))
+        chord.own[1], chord.renewed[1] = own, True
+        got = chord.solve(np.array([2, 1]), residual[[2, 1]])
+        assert np.allclose(got[0], expected[2], rtol=0, atol=1e-9 * np.abs(expected).max())
+        assert np.array_equal(got[1], own @ residual[1])

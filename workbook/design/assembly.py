@@ -1,12 +1,10 @@
 """Assemble and solve the linearised mount of a design from a scene expansion.
 
 The arithmetic of :mod:`workbook.design.linear_mount`, on plain arrays:
-
-- :func:`static_state`: Newton (with its tangent kept while it serves) on
-  the preload equilibrium in the independent coordinates (Euler parameters
-  renormalised);
-- :func:`tangent_stiffness`, :func:`rest_matrices` and :func:`projection`:
-  the linearisation at a state, projected on the independent coordinates.
+:func:`static_residual`, the preload's residual that
+:mod:`workbook.design.equilibrium` solves; :func:`tangent_stiffness`,
+:func:`rest_matrices` and :func:`projection`, the linearisation at a state,
+projected on the independent coordinates (Euler parameters renormalised).
 
 A channel with stiffness S (3x3, N/m) has the potential ``d^T S d / 2``:
 generalised force ``J^T S d`` and tangent stiffness
@@ -27,18 +25,7 @@ from workbook.design.expansion import SceneExpansion
 
 __all__ = ["ChannelSprings", "AddedRigidMass", "StateLoads", "Projection", "total", "rest_stiffness",
            "rest_matrices", "turned_mass", "static_residual", "normal_components", "without_normal",
-           "tangent_stiffness", "static_state", "StaticSolution", "solve_each", "projection", "NEWTON_TOLERANCE",
-           "PRELOAD_STEPS", "RENEWAL_RATE"]
-
-#: The preload solve ends when the error it leaves is below this (relative to the state change).
-NEWTON_TOLERANCE = 1e-10
-#: Smallest state change the tolerance is relative to (m, rad, modal coordinates).
-STATE_SCALE = 1e-3
-#: Most steps of one preload solve.
-PRELOAD_STEPS = 40
-#: A design's tangent stiffness is renewed when its updates shrink by less than this factor per step.
-RENEWAL_RATE = 0.1
-
+           "tangent_stiffness", "solve_each", "projection"]
 
 @dataclass(frozen=True)
 class ChannelSprings:
@@ -55,8 +42,9 @@ class ChannelSprings:
     damping: np.ndarray
     structural: np.ndarray
 
-    def take(self, rows: np.ndarray | int) -> "ChannelSprings":
-        """The designs *rows* of springs given per design (leading axis; an index: one design without it)."""
+    def take(self, rows: np.ndarray | int | None) -> "ChannelSprings":
+        """The designs *rows* of springs given per design (leading axis; an index: one design without it;
+        None: one design as a batch of one)."""
         return ChannelSprings(self.stiffness[rows], self.damping[rows], self.structural[rows])
 
 
@@ -86,7 +74,7 @@ class AddedRigidMass:
         block[..., 3:, 3:] = rotation.swapaxes(-1, -2) @ self.inertia @ rotation
         return block
 
-    def take(self, rows: np.ndarray | int) -> "AddedRigidMass":
+    def take(self, rows: np.ndarray | int | None) -> "AddedRigidMass":
         """The designs *rows*."""
         return AddedRigidMass(self.coordinates, self.mass[rows], self.inertia[rows])
 
@@ -119,7 +107,7 @@ class StateLoads:
     mass: list
     force: np.ndarray
 
-    def take(self, rows: np.ndarray | int) -> "StateLoads":
+    def take(self, rows: np.ndarray | int | None) -> "StateLoads":
         """The designs *rows* of loads given per design (leading axis; an index: one design without it)."""
         return StateLoads([(indices, added[rows] if added.ndim == 3 else added)
                            for indices, added in self.modal_stiffness],
@@ -330,128 +318,6 @@ def projection(expansion: SceneExpansion, dq: np.ndarray) -> Projection:
     tangents = np.stack([np.stack([-t1, t0, t3, -t2], axis=-1), np.stack([-t2, -t3, t0, t1], axis=-1),
                          np.stack([-t3, t2, -t1, t0], axis=-1)], axis=-1)
     return Projection(expansion.free, euler, tangents, q.shape[-1])
-
-
-def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force: np.ndarray, loads: StateLoads,
-                 start: np.ndarray, inverse: np.ndarray | None = None, *,
-                 keep_tangent: bool = True) -> "StaticSolution":
-    """The preload equilibrium's state change from the prepared state of each design, from *start*.
-
-    With *keep_tangent*, Newton with its tangent stiffness kept while it
-    serves (a chord iteration, for designs together: the tangent's inversion
-    is their larger cost): the tangent at the start is inverted once, and a
-    design's tangent is renewed at its current state only when its updates
-    shrink by less than :data:`RENEWAL_RATE` per step; a design has converged
-    when the error its updates leave (``rate / (1 - rate)`` times the last
-    update) is below :data:`NEWTON_TOLERANCE` of its state change. Without,
-    Newton with a tangent per step (for one design, whose cost is mostly
-    NumPy's per call: fewer steps win), converged when an update is below
-    the square root of the tolerance (quadratic convergence leaves an error
-    of the order of its square).
-
-    Parameters
-    ----------
-    springs, loads
-        Per design (leading axis B).
-    start : ndarray, shape (B, N)
-    inverse : ndarray, shape (B, n, n), optional
-        With *keep_tangent*: inverses of projected tangent stiffnesses to
-        start with (e.g. a previous solve's, :attr:`StaticSolution.inverse`);
-        else the tangent at *start*.
-    """
-    dq = start.copy()
-    count = len(dq)
-    steps = np.zeros(count, dtype=int)
-    failures: dict[int, str] = {}
-    if keep_tangent:
-        inverse = _tangent_inverse(expansion, springs, loads, dq, failures) if inverse is None else inverse.copy()
-    last = np.full(count, np.inf)
-    active = np.array([k for k in range(count) if k not in failures], dtype=int)
-    for step in range(1, PRELOAD_STEPS + 1):
-        part, part_springs, part_loads = dq[active], springs.take(active), loads.take(active)
-        state = expansion.channels.state(total(expansion, part), second=not keep_tangent)
-        basis = projection(expansion, part)
-        residual = basis.rows(static_residual(expansion, part, part_springs, base_force, part_loads, state))
-        if keep_tangent:
-            assert inverse is not None
-            update = -(inverse[active] @ residual[..., None])[..., 0]
-        else:
-            tangent = tangent_stiffness(expansion, part, rest_stiffness(expansion, part, part_loads), part_springs,
-                                        state, basis, basis.columns(expansion.channels.jacobian(state)))
-            update, singular = solve_each(tangent, -residual)
-            for k in np.flatnonzero(singular):
-                failures[int(active[k])] = "its tangent stiffness is singular"
-        full_update = basis.expand(update)
-        q = total(expansion, part + full_update)
-        q[..., expansion.euler_blocks] /= np.linalg.norm(q[..., expansion.euler_blocks], axis=-1)[..., None]
-        moved = q - expansion.reference - expansion.state
-        dq[active] = moved
-        size = np.abs(full_update).max(axis=-1) / np.maximum(np.abs(moved).max(axis=-1), STATE_SCALE)
-        known = np.isfinite(last[active])
-        rate = np.where(known, size / np.where(known, last[active], 1.0), np.inf)
-        last[active] = size
-        shrinking = rate < 1.0
-        left = np.full(len(rate), np.inf)                 # the error the updates leave
-        left[shrinking] = rate[shrinking] * size[shrinking] / (1.0 - rate[shrinking])
-        converged = (size <= np.sqrt(NEWTON_TOLERANCE)) if not keep_tangent else \
-            (size <= NEWTON_TOLERANCE) | (left <= NEWTON_TOLERANCE)
-        steps[active[converged]] = step
-        going = ~converged & np.array([int(k) not in failures for k in active], dtype=bool)
-        renew = active[going & known & (rate > RENEWAL_RATE)] if keep_tangent else np.zeros(0, dtype=int)
-        active = active[going]
-        if len(renew):
-            assert inverse is not None
-            found: dict[int, str] = {}
-            inverse[renew] = _tangent_inverse(expansion, springs.take(renew), loads.take(renew), dq[renew], found)
-            failures.update({int(renew[k]): reason for k, reason in found.items()})
-            last[renew] = np.inf
-            active = np.array([k for k in active if k not in failures], dtype=int)
-        if not len(active):
-            break
-    for k in active:
-        failures[int(k)] = f"the preload did not converge in {PRELOAD_STEPS} steps"
-    return StaticSolution(dq, steps, failures, inverse)
-
-
-@dataclass(frozen=True)
-class StaticSolution:
-    """The preload equilibria of B designs (:func:`static_state`).
-
-    Attributes
-    ----------
-    dq : ndarray, shape (B, N)
-    steps : ndarray of int, shape (B,)
-        Steps each design took.
-    failures : dict of int to str
-        The designs whose tangent stiffness was singular or that did not
-        converge, with the reason (their rows of *dq* mean nothing).
-    inverse : ndarray, shape (B, n, n), or None
-        The inverse tangent stiffnesses last used (None: a tangent per step).
-    """
-
-    dq: np.ndarray
-    steps: np.ndarray
-    failures: dict
-    inverse: np.ndarray | None
-
-
-def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: StateLoads, dq: np.ndarray,
-                     failures: dict) -> np.ndarray:
-    """The inverse projected tangent stiffness at *dq* (B, N) per design, (B, n, n); a singular one is noted
-    in *failures* (its inverse is zero). Designs all at the prepared state share its kinematics."""
-    at = dq[0] if not dq.any() else dq
-    state = expansion.channels.state(total(expansion, at))
-    basis = projection(expansion, at)
-    jacobian = basis.columns(expansion.channels.jacobian(state))
-    basis = Projection(basis.free, basis.euler, np.broadcast_to(basis.tangents, dq.shape[:-1] + basis.tangents.shape[-3:]),
-                       basis.size)
-    rest = rest_stiffness(expansion, at, loads)
-    rest = np.broadcast_to(rest, dq.shape[:-1] + rest.shape[-2:])
-    tangent = tangent_stiffness(expansion, at, rest, springs, state, basis, jacobian)
-    inverse, singular = solve_each(tangent, np.broadcast_to(np.eye(tangent.shape[-1]), tangent.shape))
-    for k in np.flatnonzero(singular):
-        failures[int(k)] = "its tangent stiffness is singular"
-    return inverse
 
 
 def solve_each(matrices: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -43,12 +43,12 @@ from workbook.design.assembly import (
     projection,
     rest_matrices,
     solve_each,
-    static_state,
     tangent_stiffness,
     total,
     without_normal,
 )
 from workbook.design.channel_set import spring_matrix, spring_rows
+from workbook.design.equilibrium import ChordStiffness, PreparedTangent, prepared_tangent, static_state
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, SimulationError, UnstablePreloadError
 from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, SingleFrequencyExcitation, Sweep
@@ -192,6 +192,7 @@ class _Item:
     prepared_seconds: float
     stressed: dict = field(default_factory=dict)     # name -> StressedLink, the links with stress shapes
     casing: _Casing | None = None                    # a flexible engine casing
+    tangent: PreparedTangent | None = None           # at the prepared state, links unstiffened (None: singular)
 
 
 @dataclass(frozen=True)
@@ -609,10 +610,12 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
             stressed[link.name] = StressedLink(
                 link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
                 np.ascontiguousarray(shapes.transpose(1, 0, 2)), np.linalg.norm(shapes, ord=2, axis=(1, 2)))
+    unstiffened = StateLoads(_link_stiffness(flexible, np.zeros((1, len(flexible)))), [], np.zeros((1, size)))
+    tangent = prepared_tangent(expansion, base_springs, unstiffened.take(0))
     return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine,
                  [names.index(link.name) for link in flexible], points, warnings,
                  prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed,
-                 _prepared_casing(case, scene))
+                 _prepared_casing(case, scene), tangent)
 
 
 def _prepared_casing(case: Case, scene: Scene) -> _Casing | None:
@@ -678,12 +681,18 @@ def _state_loads(designs: _Designs, prepared: _Item, tensions: np.ndarray) -> St
             for load in case.static_loads:
                 if isinstance(load, Gravity):
                     force[:, prepared.engine[:3]] += designs.added_mass[:, None] * np.asarray(load.acceleration)
-    modal = [(link.modal, (tensions[:, k] - link.base_tension)[:, None, None] * link.geometric)
-             for k, link in enumerate(prepared.links) if np.any(tensions[:, k] != link.base_tension)]
+    modal = _link_stiffness(prepared.links, tensions)
     casing = prepared.casing
     if casing is not None and np.any(designs.casing_scale != 1.0):
         modal.append((casing.modal, (designs.casing_scale - 1.0)[:, None, None] * casing.stiffness))
     return StateLoads(modal, mass, force)
+
+
+def _link_stiffness(links: list, tensions: np.ndarray) -> list:
+    """The stiffness the flexible *links* add at the *tensions* (B, L) to the prepared scene's, as
+    :attr:`StateLoads.modal_stiffness`."""
+    return [(link.modal, (tensions[:, k] - link.base_tension)[:, None, None] * link.geometric)
+            for k, link in enumerate(links) if np.any(tensions[:, k] != link.base_tension)]
 
 
 def _channel_forces(prepared: _Item, springs: ChannelSprings, dq: np.ndarray) -> np.ndarray:
@@ -728,13 +737,16 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
     forces = np.zeros((count, prepared.compression.shape[1], 3))
     failures: dict[int, SimulationError] = {}
     passes: list = []
-    inverses: list[np.ndarray] = []           # each design's inverse tangent stiffness, kept between passes
+    # designs together: a chord iteration, each design's chord (and its renewals) kept between passes
+    chord = ChordStiffness.of(prepared.tangent, designs.springs) \
+        if count > 1 and prepared.tangent is not None else None
 
     def solve(rows: np.ndarray) -> np.ndarray:
         """Solve the designs *rows* from their current state and tensions; the ones that solved."""
         loads = _state_loads(designs.take(rows), prepared, tensions[rows])
+        part = None if chord is None else chord.take(rows)
         solution = static_state(prepared.expansion, designs.springs.take(rows), prepared.base_force, loads, dq[rows],
-                                inverses[0][rows] if inverses else None, keep_tangent=count > 1)
+                                part)
         for k, reason in solution.failures.items():
             failures[int(rows[k])] = UnstablePreloadError(
                 f"{designs.cases[rows[k]].name}: the design's preload has no stable equilibrium ({reason})", [])
@@ -742,10 +754,8 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
         forces[rows] = _channel_forces(prepared, designs.springs.take(rows), solution.dq)
         if keep_passes:
             passes.append((rows, solution.dq, tensions[rows].copy(), stiffened[rows].copy()))
-        if solution.inverse is not None and inverses:
-            inverses[0][rows] = solution.inverse
-        elif solution.inverse is not None:
-            inverses.append(solution.inverse)
+        if chord is not None and part is not None:
+            chord.put(rows, part)
         return np.delete(rows, list(solution.failures))
 
     def link_tensions(rows: np.ndarray) -> np.ndarray:
