@@ -92,6 +92,23 @@ def test_hinge_parameters_by_group_and_direction(base):
         row_case(base, {"transducer_stiffness": 1e8}, 0)
 
 
+def test_a_row_sets_its_parameters_in_its_order(base):
+    """A row's changes of every hinge are made together, yet a later value wins as if each parameter were
+    applied in turn: a group's value before the value of every hinge is overwritten, after it is kept."""
+    from workbook.studies.parametric import parameter
+
+    for row in ({"hinge_stiffness/front": 1e8, "hinge_stiffness": 2e7, "hinge_loss_factor": 0.03},
+                {"hinge_stiffness": 2e7, "hinge_loss_factor": 0.03, "hinge_stiffness/front": 1e8, "clearance": 1e-4},
+                {"hinge_damping": 300.0, "engine_mass": 2500.0, "hinge_damping/rear": 700.0}):
+        expected = base
+        for name, value in row.items():
+            expected = parameter(name).apply(expected, value)
+        got = row_case(base, row, 3)
+        assert got.hinges == expected.hinges and got.engine == expected.engine
+    assert {h.values("stiffness")[0] for h in row_case(base, {"hinge_stiffness/front": 1e8, "hinge_stiffness": 2e7},
+                                                       0).hinges} == {2e7}
+
+
 def test_processes_equal_serial_and_failing_rows_are_reported(base, rows, serial):
     processes = study_frame(rows, run_rows(study_cases(base, rows), workers=2))
     # the same to round-off, not bit for bit: NumPy's reductions round by the memory alignment of their data,

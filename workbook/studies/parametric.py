@@ -63,12 +63,16 @@ class Parameter:
     help : str
     apply : callable
         ``apply(case, value) -> Case``.
+    hinge_field : str or None
+        The :class:`~workbook.model.case.Hinge` field it sets on every hinge (None: another change), so that
+        a row's changes of every hinge make one new hinge each (:func:`row_case`).
     """
 
     name: str
     unit: str
     help: str
     apply: Callable[[Case, Any], Case]
+    hinge_field: str | None = None
 
     @property
     def numeric(self) -> bool:
@@ -246,13 +250,13 @@ def _frequency(case: Case, frequency_hz: float) -> Case:
 
 PARAMETERS = {p.name: p for p in (
     Parameter("hinge_stiffness", "N/m", "translational stiffness of every hinge",
-              lambda case, v: _hinges(case, stiffness=float(v))),
+              lambda case, v: _hinges(case, stiffness=float(v)), "stiffness"),
     Parameter("hinge_damping", "N*s/m", "translational damping of every hinge",
-              lambda case, v: _hinges(case, damping=float(v))),
+              lambda case, v: _hinges(case, damping=float(v)), "damping"),
     Parameter("hinge_loss_factor", "-", "structural loss factor of every hinge",
-              lambda case, v: _hinges(case, loss_factor=float(v))),
+              lambda case, v: _hinges(case, loss_factor=float(v)), "loss_factor"),
     Parameter("clearance", "m", "radial clearance of every hinge",
-              lambda case, v: _hinges(case, radial_clearance=float(v))),
+              lambda case, v: _hinges(case, radial_clearance=float(v)), "radial_clearance"),
     Parameter("section_scale", "-", "factor on the cross-section of every link (shank width and thickness, "
               "eye thickness)",
               lambda case, v: _section(case, float(v))),
@@ -350,8 +354,17 @@ def row_case(case: Case, row: dict, index: int) -> Case:
         A value the case rejects (e.g. a stiffness of 0).
     """
     _check_names(row)
+    pending: dict = {}                 # consecutive changes of every hinge, made together
     for name, value in row.items():
-        case = parameter(name).apply(case, value)
+        chosen = parameter(name)
+        if chosen.hinge_field is not None:
+            pending[chosen.hinge_field] = float(value)
+            continue
+        if pending:
+            case, pending = _hinges(case, **pending), {}
+        case = chosen.apply(case, value)
+    if pending:
+        case = _hinges(case, **pending)
     return dataclasses.replace(case, name=f"{case.name} / row {index}")
 
 
