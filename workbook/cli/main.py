@@ -157,9 +157,25 @@ def main(argv: list[str] | None = None) -> int:
         signal.signal(signal.SIGTERM, previous)
 
 
-def _main(argv: list[str] | None) -> int:
-    # Multithreaded BLAS made the small dense solves of a run many times slower on 2 cores.
+#: The environment variables of the BLAS and OpenMP libraries' thread counts.
+_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+
+
+def _one_blas_thread() -> None:
+    """Run the BLAS of NumPy and SciPy on one thread: each command's dense solves are small, and more
+    threads made a run several times slower on 2 cores.
+
+    A library reads its thread count when it is first loaded, which a command does after this (it
+    imports what it needs when it runs): so the variables of :data:`_THREAD_VARIABLES` are set to 1 for
+    this process and its workers, and the libraries already loaded are limited too.
+    """
+    for name in _THREAD_VARIABLES:
+        os.environ[name] = "1"
     threadpool_limits(limits=1)
+
+
+def _main(argv: list[str] | None) -> int:
+    _one_blas_thread()
     words = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(_command_of(words)).parse_args(words)
     level = {0: logging.WARNING, 1: logging.INFO}.get(args.verbose, logging.DEBUG)
