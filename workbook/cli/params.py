@@ -248,7 +248,7 @@ def run_parameter_study(args) -> int:
     failed = [outcome for outcome in outcomes if outcome.status != "ok"]
     for outcome in failed:
         print(f"row {outcome.index} failed: {outcome.error}")
-    for written in write_study(frame, list(rows[0]) if rows else [], path):
+    for written in write_study(frame, list(rows[0]) if rows else [], path, table_written=True):
         print(written)
     fast = sum(outcome.path == NUMPY_PATH for outcome in outcomes)
     if fast:

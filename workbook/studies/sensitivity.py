@@ -280,7 +280,7 @@ def _study_workbook(frame, parameters: list[str], title: str, sheets: dict):
 
 
 def write_study(frame, parameters: list[str], table: str | Path, *, title: str = "Parameter study",
-                sheets: dict | None = None, figure=None) -> list[Path]:
+                sheets: dict | None = None, figure=None, table_written: bool = False) -> list[Path]:
     """Write the table (CSV or Parquet, and a sheet) and the sensitivity plot, each all at once.
 
     Parameters
@@ -295,6 +295,8 @@ def write_study(frame, parameters: list[str], table: str | Path, *, title: str =
         More sheets of the workbook, by title.
     figure : matplotlib.figure.Figure, optional
         The plot to write (closed after), instead of :func:`plot_sensitivity`'s.
+    table_written : bool
+        The table file holds *frame* already (:meth:`StudyTable.flush`): it is not written again.
 
     Returns
     -------
@@ -302,7 +304,8 @@ def write_study(frame, parameters: list[str], table: str | Path, *, title: str =
         ``<table>``, ``<table stem>.xlsx``, ``<table stem>.png``.
     """
     table = Path(table)
-    _write_table(frame, table)
+    if not table_written:
+        _write_table(frame, table)
     sheet = table.with_suffix(".xlsx")
     with replacing(sheet, suffix=".xlsx.tmp") as temporary:
         _study_workbook(frame, parameters, title, sheets or {}).save(temporary)
