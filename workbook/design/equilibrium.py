@@ -92,17 +92,15 @@ class ChordStiffness:
     capacitance : ndarray, shape (B, 3 C, 3 C)
         ``(I + dS G)^-1 dS`` of each design's spring change ``dS = S - S_0`` and ``G = J_0 T_0^-1 J_0^T``:
         the chord's inverse is ``T_0^-1 - T_0^-1 J_0^T capacitance J_0 T_0^-1`` (Woodbury).
-    own : ndarray, shape (B, n, n)
-        The inverse tangent of each design renewed at its own state (rows of the others mean nothing).
-    renewed : ndarray of bool, shape (B,)
+    own : dict of int to ndarray, shape (n, n)
+        The inverse tangent of each design renewed at its own state, by its position.
     singular : ndarray of bool, shape (B,)
         The designs whose chord is singular (so is their tangent at the prepared state).
     """
 
     prepared: PreparedTangent
     capacitance: np.ndarray
-    own: np.ndarray
-    renewed: np.ndarray
+    own: dict
     singular: np.ndarray
 
     @classmethod
@@ -114,17 +112,16 @@ class ChordStiffness:
         blocks[:, np.arange(channels), :, np.arange(channels), :] = change.transpose(1, 0, 2, 3)
         spring_change = blocks.reshape(count, 3 * channels, 3 * channels)
         capacitance, singular = solve_each(np.eye(3 * channels) + spring_change @ prepared.coupling, spring_change)
-        size = len(prepared.inverse)
-        return cls(prepared, capacitance, np.zeros((count, size, size)), np.zeros(count, dtype=bool), singular)
+        return cls(prepared, capacitance, {}, singular)
 
     def take(self, rows: np.ndarray) -> "ChordStiffness":
         """The designs *rows*."""
-        return ChordStiffness(self.prepared, self.capacitance[rows], self.own[rows], self.renewed[rows],
-                              self.singular[rows])
+        own = {k: self.own[int(row)] for k, row in enumerate(rows) if int(row) in self.own}
+        return ChordStiffness(self.prepared, self.capacitance[rows], own, self.singular[rows])
 
     def put(self, rows: np.ndarray, part: "ChordStiffness") -> None:
-        """Keep the chords *part* of the designs *rows* (their renewals)."""
-        self.own[rows], self.renewed[rows] = part.own, part.renewed
+        """Keep the renewals of the chords *part* of the designs *rows*."""
+        self.own.update({int(rows[k]): inverse for k, inverse in part.own.items()})
 
     def solve(self, rows: np.ndarray, residual: np.ndarray) -> np.ndarray:
         """The chord's solution for the designs *rows* with the right-hand sides *residual* (len(rows), n)."""
@@ -132,9 +129,9 @@ class ChordStiffness:
         plain = residual @ prepared.inverse.T
         spread = (self.capacitance[rows] @ (plain @ prepared.jacobian.T)[..., None])[..., 0]
         solution = plain - spread @ prepared.reach.T
-        own = self.renewed[rows]
-        if own.any():
-            solution[own] = (self.own[rows[own]] @ residual[own, :, None])[..., 0]
+        for k, row in enumerate(rows):
+            if int(row) in self.own:
+                solution[k] = self.own[int(row)] @ residual[k]
         return solution
 
 
@@ -201,8 +198,8 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         if len(renew):
             assert chord is not None
             found: dict[int, str] = {}
-            chord.own[renew] = _tangent_inverse(expansion, springs.take(renew), loads.take(renew), dq[renew], found)
-            chord.renewed[renew] = True
+            inverses = _tangent_inverse(expansion, springs.take(renew), loads.take(renew), dq[renew], found)
+            chord.own.update({int(k): inverse for k, inverse in zip(renew, inverses, strict=True)})
             failures.update({int(renew[k]): reason for k, reason in found.items()})
             last[renew] = np.inf
             active = np.array([k for k in active if k not in failures], dtype=int)
