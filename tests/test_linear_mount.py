@@ -6,7 +6,7 @@ import pytest
 
 from workbook import run_case
 from workbook.design.equilibrium import ChordStiffness
-from workbook.design.linear_mount import LinearMount
+from workbook.design.linear_mount import LinearMount, channel_springs
 from workbook.errors import OutsideDesignModel, UnstablePreloadError
 from workbook.model.reference import reference_case
 
@@ -246,3 +246,31 @@ def test_chord_is_the_prepared_tangent_with_each_designs_springs(mount):
         got = chord.solve(np.array([2, 1]), residual[[2, 1]])
         assert np.allclose(got[0], expected[2], rtol=0, atol=1e-9 * np.abs(expected).max())
         assert np.array_equal(got[1], own @ residual[1])
+
+
+def test_channels_tangent_is_the_derivative_of_their_forces(mount):
+    """The channels' tangent stiffness in full coordinates, ``J^T S J`` plus the markers' curvature summed
+    onto the matrix in place, is the derivative of their generalised force ``J^T S d``: central differences
+    along random directions, to 1e-6 of its largest entry."""
+    rng = np.random.default_rng(11)
+    for item in mount.items.values():
+        expansion = item.expansion
+        channels = expansion.channels
+        springs = channel_springs(mount.case, mount.channels).stiffness
+        q = expansion.reference + expansion.state
+        state = channels.state(q)
+        jacobian = channels.jacobian(state)
+        blocks = np.zeros((channels.count, 3, channels.count, 3))
+        blocks[np.arange(channels.count), :, np.arange(channels.count), :] = springs
+        tangent = jacobian.T @ blocks.reshape(3 * channels.count, -1) @ jacobian
+        curvature = np.zeros_like(tangent)
+        channels.add_curvature(curvature, state, springs)
+        assert np.abs(curvature).max() > 1e-6 * np.abs(tangent).max()      # the curvature term counts
+        tangent += curvature
+        step = 1e-6
+        for _ in range(3):
+            direction = rng.standard_normal(len(q))
+            forces = [channels.force(channels.state(q + sign * step * direction, second=False), springs)
+                      for sign in (1.0, -1.0)]
+            difference = (forces[0] - forces[1]) / (2 * step)
+            assert np.abs(tangent @ direction - difference).max() <= 1e-6 * np.abs(tangent).max()

@@ -230,10 +230,13 @@ def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarra
     ``B^T`` (the rest's stiffness *rest* plus every channel's ``(S d) . H``
     and Exudyn's term of the normal force components,
     :func:`normal_components`) ``B``, plus every channel's ``J^T S J`` on
-    the projected channel Jacobians *jacobian* (..., 3 C, n).
+    the projected channel Jacobians *jacobian* (..., 3 C, n). The terms are
+    added to *rest* in place (a contiguous array of the caller's, not used
+    after).
     """
     channels = expansion.channels
-    curved = rest + channels.curvature(state, springs.stiffness)
+    curved = rest
+    channels.add_curvature(curved, state, springs.stiffness)
     _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
     theta = total(expansion, dq)[..., expansion.euler_blocks]
     diagonal = expansion.euler_blocks

@@ -13,9 +13,11 @@ the independent coordinates (fewer columns, no N x N scatter).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import sparse
 
 from workbook.design.kinematics import EULER, PointKinematics
 
@@ -138,16 +140,29 @@ class ChannelSet:
         full = _scatter(index, jacobian.reshape(jacobian.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
         return full.reshape(jacobian.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
 
-    def curvature(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
-        """``sum_c (S_c d_c) . H_c`` (..., N, N) of the springs *stiffness* (..., C, 3, 3): the tangent
-        stiffness's term of the markers' curvature."""
+    def add_curvature(self, out: np.ndarray, state: ChannelState, stiffness: np.ndarray) -> None:
+        """Add ``sum_c (S_c d_c) . H_c`` of the springs *stiffness* (..., C, 3, 3), the tangent stiffness's
+        term of the markers' curvature, to the matrices *out* (..., N, N), in place (contiguous)."""
         assert state.hessian is not None, "the curvature needs the Hessians"
         on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
         hessian = state.hessian
         curvature = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))   # (..., 2 C, 1, M M)
-        index = (self.coordinates[:, :, None] * (self.size + 1) + self.coordinates[:, None, :]).ravel()
-        full = _scatter(index, curvature.reshape(curvature.shape[:-3] + (-1,)), (self.size + 1) ** 2)
-        return full.reshape(curvature.shape[:-3] + (self.size + 1, self.size + 1))[..., :self.size, :self.size]
+        positions, summing = self._curvature_positions
+        target = out.reshape((-1, self.size * self.size))
+        assert np.may_share_memory(target, out), "the sums need a contiguous out"
+        target[:, positions] += (summing @ curvature.reshape((len(target), -1)).T).T
+
+    @functools.cached_property
+    def _curvature_positions(self) -> tuple[np.ndarray, sparse.csr_array]:
+        """The distinct positions in a flat N x N matrix of the markers' curvature terms, and the sparse sum
+        (positions, terms) of the terms onto them (terms on the padding coordinate N dropped)."""
+        rows = np.broadcast_to(self.coordinates[:, :, None], self.coordinates.shape + self.coordinates.shape[-1:])
+        columns = np.broadcast_to(self.coordinates[:, None, :], rows.shape)
+        rows, columns = rows.ravel(), columns.ravel()
+        kept = np.flatnonzero((rows < self.size) & (columns < self.size))
+        positions, target = np.unique(rows[kept] * self.size + columns[kept], return_inverse=True)
+        summing = sparse.csr_array((np.ones(len(kept)), (target, kept)), shape=(len(positions), len(rows)))
+        return positions, summing
 
     def _channel_jacobians(self, state: ChannelState) -> np.ndarray:
         """Each channel's two marker Jacobians with the sign of d: shape (..., C, 2, 3, M)."""

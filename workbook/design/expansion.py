@@ -137,10 +137,22 @@ class RestBlocks:
         self._operators["curvature"].add_to(out.reshape(out.shape[:-3] + (-1,)), pairs, weight)
 
     def _full(self, blocks: np.ndarray) -> np.ndarray:
-        """The blocks (..., B, b, b) scattered into a full matrix (..., N, N)."""
-        full = np.zeros(blocks.shape[:-3] + (self.size + 1, self.size + 1))
-        full[..., self.coordinates[:, :, None], self.coordinates[:, None, :]] = blocks
-        return full[..., :self.size, :self.size]
+        """The blocks (..., B, b, b) scattered into a full matrix (..., N, N), contiguous."""
+        batch = blocks.shape[:-3]
+        placement, kept = self._placement
+        full = np.zeros(batch + (self.size * self.size,))
+        full[..., placement] = blocks.reshape(batch + (-1,))[..., kept]
+        return full.reshape(batch + (self.size, self.size))
+
+    @functools.cached_property
+    def _placement(self) -> tuple[np.ndarray, np.ndarray]:
+        """Where the blocks' entries go in a flat N x N matrix, and which of the blocks' flat entries they
+        are (the others fall on the padding coordinate N; each coordinate is in one block)."""
+        rows = np.broadcast_to(self.coordinates[:, :, None], self.coordinates.shape + self.coordinates.shape[-1:])
+        columns = np.broadcast_to(self.coordinates[:, None, :], rows.shape)
+        rows, columns = rows.ravel(), columns.ravel()
+        kept = np.flatnonzero((rows < self.size) & (columns < self.size))
+        return rows[kept] * self.size + columns[kept], kept
 
     @functools.cached_property
     def _operators(self) -> dict:
