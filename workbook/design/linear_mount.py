@@ -464,7 +464,9 @@ class LinearMount:
                 continue
             chosen = [excitations[k][point] for k in rows]
             omega = 2 * np.pi * np.array([e.frequency for e in chosen])
-            models = model.take(np.searchsorted(solved, rows))
+            positions = np.searchsorted(solved, rows)
+            # every solved design (a study's batch): the models as they are, not copied
+            models = model if np.array_equal(positions, np.arange(len(solved))) else model.take(positions)
             phasors: dict = {}                   # the designs of a study mostly share their excitations
             for e in chosen:
                 if id(e) not in phasors:
