@@ -248,6 +248,26 @@ def test_chord_is_the_prepared_tangent_with_each_designs_springs(mount):
         assert np.array_equal(got[1], own @ residual[1])
 
 
+def test_a_design_whose_chord_is_singular_starts_with_its_own_tangent(mount):
+    """A design whose chord (the prepared tangent with its springs) is singular is solved with its own
+    tangent instead, to the same preload as the others' chords give it."""
+    from workbook.design.equilibrium import static_state
+    from workbook.design.linear_mount import _state_loads
+
+    rng = np.random.default_rng(5)
+    designs = mount._designs([_design(mount.case, rng) for _ in range(3)])
+    for item in mount.items.values():
+        loads = _state_loads(designs, item, np.zeros((3, len(item.links))))
+        start = np.zeros((3, item.size))
+        plain = static_state(item.expansion, designs.springs, item.base_force, loads, start,
+                             ChordStiffness.of(item.tangent, designs.springs))
+        chord = ChordStiffness.of(item.tangent, designs.springs)
+        chord.singular[1] = True
+        solved = static_state(item.expansion, designs.springs, item.base_force, loads, start, chord)
+        assert list(chord.own) == [1] and not solved.failures and not plain.failures
+        assert np.abs(solved.dq - plain.dq).max() <= 1e-7 * np.abs(plain.dq).max()
+
+
 def test_channels_tangent_is_the_derivative_of_their_forces(mount):
     """The channels' tangent stiffness in full coordinates, ``J^T S J`` plus the markers' curvature summed
     onto the matrix in place, is the derivative of their generalised force ``J^T S d``: central differences

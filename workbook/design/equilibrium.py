@@ -101,7 +101,7 @@ class ChordStiffness:
     own : dict of int to ndarray, shape (n, n)
         The inverse tangent of each design renewed at its own state, by its position.
     singular : ndarray of bool, shape (B,)
-        The designs whose chord is singular (so is their tangent at the prepared state).
+        The designs whose chord is singular: :func:`static_state` starts them with their own tangent.
     """
 
     prepared: PreparedTangent
@@ -166,8 +166,10 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
     dq = start.copy()
     count = len(dq)
     steps = np.zeros(count, dtype=int)
-    failures = {} if chord is None else {int(k): "its tangent stiffness is singular"
-                                         for k in np.flatnonzero(chord.singular)}
+    failures: dict[int, str] = {}
+    if chord is not None:
+        _renew(chord, np.array([k for k in np.flatnonzero(chord.singular) if int(k) not in chord.own], dtype=int),
+               expansion, springs, loads, dq, failures)
     last = np.full(count, np.inf)
     active = np.array([k for k in range(count) if k not in failures], dtype=int)
     for step in range(1, PRELOAD_STEPS + 1):
@@ -203,10 +205,7 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
         active = active[going]
         if len(renew):
             assert chord is not None
-            found: dict[int, str] = {}
-            inverses = _tangent_inverse(expansion, springs.take(renew), loads.take(renew), dq[renew], found)
-            chord.own.update({int(k): inverse for k, inverse in zip(renew, inverses, strict=True)})
-            failures.update({int(renew[k]): reason for k, reason in found.items()})
+            _renew(chord, renew, expansion, springs, loads, dq, failures)
             last[renew] = np.inf
             active = np.array([k for k in active if k not in failures], dtype=int)
         if not len(active):
@@ -214,6 +213,18 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
     for k in active:
         failures[int(k)] = f"the preload did not converge in {PRELOAD_STEPS} steps"
     return StaticSolution(dq, steps, failures)
+
+
+def _renew(chord: ChordStiffness, rows: np.ndarray, expansion: SceneExpansion, springs: ChannelSprings,
+           loads: StateLoads, dq: np.ndarray, failures: dict) -> None:
+    """Give the designs *rows* of *chord* their own tangent at their states *dq*; a singular one is noted in
+    *failures*."""
+    if not len(rows):
+        return
+    found: dict[int, str] = {}
+    inverses = _tangent_inverse(expansion, springs.take(rows), loads.take(rows), dq[rows], found)
+    chord.own.update({int(k): inverse for k, inverse in zip(rows, inverses, strict=True)})
+    failures.update({int(rows[k]): reason for k, reason in found.items()})
 
 
 @dataclass(frozen=True)
