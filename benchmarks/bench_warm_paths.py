@@ -14,8 +14,9 @@ less than the wall time:
 - ``mountwb run`` with an empty cache (a new, empty cache folder each time:
   the three distinct links reduced side by side, one worker process per
   core);
-- which of pandas, pint, matplotlib, openpyxl, scikit-fem, meshio and gmsh
-  the warm ``mountwb run`` imports (none is needed).
+- which of pandas, pint, matplotlib, openpyxl, scikit-fem, meshio, gmsh and
+  SciPy's ``linalg`` and ``sparse`` the warm ``mountwb run`` imports (none
+  is needed).
 
 ``--before REV`` measures the source tree of the git revision REV the same
 way, interleaved with this one (``git archive`` into a temporary folder), so
@@ -106,7 +107,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Packages the warm ``mountwb run`` of the reference mount has no use for.
-NOT_NEEDED = ("pandas", "pint", "matplotlib", "openpyxl", "skfem", "meshio", "gmsh")
+NOT_NEEDED = ("pandas", "pint", "matplotlib", "openpyxl", "skfem", "meshio", "gmsh", "scipy.linalg", "scipy.sparse")
 
 _PROBE = """
 import sys
