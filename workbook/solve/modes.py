@@ -1,7 +1,7 @@
 """Linearised modes of a scene: free motions (mechanisms) and mounted modes.
 
-Exudyn linearises the system at its initial state (``ComputeLinearizedSystem``:
-M, K, D). K holds the geometric stiffness of the preload for the bodies'
+Exudyn linearises the system at its initial state (its static solver's mass
+matrix and Jacobians, as ``ComputeLinearizedSystem`` takes them: M, K, D). K holds the geometric stiffness of the preload for the bodies'
 rigid-body motion (the hinge forces turning with a link or the engine); a
 flexible link's modal coordinates have the stiffness of its reduced body,
 which holds its own stress stiffening only when that effect built it in
