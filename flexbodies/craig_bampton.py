@@ -12,13 +12,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
 
-from .eigen import factorize, lowest_modes
 from .errors import LinkModelError
+
+if TYPE_CHECKING:  # SciPy is imported where a basis is made: a run with its bodies cached needs only the errors
+    import scipy.sparse as sp
 
 __all__ = ["CraigBamptonBasis", "craig_bampton", "elastic_modes", "elastic_coefficients", "fixed_interface_set", "kept_count",
            "ModeBudgetExceeded", "MODE_BUDGET", "estimated_mode_count"]
@@ -193,6 +194,10 @@ def craig_bampton(stiffness, mass, boundary, *, count: int | None = None, cutoff
     -------
     CraigBamptonBasis
     """
+    import scipy.sparse as sp
+
+    from .eigen import factorize, lowest_modes
+
     if (count is None) == (cutoff_hz is None):
         raise ValueError("give exactly one of count and cutoff_hz")
     K = sp.csr_matrix(stiffness)
@@ -232,6 +237,8 @@ def elastic_coefficients(cb: CraigBamptonBasis, stiffness, mass):
     frequencies_hz : ndarray, shape (n_elastic,)
         Free-free frequencies of the reduced body, Hz.
     """
+    import scipy.linalg as sla
+
     K_r = cb.project(stiffness)
     M_r = cb.project(mass)
     lam, X = sla.eigh(K_r, M_r)

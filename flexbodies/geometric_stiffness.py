@@ -32,7 +32,9 @@ elastic coordinates, which the linear modal stiffness lacks.
 The FE part (``G``, the pinned-pinned model and its buckling load) is kept
 on disk next to the reduced links, keyed by the link model's hash
 (:meth:`flexbodies.link.LinkModel.key`); projecting ``G`` on a reduced
-link's modes costs a few sparse products.
+link's modes costs a few sparse products, and ``K_G,r`` is kept beside it,
+keyed by the mode basis as well, so that a run with its links cached loads
+NumPy arrays only (no SciPy).
 """
 from __future__ import annotations
 
@@ -41,22 +43,21 @@ import functools
 import hashlib
 import json
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.linalg as sla
-import scipy.sparse as sp
 
 from .atomic import replacing
 from .cache import MEMORY_ENTRIES, default_cache_dir, file_signature
-from .frequencies import mounted_constraint_basis
-from .interior import InteriorSolver
 from .materials import Material
 from .reduced import ReducedBody
 
-if TYPE_CHECKING:  # meshing and assembly load scikit-fem and gmsh: imported where a link is assembled
+if TYPE_CHECKING:  # SciPy, scikit-fem and gmsh: imported where a link's geometric stiffness is computed
+    import scipy.sparse as sp
+
+    from .interior import InteriorSolver
     from .meshing import BodyMesh
 
 __all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement",
@@ -82,10 +83,8 @@ class LinkStiffening:
 
     Attributes
     ----------
-    scalar : scipy.sparse.csr_matrix, shape (n, n)
-        ``G`` of the unit tension's stress field on the scalar element (FE
-        nodes); the FE geometric stiffness is ``G (x) I3`` node-major,
-        (N/m) per N of tension.
+    csr : tuple of ndarray
+        ``data``, ``indices`` and ``indptr`` of :attr:`scalar` (compressed rows).
     pinned_stiffness, pinned_mass, pinned_geometric : ndarray, shape (k, k)
         The pinned-pinned Craig-Bampton model (both masters pinned, spin
         held): stiffness (N/m), mass (kg) and geometric stiffness per N of
@@ -93,13 +92,30 @@ class LinkStiffening:
     buckling_load : float
         Compression at which the first pinned-pinned mode reaches zero, N
         (``inf`` when no compression buckles the model).
+    cache_file : Path or None
+        The cache file it was read from or written to; the projections
+        (:func:`stiffened`) are kept beside it.
     """
 
-    scalar: sp.csr_matrix
+    csr: tuple[np.ndarray, np.ndarray, np.ndarray]
     pinned_stiffness: np.ndarray
     pinned_mass: np.ndarray
     pinned_geometric: np.ndarray
     buckling_load: float
+    cache_file: Path | None = field(default=None, compare=False)
+
+    @property
+    def nodes(self) -> int:
+        """FE nodes of the link (the order of :attr:`scalar`)."""
+        return len(self.csr[2]) - 1
+
+    @functools.cached_property
+    def scalar(self) -> sp.csr_matrix:
+        """``G`` of the unit tension's stress field on the scalar element (FE nodes), shape (n, n); the FE
+        geometric stiffness is ``G (x) I3`` node-major, (N/m) per N of tension."""
+        import scipy.sparse as sp
+
+        return sp.csr_matrix(self.csr, shape=(self.nodes, self.nodes))
 
     def project(self, basis: np.ndarray) -> np.ndarray:
         """``V^T (G (x) I3) V`` of node-major displacement vectors (rows beyond the FE nodes ignored).
@@ -114,7 +130,7 @@ class LinkStiffening:
         ndarray, shape (k, k)
             (N/m) per N of tension.
         """
-        n = self.scalar.shape[0]
+        n = self.nodes
         nodal = np.asarray(basis)[: 3 * n].reshape(n, 3, -1)
         product = np.einsum("ick,icl->kl", nodal, (self.scalar @ nodal.reshape(n, -1)).reshape(n, 3, -1))
         return 0.5 * (product + product.T)
@@ -136,20 +152,17 @@ class LinkStiffening:
             squared frequency, returned as a negative number.
         """
         tension = np.asarray(tension, dtype=float)
-        if tension.ndim == 0:
-            lam = sla.eigh(self.pinned_stiffness + tension * self.pinned_geometric, self.pinned_mass,
-                           eigvals_only=True, subset_by_index=[0, count - 1])
-        else:       # one symmetric pencil per tension, whitened by M = L L^T
-            stiffness, geometric = self._whitened
-            lam = np.linalg.eigvalsh(stiffness + tension[..., None, None] * geometric)[..., :count]
+        stiffness, geometric = self._whitened      # one symmetric pencil per tension, whitened by M = L L^T
+        lam = np.linalg.eigvalsh(stiffness + tension[..., None, None] * geometric)[..., :count]
         return np.sign(lam) * np.sqrt(np.abs(lam)) / (2 * np.pi)
 
     @functools.cached_property
     def _whitened(self) -> tuple[np.ndarray, np.ndarray]:
         """``L^-1 K L^-T`` and ``L^-1 G L^-T`` of the pinned-pinned model, ``M = L L^T``."""
         factor = np.linalg.cholesky(self.pinned_mass)
-        return tuple(sla.solve_triangular(factor, sla.solve_triangular(factor, m, lower=True).T, lower=True)
-                     for m in (self.pinned_stiffness, self.pinned_geometric))
+        stiffness, geometric = (np.linalg.solve(factor, np.linalg.solve(factor, m).T)
+                                for m in (self.pinned_stiffness, self.pinned_geometric))
+        return stiffness, geometric
 
     def first_mode_shift(self, tension: float) -> float:
         """Relative change of the first pinned-pinned frequency under *tension* (N); -1 at buckling."""
@@ -213,6 +226,7 @@ def geometric_stiffness(link_mesh: BodyMesh, stress: np.ndarray) -> sp.csr_matri
     scipy.sparse.csr_matrix, shape (n, n)
         N/m, symmetric; rows follow the finite element nodes.
     """
+    import scipy.sparse as sp
     import skfem
 
     matrix = skfem.asm(skfem.BilinearForm(_initial_stress), _scalar_basis(link_mesh), sigma=stress)
@@ -243,6 +257,8 @@ def unit_tension_displacement(solver: InteriorSolver) -> np.ndarray:
 
 def _buckling_load(stiffness: np.ndarray, geometric: np.ndarray) -> float:
     """Smallest compression ``P`` with ``(K - P G) x = 0``, N (inf when none)."""
+    import scipy.linalg as sla
+
     # G x = kappa K x: the largest positive kappa is 1 / P_cr
     kappa = sla.eigh(geometric, stiffness, eigvals_only=True)
     return float(1.0 / kappa.max()) if kappa.max() > 0 else float("inf")
@@ -266,6 +282,7 @@ def mesh_stiffening(link_mesh: BodyMesh, material: Material, interface: str = "R
     LinkStiffening
     """
     from .assembly import assemble
+    from .interior import InteriorSolver
     from .reduction import couple
 
     coupled = couple(assemble(link_mesh, material), interface)
@@ -297,6 +314,8 @@ def coupled_stiffening(link_mesh: BodyMesh, coupled, solver: InteriorSolver, mat
     -------
     LinkStiffening
     """
+    from .frequencies import mounted_constraint_basis
+
     transform = coupled.coupling.transform
     displacement = transform @ unit_tension_displacement(solver)
     if rotation is not None:
@@ -309,7 +328,8 @@ def coupled_stiffening(link_mesh: BodyMesh, coupled, solver: InteriorSolver, mat
         product = basis.T @ (matrix @ basis)
         return 0.5 * (product + product.T)
 
-    stiffening = LinkStiffening(scalar, project(coupled.stiffness), project(coupled.mass), np.zeros(0), 0.0)
+    stiffening = LinkStiffening((scalar.data, scalar.indices, scalar.indptr), project(coupled.stiffness),
+                                project(coupled.mass), np.zeros(0), 0.0)
     g_pinned = stiffening.project((transform @ basis))
     return dataclasses.replace(stiffening, pinned_geometric=g_pinned,
                                buckling_load=_buckling_load(stiffening.pinned_stiffness, g_pinned))
@@ -333,10 +353,13 @@ def _load(path: Path) -> LinkStiffening | None:
         return remembered[0]
     try:
         with np.load(path, allow_pickle=False) as data:
-            scalar = sp.csr_matrix((data["data"], data["indices"], data["indptr"]), shape=tuple(data["shape"]))
-            stiffening = LinkStiffening(scalar, data["pinned_stiffness"], data["pinned_mass"],
-                                        data["pinned_geometric"], float(data["buckling_load"]))
+            csr = (data["data"], data["indices"], data["indptr"])
+            stiffening = LinkStiffening(csr, data["pinned_stiffness"], data["pinned_mass"], data["pinned_geometric"],
+                                        float(data["buckling_load"]), path)
+            shape = tuple(data["shape"])
     except (OSError, ValueError, KeyError, EOFError):
+        return None
+    if shape != (stiffening.nodes,) * 2 or not len(csr[0]) == len(csr[1]) == csr[2][-1]:
         return None
     _memory[path] = (stiffening, signature)
     _memory.move_to_end(path)
@@ -370,7 +393,7 @@ def link_stiffening(model, *, cache_dir=None, use_cache: bool = True) -> LinkSti
             return stored
     stiffening = mesh_stiffening(model.meshed(), model.material, model.interface)
     if use_cache:
-        save_stiffening(model, stiffening, cache_dir=cache_dir)
+        stiffening = dataclasses.replace(stiffening, cache_file=save_stiffening(model, stiffening, cache_dir=cache_dir))
     return stiffening
 
 
@@ -389,10 +412,10 @@ def save_stiffening(model, stiffening: LinkStiffening, *, cache_dir=None) -> Pat
     """
     path = _path(model, cache_dir)
     path.parent.mkdir(parents=True, exist_ok=True)
-    scalar = stiffening.scalar
+    data, indices, indptr = stiffening.csr
     with replacing(path) as temporary, open(temporary, "wb") as handle:
-        np.savez(handle, data=scalar.data, indices=scalar.indices, indptr=scalar.indptr,
-                 shape=np.array(scalar.shape), pinned_stiffness=stiffening.pinned_stiffness,
+        np.savez(handle, data=data, indices=indices, indptr=indptr,
+                 shape=np.array([stiffening.nodes] * 2), pinned_stiffness=stiffening.pinned_stiffness,
                  pinned_mass=stiffening.pinned_mass, pinned_geometric=stiffening.pinned_geometric,
                  buckling_load=np.float64(stiffening.buckling_load))
     return path
@@ -406,14 +429,45 @@ _projections: OrderedDict = OrderedDict()
 
 def _projection(stiffening: LinkStiffening, basis: np.ndarray) -> np.ndarray:
     """``stiffening.project(basis)``, computed once per pair of objects (the result is not to be changed)."""
-    key = (id(stiffening.scalar), id(basis))
+    key = (id(stiffening), id(basis))
     kept = _projections.get(key)
     if kept is None:
-        kept = _projections[key] = (stiffening.scalar, basis, stiffening.project(basis))
+        kept = _projections[key] = (stiffening, basis, _kept_projection(stiffening, basis))
         while len(_projections) > MEMORY_ENTRIES:
             _projections.popitem(last=False)
     _projections.move_to_end(key)
     return kept[2]
+
+
+def _projection_file(stiffening_file: Path, basis: np.ndarray) -> Path:
+    """Where ``K_G,r`` of a cached geometric stiffness and a mode basis is kept: beside the
+    stiffening's file, named by the basis's SHA-256 as well."""
+    basis = np.ascontiguousarray(basis)
+    digest = hashlib.sha256(f"{basis.dtype} {basis.shape}".encode())
+    digest.update(basis.reshape(-1).view(np.uint8).data)
+    return stiffening_file.with_name(f"{stiffening_file.stem}-{digest.hexdigest()[:24]}.npy")
+
+
+def _kept_projection(stiffening: LinkStiffening, basis: np.ndarray) -> np.ndarray:
+    """``stiffening.project(basis)``, read from its file beside the stiffening's cache file or
+    computed (SciPy's sparse product) and kept there; a file that cannot be read is recomputed and
+    replaced, one that cannot be written is left out."""
+    if stiffening.cache_file is None:
+        return stiffening.project(basis)
+    path = _projection_file(stiffening.cache_file, basis)
+    try:
+        kept = np.load(path, allow_pickle=False)
+        if kept.shape == (basis.shape[1],) * 2 and kept.dtype == float:
+            return kept
+    except (OSError, ValueError, EOFError):
+        pass
+    projected = stiffening.project(basis)
+    try:
+        with replacing(path) as temporary, open(temporary, "wb") as handle:
+            np.save(handle, projected)
+    except OSError:
+        pass
+    return projected
 
 
 def stiffened(link: ReducedBody, stiffening: LinkStiffening, tension: float) -> ReducedBody:
@@ -432,9 +486,9 @@ def stiffened(link: ReducedBody, stiffening: LinkStiffening, tension: float) -> 
     ReducedBody
         A copy; ``info["axial_tension_N"]`` records the tension.
     """
-    if int(link.master_nodes[0]) != stiffening.scalar.shape[0]:
+    if int(link.master_nodes[0]) != stiffening.nodes:
         raise ValueError(f"the link's reduction has {int(link.master_nodes[0])} FE nodes but its geometric "
-                         f"stiffness {stiffening.scalar.shape[0]}: they were meshed differently")
+                         f"stiffness {stiffening.nodes}: they were meshed differently")
     ffrf = dict(link.ffrf)
     ffrf["stiffnessMatrixReduced"] = (np.asarray(link.ffrf["stiffnessMatrixReduced"])
                                       + tension * _projection(stiffening, link.mode_basis))

@@ -10,6 +10,7 @@ from test_sdof import sdof_case
 
 from workbook.errors import CaseError, DivergenceError, NewtonFailure, RunTooLong, SimulationError, TimeBudgetExceeded
 from workbook.model.case import AnalysisSettings, HarmonicForce
+from workbook.solve.guards import RoundOffWarning, checked_solve
 from workbook.solve.pipeline import run_excitation
 
 SDOF = sdof_case((1.0,))
@@ -96,3 +97,30 @@ def test_a_long_measured_window_is_sampled_once_per_step():
     assert len(result.time) == 2 * 4000 * 40 + 1
     assert np.abs(np.diff(result.time) - step).max() < 1e-9 * step
     assert np.all(np.isfinite(result.transmissibility))
+
+
+@pytest.mark.parametrize("condition", [1e2, 1e10, 1e19, 1e22])
+def test_a_solve_singular_to_round_off_warns_as_scipys_does(condition):
+    """:func:`checked_solve` against SciPy's ``solve``: the same answer, and a warning on the same
+    complex matrices (dynamic stiffnesses of a given condition number)."""
+    import warnings
+
+    import scipy.linalg as sla
+
+    generator = np.random.default_rng(3)
+    size = 40
+    left, _ = np.linalg.qr(generator.normal(size=(size, size)) + 1j * generator.normal(size=(size, size)))
+    right, _ = np.linalg.qr(generator.normal(size=(size, size)) + 1j * generator.normal(size=(size, size)))
+    matrix = left @ np.diag(np.logspace(0, -np.log10(condition), size)) @ right
+    load = generator.normal(size=size) + 1j * generator.normal(size=size)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        expected = sla.solve(matrix, load)
+        answer = checked_solve(matrix, load)
+    scipy_warned = any(issubclass(w.category, sla.LinAlgWarning) for w in caught)
+    warned = any(issubclass(w.category, RoundOffWarning) for w in caught)
+    assert warned == scipy_warned == (condition > 1e16)
+    if not warned:
+        np.testing.assert_allclose(answer, expected, rtol=1e-15 * condition * 100)
+    with pytest.raises(np.linalg.LinAlgError):
+        checked_solve(np.zeros((3, 3)), np.ones(3))

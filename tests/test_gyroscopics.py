@@ -77,6 +77,41 @@ def test_mounted_modes_split_into_forward_and_backward_whirl():
     assert scene.gyroscopics.rotors == ("rotor",)
 
 
+@pytest.mark.parametrize("spin", [0.0, 300.0])
+def test_eigenpairs_are_those_of_scipys_generalised_problem(spin):
+    """The eigenpairs (whitened by the Cholesky factor of M) against SciPy's QZ of the pencil as
+    given, and each pair's residual: ``(lambda^2 M + lambda G + K) x = 0`` with ``lambda = i w``.
+    The masses span 1e-3 to 1e3 as a link's modal and a heavy engine's coordinates do; without spin
+    K has an unsymmetric part, as the preload's geometric stiffness gives it (with spin it is kept
+    symmetric, so that every ``lambda`` is imaginary)."""
+    import scipy.linalg as sla
+
+    from workbook.solve.modes import Linearization, eigenpairs
+
+    generator = np.random.default_rng(7)
+    size = 12
+    shape = generator.normal(size=(size, size))
+    scale = np.diag(np.logspace(-1.5, 1.5, size))
+    mass = scale @ (shape @ shape.T + size * np.eye(size)) @ scale
+    shape = generator.normal(size=(size, size))
+    stiffness = 1e4 * (shape @ shape.T + size * np.eye(size)) + (spin == 0) * 10.0 * generator.normal(size=(size, size))
+    gyroscopic = spin * np.triu(generator.normal(size=(size, size)), 1)
+    gyroscopic = gyroscopic - gyroscopic.T
+    lin = Linearization(mass, stiffness, gyroscopic, np.eye(size), mass, {}, gyroscopic if spin else None)
+    squared, vectors = eigenpairs(lin)
+    if spin:
+        first_order = sla.eig(np.block([[np.zeros((size, size)), np.eye(size)], [-stiffness, -gyroscopic]]),
+                              sla.block_diag(np.eye(size), mass), right=False)
+        expected = np.sort(-(first_order[first_order.imag > 0] ** 2).real)
+    else:
+        expected = np.sort(sla.eig(stiffness, mass, right=False).real)
+    np.testing.assert_allclose(squared, expected, rtol=1e-9)
+    lam = 1j * np.sqrt(squared)
+    residual = (lam ** 2 * (mass @ vectors) + lam * (gyroscopic @ vectors) + stiffness @ vectors)
+    scale = np.abs(lam) ** 2 * np.linalg.norm(mass, 2) * np.linalg.norm(vectors, axis=0)
+    assert np.all(np.linalg.norm(residual, axis=0) < 1e-10 * scale)
+
+
 def test_moment_is_exact_for_a_large_rotation():
     """M = -Ip Omega (omega x a), with a turned with the engine, as generalised
     force G^T M on the Tait-Bryan angles; omega, G and the rotation from Exudyn's node."""

@@ -8,6 +8,7 @@ import skfem
 from conftest import COARSE_ELEMENT_SIZE
 from excel_helpers import copy_reference, set_cells
 
+import flexbodies.geometric_stiffness as geometric_stiffness
 from flexbodies import LinkGeometry, LinkModel, reduce_link, reduce_link_set
 from flexbodies.geometric_stiffness import link_stiffening, mesh_stiffening, stiffened
 from flexbodies.materials import STEEL
@@ -200,6 +201,42 @@ def test_the_geometric_stiffness_is_cached_and_a_damaged_entry_recomputed(tmp_pa
     np.testing.assert_allclose(pulled + pushed, 2 * base, rtol=1e-12, atol=1e-9 * np.abs(base).max())
     np.testing.assert_allclose(pulled, pulled.T, rtol=0, atol=1e-12 * np.abs(base).max())
     assert np.abs(pulled - base).max() > 1e-6 * np.abs(base).max()
+
+
+@pytest.mark.slow
+def test_the_projected_geometric_stiffness_is_kept_beside_it_and_a_damaged_one_recomputed(tmp_path):
+    """K_G,r of a reduction is kept beside the stiffening's cache file: a later process reads it
+    (no sparse product), equal to the projection; a damaged file is recomputed and replaced."""
+    model = LinkModel(geometry=LinkGeometry(length=0.20, eye_outer_radius=0.025, bore_radius=0.012, thickness=0.020,
+                                            shank_width=0.030, shank_thickness=0.020), element_size=0.02)
+    link = reduce_link(model, 4, cache_dir=tmp_path)
+    stiffening = link_stiffening(model, cache_dir=tmp_path)
+    assert not list(tmp_path.glob("stiffening-*.npy"))
+    base = np.asarray(link.ffrf["stiffnessMatrixReduced"])
+    pulled = stiffened(link, stiffening, 1e4).ffrf["stiffnessMatrixReduced"]
+    (kept,) = tmp_path.glob("stiffening-*.npy")
+    projected = link_stiffening(model, use_cache=False).project(link.mode_basis)
+    np.testing.assert_allclose(np.load(kept), projected, rtol=1e-7, atol=1e-9 * np.abs(projected).max())
+    np.testing.assert_array_equal(pulled, base + 1e4 * np.load(kept))
+
+    def in_a_new_process():
+        """The stiffened matrix as a new process makes it (the files alone, nothing in memory), and
+        whether it made the sparse G (that is, projected it)."""
+        geometric_stiffness._memory.clear()
+        geometric_stiffness._projections.clear()
+        loaded = link_stiffening(model, cache_dir=tmp_path)
+        return stiffened(link, loaded, 1e4).ffrf["stiffnessMatrixReduced"], "scalar" in vars(loaded)
+
+    again, projected_again = in_a_new_process()
+    np.testing.assert_array_equal(again, pulled)
+    assert not projected_again
+    kept.write_bytes(b"not an array")
+    again, projected_again = in_a_new_process()
+    np.testing.assert_array_equal(again, pulled)
+    assert projected_again and np.load(kept).shape == (link.n_modes, link.n_modes)
+    other = reduce_link(model, 2, cache_dir=tmp_path)      # another mode basis: a file of its own
+    stiffened(other, link_stiffening(model, cache_dir=tmp_path), 1e4)
+    assert len(list(tmp_path.glob("stiffening-*.npy"))) == 2
 
 
 def test_the_reduction_keeps_the_geometric_stiffness_of_its_own_factorisation(tmp_path):

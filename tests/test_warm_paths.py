@@ -27,8 +27,10 @@ from workbook.model import units
 
 ROOT = Path(__file__).resolve().parents[1]
 
-#: Packages ``mountwb run`` on a JSON case with cached links has no use for.
-NOT_NEEDED = ("pandas", "pint", "matplotlib", "openpyxl", "skfem", "meshio", "gmsh", "dask", "pyarrow")
+#: Packages ``mountwb run`` on a JSON case with cached links has no use for. SciPy's own package is
+#: imported (Exudyn's FEM module checks that SciPy is installed, 15 ms); its subpackages are not.
+NOT_NEEDED = ("pandas", "pint", "matplotlib", "openpyxl", "skfem", "meshio", "gmsh", "dask", "pyarrow",
+              "scipy.linalg", "scipy.sparse")
 
 _PROBE = """
 import sys

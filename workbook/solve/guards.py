@@ -27,11 +27,12 @@ import logging
 import math
 import warnings
 
-from scipy.linalg import LinAlgWarning
+import numpy as np
 
 from workbook.errors import ResonanceError
 
-__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "singular_solve_guard", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
+__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "singular_solve_guard", "checked_solve",
+           "RoundOffWarning", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
 
 log = logging.getLogger(__name__)
 
@@ -41,6 +42,11 @@ UNDAMPED_RATIO = 1e-6
 #: Planned time steps above which a run is refused as not meant (about a day
 #: of wall time for the reference mount with flexible links).
 MAX_STEPS = 50_000_000
+
+
+class RoundOffWarning(RuntimeWarning):
+    """A linear solve whose matrix is singular to round-off: its answer may be noise
+    (:func:`checked_solve`; :func:`singular_solve_guard` turns it into a :class:`ResonanceError`)."""
 
 
 def run_label(case_name: str, run_name: str) -> str:
@@ -131,10 +137,27 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
                 f"excitation frequency.")
 
 
+def checked_solve(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """``matrix^-1 rhs`` (LU), with a :class:`RoundOffWarning` when *matrix* is singular to round-off:
+    its reciprocal condition number (1-norm) below the machine epsilon, as SciPy's ``solve`` warns.
+
+    Raises
+    ------
+    numpy.linalg.LinAlgError
+        *matrix* is exactly singular.
+    """
+    solution = np.linalg.solve(matrix, rhs)
+    reciprocal = 1.0 / np.linalg.cond(matrix, 1)
+    if not reciprocal >= np.finfo(float).eps:
+        warnings.warn(f"ill-conditioned matrix (reciprocal condition number {reciprocal:.3g})", RoundOffWarning,
+                      stacklevel=2)
+    return solution
+
+
 @contextlib.contextmanager
 def singular_solve_guard(where: str, frequency_hz: float, modes):
-    """Turn a harmonic solve that is singular to round-off (scipy's
-    ``LinAlgWarning``) into a :class:`ResonanceError` naming the mode nearest
+    """Turn a harmonic solve that is singular to round-off (a :class:`RoundOffWarning`
+    of :func:`checked_solve`) into a :class:`ResonanceError` naming the mode nearest
     to the excitation, instead of an answer that is noise.
 
     Parameters
@@ -151,10 +174,10 @@ def singular_solve_guard(where: str, frequency_hz: float, modes):
     ResonanceError
     """
     with warnings.catch_warnings():
-        warnings.simplefilter("error", LinAlgWarning)
+        warnings.simplefilter("error", RoundOffWarning)
         try:
             yield
-        except LinAlgWarning as warning:
+        except RoundOffWarning as warning:
             def distance(mode) -> float:
                 return abs(frequency_hz / mode.frequency_hz - 1.0) if mode.frequency_hz > 0 else math.inf
 

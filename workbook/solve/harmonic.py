@@ -39,12 +39,12 @@ from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
 from workbook.model.case import ENGINE, SingleFrequencyExcitation
 from workbook.scene.build import Scene, loss_factors
+from workbook.solve.guards import checked_solve
 from workbook.solve.modes import Linearization, linearize
 from workbook.solve.truncation import residual_stiffness
 
@@ -169,7 +169,7 @@ class HarmonicModel:
             dynamic = dynamic + 1j * lin.structural
         if added is not None:
             dynamic = dynamic + added
-        return sla.solve(dynamic, load, check_finite=False)
+        return checked_solve(dynamic, load)
 
     def respond_generalised(self, frequency_hz: float, load: np.ndarray, added=None) -> FrequencyResponse:
         """Steady-state hinge forces for the generalised force phasor *load* (shape (n,)) at *frequency_hz*

@@ -1,7 +1,7 @@
 """Linearised modes of a scene: free motions (mechanisms) and mounted modes.
 
-Exudyn linearises the system at its initial state (``ComputeLinearizedSystem``:
-M, K, D). K holds the geometric stiffness of the preload for the bodies'
+Exudyn linearises the system at its initial state (its static solver's mass
+matrix and Jacobians, as ``ComputeLinearizedSystem`` takes them: M, K, D). K holds the geometric stiffness of the preload for the bodies'
 rigid-body motion (the hinge forces turning with a link or the engine); a
 flexible link's modal coordinates have the stiffness of its reduced body,
 which holds its own stress stiffening only when that effect built it in
@@ -31,9 +31,9 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
@@ -153,6 +153,36 @@ def body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
     return indices
 
 
+def _linearized_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """M, K, D and the constraint Jacobian ``C`` (ODE2 rows, one column per algebraic equation) of
+    *mbs* at its initial state.
+
+    The calls of Exudyn's ``ComputeLinearizedSystem(returnConstraintJacobian=True)``, which imports
+    SciPy for a null space it is not asked for.
+    """
+    import exudyn as exu
+
+    settings = exu.SimulationSettings()
+    settings.solution.file.write = False
+    settings.solution.sensors.active = False
+    settings.staticSolver.verboseMode = 0
+    solver: Any = exu.MainSolverStatic()    # Any: Exudyn's stubs declare the solver's methods without self
+    with solver_output():
+        solver.InitializeSolver(mbs, settings)
+        ode2, ode1 = solver.GetODE2size(), solver.GetODE1size()
+        solver.ComputeMassMatrix(mbs)
+        mass = np.asarray(solver.GetSystemMassMatrix())[:ode2, :ode2]
+        solver.ComputeJacobianODE2RHS(mbs, scalarFactor_ODE2=-1, scalarFactor_ODE2_t=0, scalarFactor_ODE1=0)
+        if solver.GetAEsize() > 0:
+            solver.ComputeJacobianAE(mbs, scalarFactor_ODE2=1.0, scalarFactor_ODE2_t=0.0, scalarFactor_ODE1=0.0,
+                                     velocityLevel=False)
+        jacobian = np.asarray(solver.GetSystemJacobian())
+        solver.ComputeJacobianODE2RHS(mbs, scalarFactor_ODE2=0, scalarFactor_ODE2_t=-1, scalarFactor_ODE1=0)
+        damping = np.asarray(solver.GetSystemJacobian())[:ode2, :ode2]
+        solver.FinalizeSolver(mbs, settings)
+    return mass, jacobian[:ode2, :ode2], damping, jacobian[:ode2, ode2 + ode1:]
+
+
 def linearize(scene: Scene) -> Linearization:
     """Linearise *scene* at its initial state (after a static solve with
     ``updateInitialValues=True``: the preloaded state).
@@ -162,19 +192,10 @@ def linearize(scene: Scene) -> Linearization:
     (the only skew-symmetric damping of the scene: hinge and Rayleigh damping
     are symmetric).
     """
-    import exudyn as exu
-
-    settings = exu.SimulationSettings()
-    settings.solution.file.write = False
-    mbs = scene.mbs
-    with solver_output():
-        matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
-                                               returnConstraintJacobian=True)
-    mass, stiffness, damping = (np.asarray(m) for m in matrices[:3])
+    mass, stiffness, damping, jacobian = _linearized_matrices(scene.mbs)
     size = mass.shape[0]
-    if mbs.systemData.AEsize() > 0:
-        jacobian = np.asarray(matrices[3])
-        left, singular, _ = sla.svd(jacobian)
+    if jacobian.shape[1] > 0:
+        left, singular, _ = np.linalg.svd(jacobian)
         rank = int((singular > 1e-12 * max(singular.max(), 1.0)).sum())
         basis = left[:, rank:]
     else:
@@ -201,23 +222,27 @@ def eigenpairs(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
     negative-stiffness pair ``+-lambda`` counting as ``w^2 = -lambda^2``)
     the larger half.
     """
+    # M = L L^T (every coordinate has mass): a standard eigenproblem in y = L^T x
+    factor = np.linalg.cholesky(lin.mass)
+
+    def whitened(matrix):
+        """``L^-1 A L^-T``."""
+        return np.linalg.solve(factor, np.linalg.solve(factor, matrix).T).T
+
+    stiffness = whitened(lin.stiffness)
     if lin.gyroscopic is None:
-        eigenvalues, vectors = sla.eig(lin.stiffness, lin.mass)
+        eigenvalues, vectors = np.linalg.eig(stiffness)
         order = np.argsort(eigenvalues.real)
-        return eigenvalues.real[order], vectors[:, order]
+        return eigenvalues.real[order], np.linalg.solve(factor.T, vectors[:, order])
     size = lin.mass.shape[0]
     identity, zero = np.eye(size), np.zeros((size, size))
-    if np.array_equal(lin.mass, identity):       # a mass-orthonormal basis: a standard eigenproblem, faster
-        eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]))
-    else:
-        eigenvalues, vectors = sla.eig(np.block([[zero, identity], [-lin.stiffness, -lin.gyroscopic]]),
-                                       np.block([[identity, zero], [zero, lin.mass]]))
+    eigenvalues, vectors = np.linalg.eig(np.block([[zero, identity], [-stiffness, -whitened(lin.gyroscopic)]]))
     tolerance = 1e-9 * np.abs(eigenvalues).max()
     half_plane = np.where(eigenvalues.imag > tolerance, 0, np.where(eigenvalues.imag < -tolerance, 2, 1))
     keep = np.lexsort((-eigenvalues.real, half_plane))[:size]
     squared = -(eigenvalues[keep] ** 2).real
     order = np.argsort(squared)
-    return squared[order], vectors[:size, keep[order]]
+    return squared[order], np.linalg.solve(factor.T, vectors[:size, keep[order]])
 
 
 def modes_of(linearization: Linearization, *, gyroscopic: bool = True) -> list[Mode]:

@@ -19,7 +19,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from workbook.answers.isolation import pylon_sum
 from workbook.solve.harmonic import FrequencyResponse, HarmonicModel
@@ -152,11 +151,8 @@ def respond_many(model: HarmonicModel, frequencies_hz, force, point) -> SweepRes
     omegas = 2 * np.pi * frequencies_hz
     load = model.input_matrix(point) @ np.asarray(force, dtype=complex)
     motion, errors = modal_motions(model, omegas, load)
-    lin = model.linearization
-    stiffness = _complex_stiffness(model)
     for j in np.flatnonzero(errors > ROUND_OFF):
-        dynamic = stiffness - omegas[j] ** 2 * lin.mass + 1j * omegas[j] * lin.damping
-        motion[:, j] = sla.solve(dynamic, load, check_finite=False)
+        motion[:, j] = model.motion(frequencies_hz[j], load)
     outputs = _times(np.vstack([model.stiffness_output, model.structural_output, model.damping_output]), motion)
     third = len(outputs) // 3
     forces = (outputs[:third] + 1j * (outputs[third:2 * third] + omegas * outputs[2 * third:]))
