@@ -45,8 +45,8 @@ from workbook.design.channel_set import ChannelSet
 from workbook.design.kinematics import PointKinematics, identify
 from workbook.errors import OutsideDesignModel, SimulationError
 from workbook.scene.build import Scene
-from workbook.solve.guards import solver_output
 from workbook.solve.modes import body_coordinates as _body_coordinates
+from workbook.solve.modes import linearized_matrices
 
 __all__ = ["RestBlocks", "SceneExpansion", "expand_scene"]
 
@@ -306,13 +306,7 @@ def _position_expansion(set_state, base: np.ndarray, positions, coordinates: lis
 
 
 def _rest_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    import exudyn as exu
-
-    settings = exu.SimulationSettings()
-    settings.solution.file.write = False
-    with solver_output():
-        matrices = mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False)
-    return tuple(np.asarray(m) for m in matrices[:3])  # type: ignore[return-value]
+    return linearized_matrices(mbs)[:3]
 
 
 def _channels_released(scene: Scene):
@@ -450,16 +444,10 @@ def _stiffness_curvature(scene: Scene, set_state, base: np.ndarray, coordinates:
 
 
 def _euler_blocks(scene: Scene) -> np.ndarray:
-    import exudyn as exu
-
     mbs = scene.mbs
     if mbs.systemData.AEsize() == 0:
         return np.zeros((0, 4), dtype=int)
-    settings = exu.SimulationSettings()
-    settings.solution.file.write = False
-    with solver_output():
-        jacobian = np.asarray(mbs.ComputeLinearizedSystem(settings, projectIntoConstraintNullspace=False,
-                                                          returnConstraintJacobian=True)[3])
+    jacobian = linearized_matrices(mbs)[3]
     blocks = []
     for row in jacobian.T:  # Exudyn gives it transposed: (coordinates, constraints)
         support = np.flatnonzero(row)

@@ -39,7 +39,7 @@ from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
 
-__all__ = ["Linearization", "Mode", "linearize",
+__all__ = ["Linearization", "Mode", "linearize", "linearized_matrices",
            "body_coordinates", "eigenpairs", "modes_from", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
            "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
 
@@ -153,7 +153,7 @@ def body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
     return indices
 
 
-def _linearized_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def linearized_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """M, K, D and the constraint Jacobian ``C`` (ODE2 rows, one column per algebraic equation) of
     *mbs* at its initial state.
 
@@ -192,7 +192,7 @@ def linearize(scene: Scene) -> Linearization:
     (the only skew-symmetric damping of the scene: hinge and Rayleigh damping
     are symmetric).
     """
-    mass, stiffness, damping, jacobian = _linearized_matrices(scene.mbs)
+    mass, stiffness, damping, jacobian = linearized_matrices(scene.mbs)
     size = mass.shape[0]
     if jacobian.shape[1] > 0:
         left, singular, _ = np.linalg.svd(jacobian)
