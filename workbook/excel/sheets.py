@@ -14,8 +14,9 @@ import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
+from openpyxl.cell.read_only import EmptyCell
 from openpyxl.utils import get_column_letter
 from openpyxl.utils.cell import coordinate_to_tuple
 from openpyxl.utils.datetime import to_excel
@@ -26,7 +27,7 @@ from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
 from workbook.model.units import DIMENSIONLESS, si_factor
 
-__all__ = ["Record", "SheetReader", "OpenedWorkbook", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
+__all__ = ["Record", "SheetReader", "CachedValues", "OpenedWorkbook", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
            "MAX_FILE_BYTES", "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
 
 
@@ -68,15 +69,14 @@ MAX_DATA_ROWS = 10_000
 class _Cells:
     """The stored cells of one sheet (values as cached, and formulas), looked up without creating cells."""
 
-    def __init__(self, ws_values, ws_formulas):
-        cells = stored_cells(ws_values)
-        self._values = {(c.row, c.column): c.value for c in cells}
+    def __init__(self, values: dict, ws_formulas):
+        self._values = {key: cell.value for key, cell in values.items()}
         #: Cells holding a number shown as a percentage (5 % is stored as 0.05).
-        self.percent = {(c.row, c.column) for c in cells
-                        if isinstance(c.value, (int, float)) and not isinstance(c.value, bool)
-                        and _percent_format(c.number_format)}
+        self.percent = {key for key, cell in values.items()
+                        if isinstance(cell.value, (int, float)) and not isinstance(cell.value, bool)
+                        and _percent_format(cell.number_format)}
         self._formulas = {(c.row, c.column): c.value for c in stored_cells(ws_formulas) if c.data_type == "f"}
-        self.merged = list(ws_values.merged_cells.ranges)
+        self.merged = list(ws_formulas.merged_cells.ranges)
 
     def value(self, row: int, col: int) -> Any:
         return self._values.get((row, col))
@@ -226,7 +226,7 @@ class SheetReader:
                 self.problem(table.sheet, None, None, None,
                              f"a sheet named '{table.sheet}' (sheets: {', '.join(self.values.sheetnames)})")
             return []
-        sheet = _Cells(self.values[title], self.formulas[title])
+        sheet = _Cells(self.values.cells(title), self.formulas[title])
         positions = self._headers(table, sheet)
         if positions is None:
             return []
@@ -610,6 +610,63 @@ def _too_large(path: Path) -> Problem | None:
     return None
 
 
+class CachedValues:
+    """The values Excel cached in a workbook's cells, each sheet parsed the first time it is asked for.
+
+    Holds the workbook loaded ``read_only=True, data_only=True``: only the
+    sheets read are parsed (not, say, the result sheets of an earlier run).
+    :meth:`close` keeps the cached values of the formula cells, which the
+    writer puts back (:meth:`formula_values`), and closes the workbook.
+
+    Parameters
+    ----------
+    values : openpyxl.Workbook
+        Loaded read-only with the cached values.
+    formulas : openpyxl.Workbook
+        The same file loaded with its formulas.
+    """
+
+    def __init__(self, values, formulas):
+        self._workbook, self._formulas = values, formulas
+        self._sheets: dict[str, dict] = {}
+        self._formula_values: dict[str, dict[str, Any]] = {}
+        self.sheetnames: list[str] = list(values.sheetnames)
+
+    def cells(self, title: str) -> dict:
+        """The stored cells of sheet *title* by ``(row, column)``, each with its ``value`` and ``number_format``."""
+        if title not in self._sheets:
+            ws = self._workbook[title]
+            ws.reset_dimensions()    # every stored cell, whatever size the file says the sheet has
+            self._sheets[title] = {(cell.row, cell.column): cell for row in ws.iter_rows() for cell in row
+                                   if not isinstance(cell, EmptyCell)}
+        return self._sheets[title]
+
+    def rows(self, title: str) -> Iterator[tuple]:
+        """The values of sheet *title* row by row from row 1, each row as wide as the sheet (as openpyxl's
+        ``iter_rows(values_only=True)`` of a loaded sheet)."""
+        cells = self.cells(title)
+        last_row = max((row for row, _ in cells), default=1)
+        last_col = max((col for _, col in cells), default=1)
+        for row in range(1, last_row + 1):
+            yield tuple(cell.value if (cell := cells.get((row, col))) is not None else None
+                        for col in range(1, last_col + 1))
+
+    def formula_values(self, title: str) -> dict[str, Any]:
+        """The cached value of each formula cell of sheet *title* that has one, by coordinate (once closed)."""
+        return self._formula_values.get(title, {})
+
+    def close(self) -> None:
+        """Keep the cached values of the formula cells (:meth:`formula_values`), then close the workbook."""
+        for ws in self._formulas.worksheets:
+            formulas = [cell for cell in stored_cells(ws) if cell.data_type == "f"]
+            if formulas and ws.title in self.sheetnames:
+                cells = self.cells(ws.title)
+                found = {cell.coordinate: cells.get((cell.row, cell.column)) for cell in formulas}
+                self._formula_values[ws.title] = {coordinate: cell.value for coordinate, cell in found.items()
+                                                  if cell is not None and cell.value is not None}
+        self._workbook.close()
+
+
 class OpenedWorkbook:
     """A case workbook as the reader opened it, handed on once to the writer of its results.
 
@@ -621,8 +678,10 @@ class OpenedWorkbook:
     ----------
     sha256 : str
         SHA-256 of the bytes both workbooks were loaded from.
-    formulas, values : openpyxl.Workbook
-        Loaded with formulas (and rich text), and with the cached values.
+    formulas : openpyxl.Workbook
+        Loaded with formulas (and rich text).
+    values : CachedValues
+        The cached values, closed.
     """
 
     def __init__(self, sha256: str, formulas, values):
@@ -655,8 +714,8 @@ def read_workbook_bytes(path: Path) -> bytes:
     return path.read_bytes()
 
 
-def open_workbook(path: str | Path, data: bytes | None = None):
-    """Open a workbook twice: with formulas (and rich text, kept for the writer) and with the cached values.
+def open_workbook(path: str | Path, data: bytes | None = None) -> tuple[Any, CachedValues]:
+    """Open a workbook with its formulas (and rich text, kept for the writer) and with its cached values.
 
     Parameters
     ----------
@@ -667,7 +726,8 @@ def open_workbook(path: str | Path, data: bytes | None = None):
 
     Returns
     -------
-    (formulas, values) : two openpyxl Workbooks
+    (formulas, values) : openpyxl.Workbook and CachedValues
+        *values* to be closed by the caller (:meth:`CachedValues.close`).
 
     Raises
     ------
@@ -687,8 +747,8 @@ def open_workbook(path: str | Path, data: bytes | None = None):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             # rich text changes no formula, the only cells the reader takes from this one (the writer keeps it)
-            return (load_workbook(io.BytesIO(data), data_only=False, rich_text=True),
-                    load_workbook(io.BytesIO(data), data_only=True))
+            formulas = load_workbook(io.BytesIO(data), data_only=False, rich_text=True)
+            return formulas, CachedValues(load_workbook(io.BytesIO(data), data_only=True, read_only=True), formulas)
     except Exception as exc:  # openpyxl raises many kinds for a damaged file
         raise WorkbookError([Problem(path.name, None, None, None, f"{type(exc).__name__}: {exc}",
                                      "a readable Excel .xlsx workbook")]) from None
