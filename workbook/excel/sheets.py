@@ -27,7 +27,8 @@ from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
 from workbook.model.units import DIMENSIONLESS, si_factor
 
-__all__ = ["Record", "SheetReader", "CachedValues", "OpenedWorkbook", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
+__all__ = ["Record", "SheetReader", "CachedValues", "OpenedWorkbook", "open_workbook", "peek", "stored_cells",
+           "stored_values", "value_rows", "matching_sheets", "MAX_DATA_ROWS",
            "MAX_FILE_BYTES", "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
 
 
@@ -44,6 +45,23 @@ def peek(ws, coordinate: str) -> Any:
 def stored_cells(ws) -> list:
     """The cells stored in *ws* (those in the file), by row then column; no empty cell is created."""
     return [ws._cells[key] for key in sorted(ws._cells)]
+
+
+def value_rows(values: dict) -> Iterator[tuple]:
+    """The *values* by ``(row, column)`` row by row from row 1, each row as wide as the widest.
+
+    As openpyxl's ``iter_rows(values_only=True)`` gives a sheet's values
+    (:func:`stored_values`), without creating a cell for every empty place.
+    """
+    last_row = max((row for row, _ in values), default=1)
+    last_col = max((col for _, col in values), default=1)
+    for row in range(1, last_row + 1):
+        yield tuple(values.get((row, col)) for col in range(1, last_col + 1))
+
+
+def stored_values(ws) -> Iterator[tuple]:
+    """The values of the openpyxl worksheet *ws* row by row from row 1 (:func:`value_rows`); no cell is created."""
+    return value_rows({key: cell.value for key, cell in ws._cells.items()})
 
 
 def _sheet_key(name: str) -> str:
@@ -644,12 +662,7 @@ class CachedValues:
     def rows(self, title: str) -> Iterator[tuple]:
         """The values of sheet *title* row by row from row 1, each row as wide as the sheet (as openpyxl's
         ``iter_rows(values_only=True)`` of a loaded sheet)."""
-        cells = self.cells(title)
-        last_row = max((row for row, _ in cells), default=1)
-        last_col = max((col for _, col in cells), default=1)
-        for row in range(1, last_row + 1):
-            yield tuple(cell.value if (cell := cells.get((row, col))) is not None else None
-                        for col in range(1, last_col + 1))
+        return value_rows({key: cell.value for key, cell in self.cells(title).items()})
 
     def formula_values(self, title: str) -> dict[str, Any]:
         """The cached value of each formula cell of sheet *title* that has one, by coordinate (once closed)."""

@@ -63,7 +63,7 @@ from workbook.excel.files import (
     write_atomic,
 )
 from workbook.excel.runs import RunSpec, TestPoint
-from workbook.excel.sheets import CachedValues, open_workbook, peek
+from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_values
 from workbook.excel.styling import print_setup, write_frame, write_text_lines
 from workbook.model.case import DIRECTIONS
 
@@ -264,17 +264,17 @@ def _merged(earlier: list[tuple], fresh: list[tuple], computed: set[str]) -> lis
 
 def _earlier_rows(ws) -> tuple[list[str], list[tuple[str, dict]]]:
     """The header and the rows ``(run, {header: value})`` of a result table written before."""
-    header = [value for value in next(ws.iter_rows(min_row=2, max_row=2, values_only=True), ()) if value]
-    rows = [(values[0], dict(zip(header, values, strict=False))) for values in ws.iter_rows(min_row=3, values_only=True)
-            if values and values[0] is not None]
-    return header, rows
+    rows = list(stored_values(ws))
+    header = [value for value in (rows[1] if len(rows) > 1 else ()) if value]
+    return header, [(values[0], dict(zip(header, values, strict=False))) for values in rows[2:]
+                    if values and values[0] is not None]
 
 
 def _earlier_cards(ws) -> list[tuple[str, list[str]]]:
     """The model card of each run, ``(run, lines)``, of a model-card sheet written before."""
     blocks: list[tuple[str, list[str]]] = []
-    for (line,) in ws.iter_rows(min_row=2, max_col=1, values_only=True):
-        line = "" if line is None else str(line)
+    for values in list(stored_values(ws))[1:]:
+        line = "" if values[0] is None else str(values[0])
         if line.startswith("Run '") and line.endswith("'"):
             blocks.append((line[len("Run '"):-1], []))
         if blocks:
