@@ -746,6 +746,7 @@ def read_workbook(path: str | Path) -> CaseBook:
         optimise = read_optimise_sheet(reader, tables[L.OPTIMISE.sheet], case)
         if reader.problems:
             raise WorkbookError(reader.problems)
+        values.keep_formula_values()     # for the writer
     finally:
         values.close()
     log.info("read %s: %d links, %d hinges, %d runs", path.name, len(case.links), len(case.hinges), len(runs))

@@ -633,8 +633,9 @@ class CachedValues:
 
     Holds the workbook loaded ``read_only=True, data_only=True``: only the
     sheets read are parsed (not, say, the result sheets of an earlier run).
-    :meth:`close` keeps the cached values of the formula cells, which the
-    writer puts back (:meth:`formula_values`), and closes the workbook.
+    :meth:`keep_formula_values` keeps the cached values of the formula
+    cells, which the writer puts back (:meth:`formula_values`), before
+    :meth:`close`.
 
     Parameters
     ----------
@@ -642,21 +643,32 @@ class CachedValues:
         Loaded read-only with the cached values.
     formulas : openpyxl.Workbook
         The same file loaded with its formulas.
+    name : str
+        The file's name, for messages.
     """
 
-    def __init__(self, values, formulas):
-        self._workbook, self._formulas = values, formulas
+    def __init__(self, values, formulas, name: str):
+        self._workbook, self._formulas, self._name = values, formulas, name
         self._sheets: dict[str, dict] = {}
         self._formula_values: dict[str, dict[str, Any]] = {}
         self.sheetnames: list[str] = list(values.sheetnames)
 
     def cells(self, title: str) -> dict:
-        """The stored cells of sheet *title* by ``(row, column)``, each with its ``value`` and ``number_format``."""
+        """The stored cells of sheet *title* by ``(row, column)``, each with its ``value`` and ``number_format``.
+
+        Raises
+        ------
+        WorkbookError
+            The sheet cannot be read (a cached value that is no number in a number cell, say).
+        """
         if title not in self._sheets:
             ws = self._workbook[title]
             ws.reset_dimensions()    # every stored cell, whatever size the file says the sheet has
-            self._sheets[title] = {(cell.row, cell.column): cell for row in ws.iter_rows() for cell in row
-                                   if not isinstance(cell, EmptyCell)}
+            try:
+                self._sheets[title] = {(cell.row, cell.column): cell for row in ws.iter_rows() for cell in row
+                                       if not isinstance(cell, EmptyCell)}
+            except Exception as exc:  # openpyxl raises many kinds for a damaged file
+                raise _unreadable(self._name, exc) from None
         return self._sheets[title]
 
     def rows(self, title: str) -> Iterator[tuple]:
@@ -664,12 +676,14 @@ class CachedValues:
         ``iter_rows(values_only=True)`` of a loaded sheet)."""
         return value_rows({key: cell.value for key, cell in self.cells(title).items()})
 
-    def formula_values(self, title: str) -> dict[str, Any]:
-        """The cached value of each formula cell of sheet *title* that has one, by coordinate (once closed)."""
-        return self._formula_values.get(title, {})
+    def keep_formula_values(self) -> None:
+        """Parse the sheets holding formulas and keep the cached values of their formula cells (:meth:`formula_values`).
 
-    def close(self) -> None:
-        """Keep the cached values of the formula cells (:meth:`formula_values`), then close the workbook."""
+        Raises
+        ------
+        WorkbookError
+            Such a sheet cannot be read.
+        """
         for ws in self._formulas.worksheets:
             formulas = [cell for cell in stored_cells(ws) if cell.data_type == "f"]
             if formulas and ws.title in self.sheetnames:
@@ -677,6 +691,14 @@ class CachedValues:
                 found = {cell.coordinate: cells.get((cell.row, cell.column)) for cell in formulas}
                 self._formula_values[ws.title] = {coordinate: cell.value for coordinate, cell in found.items()
                                                   if cell is not None and cell.value is not None}
+
+    def formula_values(self, title: str) -> dict[str, Any]:
+        """The cached value of each formula cell of sheet *title* that has one, by coordinate
+        (:meth:`keep_formula_values` first)."""
+        return self._formula_values.get(title, {})
+
+    def close(self) -> None:
+        """Close the workbook (the sheets parsed stay readable)."""
         self._workbook.close()
 
 
@@ -694,7 +716,7 @@ class OpenedWorkbook:
     formulas : openpyxl.Workbook
         Loaded with formulas (and rich text).
     values : CachedValues
-        The cached values, closed.
+        The cached values, those of the formula cells kept, closed.
     """
 
     def __init__(self, sha256: str, formulas, values):
@@ -761,7 +783,13 @@ def open_workbook(path: str | Path, data: bytes | None = None) -> tuple[Any, Cac
             warnings.simplefilter("ignore")
             # rich text changes no formula, the only cells the reader takes from this one (the writer keeps it)
             formulas = load_workbook(io.BytesIO(data), data_only=False, rich_text=True)
-            return formulas, CachedValues(load_workbook(io.BytesIO(data), data_only=True, read_only=True), formulas)
+            values = load_workbook(io.BytesIO(data), data_only=True, read_only=True)
     except Exception as exc:  # openpyxl raises many kinds for a damaged file
-        raise WorkbookError([Problem(path.name, None, None, None, f"{type(exc).__name__}: {exc}",
-                                     "a readable Excel .xlsx workbook")]) from None
+        raise _unreadable(path.name, exc) from None
+    return formulas, CachedValues(values, formulas, path.name)
+
+
+def _unreadable(name: str, error: Exception) -> WorkbookError:
+    """The problem of a workbook *name* openpyxl cannot read (*error*: what it raised)."""
+    return WorkbookError([Problem(name, None, None, None, f"{type(error).__name__}: {error}",
+                                  "a readable Excel .xlsx workbook")])

@@ -373,7 +373,10 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=
         workbook, values = pair
     else:
         workbook, values = open_workbook(path)
-        values.close()
+        try:
+            values.keep_formula_values()
+        finally:
+            values.close()
     conflicts = _conflicts(workbook, titles)
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
