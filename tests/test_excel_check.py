@@ -189,6 +189,39 @@ def test_formula_cells_are_read_as_their_cached_values(tmp_path):
     assert read_workbook(path).case.engine.mass == 3568.0
 
 
+@pytest.mark.parametrize("read", [True, False], ids=["a sheet read", "a sheet of notes"])
+def test_a_cached_value_that_cannot_be_read_is_bad_input(tmp_path, read):
+    """A formula cell whose cached value is no number: the workbook is refused as unreadable, not a crash."""
+    path = copy_reference(tmp_path)
+    if read:
+        set_cells(path, {("Engine", "mass", 3): "=3000+568"})
+        sheet, cell = 3, "A3"     # Instructions, Case, Engine
+    else:
+        wb = load_workbook(path)
+        wb["Instructions"]["H1"] = "=1+1"
+        wb.save(path)
+        sheet, cell = 1, "H1"
+    _with_cached_value(path, sheet, cell, "abc")
+    with pytest.raises(WorkbookError, match="a readable Excel .xlsx workbook"):
+        read_workbook(path)
+
+
+def test_a_sheet_whose_stored_size_is_wrong_is_read_whole(tmp_path):
+    """Some programs store a sheet's size as 'A1' whatever it holds: every cell stored is read all the same."""
+    path = copy_reference(tmp_path)
+    with zipfile.ZipFile(path) as archive:
+        contents = {name: archive.read(name) for name in archive.namelist()}
+    for name in [name for name in contents if name.startswith("xl/worksheets/sheet")]:
+        contents[name], count = re.subn(rb'<dimension ref="[^"]*"\s*/>', b'<dimension ref="A1"/>', contents[name])
+        assert count == 1
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in contents.items():
+            archive.writestr(name, data)
+    book, reference = read_workbook(path), read_workbook(REFERENCE)
+    assert to_dict(book.case) == to_dict(reference.case)
+    assert (book.runs, book.tests) == (reference.runs, reference.tests)
+
+
 # -- the bad-input suite ---------------------------------------------------------------------------------------
 
 

@@ -150,18 +150,16 @@ def test_a_sheet_in_known_units_builds_no_registry():
 
 def test_the_writer_takes_the_workbook_the_reader_opened(tmp_path, monkeypatch):
     """The case workbook is loaded once: the writer adds its sheets to the reader's workbook."""
-    import openpyxl
-
     import workbook.excel.writer as writer
     from workbook.excel.reader import read_workbook
-    from workbook.excel.sheets import OpenedWorkbook
+    from workbook.excel.sheets import OpenedWorkbook, open_workbook
 
     path = tmp_path / "reference.xlsx"
     path.write_bytes((ROOT / "cases" / "reference.xlsx").read_bytes())
     book = read_workbook(path)
     assert isinstance(book.opened, OpenedWorkbook)
     loads = []
-    monkeypatch.setattr(writer, "load_workbook", lambda *a, **k: loads.append(a) or openpyxl.load_workbook(*a, **k))
+    monkeypatch.setattr(writer, "open_workbook", lambda *a, **k: loads.append(a) or open_workbook(*a, **k))
     pair = book.opened.take(book.sha256)
     assert pair is not None and book.opened.take(book.sha256) is None      # handed on once
     assert OpenedWorkbook("0" * 64, *pair).take(book.sha256) is None       # not for other bytes

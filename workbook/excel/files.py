@@ -378,8 +378,11 @@ def restore_formula_values(data: bytes, cached: dict[int, dict[str, object]]) ->
     Returns
     -------
     bytes
-        The .xlsx with the values.
+        The .xlsx with the values (*data* itself when there are none).
     """
+    if not any(cached.values()):
+        return data
+
     def edit(name: str, xml: bytes) -> bytes:
         match = re.match(r"^xl/worksheets/sheet(\d+)\.xml$", name)
         if not match or int(match.group(1)) not in cached:

@@ -10,7 +10,7 @@ import dataclasses
 from pathlib import Path
 
 from workbook.errors import CaseError, Problem, WorkbookError
-from workbook.excel.sheets import matching_sheets
+from workbook.excel.sheets import CachedValues, matching_sheets
 from workbook.model.case import Case
 from workbook.model.pylon_impedance import impedance_from_rows
 
@@ -20,7 +20,7 @@ __all__ = ["SHEET", "with_impedance_sheet"]
 SHEET = "Pylon impedance"
 
 
-def with_impedance_sheet(case: Case, path: Path, values) -> Case:
+def with_impedance_sheet(case: Case, path: Path, values: CachedValues) -> Case:
     """*case* with the pylon impedance of the workbook's sheet, if it has one
     (found up to letter case and spaces; the reader has refused two such sheets).
 
@@ -29,8 +29,8 @@ def with_impedance_sheet(case: Case, path: Path, values) -> Case:
     case : Case
     path : Path
         The workbook, for messages.
-    values : openpyxl.Workbook
-        The workbook opened with its cached values.
+    values : CachedValues
+        The workbook's cached values.
 
     Raises
     ------
@@ -41,7 +41,7 @@ def with_impedance_sheet(case: Case, path: Path, values) -> Case:
     titles = matching_sheets(values.sheetnames, SHEET)
     if not titles:
         return case
-    impedance = impedance_from_rows(values[titles[0]].iter_rows(values_only=True), path.name, SHEET)
+    impedance = impedance_from_rows(values.rows(titles[0]), path.name, SHEET)
     try:
         return dataclasses.replace(case, pylon=impedance)
     except CaseError as error:

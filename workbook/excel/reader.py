@@ -728,23 +728,27 @@ def read_workbook(path: str | Path) -> CaseBook:
     data = read_workbook_bytes(path)
     sha256 = hashlib.sha256(data).hexdigest()
     formulas, values = open_workbook(path, data)
-    reader = _CaseReader(path, formulas, values)
-    tables = {table.sheet: reader.table(table) for table in L.TABLES}
-    reader.sheet_title(IMPEDANCE_SHEET)
-    reader.misspelt_sheets((*(table.sheet for table in L.TABLES), IMPEDANCE_SHEET),
-                           (L.INSTRUCTIONS_SHEET,))
-    if reader.merged_found:
-        raise WorkbookError(reader.problems)
-    case = reader.case(tables)
-    if case is None:
-        reader.unique(tables["Runs"])
-        raise WorkbookError(reader.problems)
-    case = with_impedance_sheet(case, path, values)
-    runs = reader.runs(case, tables["Runs"])
-    tests = reader.tests(runs, tables["Test data"], case)
-    optimise = read_optimise_sheet(reader, tables[L.OPTIMISE.sheet], case)
-    if reader.problems:
-        raise WorkbookError(reader.problems)
+    try:
+        reader = _CaseReader(path, formulas, values)
+        tables = {table.sheet: reader.table(table) for table in L.TABLES}
+        reader.sheet_title(IMPEDANCE_SHEET)
+        reader.misspelt_sheets((*(table.sheet for table in L.TABLES), IMPEDANCE_SHEET),
+                               (L.INSTRUCTIONS_SHEET,))
+        if reader.merged_found:
+            raise WorkbookError(reader.problems)
+        case = reader.case(tables)
+        if case is None:
+            reader.unique(tables["Runs"])
+            raise WorkbookError(reader.problems)
+        case = with_impedance_sheet(case, path, values)
+        runs = reader.runs(case, tables["Runs"])
+        tests = reader.tests(runs, tables["Test data"], case)
+        optimise = read_optimise_sheet(reader, tables[L.OPTIMISE.sheet], case)
+        if reader.problems:
+            raise WorkbookError(reader.problems)
+        values.keep_formula_values()     # for the writer
+    finally:
+        values.close()
     log.info("read %s: %d links, %d hinges, %d runs", path.name, len(case.links), len(case.hinges), len(runs))
     return CaseBook(path, case, tuple(run for _, run in runs), tuple(tests), sha256,
                     OpenedWorkbook(sha256, formulas, values), optimise)

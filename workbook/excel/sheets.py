@@ -14,8 +14,9 @@ import warnings
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
+from openpyxl.cell.read_only import EmptyCell
 from openpyxl.utils import get_column_letter
 from openpyxl.utils.cell import coordinate_to_tuple
 from openpyxl.utils.datetime import to_excel
@@ -26,7 +27,8 @@ from workbook.excel.runs import FIDELITY_RIGID
 from workbook.model.case import ModeCutoff
 from workbook.model.units import DIMENSIONLESS, si_factor
 
-__all__ = ["Record", "SheetReader", "OpenedWorkbook", "open_workbook", "peek", "stored_cells", "matching_sheets", "MAX_DATA_ROWS",
+__all__ = ["Record", "SheetReader", "CachedValues", "OpenedWorkbook", "open_workbook", "peek", "stored_cells",
+           "stored_values", "value_rows", "matching_sheets", "MAX_DATA_ROWS",
            "MAX_FILE_BYTES", "MAX_UNPACKED_BYTES", "FORMULA_ERRORS"]
 
 
@@ -43,6 +45,23 @@ def peek(ws, coordinate: str) -> Any:
 def stored_cells(ws) -> list:
     """The cells stored in *ws* (those in the file), by row then column; no empty cell is created."""
     return [ws._cells[key] for key in sorted(ws._cells)]
+
+
+def value_rows(values: dict) -> Iterator[tuple]:
+    """The *values* by ``(row, column)`` row by row from row 1, each row as wide as the widest.
+
+    As openpyxl's ``iter_rows(values_only=True)`` gives a sheet's values
+    (:func:`stored_values`), without creating a cell for every empty place.
+    """
+    last_row = max((row for row, _ in values), default=1)
+    last_col = max((col for _, col in values), default=1)
+    for row in range(1, last_row + 1):
+        yield tuple(values.get((row, col)) for col in range(1, last_col + 1))
+
+
+def stored_values(ws) -> Iterator[tuple]:
+    """The values of the openpyxl worksheet *ws* row by row from row 1 (:func:`value_rows`); no cell is created."""
+    return value_rows({key: cell.value for key, cell in ws._cells.items()})
 
 
 def _sheet_key(name: str) -> str:
@@ -68,15 +87,14 @@ MAX_DATA_ROWS = 10_000
 class _Cells:
     """The stored cells of one sheet (values as cached, and formulas), looked up without creating cells."""
 
-    def __init__(self, ws_values, ws_formulas):
-        cells = stored_cells(ws_values)
-        self._values = {(c.row, c.column): c.value for c in cells}
+    def __init__(self, values: dict, ws_formulas):
+        self._values = {key: cell.value for key, cell in values.items()}
         #: Cells holding a number shown as a percentage (5 % is stored as 0.05).
-        self.percent = {(c.row, c.column) for c in cells
-                        if isinstance(c.value, (int, float)) and not isinstance(c.value, bool)
-                        and _percent_format(c.number_format)}
+        self.percent = {key for key, cell in values.items()
+                        if isinstance(cell.value, (int, float)) and not isinstance(cell.value, bool)
+                        and _percent_format(cell.number_format)}
         self._formulas = {(c.row, c.column): c.value for c in stored_cells(ws_formulas) if c.data_type == "f"}
-        self.merged = list(ws_values.merged_cells.ranges)
+        self.merged = list(ws_formulas.merged_cells.ranges)
 
     def value(self, row: int, col: int) -> Any:
         return self._values.get((row, col))
@@ -226,7 +244,7 @@ class SheetReader:
                 self.problem(table.sheet, None, None, None,
                              f"a sheet named '{table.sheet}' (sheets: {', '.join(self.values.sheetnames)})")
             return []
-        sheet = _Cells(self.values[title], self.formulas[title])
+        sheet = _Cells(self.values.cells(title), self.formulas[title])
         positions = self._headers(table, sheet)
         if positions is None:
             return []
@@ -610,6 +628,80 @@ def _too_large(path: Path) -> Problem | None:
     return None
 
 
+class CachedValues:
+    """The values Excel cached in a workbook's cells, each sheet parsed the first time it is asked for.
+
+    Holds the workbook loaded ``read_only=True, data_only=True``: only the
+    sheets read are parsed (not, say, the result sheets of an earlier run).
+    :meth:`keep_formula_values` keeps the cached values of the formula
+    cells, which the writer puts back (:meth:`formula_values`), before
+    :meth:`close`.
+
+    Parameters
+    ----------
+    values : openpyxl.Workbook
+        Loaded read-only with the cached values.
+    formulas : openpyxl.Workbook
+        The same file loaded with its formulas.
+    name : str
+        The file's name, for messages.
+    """
+
+    def __init__(self, values, formulas, name: str):
+        self._workbook, self._formulas, self._name = values, formulas, name
+        self._sheets: dict[str, dict] = {}
+        self._formula_values: dict[str, dict[str, Any]] = {}
+        self.sheetnames: list[str] = list(values.sheetnames)
+
+    def cells(self, title: str) -> dict:
+        """The stored cells of sheet *title* by ``(row, column)``, each with its ``value`` and ``number_format``.
+
+        Raises
+        ------
+        WorkbookError
+            The sheet cannot be read (a cached value that is no number in a number cell, say).
+        """
+        if title not in self._sheets:
+            ws = self._workbook[title]
+            ws.reset_dimensions()    # every stored cell, whatever size the file says the sheet has
+            try:
+                self._sheets[title] = {(cell.row, cell.column): cell for row in ws.iter_rows() for cell in row
+                                       if not isinstance(cell, EmptyCell)}
+            except Exception as exc:  # openpyxl raises many kinds for a damaged file
+                raise _unreadable(self._name, exc) from None
+        return self._sheets[title]
+
+    def rows(self, title: str) -> Iterator[tuple]:
+        """The values of sheet *title* row by row from row 1, each row as wide as the sheet (as openpyxl's
+        ``iter_rows(values_only=True)`` of a loaded sheet)."""
+        return value_rows({key: cell.value for key, cell in self.cells(title).items()})
+
+    def keep_formula_values(self) -> None:
+        """Parse the sheets holding formulas and keep the cached values of their formula cells (:meth:`formula_values`).
+
+        Raises
+        ------
+        WorkbookError
+            Such a sheet cannot be read.
+        """
+        for ws in self._formulas.worksheets:
+            formulas = [cell for cell in stored_cells(ws) if cell.data_type == "f"]
+            if formulas and ws.title in self.sheetnames:
+                cells = self.cells(ws.title)
+                found = {cell.coordinate: cells.get((cell.row, cell.column)) for cell in formulas}
+                self._formula_values[ws.title] = {coordinate: cell.value for coordinate, cell in found.items()
+                                                  if cell is not None and cell.value is not None}
+
+    def formula_values(self, title: str) -> dict[str, Any]:
+        """The cached value of each formula cell of sheet *title* that has one, by coordinate
+        (:meth:`keep_formula_values` first)."""
+        return self._formula_values.get(title, {})
+
+    def close(self) -> None:
+        """Close the workbook (the sheets parsed stay readable)."""
+        self._workbook.close()
+
+
 class OpenedWorkbook:
     """A case workbook as the reader opened it, handed on once to the writer of its results.
 
@@ -621,8 +713,10 @@ class OpenedWorkbook:
     ----------
     sha256 : str
         SHA-256 of the bytes both workbooks were loaded from.
-    formulas, values : openpyxl.Workbook
-        Loaded with formulas (and rich text), and with the cached values.
+    formulas : openpyxl.Workbook
+        Loaded with formulas (and rich text).
+    values : CachedValues
+        The cached values, those of the formula cells kept, closed.
     """
 
     def __init__(self, sha256: str, formulas, values):
@@ -655,8 +749,8 @@ def read_workbook_bytes(path: Path) -> bytes:
     return path.read_bytes()
 
 
-def open_workbook(path: str | Path, data: bytes | None = None):
-    """Open a workbook twice: with formulas (and rich text, kept for the writer) and with the cached values.
+def open_workbook(path: str | Path, data: bytes | None = None) -> tuple[Any, CachedValues]:
+    """Open a workbook with its formulas (and rich text, kept for the writer) and with its cached values.
 
     Parameters
     ----------
@@ -667,7 +761,8 @@ def open_workbook(path: str | Path, data: bytes | None = None):
 
     Returns
     -------
-    (formulas, values) : two openpyxl Workbooks
+    (formulas, values) : openpyxl.Workbook and CachedValues
+        *values* to be closed by the caller (:meth:`CachedValues.close`).
 
     Raises
     ------
@@ -687,8 +782,14 @@ def open_workbook(path: str | Path, data: bytes | None = None):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             # rich text changes no formula, the only cells the reader takes from this one (the writer keeps it)
-            return (load_workbook(io.BytesIO(data), data_only=False, rich_text=True),
-                    load_workbook(io.BytesIO(data), data_only=True))
+            formulas = load_workbook(io.BytesIO(data), data_only=False, rich_text=True)
+            values = load_workbook(io.BytesIO(data), data_only=True, read_only=True)
     except Exception as exc:  # openpyxl raises many kinds for a damaged file
-        raise WorkbookError([Problem(path.name, None, None, None, f"{type(exc).__name__}: {exc}",
-                                     "a readable Excel .xlsx workbook")]) from None
+        raise _unreadable(path.name, exc) from None
+    return formulas, CachedValues(values, formulas, path.name)
+
+
+def _unreadable(name: str, error: Exception) -> WorkbookError:
+    """The problem of a workbook *name* openpyxl cannot read (*error*: what it raised)."""
+    return WorkbookError([Problem(name, None, None, None, f"{type(error).__name__}: {error}",
+                                  "a readable Excel .xlsx workbook")])

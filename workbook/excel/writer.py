@@ -37,12 +37,11 @@ from __future__ import annotations
 import datetime
 import hashlib
 import logging
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
-from openpyxl import Workbook, load_workbook
+from openpyxl import Workbook
 from openpyxl.styles import Font, PatternFill
 
 import workbook.excel.layout as L
@@ -64,7 +63,7 @@ from workbook.excel.files import (
     write_atomic,
 )
 from workbook.excel.runs import RunSpec, TestPoint
-from workbook.excel.sheets import peek, stored_cells
+from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_values
 from workbook.excel.styling import print_setup, write_frame, write_text_lines
 from workbook.model.case import DIRECTIONS
 
@@ -265,17 +264,17 @@ def _merged(earlier: list[tuple], fresh: list[tuple], computed: set[str]) -> lis
 
 def _earlier_rows(ws) -> tuple[list[str], list[tuple[str, dict]]]:
     """The header and the rows ``(run, {header: value})`` of a result table written before."""
-    header = [value for value in next(ws.iter_rows(min_row=2, max_row=2, values_only=True), ()) if value]
-    rows = [(values[0], dict(zip(header, values, strict=False))) for values in ws.iter_rows(min_row=3, values_only=True)
-            if values and values[0] is not None]
-    return header, rows
+    rows = list(stored_values(ws))
+    header = [value for value in (rows[1] if len(rows) > 1 else ()) if value]
+    return header, [(values[0], dict(zip(header, values, strict=False))) for values in rows[2:]
+                    if values and values[0] is not None]
 
 
 def _earlier_cards(ws) -> list[tuple[str, list[str]]]:
     """The model card of each run, ``(run, lines)``, of a model-card sheet written before."""
     blocks: list[tuple[str, list[str]]] = []
-    for (line,) in ws.iter_rows(min_row=2, max_col=1, values_only=True):
-        line = "" if line is None else str(line)
+    for values in list(stored_values(ws))[1:]:
+        line = "" if values[0] is None else str(values[0])
         if line.startswith("Run '") and line.endswith("'"):
             blocks.append((line[len("Run '"):-1], []))
         if blocks:
@@ -352,7 +351,7 @@ def _conflicts(workbook, titles: list[str]) -> list[str]:
 
 
 def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=None):
-    """(reason or None, the loaded workbook or None, the cached values' workbook or None).
+    """(reason or None, the loaded workbook or None, its cached values (a closed CachedValues) or None).
 
     *opened* (an :class:`~workbook.excel.sheets.OpenedWorkbook`) gives the workbook as the reader
     loaded it, when the file on disk still has its SHA-256; otherwise the file is loaded here.
@@ -373,9 +372,11 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=
     if pair is not None:
         workbook, values = pair
     else:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            workbook, values = load_workbook(path, rich_text=True), None
+        workbook, values = open_workbook(path)
+        try:
+            values.keep_formula_values()
+        finally:
+            values.close()
     conflicts = _conflicts(workbook, titles)
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
@@ -383,22 +384,12 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=
     return None, workbook, values
 
 
-def _cached_formula_values(path: Path, workbook, values=None) -> dict[int, dict[str, object]]:
-    """The values Excel cached for the formula cells of *workbook* (read from *path*, or given as the
-    workbook *values* loaded with ``data_only=True``), by sheet number."""
-    if values is None:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            values = load_workbook(path, data_only=True)
-    cached: dict[int, dict[str, object]] = {}
-    for number, ws in enumerate(workbook.worksheets, start=1):
-        if ws.title not in values.sheetnames:
-            continue
-        for cell in stored_cells(ws):
-            value = peek(values[ws.title], cell.coordinate) if cell.data_type == "f" else None
-            if value is not None:
-                cached.setdefault(number, {})[cell.coordinate] = value
-    return cached
+def _cached_formula_values(workbook, values: CachedValues) -> dict[int, dict[str, object]]:
+    """The values Excel cached for the formula cells of *workbook* (as the reader found them in *values*), by
+    sheet number."""
+    cached = {number: values.formula_values(ws.title) for number, ws in enumerate(workbook.worksheets, start=1)
+              if ws.title in values.sheetnames}
+    return {number: found for number, found in cached.items() if found}
 
 
 def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = (), *,
@@ -436,7 +427,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         if reason is None:
             log.info("building the new %s with the results", path.name)
             add_result_sheets(workbook, runs, tests, stamp, frames, loads, fatigue)
-            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(path, workbook, values))
+            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(workbook, values))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
         if reason is None:
