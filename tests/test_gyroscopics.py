@@ -112,6 +112,19 @@ def test_eigenpairs_are_those_of_scipys_generalised_problem(spin):
     assert np.all(np.linalg.norm(residual, axis=0) < 1e-10 * scale)
 
 
+def test_a_motion_without_mass_is_named_not_solved():
+    """A linearised M that is not positive definite (a coordinate without mass) is numerical trouble
+    said in words, not a crash of the Cholesky factor or modes of noise."""
+    from workbook.errors import SimulationError
+    from workbook.solve.modes import Linearization, eigenpairs
+
+    mass = np.diag([2.0, 1.0, 0.0])
+    stiffness = np.diag([1e4, 2e4, 3e4])
+    lin = Linearization(mass, stiffness, np.zeros((3, 3)), np.eye(3), mass, {}, None)
+    with pytest.raises(SimulationError, match="motion without mass"):
+        eigenpairs(lin)
+
+
 def test_moment_is_exact_for_a_large_rotation():
     """M = -Ip Omega (omega x a), with a turned with the engine, as generalised
     force G^T M on the Tait-Bryan angles; omega, G and the rotation from Exudyn's node."""

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from workbook.errors import SimulationError
 from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
@@ -221,9 +222,18 @@ def eigenpairs(lin: Linearization) -> tuple[np.ndarray, np.ndarray]:
     of each pair is kept; of the real ones (free motions near zero, or a
     negative-stiffness pair ``+-lambda`` counting as ``w^2 = -lambda^2``)
     the larger half.
+
+    Raises
+    ------
+    SimulationError
+        M is not positive definite (a motion without mass).
     """
     # M = L L^T (every coordinate has mass): a standard eigenproblem in y = L^T x
-    factor = np.linalg.cholesky(lin.mass)
+    try:
+        factor = np.linalg.cholesky(lin.mass)
+    except np.linalg.LinAlgError:
+        raise SimulationError("the linearised mass matrix is not positive definite: the scene has a motion "
+                              "without mass, whose modes are undefined") from None
 
     def whitened(matrix):
         """``L^-1 A L^-T``."""
