@@ -11,6 +11,10 @@ apart). Timed, each ``--repeats`` times (medians printed):
   many single-threaded workers (the linear mount scattered to them once):
   rows per second per worker.
 
+It prints the CPU time, user and system, of the study's worker processes
+(the kernel's share is mostly its mapping of freed memory again, see
+:func:`workbook.processes.loosen_allocator`).
+
 Some rows are checked against :func:`workbook.run_case` (Exudyn) to 1e-6,
 and the time of a Sobol' analysis of ``--sobol`` base samples over the two
 parameters (N (d + 2) rows) is extrapolated from the measured rate. Run::
@@ -68,7 +72,9 @@ def main() -> None:
     assert not isinstance(model, str), model
     rows = latin_hypercube(BOUNDS, args.rows, seed=1)
     cases = study_cases(case, rows)
+    before = os.times()
     study, outcomes = timed(lambda: run_rows(cases, workers=args.workers, design_model=model), args.repeats)
+    after = os.times()
     assert all(o.status == "ok" and o.path == NUMPY_PATH for o in outcomes)
     frame = study_frame(rows, outcomes)
     normwise = elementwise = 0.0         # normwise: per run, over its largest T (as tests/test_linear_mount.py)
@@ -100,6 +106,10 @@ def main() -> None:
           f"{len(few) / dask / args.workers:.1f} ({100 * local / dask:.0f} % of local processes) |")
     print(f"| Sobol', {args.sobol:,} base samples x {len(BOUNDS) + 2} = {sobol_rows:,} rows (extrapolated) | "
           f"{sobol_rows / (rate * args.workers):.0f} | | |")
+    user, system = ((getattr(after, name) - getattr(before, name)) / args.repeats
+                    for name in ("children_user", "children_system"))
+    print(f"CPU of the {len(rows):,}-row study's worker processes: {user:.1f} s user, {system:.1f} s system "
+          f"({100 * system / (user + system):.0f} % in the kernel)")
     print(f"T against run_case over {args.checked} rows: largest difference {normwise:.1e} of the run's largest T, "
           f"{elementwise:.1e} of the T itself")
 

@@ -24,7 +24,7 @@ WORKER_STOP_TIMEOUT = 5.0
 #: Seconds between a worker's checks that its parent still lives.
 PARENT_CHECK_INTERVAL = 1.0
 #: Bytes of freed memory glibc may keep for reuse, and the allocation size from which it maps memory of its own,
-#: in a worker whose allocator was set to return every freed page at once (:func:`loosen_allocator`).
+#: in a worker that evaluates designs (:func:`loosen_allocator`).
 ALLOCATOR_KEEPS = 64 * 2 ** 20
 
 
@@ -60,13 +60,17 @@ def stop_workers(workers) -> None:
 
 
 def loosen_allocator() -> bool:
-    """In a Dask worker: let glibc keep up to :data:`ALLOCATOR_KEEPS` bytes of freed memory for reuse.
+    """In a worker that evaluates designs: let glibc keep up to :data:`ALLOCATOR_KEEPS` bytes of freed
+    memory for reuse.
 
     Dask's nanny starts its workers with ``MALLOC_TRIM_THRESHOLD_=65536`` (to
     give memory back to the system), which also fixes glibc's mmap threshold:
     every NumPy temporary above 128 kB is then mapped and unmapped anew, and a
     batch of design evaluations ran 2.4 times slower than in a local process.
-    Memory above the limit is still given back.
+    A local process with glibc's own settings gives back the top of its heap
+    whenever a batch's temporaries (several MB each) are freed, and a sixth of
+    its time went to the kernel mapping those pages again
+    (``benchmarks/bench_uq.py``). Memory above the limit is still given back.
 
     Returns
     -------

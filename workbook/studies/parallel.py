@@ -405,11 +405,14 @@ _started = None
 def _worker_init(started, design_model: LinearMount | None) -> None:
     """Set up a worker: Ctrl-C is the parent's to handle (it stops the workers),
     the worker ends when its parent is gone (killed with no chance to stop it),
-    and it answers the rows *design_model* follows with it."""
+    and it answers the rows *design_model* follows with it (its allocator keeping
+    freed memory for NumPy's temporaries, :func:`~workbook.processes.loosen_allocator`)."""
     global _started, _design_model
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _started, _design_model = started, design_model
     end_with_parent()
+    if design_model is not None:
+        loosen_allocator()
 
 
 def _reported_batch(batch: list[tuple[int, Case]]) -> list[RowOutcome]:
