@@ -68,7 +68,7 @@ def loosen_allocator() -> bool:
     every NumPy temporary above 128 kB is then mapped and unmapped anew, and a
     batch of design evaluations ran 2.4 times slower than in a local process.
     A local process with glibc's own settings gives back the top of its heap
-    whenever a batch's temporaries (several MB each) are freed, and a sixth of
+    whenever a batch's temporaries (several MB each) are freed, and a fifth of
     its time went to the kernel mapping those pages again
     (``benchmarks/bench_uq.py``). Memory above the limit is still given back.
 
