@@ -10,7 +10,12 @@ entry, each named by its key (a hash of every input it depends on):
 - ``clamped-<key>.npz``: a reduced clamped body, the mesh pylon
   (:class:`~flexbodies.reduced.ClampedReduction`).
 
-Both carry their own key and a SHA-256 checksum of their content. An entry
+Beside them, :mod:`flexbodies.geometric_stiffness` keeps a link's geometric
+stiffness (``stiffening-<key>.npz``) and its projections on mode bases
+(``stiffening-<key>-<basis>.npy``); the store lists, checks (readable) and
+clears them too.
+
+The reduced bodies carry their own key and a SHA-256 checksum of their content. An entry
 whose stored key is not the key of its name, whose checksum does not match,
 or that cannot be read is *corrupt*: it is reported once (naming the file),
 never used, and replaced by the recomputed entry.
@@ -32,6 +37,7 @@ import json
 import logging
 import os
 import time
+import zipfile
 from collections import OrderedDict
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -192,7 +198,7 @@ class BodyCache:
         """Temporary files of the store older than ``age`` s."""
         now = time.time()
         found = []
-        for pattern in (".fe-*.tmp", ".link-*.tmp", ".clamped-*.tmp"):
+        for pattern in (".fe-*.tmp", ".link-*.tmp", ".clamped-*.tmp", ".stiffening-*.tmp"):
             for path in self.folder.glob(pattern):
                 try:
                     if now - path.stat().st_mtime > age:
@@ -353,19 +359,26 @@ class BodyCache:
     # -- the command line's view ------------------------------------------------------------
 
     def entries(self) -> list:
-        """Every entry file in the folder, summaries first."""
+        """Every entry file in the folder, summaries first, the links' geometric stiffness last."""
         if not self.folder.is_dir():
             return []
         return (sorted(self.folder.glob("fe-*.json")) + sorted(self.folder.glob("link-*.npz"))
-                + sorted(self.folder.glob("clamped-*.npz")))
+                + sorted(self.folder.glob("clamped-*.npz")) + self.stiffening_files())
+
+    def stiffening_files(self) -> list:
+        """The files of the links' geometric stiffness and its projections in the folder."""
+        return sorted(self.folder.glob("stiffening-*.npz")) + sorted(self.folder.glob("stiffening-*.npy"))
 
     def verify(self) -> list:
-        """Check every entry's key and checksum; a list of :class:`EntryReport`."""
+        """Check every entry's key and checksum (a geometric stiffness file: that it reads); a list of
+        :class:`EntryReport`."""
         reports = []
         for path in self.entries():
             key = path.stem.split("-", 1)[1]
             try:
-                if path.suffix == ".json":
+                if path.name.startswith("stiffening-"):
+                    _read_arrays(path)
+                elif path.suffix == ".json":
                     read_summary_file(path, key)
                 elif path.name.startswith("clamped-"):
                     load_clamped_reduction(path, key=key)
@@ -387,6 +400,25 @@ class BodyCache:
         for path in [p for p in _memory if p.parent == self.folder]:
             del _memory[path]
         return len(files)
+
+
+def _read_arrays(path: Path) -> None:
+    """Read every array of the NumPy file *path* (``.npz`` or ``.npy``).
+
+    Raises
+    ------
+    ReducedBodyFileError
+        It cannot be read.
+    """
+    try:
+        if path.suffix == ".npz":
+            with np.load(path, allow_pickle=False) as data:
+                for name in data.files:
+                    data[name]
+        else:
+            np.load(path, allow_pickle=False)
+    except (ValueError, EOFError, zipfile.BadZipFile) as error:
+        raise ReducedBodyFileError(f"{path}: cannot be read ({error})") from None
 
 
 def file_signature(path: Path):

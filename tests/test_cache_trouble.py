@@ -10,6 +10,7 @@ import time
 from contextlib import contextmanager
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from flexbodies import LinkGeometry, LinkModel, load_reduced_body, reduce_link
@@ -163,3 +164,25 @@ def test_cache_command_lists_verifies_and_clears(tmp_path, capsys):
     again = reduce_link(MODEL, "static", cache_dir=tmp_path)
     assert not again.cache_hit and again.mass == link.mass
     assert load_reduced_body(path).input_hash == link.input_hash
+
+
+def test_cache_command_lists_checks_and_clears_the_geometric_stiffness_files(tmp_path, capsys):
+    """The links' geometric stiffness files beside the reduced bodies are the store's too: listed, an
+    unreadable one named by verify, every one (and a temporary file a killed writer left) removed by
+    clear, and nothing else."""
+    np.savez(tmp_path / "stiffening-aaaa.npz", data=np.ones(3), indptr=np.arange(3))
+    np.save(tmp_path / "stiffening-aaaa-bbbb.npy", np.eye(2))
+    (tmp_path / "stiffening-cccc-dddd.npy").write_bytes(b"not a NumPy file")
+    (tmp_path / ".stiffening-aaaa.npz-x.tmp").write_bytes(bytes(10))
+    (tmp_path / "notes.txt").write_text("not the cache's")
+    folder = str(tmp_path)
+    assert main(["cache", "info", "--folder", folder]) == 0
+    assert ("0 reduced body(ies), 0 clamped reduction(s), 0 frequency summary(ies), 3 geometric stiffness file(s)"
+            in capsys.readouterr().out)
+    assert main(["cache", "verify", "--folder", folder]) == 1
+    output = capsys.readouterr().out
+    assert "corrupt:" in output and "stiffening-cccc-dddd.npy" in output and "3 entries checked, 1 corrupt" in output
+    assert main(["cache", "clear", "--folder", folder]) == 0
+    assert "removed 4 file(s)" in capsys.readouterr().out
+    assert not list(tmp_path.glob("stiffening-*")) and not list(tmp_path.glob(".stiffening-*"))
+    assert (tmp_path / "notes.txt").exists(), "clear removes the store's files only"

@@ -1,4 +1,5 @@
-"""``mountwb cache {info,verify,clear} [--folder DIR]``: the store of reduced bodies (links, casing, mesh pylon).
+"""``mountwb cache {info,verify,clear} [--folder DIR]``: the store of reduced bodies (links, casing, mesh pylon)
+and of the links' geometric stiffness.
 
 ``info`` lists the folder, its entries and their size; ``verify`` checks
 every entry's key and checksum and names each corrupt one (exit 1 when
@@ -36,9 +37,11 @@ def cache(args) -> int:
         entries = store.entries()
         summaries = sum(1 for path in entries if path.suffix == ".json")
         clamped = sum(1 for path in entries if path.name.startswith("clamped-"))
+        stiffening = len(store.stiffening_files())
         total = sum(path.stat().st_size for path in entries)
-        print(f"{store.folder}: {len(entries) - summaries - clamped} reduced body(ies), {clamped} clamped reduction(s), "
-              f"{summaries} frequency summary(ies), {_size(total)}")
+        print(f"{store.folder}: {len(entries) - summaries - clamped - stiffening} reduced body(ies), {clamped} clamped "
+              f"reduction(s), {summaries} frequency summary(ies), {stiffening} geometric stiffness file(s), "
+              f"{_size(total)}")
         for path in store.stale_temporaries():
             print(f"  stale temporary file (the next run removes it): {path.name}")
         return 0
