@@ -83,6 +83,11 @@ def _hinges(case: Case, **changes) -> Case:
     return dataclasses.replace(case, hinges=tuple(dataclasses.replace(h, **changes) for h in case.hinges))
 
 
+def _every_hinge(name: str, unit: str, help_text: str, field_name: str) -> Parameter:
+    """The parameter *name* setting the field *field_name* of every hinge to its value (a float)."""
+    return Parameter(name, unit, help_text, lambda case, v: _hinges(case, **{field_name: float(v)}), field_name)
+
+
 #: Directions of a hinge's frame a hinge parameter may name, as indices of its three values.
 HINGE_DIRECTIONS = {"radial1": (0,), "radial2": (1,), "radial": (0, 1), "axial": (2,)}
 #: The group of every hinge in a qualified hinge parameter.
@@ -249,14 +254,10 @@ def _frequency(case: Case, frequency_hz: float) -> Case:
 
 
 PARAMETERS = {p.name: p for p in (
-    Parameter("hinge_stiffness", "N/m", "translational stiffness of every hinge",
-              lambda case, v: _hinges(case, stiffness=float(v)), "stiffness"),
-    Parameter("hinge_damping", "N*s/m", "translational damping of every hinge",
-              lambda case, v: _hinges(case, damping=float(v)), "damping"),
-    Parameter("hinge_loss_factor", "-", "structural loss factor of every hinge",
-              lambda case, v: _hinges(case, loss_factor=float(v)), "loss_factor"),
-    Parameter("clearance", "m", "radial clearance of every hinge",
-              lambda case, v: _hinges(case, radial_clearance=float(v)), "radial_clearance"),
+    _every_hinge("hinge_stiffness", "N/m", "translational stiffness of every hinge", "stiffness"),
+    _every_hinge("hinge_damping", "N*s/m", "translational damping of every hinge", "damping"),
+    _every_hinge("hinge_loss_factor", "-", "structural loss factor of every hinge", "loss_factor"),
+    _every_hinge("clearance", "m", "radial clearance of every hinge", "radial_clearance"),
     Parameter("section_scale", "-", "factor on the cross-section of every link (shank width and thickness, "
               "eye thickness)",
               lambda case, v: _section(case, float(v))),
