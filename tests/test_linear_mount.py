@@ -208,9 +208,9 @@ def test_sparse_slopes_are_the_dense_expansion(mount):
                                size),
         }
         for name, matrices in expected.items():
-            got = getattr(rest, f"{name}_at")(dq)
+            got = rest.full(rest.at(name, dq))
             assert np.abs(got - matrices).max() <= 1e-12 * np.abs(matrices).max(), name
-            alone = getattr(rest, f"{name}_at")(dq[1])
+            alone = rest.full(rest.at(name, dq[1]))
             assert np.abs(alone - matrices[1]).max() <= 1e-12 * np.abs(matrices).max(), name
         secant = _dense_blocks(rest.stiffness, rest.stiffness_slope, local, 0.5) + curvature / 6.0
         change = np.zeros((3, size + 1))
@@ -270,7 +270,7 @@ def test_a_design_whose_chord_is_singular_starts_with_its_own_tangent(mount):
 
 def test_channels_tangent_is_the_derivative_of_their_forces(mount):
     """The channels' tangent stiffness in full coordinates, ``J^T S J`` plus the markers' curvature summed
-    onto the matrix in place, is the derivative of their generalised force ``J^T S d``: central differences
+    onto the bodies' blocks in place, is the derivative of their generalised force ``J^T S d``: central differences
     along random directions, to 1e-6 of its largest entry."""
     rng = np.random.default_rng(11)
     for item in mount.items.values():
@@ -283,8 +283,9 @@ def test_channels_tangent_is_the_derivative_of_their_forces(mount):
         blocks = np.zeros((channels.count, 3, channels.count, 3))
         blocks[np.arange(channels.count), :, np.arange(channels.count), :] = springs
         tangent = jacobian.T @ blocks.reshape(3 * channels.count, -1) @ jacobian
-        curvature = np.zeros_like(tangent)
-        channels.add_curvature(curvature, state, springs)
+        bodies = np.zeros(expansion.rest.stiffness.shape)
+        expansion.layout.add_point_terms(bodies, channels.curvature(state, springs))
+        curvature = expansion.rest.full(bodies)
         assert np.abs(curvature).max() > 1e-6 * np.abs(tangent).max()      # the curvature term counts
         tangent += curvature
         step = 1e-6

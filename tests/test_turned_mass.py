@@ -35,9 +35,9 @@ def test_turned_mass_is_exudyns_at_the_design_state(cache_dir):
     expansion, exact = solution.prepared.expansion, at_design.items[name].expansion
     dq = exact.state - expansion.state            # the design's state, solved by Exudyn
     assert np.abs(dq - solution.state.dq).max() < 1e-3 * np.abs(dq).max()
-    expected = exact.rest.mass_at(np.zeros_like(dq))
-    first_order = expansion.rest.mass_at(dq)
-    turned = turned_mass(expansion, dq)
+    expected = exact.rest.full(exact.rest.at("mass", np.zeros_like(dq)))
+    first_order = expansion.rest.full(expansion.rest.at("mass", dq))
+    turned = expansion.rest.full(turned_mass(expansion, dq))
     for block in expansion.rest.coordinates:
         block = block[block < len(dq)]
         own = np.abs(expected[np.ix_(block, block)]).max()

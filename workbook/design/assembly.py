@@ -120,24 +120,26 @@ def total(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
 
 
 def rest_stiffness(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads) -> np.ndarray:
-    """K of the rest of the scene at the state change *dq* (..., N), full coordinates (..., N, N)."""
-    stiffness = expansion.rest.stiffness_at(dq)
+    """K of the rest of the scene at the state change *dq* (..., N), per body: blocks (..., K, b, b)."""
+    stiffness = expansion.rest.at("stiffness", dq)
+    layout = expansion.layout
     for indices, added in loads.modal_stiffness:
-        if added.ndim > stiffness.ndim:           # one state for designs of their own loads
+        if added.ndim - 2 > stiffness.ndim - 3:           # one state for designs of their own loads
             stiffness = np.repeat(stiffness[None], len(added), axis=0)
-        stiffness[..., indices[:, None], indices] += added
+        block, positions = layout.locate(indices)
+        stiffness[..., block, positions[:, None], positions] += added
     return stiffness
 
 
 def rest_matrices(expansion: SceneExpansion, dq: np.ndarray, loads: StateLoads
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """M, K, D of the rest of the scene at the state change *dq* (..., N), full coordinates (..., N, N) (M with
-    each Euler-parameter body's rotation exact, :func:`turned_mass`)."""
-    mass, damping = turned_mass(expansion, dq), expansion.rest.damping_at(dq)
+    """M, K, D of the rest of the scene at the state change *dq* (..., N), per body: blocks (..., K, b, b) (M
+    with each Euler-parameter body's rotation exact, :func:`turned_mass`)."""
+    mass, damping = turned_mass(expansion, dq), expansion.rest.at("damping", dq)
     q = total(expansion, dq)
     for added in loads.mass:
-        indices = added.coordinates
-        mass[..., indices[:, None], indices] += added.matrix(q[..., indices])
+        block, positions = expansion.layout.locate(added.coordinates)
+        mass[..., block, positions[:, None], positions] += added.matrix(q[..., added.coordinates])
     return mass, rest_stiffness(expansion, dq, loads), damping
 
 
@@ -154,7 +156,8 @@ def _rotation(theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def turned_mass(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
-    """The rest's M at the state change *dq*, full coordinates, each Euler-parameter body's rotation exact.
+    """The rest's M at the state change *dq*, per body (blocks (..., K, b, b)), each Euler-parameter body's
+    rotation exact.
 
     A floating-frame body's kinetic energy depends on its velocities only
     through the local ones, ``A^T r'``, ``G theta'`` and the modal rates, and
@@ -168,11 +171,11 @@ def turned_mass(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
     """
     euler = expansion.euler_blocks
     if not len(euler):
-        return expansion.rest.mass_at(dq)
+        return expansion.rest.at("mass", dq)
     nodes = np.concatenate([euler[:, :1] - 3 + np.arange(3), euler], axis=1)      # (E, 7): position, parameters
     unturned = dq.copy()
     unturned[..., nodes] = 0.0
-    mass = expansion.rest.mass_at(unturned)
+    mass = expansion.rest.at("mass", unturned)
     at = [total(expansion, change)[..., euler] for change in (np.zeros_like(dq), dq)]
     (base_rotation, base_local), (rotation, local) = (_rotation(theta / np.linalg.norm(theta, axis=-1)[..., None])
                                                       for theta in at)
@@ -180,9 +183,11 @@ def turned_mass(expansion: SceneExpansion, dq: np.ndarray) -> np.ndarray:
     turn[..., :3, :3] = base_rotation @ rotation.swapaxes(-1, -2)
     turn[..., 3:, 3:] = base_local.swapaxes(-1, -2) @ local / 4
     for k, index in enumerate(nodes):
-        block = turn[..., k, :, :]
-        mass[..., :, index] = mass[..., :, index] @ block
-        mass[..., index, :] = block.swapaxes(-1, -2) @ mass[..., index, :]
+        block, positions = expansion.layout.locate(index)
+        own = mass[..., block, :, :]
+        step = turn[..., k, :, :]
+        own[..., :, positions] = own[..., :, positions] @ step
+        own[..., positions, :] = step.swapaxes(-1, -2) @ own[..., positions, :]
     return mass
 
 
@@ -223,25 +228,31 @@ def static_residual(expansion: SceneExpansion, dq: np.ndarray, springs: ChannelS
     return residual + without_normal(expansion, dq, expansion.channels.force(state, springs.stiffness))
 
 
+def add_tangent_terms(expansion: SceneExpansion, dq: np.ndarray, blocks: np.ndarray, springs: ChannelSprings,
+                      state: ChannelState) -> None:
+    """Add the channels' curvature ``sum_c (S d) . H`` and Exudyn's term of the normal force components
+    (:func:`normal_components`) to the bodies' stiffness blocks *blocks* (..., K, b, b), in place (contiguous):
+    with the channels' ``J^T S J``, the tangent stiffness."""
+    channels, layout = expansion.channels, expansion.layout
+    layout.add_point_terms(blocks, channels.curvature(state, springs.stiffness))
+    _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
+    theta = total(expansion, dq)[..., expansion.euler_blocks]
+    nodes, positions, _ = layout.euler
+    blocks[..., nodes[:, None], positions, positions] -= (normal / np.linalg.norm(theta, axis=-1))[..., None]
+
+
 def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarray, springs: ChannelSprings,
                       state: ChannelState, basis: "Projection", jacobian: np.ndarray) -> np.ndarray:
     """The tangent stiffness projected on the independent coordinates *basis*, (..., n, n).
 
-    ``B^T`` (the rest's stiffness *rest* plus every channel's ``(S d) . H``
-    and Exudyn's term of the normal force components,
-    :func:`normal_components`) ``B``, plus every channel's ``J^T S J`` on
-    the projected channel Jacobians *jacobian* (..., 3 C, n). The terms are
-    added to *rest* in place (a contiguous array of the caller's, not used
-    after).
+    The bodies' blocks (the rest's stiffness blocks *rest*, :func:`rest_stiffness`, plus
+    :func:`add_tangent_terms`, added to *rest* in place: a contiguous array of the caller's, not used after)
+    projected, plus every channel's ``J^T S J`` on the projected channel Jacobians *jacobian* (..., 3 C, n).
     """
-    channels = expansion.channels
-    curved = rest
-    channels.add_curvature(curved, state, springs.stiffness)
-    _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
-    theta = total(expansion, dq)[..., expansion.euler_blocks]
-    diagonal = expansion.euler_blocks
-    curved[..., diagonal, diagonal] -= (normal / np.linalg.norm(theta, axis=-1))[..., None]
-    return basis.both(curved) + spring_matrix(springs.stiffness, jacobian)
+    add_tangent_terms(expansion, dq, rest, springs, state)
+    layout = expansion.layout
+    return layout.dense(layout.project(rest, layout.basis(basis.tangents))) + spring_matrix(springs.stiffness,
+                                                                                         jacobian)
 
 
 @dataclass(frozen=True)

@@ -5,19 +5,18 @@ kind (:mod:`workbook.design.kinematics`), on coordinates padded to one
 length with a spare coordinate (index N, always zero) that collects the
 padding. A channel with stiffness S (3x3) adds ``J^T S d`` to the
 generalised force, ``J^T S J + (S d) . H`` to the tangent stiffness and
-``S J`` to its force output. The channels' Jacobians J (3 rows each) and
-the curvature terms are scattered into the full coordinates by one
-``bincount`` each; the products with the springs (:func:`spring_rows`,
-:func:`spring_matrix`) are then formed on J as it is, or on J projected on
-the independent coordinates (fewer columns, no N x N scatter).
+``S J`` to its force output. The channels' Jacobians J (3 rows each) are
+scattered into the full coordinates by one ``bincount``, the curvature
+terms onto the bodies' blocks (:mod:`workbook.design.blocks`); the
+products with the springs (:func:`spring_rows`, :func:`spring_matrix`) are
+then formed on J as it is, or on J projected on the independent
+coordinates (fewer columns, no N x N scatter).
 """
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
 
 from workbook.design.kinematics import EULER, PointKinematics
 
@@ -140,29 +139,15 @@ class ChannelSet:
         full = _scatter(index, jacobian.reshape(jacobian.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
         return full.reshape(jacobian.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
 
-    def add_curvature(self, out: np.ndarray, state: ChannelState, stiffness: np.ndarray) -> None:
-        """Add ``sum_c (S_c d_c) . H_c`` of the springs *stiffness* (..., C, 3, 3), the tangent stiffness's
-        term of the markers' curvature, to the matrices *out* (..., N, N), in place (contiguous)."""
+    def curvature(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
+        """``(S_c d_c) . H`` of every point, the tangent stiffness's term of the markers' curvature for the
+        springs *stiffness* (..., C, 3, 3), on each point's padded coordinates: shape (..., 2 C, M, M)
+        (:meth:`workbook.design.blocks.BodyLayout.add_point_terms` sums them onto the bodies' blocks)."""
         assert state.hessian is not None, "the curvature needs the Hessians"
         on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
         hessian = state.hessian
-        curvature = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))   # (..., 2 C, 1, M M)
-        positions, summing = self._curvature_positions
-        target = out.reshape((-1, self.size * self.size))
-        assert np.may_share_memory(target, out), "the sums need a contiguous out"
-        target[:, positions] += (summing @ curvature.reshape((len(target), -1)).T).T
-
-    @functools.cached_property
-    def _curvature_positions(self) -> tuple[np.ndarray, sparse.csr_array]:
-        """The distinct positions in a flat N x N matrix of the markers' curvature terms, and the sparse sum
-        (positions, terms) of the terms onto them (terms on the padding coordinate N dropped)."""
-        rows = np.broadcast_to(self.coordinates[:, :, None], self.coordinates.shape + self.coordinates.shape[-1:])
-        columns = np.broadcast_to(self.coordinates[:, None, :], rows.shape)
-        rows, columns = rows.ravel(), columns.ravel()
-        kept = np.flatnonzero((rows < self.size) & (columns < self.size))
-        positions, target = np.unique(rows[kept] * self.size + columns[kept], return_inverse=True)
-        summing = sparse.csr_array((np.ones(len(kept)), (target, kept)), shape=(len(positions), len(rows)))
-        return positions, summing
+        terms = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))      # (..., 2 C, 1, M M)
+        return terms.reshape(hessian.shape[:-3] + hessian.shape[-2:])
 
     def _channel_jacobians(self, state: ChannelState) -> np.ndarray:
         """Each channel's two marker Jacobians with the sign of d: shape (..., C, 2, 3, M)."""

@@ -257,7 +257,7 @@ def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: 
     basis = Projection(basis.free, basis.euler, np.broadcast_to(basis.tangents, dq.shape[:-1] + basis.tangents.shape[-3:]),
                        basis.size)
     rest = rest_stiffness(expansion, at, loads)
-    rest = np.array(np.broadcast_to(rest, dq.shape[:-1] + rest.shape[-2:]))
+    rest = np.array(np.broadcast_to(rest, dq.shape[:-1] + rest.shape[-3:]))
     tangent = tangent_stiffness(expansion, at, rest, springs, state, basis, jacobian)
     inverse, singular = solve_each(tangent, np.broadcast_to(np.eye(tangent.shape[-1]), tangent.shape))
     for k in np.flatnonzero(singular):

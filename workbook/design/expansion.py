@@ -41,6 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
+from workbook.design.blocks import BodyLayout, body_layout
 from workbook.design.channel_set import ChannelSet
 from workbook.design.kinematics import PointKinematics, identify
 from workbook.errors import OutsideDesignModel, SimulationError
@@ -136,8 +137,8 @@ class RestBlocks:
         pairs = (turned[..., :, None] * turned[..., None, :]).reshape(local.shape[:-2] + (blocks, -1))
         self._operators["curvature"].add_to(out.reshape(out.shape[:-3] + (-1,)), pairs, weight)
 
-    def _full(self, blocks: np.ndarray) -> np.ndarray:
-        """The blocks (..., B, b, b) scattered into a full matrix (..., N, N), contiguous."""
+    def full(self, blocks: np.ndarray) -> np.ndarray:
+        """The blocks (..., B, b, b) scattered into a full matrix (..., N, N)."""
         batch = blocks.shape[:-3]
         placement, kept = self._placement
         full = np.zeros(batch + (self.size * self.size,))
@@ -171,21 +172,15 @@ class RestBlocks:
         self._operators[name].add_to(out.reshape(len(out), -1), local, weight)
         return out.reshape(local.shape[:-2] + matrix.shape)
 
-    def stiffness_at(self, dq: np.ndarray) -> np.ndarray:
-        """K (..., N, N) at the state change *dq* (..., N): of second order in the Euler parameters, first in
-        the rest."""
+    def at(self, name: str, dq: np.ndarray) -> np.ndarray:
+        """The blocks (..., B, b, b) of the matrix *name* (``"mass"``, ``"stiffness"``, ``"damping"``) at the
+        state change *dq* (..., N): K of second order in the Euler parameters and of first in the rest, M and
+        D of first order (:meth:`full` places them in the whole matrix)."""
         local = self._local(dq)
-        stiffness = self._sloped("stiffness", local)
-        self._curved(stiffness, local, 0.5)
-        return self._full(stiffness)
-
-    def mass_at(self, dq: np.ndarray) -> np.ndarray:
-        """M (..., N, N) at the state change *dq* (..., N), of first order in it."""
-        return self._full(self._sloped("mass", self._local(dq)))
-
-    def damping_at(self, dq: np.ndarray) -> np.ndarray:
-        """D (..., N, N) at the state change *dq* (..., N), of first order in it."""
-        return self._full(self._sloped("damping", self._local(dq)))
+        blocks = self._sloped(name, local)
+        if name == "stiffness":
+            self._curved(blocks, local, 0.5)
+        return blocks
 
     def force_change(self, dq: np.ndarray) -> np.ndarray:
         """The change of the rest's internal force over *dq* (..., N): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""
@@ -233,6 +228,11 @@ class SceneExpansion:
     def free(self) -> np.ndarray:
         """The coordinates that are not Euler parameters (independent as they are)."""
         return np.setdiff1d(np.arange(len(self.state)), self.euler_blocks.ravel())
+
+    @functools.cached_property
+    def layout(self) -> BodyLayout:
+        """Where each body's coordinates sit among the full and the independent coordinates."""
+        return body_layout(self)
 
     @functools.cached_property
     def point_set(self) -> ChannelSet:

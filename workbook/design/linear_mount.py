@@ -40,10 +40,10 @@ from workbook.design.assembly import (
     ChannelSprings,
     Projection,
     StateLoads,
+    add_tangent_terms,
     projection,
     rest_matrices,
     solve_each,
-    tangent_stiffness,
     total,
     without_normal,
 )
@@ -855,29 +855,35 @@ class ItemSolution:
 
 def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing_scale) -> _Harmonic:
     """The projected linear model of the item *prepared* at the preloaded *state* (of one design or several,
-    with their *springs* and casing moduli *casing_scale*, E / E_0)."""
+    with their *springs* and casing moduli *casing_scale*, E / E_0), assembled body by body
+    (:mod:`workbook.design.blocks`)."""
     expansion, dq = prepared.expansion, state.dq
-    channels = expansion.channels
+    channels, layout = expansion.channels, expansion.layout
     at = channels.state(total(expansion, dq))
     basis = projection(expansion, dq)
-    jacobian = basis.columns(channels.jacobian(at))
-    mass, rest_stiffness, damping = rest_matrices(expansion, dq, state.loads)
-    stiffness = tangent_stiffness(expansion, dq, rest_stiffness, springs, at, basis, jacobian)
-    structural = prepared.sign * spring_matrix(springs.structural, jacobian)
-    outputs = tuple(prepared.sign * spring_rows(spring, jacobian)
-                    for spring in (springs.stiffness, springs.damping, springs.structural))
+    frames = layout.basis(basis.tangents)
+    jacobian = layout.channel_jacobian(channels, layout.point_jacobians(channels, at, frames))
+    mass, stiffness, damping = rest_matrices(expansion, dq, state.loads)
+    add_tangent_terms(expansion, dq, stiffness, springs, at)
+    structural = np.zeros_like(stiffness)
     for k, link in enumerate(prepared.links):
         added = (state.tensions[..., k] - link.base_tension)[..., None, None] * link.geometric
-        damping[..., link.modal[:, None], link.modal] += link.stiffness_damping * added
-        modal = basis.place(link.modal)
-        structural[..., modal[:, None], modal] += link.loss_factor * (link.reduced_stiffness + added)
+        block, positions = layout.locate(link.modal)
+        damping[..., block, positions[:, None], positions] += link.stiffness_damping * added
+        structural[..., block, positions[:, None], positions] += link.loss_factor * (link.reduced_stiffness + added)
     casing = prepared.casing
     if casing is not None:
-        damping[..., casing.modal[:, None], casing.modal] += \
+        block, positions = layout.locate(casing.modal)
+        damping[..., block, positions[:, None], positions] += \
             (np.sqrt(np.asarray(casing_scale, dtype=float)) - 1.0)[..., None, None] * casing.damping
-    damping = basis.both(damping) + spring_matrix(springs.damping, jacobian)
     points = expansion.point_set
-    jacobians = points.jacobian(points.state(total(expansion, dq), second=False))
-    inputs = {key: basis.rows(jacobians[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2))
-              for k, key in enumerate(expansion.points)}
-    return _Harmonic(basis.both(mass), stiffness, damping, structural, outputs, basis, inputs)
+    inputs = layout.channel_jacobian(points, layout.point_jacobians(points, points.state(total(expansion, dq),
+                                                                                         second=False), frames))
+    return _Harmonic(
+        layout.dense(layout.project(mass, frames)),
+        layout.dense(layout.project(stiffness, frames)) + spring_matrix(springs.stiffness, jacobian),
+        layout.dense(layout.project(damping, frames)) + spring_matrix(springs.damping, jacobian),
+        layout.dense(layout.project(structural, frames)) + prepared.sign * spring_matrix(springs.structural, jacobian),
+        tuple(prepared.sign * spring_rows(spring, jacobian)
+              for spring in (springs.stiffness, springs.damping, springs.structural)),
+        basis, {key: inputs[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2) for k, key in enumerate(expansion.points)})

@@ -314,7 +314,8 @@ def _model_change(case: Case, solution: ItemSolution, change: _Change, state_cha
     at = expansion.channels.state(total(expansion, state.dq))
     channels = expansion.channels
     jacobian = basis.columns(channels.jacobian(at))
-    stiffness = tangent_stiffness(expansion, state.dq, np.zeros((prepared.size,) * 2), springs, at, basis, jacobian)
+    stiffness = tangent_stiffness(expansion, state.dq, np.zeros(expansion.rest.stiffness.shape), springs, at, basis,
+                                  jacobian)
     damping = spring_matrix(springs.damping, jacobian)
     structural = prepared.sign * spring_matrix(springs.structural, jacobian)
     engine_mass = np.zeros((prepared.size,) * 2)

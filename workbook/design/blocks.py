@@ -1,0 +1,213 @@
+"""The linearised mount body by body: each body's matrices on its own independent coordinates.
+
+Without its force channels a scene's bodies do not couple (the blocks of
+:class:`~workbook.design.expansion.RestBlocks`), and the Euler-parameter
+constraints only mix a node's own coordinates; so every term of the
+projected linear model but the channels' ``J^T Z J`` is a matrix of one
+body, of 6 to 17 independent coordinates where the whole mount has about a
+hundred. :class:`BodyLayout` says where each body's coordinates sit among
+the full and the independent coordinates, projects the bodies' blocks
+(:meth:`BodyLayout.project`) and places them in the whole matrix when one
+is needed (:meth:`BodyLayout.dense`). :func:`channel_solve` solves the
+harmonic response of designs together on the blocks (module text of
+``docs/design-evaluation.md``).
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+from scipy import sparse
+
+from workbook.errors import SimulationError
+
+if TYPE_CHECKING:
+    from workbook.design.channel_set import ChannelSet, ChannelState
+    from workbook.design.expansion import SceneExpansion
+
+__all__ = ["BodyLayout", "body_layout"]
+
+_SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
+
+#: Largest relative backward error of the body-by-body solve of a design; a design above it is solved whole.
+BACKWARD_ERROR = 1e-11
+
+
+@dataclass(frozen=True)
+class BodyLayout:
+    """Where each body block's coordinates sit.
+
+    Attributes
+    ----------
+    size : int
+        N, the full coordinates.
+    count : int
+        n, the independent coordinates: the free full coordinates, then three per Euler-parameter node.
+    coordinates : ndarray of int, shape (K, b)
+        Each block's full coordinates, padded with N.
+    block, position : ndarray of int, shape (N + 1,)
+        Each full coordinate's block and its position there (the padding coordinate N: block 0, position b).
+    independent : ndarray of int, shape (K, w)
+        Each block's independent coordinates, padded with n.
+    free : tuple of ndarray of int
+        (blocks, positions, columns) of the free coordinates: the basis's unit entries.
+    euler : tuple of ndarray of int
+        (blocks (E,), positions (E, 4), columns (E, 3)) of the Euler-parameter nodes.
+    curvature : tuple of (ndarray of int, scipy.sparse.csr_array)
+        The distinct positions in the flat blocks (K b b) of the channels' points' curvature terms
+        (:meth:`~workbook.design.channel_set.ChannelSet.curvature`), and the sparse sum (positions, terms)
+        onto them (terms on the padding dropped).
+    """
+
+    size: int
+    count: int
+    coordinates: np.ndarray
+    block: np.ndarray
+    position: np.ndarray
+    independent: np.ndarray
+    free: tuple
+    euler: tuple
+    curvature: tuple
+
+    @property
+    def width(self) -> int:
+        """w, the most independent coordinates of a block."""
+        return self.independent.shape[1]
+
+    def locate(self, indices: np.ndarray) -> tuple[int, np.ndarray]:
+        """The block and positions of the full coordinates *indices*, all of one body."""
+        blocks = np.unique(self.block[indices])
+        assert len(blocks) == 1, "coordinates of several bodies"
+        return int(blocks[0]), self.position[indices]
+
+    def basis(self, tangents: np.ndarray) -> np.ndarray:
+        """Each block's null-space basis ``B_k`` for the Euler-parameter nodes' tangents (..., E, 4, 3)
+        (:func:`~workbook.design.assembly.projection`): shape (..., K, b + 1, w), the last row zero (the
+        padding coordinate)."""
+        blocks, width = self.coordinates.shape
+        out = np.zeros(tangents.shape[:-3] + (blocks, width + 1, self.width))
+        out[..., self.free[0], self.free[1], self.free[2]] = 1.0
+        nodes, rows, columns = self.euler
+        out[..., nodes[:, None, None], rows[:, :, None], columns[:, None, :]] = tangents
+        return out
+
+    def project(self, blocks: np.ndarray, basis: np.ndarray, right: np.ndarray | None = None) -> np.ndarray:
+        """``B_k^T A_k B_k`` of the blocks *blocks* (..., K, b, b) on the *basis* (:meth:`basis`; *right*: another
+        on the right), (..., K, w, w)."""
+        width = blocks.shape[-1]
+        left = basis[..., :width, :]
+        other = left if right is None else right[..., :width, :]
+        return left.swapaxes(-1, -2) @ blocks @ other
+
+    def dense(self, blocks: np.ndarray) -> np.ndarray:
+        """The projected blocks (..., K, w, w) placed in the whole matrix (..., n, n)."""
+        batch = blocks.shape[:-3]
+        placement, kept = self._placement
+        out = np.zeros(batch + (self.count * self.count,), dtype=blocks.dtype)
+        out[..., placement] = blocks.reshape(batch + (-1,))[..., kept]
+        return out.reshape(batch + (self.count, self.count))
+
+    def vector(self, blocks: np.ndarray) -> np.ndarray:
+        """Vectors per block (..., K, w) as whole vectors (..., n)."""
+        out = np.zeros(blocks.shape[:-2] + (self.count + 1,), dtype=blocks.dtype)
+        out[..., self.independent] = blocks
+        return out[..., :self.count]
+
+    @functools.cached_property
+    def _placement(self) -> tuple[np.ndarray, np.ndarray]:
+        """Where the projected blocks' entries go in a flat n x n matrix, and which of the blocks' flat entries
+        they are (the others are padding)."""
+        rows = np.broadcast_to(self.independent[:, :, None], self.independent.shape + (self.width,)).ravel()
+        columns = np.broadcast_to(self.independent[:, None, :], self.independent.shape + (self.width,)).ravel()
+        kept = np.flatnonzero((rows < self.count) & (columns < self.count))
+        return rows[kept] * self.count + columns[kept], kept
+
+    def add_point_terms(self, out: np.ndarray, terms: np.ndarray) -> None:
+        """Add the channels' points' terms *terms* (..., P, M, M) to the blocks *out* (..., K, b, b), in place
+        (contiguous)."""
+        positions, summing = self.curvature
+        target = out.reshape((-1, out.shape[-3] * out.shape[-2] * out.shape[-1]))
+        assert np.may_share_memory(target, out), "the sums need a contiguous out"
+        target[:, positions] += (summing @ terms.reshape((len(target), -1)).T).T
+
+    @functools.cached_property
+    def padding(self) -> np.ndarray:
+        """Ones on the diagonal of each block's padding columns, zero elsewhere: (K, w, w)."""
+        return np.eye(self.width) * (self.independent == self.count)[:, None, :]
+
+    def marker_rows(self, channels: "ChannelSet") -> tuple[np.ndarray, np.ndarray]:
+        """Each of the channels' points' block and the positions of its padded coordinates there, (P,) and
+        (P, M) (a point on the ground: block 0, every position the padding's)."""
+        positions = self.position[channels.coordinates]
+        return self.block[channels.coordinates[:, 0]], positions
+
+    def point_jacobians(self, channels: "ChannelSet", state: "ChannelState", basis: np.ndarray) -> np.ndarray:
+        """Each of the channels' points' position Jacobian on its block's independent coordinates, with the
+        sign of the separation d: shape (..., P, 3, w)."""
+        blocks, positions = self.marker_rows(channels)
+        rows = basis[..., blocks[:, None], positions, :]                  # (..., P, M, w)
+        return np.tile(_SIGNS, len(blocks) // 2)[:, None, None] * (state.jacobian @ rows)
+
+    def channel_jacobian(self, channels: "ChannelSet", points: np.ndarray) -> np.ndarray:
+        """The channels' stacked Jacobian ``J_c`` (..., 3 C, n) from their points' (:meth:`point_jacobians`)."""
+        blocks, _ = self.marker_rows(channels)
+        batch = points.shape[:-3]
+        count = channels.count
+        columns = self.independent[blocks]                                 # (P, w)
+        rows = 3 * (np.arange(2 * count) // 2)[:, None, None] + np.arange(3)[None, :, None]   # (P, 3, 1)
+        index = np.broadcast_to(rows * (self.count + 1) + columns[:, None, :], points.shape[-3:]).ravel()
+        flat = int(np.prod(batch, dtype=int))
+        shifted = (index[None, :] + 3 * count * (self.count + 1) * np.arange(flat)[:, None]).ravel()
+        summed = np.bincount(shifted, points.reshape(-1), flat * 3 * count * (self.count + 1))
+        return summed.reshape(batch + (3 * count, self.count + 1))[..., :self.count]
+
+
+def body_layout(expansion: "SceneExpansion") -> BodyLayout:
+    """The :class:`BodyLayout` of *expansion*'s bodies (:attr:`~workbook.design.expansion.RestBlocks.coordinates`)."""
+    coordinates = expansion.rest.coordinates
+    size = len(expansion.state)
+    blocks, width = coordinates.shape
+    block = np.zeros(size + 1, dtype=int)
+    position = np.full(size + 1, width, dtype=int)
+    for k, row in enumerate(coordinates):
+        kept = row < size
+        block[row[kept]], position[row[kept]] = k, np.flatnonzero(kept)
+    if len(np.unique(coordinates[coordinates < size])) != size:
+        raise SimulationError("the scene has coordinates of no body; the design evaluation does not know them")
+    free, euler = expansion.free, expansion.euler_blocks
+    count = len(free) + 3 * len(euler)
+    index_of = np.full(size, -1)
+    index_of[free] = np.arange(len(free))
+    columns_of: list[list[int]] = [[] for _ in range(blocks)]
+    free_parts: list[tuple[int, int, int]] = []
+    for k, row in enumerate(coordinates):
+        for p, coordinate in enumerate(row):
+            if coordinate < size and index_of[coordinate] >= 0:
+                free_parts.append((k, p, len(columns_of[k])))
+                columns_of[k].append(int(index_of[coordinate]))
+    euler_blocks = block[euler[:, 0]] if len(euler) else np.zeros(0, dtype=int)
+    euler_columns = np.zeros((len(euler), 3), dtype=int)
+    for e, k in enumerate(euler_blocks):
+        euler_columns[e] = len(columns_of[k]) + np.arange(3)
+        columns_of[k].extend(len(free) + 3 * e + np.arange(3))
+    independent = np.full((blocks, max(len(c) for c in columns_of)), count, dtype=int)
+    for k, found in enumerate(columns_of):
+        independent[k, :len(found)] = found
+    parts = np.array(free_parts, dtype=int).reshape(-1, 3)
+    return BodyLayout(size, count, coordinates, block, position, independent, (parts[:, 0], parts[:, 1], parts[:, 2]),
+                      (euler_blocks, position[euler] if len(euler) else np.zeros((0, 4), dtype=int), euler_columns),
+                      _curvature_summing(expansion.channels.coordinates, block, position, width))
+
+
+def _curvature_summing(points: np.ndarray, block: np.ndarray, position: np.ndarray, width: int
+                       ) -> tuple[np.ndarray, sparse.csr_array]:
+    """:attr:`BodyLayout.curvature` of the points on the padded coordinates *points* (P, M)."""
+    rows = np.broadcast_to(points[:, :, None], points.shape + points.shape[-1:]).ravel()
+    columns = np.broadcast_to(points[:, None, :], points.shape + points.shape[-1:]).ravel()
+    kept = np.flatnonzero((position[rows] < width) & (position[columns] < width))
+    flat = (block[rows[kept]] * width + position[rows[kept]]) * width + position[columns[kept]]
+    positions, target = np.unique(flat, return_inverse=True)
+    summing = sparse.csr_array((np.ones(len(kept)), (target, kept)), shape=(len(positions), len(rows)))
+    return positions, summing
