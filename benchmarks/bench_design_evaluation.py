@@ -14,8 +14,9 @@ time per design of :data:`BATCH` designs answered together
 alternating rounds, and the largest difference between them; and beside
 them the floor of this way of evaluating: the LAPACK solves alone that a
 design needs together with others (per rotor, the chord's solve of the size
-of its channels' coordinates and one complex solve of its dynamic
-stiffness, of the size of its independent coordinates), timed on matrices of
+of its channels' coordinates; the inverses of its bodies' held dynamic
+stiffness, of their independent coordinates; the Woodbury solve of the
+channels between moving bodies, six per channel), timed on matrices of
 those sizes. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
@@ -135,15 +136,17 @@ def _solves_alone(mount) -> float:
     for _ in range(REPEATS):
         total = 0.0
         for item in mount.items.values():
-            size = len(item.expansion.free) + 3 * len(item.expansion.euler_blocks)
+            layout, coupled = item.expansion.layout, len(item.expansion.coupling.coupled)
             channels = 3 * len(mount.channels)
             chord = rng.standard_normal((BATCH_ROWS, channels, channels)) + channels * np.eye(channels)
-            dynamic = rng.standard_normal((BATCH_ROWS, size, size)) + size * np.eye(size) \
-                + 1j * rng.standard_normal((BATCH_ROWS, size, size))
-            load = rng.standard_normal((BATCH_ROWS, size, 1)) + 0j
+            shape = (BATCH_ROWS, len(layout.coordinates), layout.width, layout.width)
+            bodies = rng.standard_normal(shape) + layout.width * np.eye(layout.width) + 1j * rng.standard_normal(shape)
+            woodbury = rng.standard_normal((BATCH_ROWS, 3 * coupled, 3 * coupled)) + 3 * coupled * np.eye(3 * coupled) \
+                + 0j
             start = time.perf_counter()
             np.linalg.solve(chord, chord)
-            np.linalg.solve(dynamic, load)
+            np.linalg.inv(bodies)
+            np.linalg.solve(woodbury, woodbury[..., :1])
             total += time.perf_counter() - start
         times.append(total / BATCH_ROWS)
     return statistics.median(times)

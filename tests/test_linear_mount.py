@@ -295,3 +295,27 @@ def test_channels_tangent_is_the_derivative_of_their_forces(mount):
                       for sign in (1.0, -1.0)]
             difference = (forces[0] - forces[1]) / (2 * step)
             assert np.abs(tangent @ direction - difference).max() <= 1e-6 * np.abs(tangent).max()
+
+
+def test_body_by_body_response_is_the_whole_solve(mount, monkeypatch):
+    """Designs together are answered body by body (each body held by its channels, the channels between
+    bodies by the Woodbury identity): their channel forces equal the solve of the whole matrices to 1e-10,
+    and the designs the body-by-body solve does not trust go to that whole solve."""
+    import workbook.design.blocks as blocks
+    from workbook.design.linear_mount import _solve_item
+
+    rng = np.random.default_rng(13)
+    designs = mount._designs([_design(mount.case, rng) for _ in range(4)])
+    for item in mount.case.excitations:
+        model = _solve_item(designs, mount.items[item.name]).model
+        omega = 2 * np.pi * rng.uniform(20.0, 300.0, 4)
+        loads = rng.standard_normal(model.mass.shape[:2] + model.mass.shape[-1:]) * (
+            model.layout.padding.diagonal(axis1=-2, axis2=-1) == 0)
+        forces, singular = model.respond(omega, loads.astype(complex))
+        whole, _ = model.dense().respond(omega, model.layout.vector(loads).astype(complex))
+        assert not singular.any()
+        assert _normwise(forces, whole) < 1e-10
+        monkeypatch.setattr(blocks, "BACKWARD_ERROR", -1.0)      # every design to the whole solve
+        again, _ = model.respond(omega, loads.astype(complex))
+        monkeypatch.undo()
+        assert np.array_equal(again, whole)

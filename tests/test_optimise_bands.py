@@ -10,7 +10,8 @@ from conftest import COARSE_ELEMENT_SIZE
 
 from workbook.design import optimise as opt
 from workbook.design.bands import band_case, band_peaks, band_text, with_frequencies
-from workbook.design.linear_mount import ItemSolution, LinearMount, _Harmonic
+from workbook.design.harmonic_model import Harmonic
+from workbook.design.linear_mount import ItemSolution, LinearMount
 from workbook.design.sensitivity import design_case
 from workbook.errors import InputError
 from workbook.model.case import HarmonicForce, Sweep
@@ -21,7 +22,7 @@ def _isolator(mass: float, stiffness: float, eta: float) -> ItemSolution:
     """A mass on a spring k (1 + i eta) along z, its force the only (pylon) channel: T = sqrt(1 + eta^2) /
     sqrt((1 - r^2)^2 + eta^2), r = f / f_n, highest at r = 1 exactly (sqrt(1 + eta^2) / eta)."""
     z = np.array([[0.0], [0.0], [1.0]])
-    model = _Harmonic(np.array([[mass]]), np.array([[stiffness]]), np.zeros((1, 1)), np.array([[eta * stiffness]]),
+    model = Harmonic(np.array([[mass]]), np.array([[stiffness]]), np.zeros((1, 1)), np.array([[eta * stiffness]]),
                       (stiffness * z, 0 * z, eta * stiffness * z), None, {(0.0, 0.0, 0.0): z.T})
     return ItemSolution(None, None, None, model)
 

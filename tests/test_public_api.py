@@ -25,7 +25,7 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 #: Modules of the implementation: importable, but their names may change between versions.
 INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.blocks", "workbook.design.channel_set",
-    "workbook.design.equilibrium", "workbook.design.expansion",
+    "workbook.design.equilibrium", "workbook.design.expansion", "workbook.design.harmonic_model",
     "workbook.design.kinematics", "workbook.design.sensitivity",
     "workbook.design.linear_mount", "workbook.design.optimise", "workbook.design.bands", "workbook.design.link_fatigue",
     "workbook.design.link_margins", "workbook.design.section_search",

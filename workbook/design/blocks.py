@@ -27,12 +27,12 @@ if TYPE_CHECKING:
     from workbook.design.channel_set import ChannelSet, ChannelState
     from workbook.design.expansion import SceneExpansion
 
-__all__ = ["BodyLayout", "body_layout"]
+__all__ = ["BodyLayout", "body_layout", "ChannelCoupling", "channel_solve", "BACKWARD_ERROR"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 
 #: Largest relative backward error of the body-by-body solve of a design; a design above it is solved whole.
-BACKWARD_ERROR = 1e-11
+BACKWARD_ERROR = 1e-12
 
 
 @dataclass(frozen=True)
@@ -211,3 +211,120 @@ def _curvature_summing(points: np.ndarray, block: np.ndarray, position: np.ndarr
     positions, target = np.unique(flat, return_inverse=True)
     summing = sparse.csr_array((np.ones(len(kept)), (target, kept)), shape=(len(positions), len(rows)))
     return positions, summing
+
+
+@dataclass(frozen=True)
+class ChannelCoupling:
+    """How the force channels join the bodies, for :func:`channel_solve`.
+
+    Attributes
+    ----------
+    moving : ndarray of int, shape (P,)
+        The channels' points that move with a body (the others are on the ground), among all 2 C.
+    bodies : ndarray of int, shape (K, P)
+        1 where a moving point is on a body.
+    channels : ndarray of int, shape (C, P)
+        1 where a moving point is a channel's.
+    coupled : ndarray of int, shape (2 L,)
+        The moving points (positions in *moving*) of the L channels with both points moving: their first
+        points, then their second.
+    pairs : ndarray of int, shape (Q, 2)
+        The pairs of these (positions in *coupled*) on the same body, each with itself included.
+    """
+
+    moving: np.ndarray
+    bodies: np.ndarray
+    channels: np.ndarray
+    coupled: np.ndarray
+    pairs: np.ndarray
+
+    @classmethod
+    def of(cls, layout: BodyLayout, channels: "ChannelSet") -> "ChannelCoupling":
+        """The coupling of *channels* on the bodies of *layout*."""
+        blocks, positions = layout.marker_rows(channels)
+        moving = np.flatnonzero((positions < layout.coordinates.shape[1]).any(axis=1))
+        position = {int(point): k for k, point in enumerate(moving)}
+        both = [c for c in range(channels.count) if 2 * c in position and 2 * c + 1 in position]
+        coupled = np.array([position[2 * c] for c in both] + [position[2 * c + 1] for c in both], dtype=int)
+        on = blocks[moving[coupled]]
+        bodies = np.zeros((len(layout.coordinates), len(moving)))
+        bodies[blocks[moving], np.arange(len(moving))] = 1.0
+        by_channel = np.zeros((channels.count, len(moving)))
+        by_channel[moving // 2, np.arange(len(moving))] = 1.0
+        return cls(moving, bodies, by_channel, coupled, np.argwhere(on[:, None] == on[None, :]))
+
+
+def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.ndarray, impedance: np.ndarray,
+                  loads: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The channels' separation phasors of designs' harmonic responses, body by body.
+
+    The whole dynamic stiffness is the bodies' blocks plus every channel's
+    ``J_c^T Z_c J_c``, ``J_c`` the sum of its two points' Jacobians. Each
+    point's own term ``J_p^T Z_c J_p`` is added to its body's block (the body
+    held by its channels' springs, so that each block stays regular away from
+    the whole mount's own resonances); the terms joining the two points of a
+    channel between moving bodies, ``J_a^T Z J_b + J_b^T Z J_a``, are
+    ``U^T W U`` and solved by the Woodbury identity, a system of 6 per such
+    channel. A design whose solution leaves a backward error above
+    :data:`BACKWARD_ERROR` (a body near a resonance of its own), or whose
+    matrices are singular, is marked for a solve of the whole matrix.
+
+    Parameters
+    ----------
+    coupling : ChannelCoupling
+    dynamic : ndarray, complex, shape (D, K, w, w)
+        Each design's bodies' blocks ``K - w^2 M + i (w D + H)`` (regular on their padding).
+    points : ndarray, shape (D, 2 C, 3, w)
+        The channels' points' Jacobians on their bodies' independent coordinates, with the sign of d.
+    impedance : ndarray, complex, shape (D, C, 3, 3)
+        ``Z_c`` of each channel.
+    loads : ndarray, complex, shape (D, K, w)
+        The generalised force phasors on each body.
+
+    Returns
+    -------
+    separation : ndarray, complex, shape (D, C, 3)
+        ``J_c x`` of each channel.
+    trouble : ndarray of bool, shape (D,)
+        The designs to solve whole (their separations mean nothing).
+    """
+    count = len(dynamic)
+    jacobian = points[:, coupling.moving]                                    # (D, P, 3, w)
+    transposed = jacobian.swapaxes(-1, -2)
+    on_points = coupling.channels.T @ impedance.reshape(count, impedance.shape[1], 9)        # (D, P, 9)
+    own = transposed @ (on_points.reshape(on_points.shape[:-1] + (3, 3)) @ jacobian)           # (D, P, w, w)
+    held = dynamic + (coupling.bodies @ own.reshape(count, own.shape[1], -1)).reshape(dynamic.shape)
+    failed = np.ones(count, dtype=bool)
+    try:
+        inverse = np.linalg.inv(held)
+    except np.linalg.LinAlgError:
+        return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
+    body = coupling.bodies.argmax(axis=0)                                    # each moving point's body
+    coupled = coupling.coupled
+    reach = inverse[:, body[coupled]] @ transposed[:, coupled]               # (D, 2 L, w, 3)
+    free = (inverse @ loads[..., None])[..., 0]                              # (D, K, w)
+    links = len(coupled) // 2
+    first, second = coupling.pairs.T
+    receptance = np.zeros((count, 2 * links, 3, 2 * links, 3), dtype=complex)
+    receptance[:, first, :, second, :] = (jacobian[:, coupled[first]] @ reach[:, second]).swapaxes(0, 1)
+    spring = impedance[:, coupling.moving[coupled[:links]] // 2].swapaxes(0, 1)             # (L, D, 3, 3)
+    pattern = np.zeros((count, 2, links, 3, 2, links, 3), dtype=complex)
+    index = np.arange(links)
+    pattern[:, 0, index, :, 1, index, :] = pattern[:, 1, index, :, 0, index, :] = spring
+    weights = pattern.reshape(count, 6 * links, 6 * links)
+    moved = (jacobian[:, coupled] @ free[:, body[coupled], :, None]).reshape(count, 6 * links, 1)
+    motion = free
+    if links:
+        try:
+            spread = np.linalg.solve(np.eye(6 * links) + weights @ receptance.reshape(count, 6 * links, 6 * links),
+                                     weights @ moved).reshape(count, 2 * links, 3, 1)
+        except np.linalg.LinAlgError:
+            return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
+        motion = free - coupling.bodies[:, coupled] @ (reach @ spread)[..., 0]   # (D, K, w)
+    on_moving = (jacobian @ motion[:, body, :, None])[..., 0]                # (D, P, 3)
+    separation = coupling.channels @ on_moving                               # (D, C, 3)
+    force = (on_points.reshape(on_points.shape[:-1] + (3, 3)) @ (coupling.channels.T @ separation)[..., None])
+    residual = (dynamic @ motion[..., None])[..., 0] + coupling.bodies @ (transposed @ force)[..., 0] - loads
+    scale = np.abs(held).max(axis=(1, 2, 3)) * np.abs(motion).max(axis=(1, 2)) + np.abs(loads).max(axis=(1, 2))
+    error = np.abs(residual).max(axis=(1, 2)) / np.where(scale > 0, scale, 1.0)
+    return separation, ~np.isfinite(error) | (error > BACKWARD_ERROR)

@@ -14,6 +14,7 @@ coordinates (fewer columns, no N x N scatter).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,7 +25,6 @@ __all__ = ["ChannelSet", "ChannelState", "spring_rows", "spring_matrix"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 _EULER_ROWS = EULER.reshape(36, 4)                                # (a b i, j)
-_EULER_BY_B = EULER.transpose(1, 0, 2, 3).reshape(3, 48)          # (b, a i j)
 
 
 @dataclass(frozen=True)
@@ -102,26 +102,50 @@ class ChannelSet:
         batch = q.shape[:-1]
         count = int(np.prod(batch, dtype=int))
         points, width = self.coordinates.shape
-        values = np.concatenate([q.reshape(count, -1), np.zeros((count, 1))], axis=1)[:, self.coordinates]
-        values = values.reshape(count * points, width)
-        local = np.tile(self.local, (count, 1))
-        modal = np.tile(self.modal, (count, 1, 1))
-        offsets = points * np.arange(count)[:, None]
-        kinds = {kind: (offsets + index).ravel() for kind, index in self.kinds.items()}
-        position = np.zeros((count * points, 3))
-        jacobian = np.zeros((count * points, 3, width))
-        hessian = np.zeros((count * points, 3, width, width)) if second else None
-        ground, free = kinds["ground"], kinds["none"]
-        position[ground] = local[ground]
-        jacobian[:, :, :3] = np.eye(3)
-        jacobian[ground] = 0.0
-        position[free] = values[free, :3] + local[free]
-        _euler(values, local, modal, kinds["euler"], position, jacobian, hessian)
-        _rxyz(values, local, modal, kinds["rxyz"], position, jacobian, hessian)
-        position = position.reshape(batch + (points, 3))
-        return ChannelState(position[..., 1::2, :] - position[..., 0::2, :],
+        padded = np.concatenate([q.reshape(count, -1), np.zeros((count, 1))], axis=1)
+        values = padded[:, self.coordinates]                                     # (count, P, M)
+        position = np.zeros((count, points, 3))
+        jacobian = np.zeros((count, points, 3, width))
+        hessian = np.zeros((count, points, 3, width, width)) if second else None
+        ground, free = self.kinds["ground"], self.kinds["none"]
+        position[:, ground] = self.local[ground]
+        jacobian[:, :, :, :3] = np.eye(3)
+        jacobian[:, ground] = 0.0
+        position[:, free] = values[:, free, :3] + self.local[free]
+        for kind, moved in (("euler", _euler), ("rxyz", _rxyz)):
+            index = self.kinds[kind]
+            if not len(index):
+                continue
+            rotations, group = self._rotations[kind]
+            shapes = self.modal[index]
+            turned = 3 + rotations.shape[1]
+            modal = values[:, index, turned:turned + shapes.shape[-1]]
+            local = self.local[index] + (shapes @ modal[..., None])[..., 0]         # w of every point, (c, p, 3)
+            rotation, firsts, seconds = moved(padded[:, rotations], second)
+            rotation, firsts = rotation[:, group], firsts[:, group]             # per point: (c, p, 3, 3), (c, p, r, 3, 3)
+            position[:, index] = values[:, index, :3] + (rotation @ local[..., None])[..., 0]
+            jacobian[:, index, :, 3:turned] = (firsts @ local[:, :, None, :, None])[..., 0].swapaxes(-1, -2)
+            jacobian[:, index, :, turned:turned + shapes.shape[-1]] = rotation @ shapes
+            if hessian is not None:
+                assert seconds is not None
+                hessian[:, index, :, 3:turned, 3:turned] = np.einsum("cpijab,cpb->cpaij", seconds[:, group], local)
+                mixed = np.einsum("cpiab,pbk->cpaik", firsts, shapes)
+                hessian[:, index, :, 3:turned, turned:turned + shapes.shape[-1]] = mixed
+                hessian[:, index, :, turned:turned + shapes.shape[-1], 3:turned] = mixed.swapaxes(-1, -2)
+        placed = position.reshape(batch + (points, 3))
+        return ChannelState(placed[..., 1::2, :] - placed[..., 0::2, :],
                             jacobian.reshape(batch + (points, 3, width)),
                             None if hessian is None else hessian.reshape(batch + (points, 3, width, width)))
+
+    @functools.cached_property
+    def _rotations(self) -> dict:
+        """Per rotation kind (``"euler"``, ``"rxyz"``): the rotation coordinates of each distinct body (G, r)
+        and each point's body among them (p,): the points of a body share its rotation."""
+        out = {}
+        for kind, count in (("euler", 4), ("rxyz", 3)):
+            rotations, group = np.unique(self.coordinates[self.kinds[kind], 3:3 + count], axis=0, return_inverse=True)
+            out[kind] = (rotations.reshape(-1, count), group.ravel())
+        return out
 
     def force(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
         """``sum_c J_c^T S_c d_c`` (..., N) for the springs *stiffness* (..., C, 3, 3), N/m."""
@@ -182,55 +206,36 @@ def _scatter(index: np.ndarray, values: np.ndarray, length: int) -> np.ndarray:
     return np.bincount(flat, values.reshape(-1), count * length).reshape(batch + (length,))
 
 
-def _euler(values, local, modal, index, position, jacobian, hessian) -> None:
-    """Euler-parameter points *index* of the flat point arrays: their position, Jacobian and Hessian in place."""
-    if not len(index):
-        return
-    modes = modal.shape[2]
-    shapes = modal[index]
-    w = local[index] + (shapes @ values[index, 7:7 + modes, None])[..., 0]
-    e = values[index, 3:7]
-    a = (e @ _EULER_ROWS.T).reshape(-1, 3, 3, 4)              # A = I + a . e
-    rotation = np.eye(3) + (a @ e[:, None, :, None])[..., 0]
-    position[index] = values[index, :3] + (rotation @ w[..., None])[..., 0]
-    jacobian[index, :, 3:7] = 2 * (w[:, None, None, :] @ a)[:, :, 0, :]
-    jacobian[index, :, 7:7 + modes] = rotation @ shapes
-    if hessian is None:
-        return
-    hessian[index, :, 3:7, 3:7] = 2 * (w @ _EULER_BY_B).reshape(-1, 3, 4, 4)
-    mixed = 2 * (a.swapaxes(-1, -2) @ shapes[:, None, :, :])
-    hessian[index, :, 3:7, 7:7 + modes] = mixed
-    hessian[index, :, 7:7 + modes, 3:7] = mixed.transpose(0, 1, 3, 2)
+def _euler(parameters: np.ndarray, second: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """The rotation A (..., 3, 3) of Euler parameters (..., 4), its derivatives (..., 4, 3, 3) and (with
+    *second*) its second derivatives (..., 4, 4, 3, 3) (constant: A is quadratic in them)."""
+    a = (parameters @ _EULER_ROWS.T).reshape(parameters.shape[:-1] + (3, 3, 4))          # A = I + a . e
+    rotation = np.eye(3) + np.einsum("...abi,...i->...ab", a, parameters)
+    firsts = 2 * np.moveaxis(a, -1, -3)
+    seconds = np.broadcast_to(2 * EULER.transpose(2, 3, 0, 1), parameters.shape[:-1] + (4, 4, 3, 3)) if second \
+        else None
+    return rotation, firsts, seconds
 
 
-def _rxyz(values, local, modal, index, position, jacobian, hessian) -> None:
-    """Tait-Bryan points *index* of the flat point arrays: their position, Jacobian and Hessian in place."""
-    if not len(index):
-        return
-    modes = modal.shape[2]
-    shapes = modal[index]
-    w = local[index] + np.einsum("pak,pk->pa", shapes, values[index, 6:6 + modes])
-    x, y, z = np.moveaxis(_axis_derivatives(values[index, 3:6]), 1, 0)   # (p, order, 3, 3) each
+def _rxyz(angles: np.ndarray, second: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Exudyn's Tait-Bryan rotation ``R_x R_y R_z`` of the angles (..., 3), its derivatives (..., 3, 3, 3) and
+    (with *second*) its second derivatives (..., 3, 3, 3, 3)."""
+    batch = angles.shape[:-1]
+    x, y, z = np.moveaxis(_axis_derivatives(angles.reshape(-1, 3)), 1, 0)   # (p, order, 3, 3) each
 
     def product(orders: tuple[int, int, int]) -> np.ndarray:
         # d^i R_x d^j R_y d^k R_z of the derivative orders (i, j, k)
-        return x[:, orders[0]] @ y[:, orders[1]] @ z[:, orders[2]]
+        return (x[:, orders[0]] @ y[:, orders[1]] @ z[:, orders[2]]).reshape(batch + (3, 3))
 
-    rotation = product((0, 0, 0))
-    firsts = np.stack([product((1, 0, 0)), product((0, 1, 0)), product((0, 0, 1))], axis=1)
-    position[index] = values[index, :3] + np.einsum("pab,pb->pa", rotation, w)
-    jacobian[index, :, 3:6] = np.einsum("piab,pb->pai", firsts, w)
-    jacobian[index, :, 6:6 + modes] = rotation @ shapes
-    if hessian is None:
-        return
+    firsts = np.stack([product((1, 0, 0)), product((0, 1, 0)), product((0, 0, 1))], axis=-3)
+    if not second:
+        return product((0, 0, 0)), firsts, None
+    seconds = np.zeros(batch + (3, 3, 3, 3))
     for i in range(3):
         for j in range(i, 3):
-            orders = tuple(int(k == i) + int(k == j) for k in range(3))
-            second = np.einsum("pab,pb->pa", product(orders), w)  # type: ignore[arg-type]
-            hessian[index, :, 3 + i, 3 + j] = hessian[index, :, 3 + j, 3 + i] = second
-    mixed = np.einsum("piab,pbk->paik", firsts, shapes)
-    hessian[index, :, 3:6, 6:6 + modes] = mixed
-    hessian[index, :, 6:6 + modes, 3:6] = mixed.transpose(0, 1, 3, 2)
+            seconds[..., i, j, :, :] = seconds[..., j, i, :, :] = product(
+                tuple(int(k == i) + int(k == j) for k in range(3)))  # type: ignore[arg-type]
+    return product((0, 0, 0)), firsts, seconds
 
 
 def _axis_derivatives(angles: np.ndarray) -> np.ndarray:

@@ -40,7 +40,7 @@ NEWTON_TOLERANCE = 1e-10
 #: it converges linearly, a step for each factor of about 100, and a state this close changes T far less
 #: than the 1e-6 the evaluation answers to (``benchmarks/bench_design_evaluation.py`` compares designs
 #: together with the same designs alone, solved by Newton).
-CHORD_TOLERANCE = 1e-8
+CHORD_TOLERANCE = 1e-7
 #: Smallest state change the tolerance is relative to (m, rad, modal coordinates).
 STATE_SCALE = 1e-3
 #: Most steps of one preload solve.

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from workbook.design.blocks import BodyLayout, body_layout
+from workbook.design.blocks import BodyLayout, ChannelCoupling, body_layout
 from workbook.design.channel_set import ChannelSet
 from workbook.design.kinematics import PointKinematics, identify
 from workbook.errors import OutsideDesignModel, SimulationError
@@ -233,6 +233,11 @@ class SceneExpansion:
     def layout(self) -> BodyLayout:
         """Where each body's coordinates sit among the full and the independent coordinates."""
         return body_layout(self)
+
+    @functools.cached_property
+    def coupling(self) -> ChannelCoupling:
+        """How the force channels join the bodies."""
+        return ChannelCoupling.of(self.layout, self.channels)
 
     @functools.cached_property
     def point_set(self) -> ChannelSet:

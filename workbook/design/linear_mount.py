@@ -38,20 +38,18 @@ from workbook.answers.results import ExcitationResult, MountResult
 from workbook.design.assembly import (
     AddedRigidMass,
     ChannelSprings,
-    Projection,
     StateLoads,
     add_tangent_terms,
     projection,
     rest_matrices,
-    solve_each,
     total,
     without_normal,
 )
-from workbook.design.channel_set import spring_matrix, spring_rows
 from workbook.design.equilibrium import ChordStiffness, PreparedTangent, prepared_tangent, static_state
 from workbook.design.expansion import SceneExpansion, expand_scene
+from workbook.design.harmonic_model import BodyHarmonic, Harmonic
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, SimulationError, UnstablePreloadError
-from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, SingleFrequencyExcitation, Sweep
+from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, Sweep
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.harmonic import point_phasors
 from workbook.solve.stages import link_warnings
@@ -447,7 +445,7 @@ class LinearMount:
             np.array([case.engine.inertia_matrix - base.inertia_matrix for case in cases], dtype=float),
             np.array([1.0 if casing is None else casing.scale(case) for case in cases]))
 
-    def _item_runs(self, cases: list[Case], position: int, prepared: _Item, model: "_Harmonic", solved: np.ndarray,
+    def _item_runs(self, cases: list[Case], position: int, prepared: _Item, model: "Harmonic | BodyHarmonic", solved: np.ndarray,
                    failures: dict) -> list:
         """Per design *cases*, its excitation results of the item at *position* (its own excitations), or the
         error that stopped it.
@@ -472,8 +470,7 @@ class LinearMount:
                 if id(e) not in phasors:
                     phasors[id(e)] = point_phasors(e)
             loads = np.stack([models.load(e, k, phasors[id(e)]) for k, e in enumerate(chosen)])
-            motion, singular = solve_each(models.dynamic(omega), loads)
-            forces = (models.output(omega) @ motion[..., None])[..., 0].reshape(len(rows), -1, 3)
+            forces, singular = models.respond(omega, loads)
             for k, row in enumerate(rows):
                 excitation = chosen[k]
                 if singular[k]:
@@ -709,7 +706,7 @@ class _SolvedItem:
     prepared: _Item
     designs: _Designs
     state: _State              # of every design (the rows of failed ones mean nothing)
-    model: _Harmonic           # of the designs *rows*
+    model: BodyHarmonic        # of the designs *rows*
     rows: np.ndarray           # the designs solved, sorted
     failures: dict             # design -> SimulationError of the others
     passes: list               # (rows, dq, tensions, stiffened) of each preload solve, when kept
@@ -725,7 +722,7 @@ class _SolvedItem:
                 passes.append((dq[p], stiffened[p], loads))
         state = dataclasses.replace(self.state.take(k), passes=tuple(passes))
         return ItemSolution(self.prepared, self.designs.springs.take(k), state,
-                            self.model.take(int(np.searchsorted(self.rows, k))))
+                            self.model.take(int(np.searchsorted(self.rows, k))).dense())
 
 
 def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False) -> _SolvedItem:
@@ -794,57 +791,13 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
 
 
 @dataclass(frozen=True)
-class _Harmonic:
-    """The projected linear models at states: ``Z = K - w^2 M + i (w D + H)``, outputs ``C_k + i (C_h + w C_d)``;
-    of one design, or of several (leading axis)."""
-
-    mass: np.ndarray
-    stiffness: np.ndarray
-    damping: np.ndarray
-    structural: np.ndarray
-    outputs: tuple              # C_k, C_d, C_h, shape (..., 3 c, n) each
-    basis: Projection
-    inputs: dict                # point -> (..., n, 3)
-
-    def dynamic(self, omega) -> np.ndarray:
-        """Z at the circular frequency *omega* (rad/s; one per design: shape (...)), shape (..., n, n)."""
-        w = np.asarray(omega, dtype=float)[..., None, None]
-        return self.stiffness - w ** 2 * self.mass + 1j * (w * self.damping + self.structural)
-
-    def output(self, omega) -> np.ndarray:
-        """The channel force phasors per motion phasor at *omega* (rad/s, as :meth:`dynamic`), shape (..., 3 C, n)."""
-        stiffness_output, damping_output, structural_output = self.outputs
-        return stiffness_output + 1j * (structural_output + np.asarray(omega, dtype=float)[..., None, None]
-                                        * damping_output)
-
-    def load(self, excitation: SingleFrequencyExcitation, design: int | None = None, phasors=None) -> np.ndarray:
-        """The generalised force phasor of *excitation* (of the design *design* of several; *phasors*: its
-        :func:`~workbook.solve.harmonic.point_phasors` when known), shape (n,)."""
-        total_load = np.zeros(self.mass.shape[-1], dtype=complex)
-        for p, phasor in point_phasors(excitation) if phasors is None else phasors:
-            inputs = self.inputs[tuple(np.round(np.asarray(p, dtype=float), 12))]
-            total_load += (inputs if design is None else inputs[design]) @ phasor
-        return total_load
-
-    def take(self, rows) -> "_Harmonic":
-        """The designs *rows* (an index: one design without its axis)."""
-        return _Harmonic(self.mass[rows], self.stiffness[rows], self.damping[rows], self.structural[rows],
-                         tuple(o[rows] for o in self.outputs), self.basis.take(rows),
-                         {key: value[rows] for key, value in self.inputs.items()})
-
-    def stacked(self) -> "_Harmonic":
-        """One design's model as a batch of one."""
-        return self.take(np.newaxis)
-
-
-@dataclass(frozen=True)
 class ItemSolution:
     """One excitation item of a design, solved: what :mod:`workbook.design.sensitivity` differentiates."""
 
     prepared: _Item
     springs: ChannelSprings
     state: _State
-    model: _Harmonic
+    model: Harmonic
 
     @property
     def engine_static(self) -> np.ndarray:
@@ -853,16 +806,14 @@ class ItemSolution:
         return (self.prepared.expansion.state + self.state.dq)[self.prepared.engine]
 
 
-def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing_scale) -> _Harmonic:
+def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing_scale) -> BodyHarmonic:
     """The projected linear model of the item *prepared* at the preloaded *state* (of one design or several,
-    with their *springs* and casing moduli *casing_scale*, E / E_0), assembled body by body
-    (:mod:`workbook.design.blocks`)."""
+    with their *springs* and casing moduli *casing_scale*, E / E_0), body by body."""
     expansion, dq = prepared.expansion, state.dq
     channels, layout = expansion.channels, expansion.layout
     at = channels.state(total(expansion, dq))
     basis = projection(expansion, dq)
     frames = layout.basis(basis.tangents)
-    jacobian = layout.channel_jacobian(channels, layout.point_jacobians(channels, at, frames))
     mass, stiffness, damping = rest_matrices(expansion, dq, state.loads)
     add_tangent_terms(expansion, dq, stiffness, springs, at)
     structural = np.zeros_like(stiffness)
@@ -877,13 +828,10 @@ def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing
         damping[..., block, positions[:, None], positions] += \
             (np.sqrt(np.asarray(casing_scale, dtype=float)) - 1.0)[..., None, None] * casing.damping
     points = expansion.point_set
-    inputs = layout.channel_jacobian(points, layout.point_jacobians(points, points.state(total(expansion, dq),
-                                                                                         second=False), frames))
-    return _Harmonic(
-        layout.dense(layout.project(mass, frames)),
-        layout.dense(layout.project(stiffness, frames)) + spring_matrix(springs.stiffness, jacobian),
-        layout.dense(layout.project(damping, frames)) + spring_matrix(springs.damping, jacobian),
-        layout.dense(layout.project(structural, frames)) + prepared.sign * spring_matrix(springs.structural, jacobian),
-        tuple(prepared.sign * spring_rows(spring, jacobian)
-              for spring in (springs.stiffness, springs.damping, springs.structural)),
-        basis, {key: inputs[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2) for k, key in enumerate(expansion.points)})
+    on_points = layout.point_jacobians(points, points.state(total(expansion, dq), second=False), frames)
+    bodies = layout.marker_rows(points)[0]
+    return BodyHarmonic(
+        layout, channels, expansion.coupling, layout.project(mass, frames), layout.project(stiffness, frames),
+        layout.project(damping, frames), layout.project(structural, frames),
+        layout.point_jacobians(channels, at, frames), springs, prepared.sign, basis,
+        {key: (int(bodies[2 * k + 1]), on_points[..., 2 * k + 1, :, :]) for k, key in enumerate(expansion.points)})

@@ -309,7 +309,8 @@ def _model_change(case: Case, solution: ItemSolution, change: _Change, state_cha
     # along the state change: a forward difference of the whole linear model
     step = STATE_STEP / max(np.abs(d_state).max(), 1e-300)
     scale = 1.0 if prepared.casing is None else prepared.casing.scale(case)
-    moved = linear_model(prepared, solution.springs, dataclasses.replace(state, dq=state.dq + step * d_state), scale)
+    moved = linear_model(prepared, solution.springs, dataclasses.replace(state, dq=state.dq + step * d_state),
+                         scale).dense()
     basis = model.basis
     at = expansion.channels.state(total(expansion, state.dq))
     channels = expansion.channels
