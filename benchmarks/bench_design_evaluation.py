@@ -126,6 +126,10 @@ def _batch(case, mount, rng) -> None:
     print(f"{'one at a time':<24}{one:>16.4f}{1 / one:>11.1f}")
     print(f"{'together':<24}{many:>16.4f}{1 / many:>11.1f}")
     print(f"{'its LAPACK solves alone':<24}{floor:>16.4f}{1 / floor:>11.1f}")
+    for name, item in mount.items.items():
+        layout = item.expansion.layout
+        print(f"{name}: {layout.count} independent coordinates in {len(layout.coordinates)} bodies of at most "
+              f"{layout.width}; {3 * len(item.expansion.coupling.coupled)} Woodbury unknowns")
     print(f"speed-up {one / many:.1f}x; largest difference of T {difference:.1e}")
 
 

@@ -228,15 +228,15 @@ class ChannelCoupling:
     coupled : ndarray of int, shape (2 L,)
         The moving points (positions in *moving*) of the L channels with both points moving: their first
         points, then their second.
-    pairs : ndarray of int, shape (Q, 2)
-        The pairs of these (positions in *coupled*) on the same body, each with itself included.
+    same_body : ndarray, shape (6 L, 6 L)
+        1 where two of these points' rows (three each) are on the same body.
     """
 
     moving: np.ndarray
     bodies: np.ndarray
     channels: np.ndarray
     coupled: np.ndarray
-    pairs: np.ndarray
+    same_body: np.ndarray
 
     @classmethod
     def of(cls, layout: BodyLayout, channels: "ChannelSet") -> "ChannelCoupling":
@@ -251,7 +251,8 @@ class ChannelCoupling:
         bodies[blocks[moving], np.arange(len(moving))] = 1.0
         by_channel = np.zeros((channels.count, len(moving)))
         by_channel[moving // 2, np.arange(len(moving))] = 1.0
-        return cls(moving, bodies, by_channel, coupled, np.argwhere(on[:, None] == on[None, :]))
+        same = np.repeat(np.repeat((on[:, None] == on[None, :]).astype(float), 3, axis=0), 3, axis=1)
+        return cls(moving, bodies, by_channel, coupled, same)
 
 
 def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.ndarray, impedance: np.ndarray,
@@ -304,22 +305,22 @@ def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.nda
     reach = inverse[:, body[coupled]] @ transposed[:, coupled]               # (D, 2 L, w, 3)
     free = (inverse @ loads[..., None])[..., 0]                              # (D, K, w)
     links = len(coupled) // 2
-    first, second = coupling.pairs.T
-    receptance = np.zeros((count, 2 * links, 3, 2 * links, 3), dtype=complex)
-    receptance[:, first, :, second, :] = (jacobian[:, coupled[first]] @ reach[:, second]).swapaxes(0, 1)
-    spring = impedance[:, coupling.moving[coupled[:links]] // 2].swapaxes(0, 1)             # (L, D, 3, 3)
-    pattern = np.zeros((count, 2, links, 3, 2, links, 3), dtype=complex)
-    index = np.arange(links)
-    pattern[:, 0, index, :, 1, index, :] = pattern[:, 1, index, :, 0, index, :] = spring
-    weights = pattern.reshape(count, 6 * links, 6 * links)
-    moved = (jacobian[:, coupled] @ free[:, body[coupled], :, None]).reshape(count, 6 * links, 1)
+    # G = U A^-1 U^T: the products of points on different bodies are not G's (other coordinates): masked
+    receptance = (jacobian[:, coupled].reshape(count, 6 * links, -1)
+                  @ reach.transpose(0, 2, 1, 3).reshape(count, -1, 6 * links)) * coupling.same_body
+    spring = impedance[:, coupling.moving[coupled[:links]] // 2]                  # (D, L, 3, 3)
+    weight = np.concatenate([spring, spring], axis=1)                            # W's blocks, (D, 2 L, 3, 3)
+    swap = np.concatenate([np.arange(links, 2 * links), np.arange(links)])     # W pairs the two halves
+    moved = jacobian[:, coupled] @ free[:, body[coupled], :, None]              # U x_free, (D, 2 L, 3, 1)
     motion = free
     if links:
+        product = weight @ receptance.reshape(count, 2 * links, 3, 6 * links)[:, swap]      # W G
         try:
-            spread = np.linalg.solve(np.eye(6 * links) + weights @ receptance.reshape(count, 6 * links, 6 * links),
-                                     weights @ moved).reshape(count, 2 * links, 3, 1)
+            spread = np.linalg.solve(np.eye(6 * links) + product.reshape(count, 6 * links, 6 * links),
+                                     (weight @ moved[:, swap]).reshape(count, 6 * links, 1))
         except np.linalg.LinAlgError:
             return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
+        spread = spread.reshape(count, 2 * links, 3, 1)
         motion = free - coupling.bodies[:, coupled] @ (reach @ spread)[..., 0]   # (D, K, w)
     on_moving = (jacobian @ motion[:, body, :, None])[..., 0]                # (D, P, 3)
     separation = coupling.channels @ on_moving                               # (D, C, 3)
