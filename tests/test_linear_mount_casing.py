@@ -124,3 +124,37 @@ def test_a_casing_modulus_keeps_the_prepared_modes_unless_its_selection_changes(
                                                                               excitation_hz, kept):
     frequencies = FREQUENCIES if modes != "static" else {**FREQUENCIES, "fixed_interface_hz": np.zeros(0)}
     assert keeps_casing_modes(modes, frequencies, scale, prepared_hz, excitation_hz) is kept
+
+
+@pytest.mark.slow
+def test_designs_together_body_by_body_are_the_whole_solve(mount, monkeypatch):
+    """The flexible engine (core and casing one body: its bearings join them), rigid links and the rig's
+    transducer masses: the casing's block, every block padded to its width, makes the whole matrices cheaper,
+    and the mount answers whole. Body by body (forced here), the channel forces of designs together (hinge
+    designs, one with a softer casing) equal the solve of the whole matrices to 1e-10, and each design's T
+    its own alone."""
+    from workbook.design.blocks import BodyLayout
+    from workbook.design.linear_mount import _solve_item
+
+    excitation = mount.case.excitations[0]
+    assert not mount.items[excitation.name].expansion.layout.by_body
+    monkeypatch.setattr(BodyLayout, "by_body", property(lambda self: True))
+    rng = np.random.default_rng(5)
+    cases = []
+    for k in range(3):
+        hinges = tuple(dataclasses.replace(h, stiffness=tuple(h.values("stiffness") * rng.uniform(1.0, 4.0, 3)),
+                                           loss_factor=float(rng.uniform(0.02, 0.1))) for h in mount.case.hinges)
+        case = dataclasses.replace(mount.case, hinges=hinges)
+        cases.append(parameter("casing_modulus").apply(case, SOFTER * case.engine.casing.material.youngs_modulus)
+                     if k == 2 else case)
+    model = _solve_item(mount._designs(cases), mount.items[excitation.name]).model
+    assert len(model.coupling.coupled) > 0 and model.layout.width > 7    # bodies joined by channels; the casing's
+    omega = 2 * np.pi * rng.uniform(20.0, 300.0, len(cases))
+    loads = np.stack([model.load(excitation, k) for k in range(len(cases))])
+    forces, singular = model.respond(omega, loads)
+    whole, _ = model.dense().respond(omega, model.layout.vector(loads))
+    assert not singular.any()
+    assert np.abs(forces - whole).max() <= 1e-10 * np.abs(whole).max()
+    for together, case in zip(mount.evaluate_many(cases), cases, strict=True):
+        alone = mount.evaluate(case).result.runs[0].transmissibility
+        assert np.abs(together.result.runs[0].transmissibility - alone).max() <= 1e-8 * np.abs(alone).max()

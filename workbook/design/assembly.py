@@ -25,7 +25,7 @@ from workbook.design.expansion import SceneExpansion
 
 __all__ = ["ChannelSprings", "AddedRigidMass", "StateLoads", "Projection", "total", "rest_stiffness",
            "rest_matrices", "turned_mass", "static_residual", "normal_components", "without_normal",
-           "tangent_stiffness", "solve_each", "projection"]
+           "tangent_stiffness", "projected", "solve_each", "projection"]
 
 @dataclass(frozen=True)
 class ChannelSprings:
@@ -250,9 +250,17 @@ def tangent_stiffness(expansion: SceneExpansion, dq: np.ndarray, rest: np.ndarra
     projected, plus every channel's ``J^T S J`` on the projected channel Jacobians *jacobian* (..., 3 C, n).
     """
     add_tangent_terms(expansion, dq, rest, springs, state)
+    return projected(expansion, rest, basis) + spring_matrix(springs.stiffness, jacobian)
+
+
+def projected(expansion: SceneExpansion, blocks: np.ndarray, basis: "Projection") -> np.ndarray:
+    """The bodies' blocks (..., K, b, b) projected on the independent coordinates *basis*, whole (..., n, n):
+    block by block, or (bodies of very unequal size, :attr:`~workbook.design.blocks.BodyLayout.by_body`)
+    placed in the full matrix and projected there."""
     layout = expansion.layout
-    return layout.dense(layout.project(rest, layout.basis(basis.tangents))) + spring_matrix(springs.stiffness,
-                                                                                         jacobian)
+    if layout.by_body:
+        return layout.dense(layout.project(blocks, layout.basis(basis.tangents)))
+    return basis.both(expansion.rest.full(blocks))
 
 
 @dataclass(frozen=True)

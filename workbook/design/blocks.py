@@ -76,6 +76,13 @@ class BodyLayout:
         """w, the most independent coordinates of a block."""
         return self.independent.shape[1]
 
+    @property
+    def by_body(self) -> bool:
+        """Whether the bodies' blocks, all padded to the widest, cost less than the whole matrices (their
+        inverses against one factorisation of the whole: ``K w^3 <= n^3``); a flexible engine casing of many
+        modes beside small bodies makes them cost more."""
+        return len(self.coordinates) * self.width ** 3 <= self.count ** 3
+
     def locate(self, indices: np.ndarray) -> tuple[int, np.ndarray]:
         """The block and positions of the full coordinates *indices*, all of one body."""
         blocks = np.unique(self.block[indices])

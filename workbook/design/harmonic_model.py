@@ -65,6 +65,10 @@ class Harmonic:
         motion, singular = solve_each(self.dynamic(omega), loads)
         return (self.output(omega) @ motion[..., None])[..., 0].reshape(len(loads), -1, 3), singular
 
+    def dense(self) -> "Harmonic":
+        """The models in whole matrices: themselves."""
+        return self
+
     def take(self, rows) -> "Harmonic":
         """The designs *rows* (an index: one design without its axis)."""
         return Harmonic(self.mass[rows], self.stiffness[rows], self.damping[rows], self.structural[rows],

@@ -40,11 +40,13 @@ from workbook.design.assembly import (
     ChannelSprings,
     StateLoads,
     add_tangent_terms,
+    projected,
     projection,
     rest_matrices,
     total,
     without_normal,
 )
+from workbook.design.channel_set import spring_matrix, spring_rows
 from workbook.design.equilibrium import ChordStiffness, PreparedTangent, prepared_tangent, static_state
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.design.harmonic_model import BodyHarmonic, Harmonic
@@ -706,7 +708,7 @@ class _SolvedItem:
     prepared: _Item
     designs: _Designs
     state: _State              # of every design (the rows of failed ones mean nothing)
-    model: BodyHarmonic        # of the designs *rows*
+    model: BodyHarmonic | Harmonic     # of the designs *rows*
     rows: np.ndarray           # the designs solved, sorted
     failures: dict             # design -> SimulationError of the others
     passes: list               # (rows, dq, tensions, stiffened) of each preload solve, when kept
@@ -806,14 +808,15 @@ class ItemSolution:
         return (self.prepared.expansion.state + self.state.dq)[self.prepared.engine]
 
 
-def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing_scale) -> BodyHarmonic:
+def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing_scale) -> BodyHarmonic | Harmonic:
     """The projected linear model of the item *prepared* at the preloaded *state* (of one design or several,
-    with their *springs* and casing moduli *casing_scale*, E / E_0), body by body."""
+    with their *springs* and casing moduli *casing_scale*, E / E_0), assembled body by body; kept body by
+    body, or whole where the bodies' blocks would cost more
+    (:attr:`~workbook.design.blocks.BodyLayout.by_body`)."""
     expansion, dq = prepared.expansion, state.dq
     channels, layout = expansion.channels, expansion.layout
     at = channels.state(total(expansion, dq))
     basis = projection(expansion, dq)
-    frames = layout.basis(basis.tangents)
     mass, stiffness, damping = rest_matrices(expansion, dq, state.loads)
     add_tangent_terms(expansion, dq, stiffness, springs, at)
     structural = np.zeros_like(stiffness)
@@ -828,7 +831,21 @@ def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing
         damping[..., block, positions[:, None], positions] += \
             (np.sqrt(np.asarray(casing_scale, dtype=float)) - 1.0)[..., None, None] * casing.damping
     points = expansion.point_set
-    on_points = layout.point_jacobians(points, points.state(total(expansion, dq), second=False), frames)
+    points_state = points.state(total(expansion, dq), second=False)
+    if not layout.by_body:
+        jacobian = basis.columns(channels.jacobian(at))
+        inputs = points.jacobian(points_state)
+        return Harmonic(
+            projected(expansion, mass, basis), projected(expansion, stiffness, basis)
+            + spring_matrix(springs.stiffness, jacobian),
+            projected(expansion, damping, basis) + spring_matrix(springs.damping, jacobian),
+            projected(expansion, structural, basis) + prepared.sign * spring_matrix(springs.structural, jacobian),
+            tuple(prepared.sign * spring_rows(spring, jacobian)
+                  for spring in (springs.stiffness, springs.damping, springs.structural)),
+            basis, {key: basis.rows(inputs[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2))
+                    for k, key in enumerate(expansion.points)})
+    frames = layout.basis(basis.tangents)
+    on_points = layout.point_jacobians(points, points_state, frames)
     bodies = layout.marker_rows(points)[0]
     return BodyHarmonic(
         layout, channels, expansion.coupling, layout.project(mass, frames), layout.project(stiffness, frames),
