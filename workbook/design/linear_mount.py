@@ -50,6 +50,7 @@ from workbook.design.channel_set import spring_matrix, spring_rows
 from workbook.design.equilibrium import ChordStiffness, PreparedTangent, prepared_tangent, static_state
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.design.harmonic_model import BodyHarmonic, Harmonic
+from workbook.design.pinned_shift import ShiftBracket
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, SimulationError, UnstablePreloadError
 from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, Sweep
 from workbook.scene.build import Scene, loss_factors
@@ -125,6 +126,7 @@ class _FlexibleLink:
     reduced_stiffness: np.ndarray      # K_r of the prepared scene (stiffened there or not)
     unloaded_hz: float                 # first pinned-pinned frequency without tension
     stiffening: object = field(repr=False)   # flexbodies LinkStiffening
+    shift: ShiftBracket = field(repr=False)  # whether tensions shift that frequency
 
 
 @dataclass(frozen=True)
@@ -597,7 +599,7 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
                 stiffening.project(reduced.mode_basis), float(reduced.info.get("axial_tension_N", 0.0)),
                 link.stiffness_damping if case.effects.link_damping else 0.0,
                 loss_factors(case)[1].get(link.name, 0.0), reduced_stiffness,
-                float(stiffening.pinned_hz(0.0, 1)[0]), stiffening))
+                float(stiffening.pinned_hz(0.0, 1)[0]), stiffening, ShiftBracket.of(stiffening)))
             if link.modal_damping > 0 and case.effects.link_damping:
                 raise OutsideDesignModel(case.name, f"link {link.name!r}: modal damping on a stiffened link")
     engine = np.arange(scene.mbs.GetNodeODE2Index(scene.engine.node), scene.mbs.GetNodeODE2Index(scene.engine.node) + 6)
@@ -770,8 +772,7 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
             for j in np.flatnonzero(-found[:, k] >= link.stiffening.buckling_load):
                 failures.setdefault(int(rows[j]), BucklingError(designs.cases[rows[j]].name, link.name, -found[j, k],
                                                                 link.stiffening.buckling_load, link.unloaded_hz))
-            shift = np.abs(link.stiffening.pinned_hz(found[:, k], 1)[:, 0] / link.unloaded_hz - 1.0)
-            stiffened[rows, k] = setting == "on" or shift > AUTO_SHIFT
+            stiffened[rows, k] = True if setting == "on" else link.shift.shifted(found[:, k], AUTO_SHIFT)
         alive = np.array([k not in failures for k in rows], dtype=bool)
         rows, found = rows[alive], found[alive]
         tensions[rows] = np.where(stiffened[rows], found, 0.0)
