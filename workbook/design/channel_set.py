@@ -15,7 +15,7 @@ coordinates (fewer columns, no N x N scatter).
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -28,6 +28,36 @@ _EULER_ROWS = EULER.reshape(36, 4)                                # (a b i, j)
 
 
 @dataclass(frozen=True)
+class _Pose:
+    """The points of one rotation kind at a state: what their position derivatives are made of.
+
+    Attributes
+    ----------
+    index : ndarray of int, shape (p,)
+        The points, among all.
+    turned : int
+        Their padded coordinates' first modal one (3 + rotation coordinates).
+    shapes : ndarray, shape (p, 3, K)
+        Their modal rows.
+    local : ndarray, shape (c, p, 3)
+        ``w + Phi q_f``, each point's place in its body's frame.
+    rotation : ndarray, shape (c, p, 3, 3)
+    firsts : ndarray, shape (c, p, r, 3, 3)
+        The rotation's derivatives with respect to its r coordinates.
+    seconds : ndarray, shape (c, p, r, r, 3, 3), or None
+        Its second derivatives, when asked for.
+    """
+
+    index: np.ndarray
+    turned: int
+    shapes: np.ndarray
+    local: np.ndarray
+    rotation: np.ndarray
+    firsts: np.ndarray
+    seconds: np.ndarray | None
+
+
+@dataclass(frozen=True)
 class ChannelState:
     """The channels at one state (or one per design: leading axes).
 
@@ -36,14 +66,62 @@ class ChannelState:
     separation : ndarray, shape (..., C, 3)
         d of every channel, m.
     jacobian : ndarray, shape (..., 2 C, 3, M)
-        Each marker's position Jacobian on its padded coordinates.
+        Each marker's position Jacobian on its padded coordinates (formed when first read).
     hessian : ndarray, shape (..., 2 C, 3, M, M), or None
-        None when not asked for.
+        Formed when first read; None when not asked for.
     """
 
     separation: np.ndarray
-    jacobian: np.ndarray
-    hessian: np.ndarray | None
+    points: "ChannelSet" = field(repr=False)
+    poses: tuple = field(repr=False)          # _Pose of each rotation kind
+    second: bool = field(repr=False)
+
+    @functools.cached_property
+    def jacobian(self) -> np.ndarray:
+        """Each marker's position Jacobian, (..., 2 C, 3, M)."""
+        count = int(np.prod(self.separation.shape[:-2], dtype=int))
+        points, width = self.points.coordinates.shape
+        jacobian = np.zeros((count, points, 3, width))
+        jacobian[:, :, :, :3] = np.eye(3)
+        jacobian[:, self.points.kinds["ground"]] = 0.0
+        for pose in self.poses:
+            turned, modes = pose.turned, pose.shapes.shape[-1]
+            jacobian[:, pose.index, :, 3:turned] = (pose.firsts @ pose.local[:, :, None, :, None])[..., 0].swapaxes(-1, -2)
+            jacobian[:, pose.index, :, turned:turned + modes] = pose.rotation @ pose.shapes
+        return jacobian.reshape(self.separation.shape[:-2] + (points, 3, width))
+
+    @functools.cached_property
+    def hessian(self) -> np.ndarray | None:
+        """Each marker's position Hessian, (..., 2 C, 3, M, M), or None when not asked for."""
+        if not self.second:
+            return None
+        count = int(np.prod(self.separation.shape[:-2], dtype=int))
+        points, width = self.points.coordinates.shape
+        hessian = np.zeros((count, points, 3, width, width))
+        for pose in self.poses:
+            assert pose.seconds is not None
+            turned, modes = pose.turned, pose.shapes.shape[-1]
+            hessian[:, pose.index, :, 3:turned, 3:turned] = np.einsum("cpijab,cpb->cpaij", pose.seconds, pose.local)
+            mixed = np.einsum("cpiab,pbk->cpaik", pose.firsts, pose.shapes)
+            hessian[:, pose.index, :, 3:turned, turned:turned + modes] = mixed
+            hessian[:, pose.index, :, turned:turned + modes, 3:turned] = mixed.swapaxes(-1, -2)
+        return hessian.reshape(self.separation.shape[:-2] + (points, 3, width, width))
+
+    def generalised(self, on_points: np.ndarray) -> np.ndarray:
+        """``f_p . J_p`` of forces *on_points* (..., 2 C, 3) on each point, on its padded coordinates:
+        (..., 2 C, M), without forming J."""
+        count = int(np.prod(self.separation.shape[:-2], dtype=int))
+        points, width = self.points.coordinates.shape
+        force = on_points.reshape(count, points, 3)
+        out = np.zeros((count, points, width))
+        out[:, :, :3] = force
+        out[:, self.points.kinds["ground"]] = 0.0
+        for pose in self.poses:
+            turned, modes = pose.turned, pose.shapes.shape[-1]
+            own = force[:, pose.index, None, None, :]                                    # (c, p, 1, 1, 3)
+            out[:, pose.index, 3:turned] = (own @ pose.firsts @ pose.local[:, :, None, :, None])[..., 0, 0]
+            out[:, pose.index, turned:turned + modes] = (own[:, :, 0] @ pose.rotation @ pose.shapes)[:, :, 0]
+        return out.reshape(self.separation.shape[:-2] + (points, width))
 
 
 @dataclass(frozen=True)
@@ -97,21 +175,18 @@ class ChannelSet:
         return len(self.coordinates) // 2
 
     def state(self, q: np.ndarray, *, second: bool = True) -> ChannelState:
-        """Separations, Jacobians and (with *second*) Hessians at the total coordinates *q* (..., N):
-        any leading axes are designs, answered at once."""
+        """Separations and the points' poses (Jacobians and, with *second*, Hessians formed when read) at the
+        total coordinates *q* (..., N): any leading axes are designs, answered at once."""
         batch = q.shape[:-1]
         count = int(np.prod(batch, dtype=int))
-        points, width = self.coordinates.shape
+        points = len(self.coordinates)
         padded = np.concatenate([q.reshape(count, -1), np.zeros((count, 1))], axis=1)
         values = padded[:, self.coordinates]                                     # (count, P, M)
         position = np.zeros((count, points, 3))
-        jacobian = np.zeros((count, points, 3, width))
-        hessian = np.zeros((count, points, 3, width, width)) if second else None
         ground, free = self.kinds["ground"], self.kinds["none"]
         position[:, ground] = self.local[ground]
-        jacobian[:, :, :, :3] = np.eye(3)
-        jacobian[:, ground] = 0.0
         position[:, free] = values[:, free, :3] + self.local[free]
+        poses = []
         for kind, moved in (("euler", _euler), ("rxyz", _rxyz)):
             index = self.kinds[kind]
             if not len(index):
@@ -122,20 +197,12 @@ class ChannelSet:
             modal = values[:, index, turned:turned + shapes.shape[-1]]
             local = self.local[index] + (shapes @ modal[..., None])[..., 0]         # w of every point, (c, p, 3)
             rotation, firsts, seconds = moved(padded[:, rotations], second)
-            rotation, firsts = rotation[:, group], firsts[:, group]             # per point: (c, p, 3, 3), (c, p, r, 3, 3)
-            position[:, index] = values[:, index, :3] + (rotation @ local[..., None])[..., 0]
-            jacobian[:, index, :, 3:turned] = (firsts @ local[:, :, None, :, None])[..., 0].swapaxes(-1, -2)
-            jacobian[:, index, :, turned:turned + shapes.shape[-1]] = rotation @ shapes
-            if hessian is not None:
-                assert seconds is not None
-                hessian[:, index, :, 3:turned, 3:turned] = np.einsum("cpijab,cpb->cpaij", seconds[:, group], local)
-                mixed = np.einsum("cpiab,pbk->cpaik", firsts, shapes)
-                hessian[:, index, :, 3:turned, turned:turned + shapes.shape[-1]] = mixed
-                hessian[:, index, :, turned:turned + shapes.shape[-1], 3:turned] = mixed.swapaxes(-1, -2)
+            pose = _Pose(index, turned, shapes, local, rotation[:, group], firsts[:, group],
+                         None if seconds is None else seconds[:, group])
+            position[:, index] = values[:, index, :3] + (pose.rotation @ local[..., None])[..., 0]
+            poses.append(pose)
         placed = position.reshape(batch + (points, 3))
-        return ChannelState(placed[..., 1::2, :] - placed[..., 0::2, :],
-                            jacobian.reshape(batch + (points, 3, width)),
-                            None if hessian is None else hessian.reshape(batch + (points, 3, width, width)))
+        return ChannelState(placed[..., 1::2, :] - placed[..., 0::2, :], self, tuple(poses), second)
 
     @functools.cached_property
     def _rotations(self) -> dict:
@@ -149,9 +216,8 @@ class ChannelSet:
 
     def force(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
         """``sum_c J_c^T S_c d_c`` (..., N) for the springs *stiffness* (..., C, 3, 3), N/m."""
-        on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
-        generalised = on_points[..., None, :] @ state.jacobian                 # (..., 2 C, 1, M)
-        flat = generalised.reshape(generalised.shape[:-3] + (-1,))
+        generalised = state.generalised(_on_points((stiffness @ state.separation[..., None])[..., 0]))
+        flat = generalised.reshape(generalised.shape[:-2] + (-1,))
         return _scatter(self.coordinates.ravel(), flat, self.size + 1)[..., :self.size]
 
     def jacobian(self, state: ChannelState) -> np.ndarray:
