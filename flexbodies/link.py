@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -239,6 +240,25 @@ def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_
     return has_stiffening(model, cache_dir=cache_dir)
 
 
+def _timed_stress_operator(link_mesh, material, rotation, timings: dict):
+    """The link's nodal stress operator; its time in ``timings["stress_operator_seconds"]``, s."""
+    from .stress import nodal_stress_operator
+
+    start = time.perf_counter()
+    stress = nodal_stress_operator(link_mesh, material, rotation)
+    timings["stress_operator_seconds"] = time.perf_counter() - start
+    return stress
+
+
+def _timed_frequencies(solver, timings: dict) -> dict:
+    """The reference frequencies of an :class:`~flexbodies.interior.InteriorSolver`'s model, Hz; their
+    time in ``timings["frequency_seconds"]``, s."""
+    start = time.perf_counter()
+    frequencies = solver.reference_frequencies()
+    timings["frequency_seconds"] = time.perf_counter() - start
+    return frequencies
+
+
 def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
                     use_cache: bool = True, stiffening: bool = False) -> tuple:
     """Reduce a link for several excitations at once: one FE model, every decision served from it.
@@ -269,25 +289,25 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         from .geometric_stiffness import coupled_stiffening, has_stiffening, save_stiffening
         from .interior import InteriorSolver
         from .reduction import couple
-        from .stress import nodal_stress_operator
 
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
-        start = time.perf_counter()
-        stress = nodal_stress_operator(link_mesh, model.material, rotation)
-        coupled = dataclasses.replace(couple(fe, model.interface), stress=stress)
-        timings["stress_operator_seconds"] = time.perf_counter() - start
-        start = time.perf_counter()
-        solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
-        timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
-        if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
+        # a second thread takes the work beside the factorisation and beside the fixed-interface modes
+        # (SuperLU, ARPACK and NumPy release the GIL): the stress operator, then the reference frequencies
+        with ThreadPoolExecutor(max_workers=1) as beside:
+            stress = beside.submit(_timed_stress_operator, link_mesh, model.material, rotation, timings)
+            coupled = couple(fe, model.interface)
             start = time.perf_counter()
-            save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
-                            cache_dir=cache_dir)
-            timings["stiffening_seconds"] = time.perf_counter() - start
-        if frequencies is None:
-            start = time.perf_counter()
-            frequencies = solver.reference_frequencies()
-            timings["frequency_seconds"] = time.perf_counter() - start
+            solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+            timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
+            coupled = dataclasses.replace(coupled, stress=stress.result())
+            found = None if frequencies is not None else beside.submit(_timed_frequencies, solver, timings)
+            if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
+                start = time.perf_counter()
+                save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material,
+                                                          rotation=rotation), cache_dir=cache_dir)
+                timings["stiffening_seconds"] = time.perf_counter() - start
+            if found is not None:
+                frequencies = found.result()
         return coupled, solver, frequencies, timings
 
     return cached_reductions(model.fingerprint(), _decider(modes), excitations_hz, prepare, cache_dir=cache_dir,
