@@ -138,23 +138,33 @@ def _gradients(basis: skfem.CellBasis) -> np.ndarray:
     return np.stack([np.moveaxis(field[0].grad, 0, -1) for field in basis.basis], axis=2)
 
 
+#: Elements whose stiffness is formed at once: the temporaries of a batch stay in the processor's cache (the
+#: 47,000-DOF thrust rod's 9,300 elements at once took 8 times as long, in fresh pages of memory).
+_ELEMENT_BATCH = 256
+
+
 def _element_stiffness(basis: skfem.CellBasis, material: Material) -> np.ndarray:
     """Element stiffness of isotropic elasticity, shape (elements, functions, 3, functions, 3), N/m.
 
     For shape functions a, b and components i, j:
     ``K[a,i,b,j] = int mu (delta_ij grad a . grad b + d_j a d_i b) + lambda d_i a d_j b``,
-    the form ``2 mu eps(u):eps(v) + lambda div u div v``.
+    the form ``2 mu eps(u):eps(v) + lambda div u div v``, formed :data:`_ELEMENT_BATCH` elements at a time.
     """
     grad = _gradients(basis)
     n_e, n_p, n_f, _ = grad.shape
-    flat = grad.reshape(n_e, n_p, 3 * n_f)
-    # T[e, (a,i), (b,j)] = int d_i a d_j b
-    products = np.matmul(np.swapaxes(flat * basis.dx[:, :, None], 1, 2), flat).reshape(n_e, n_f, 3, n_f, 3)
-    laplace = np.einsum("eaibi->eab", products)
     lam, mu = material.lame_lambda, material.shear_modulus
-    element = lam * products + mu * np.swapaxes(products, 2, 4)
-    element += mu * laplace[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
-    return 0.5 * (element + element.transpose(0, 3, 4, 1, 2))
+    identity = np.eye(3)[None, None, :, None, :]
+    stiffness = np.empty((n_e, n_f, 3, n_f, 3))
+    for start in range(0, n_e, _ELEMENT_BATCH):
+        batch = slice(start, start + _ELEMENT_BATCH)
+        flat = grad[batch].reshape(-1, n_p, 3 * n_f)
+        # T[e, (a,i), (b,j)] = int d_i a d_j b
+        products = np.matmul(np.swapaxes(flat * basis.dx[batch, :, None], 1, 2), flat).reshape(-1, n_f, 3, n_f, 3)
+        laplace = np.einsum("eaibi->eab", products)
+        element = lam * products + mu * np.swapaxes(products, 2, 4)
+        element += mu * laplace[:, :, None, :, None] * identity
+        stiffness[batch] = 0.5 * (element + element.transpose(0, 3, 4, 1, 2))
+    return stiffness
 
 
 def _element_mass(basis: skfem.CellBasis, density: float) -> np.ndarray:
