@@ -13,9 +13,13 @@ serial run would. Ctrl-C or SIGTERM of the parent stops the workers (see
 :mod:`workbook.processes`); a worker stopped by SIGTERM unwinds, so the
 cache file it was writing is removed.
 
-Workers are forked: they start at once with the parent's modules and its
-logging. Where ``fork`` is unavailable, or the cache cannot be written, the
-links are reduced in the calling process only.
+Workers are forked: they start at once with the parent's modules (those
+that reduce a link imported once, before the fork) and its logging. The
+largest job, which decides when the workers are done, runs at the parent's
+priority; a worker takes the others at a lower one, so that the largest
+job's second thread (:func:`flexbodies.link.reduce_link_set`) finds a core.
+Where ``fork`` is unavailable, or the cache cannot be written, the links are
+reduced in the calling process only.
 """
 from __future__ import annotations
 
@@ -30,7 +34,7 @@ from typing import Any, Callable
 
 from flexbodies.cache import BodyCache
 from flexbodies.geometry import default_element_size
-from flexbodies.link import LinkModel, is_reduced, reduce_link_set
+from flexbodies.link import LinkModel, is_reduced, load_reduction_modules, reduce_link_set
 from workbook.processes import end_with_parent, stop_workers
 
 __all__ = ["LinkJob", "reduce_in_workers", "available_cores"]
@@ -39,6 +43,8 @@ log = logging.getLogger(__name__)
 
 #: Seconds between the parent's looks at its workers' progress.
 _POLL_SECONDS = 0.05
+#: Niceness a worker adds for the jobs after the largest.
+_LATER_JOBS_NICENESS = 5
 
 
 @dataclass(frozen=True)
@@ -96,12 +102,16 @@ def _work(jobs: list, next_job, finished) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's: it stops the workers
     signal.signal(signal.SIGTERM, _unwind)        # unwinding removes a cache file being written
     end_with_parent()
+    lowered = False
     while True:
         with next_job.get_lock():
             index = next_job.value
             next_job.value += 1
         if index >= len(jobs):
             return
+        if index > 0 and not lowered:  # the largest job first, at full priority
+            os.nice(_LATER_JOBS_NICENESS)
+            lowered = True
         try:
             jobs[index].reduce()
         except Exception as error:  # noqa: BLE001 - the serial pass meets it again and reports it
@@ -146,6 +156,7 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
     pending = sorted((job for job in jobs if not job.cached()), key=LinkJob.expected_work, reverse=True)
     if len(pending) < 2:
         return 0
+    load_reduction_modules()
     context = multiprocessing.get_context("fork")
     next_job, finished = context.Value("i", 0), context.SimpleQueue()
     processes = [context.Process(target=_work, args=(pending, next_job, finished), daemon=True,
