@@ -261,15 +261,6 @@ def _timed_stress_operator(link_mesh, material, rotation, timings: dict):
     return stress
 
 
-def _timed_frequencies(solver, timings: dict) -> dict:
-    """The reference frequencies of an :class:`~flexbodies.interior.InteriorSolver`'s model, Hz; their
-    time in ``timings["frequency_seconds"]``, s."""
-    start = time.perf_counter()
-    frequencies = solver.reference_frequencies()
-    timings["frequency_seconds"] = time.perf_counter() - start
-    return frequencies
-
-
 def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
                     use_cache: bool = True, stiffening: bool = False) -> tuple:
     """Reduce a link for several excitations at once: one FE model, every decision served from it.
@@ -297,28 +288,29 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         One per excitation, in order, each carrying its own decision.
     """
     def prepare(frequencies):
-        from .geometric_stiffness import coupled_stiffening, has_stiffening, save_stiffening
+        from .geometric_stiffness import PINNED_FIXED_MODES, coupled_stiffening, has_stiffening, save_stiffening
         from .interior import InteriorSolver
         from .reduction import couple
 
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
-        # a second thread takes the work beside the factorisation and beside the fixed-interface modes
-        # (SuperLU, ARPACK and NumPy release the GIL): the stress operator, then the reference frequencies
-        with ThreadPoolExecutor(max_workers=1) as beside:
+        with ThreadPoolExecutor(max_workers=1) as beside:  # SuperLU and NumPy release the GIL
             stress = beside.submit(_timed_stress_operator, link_mesh, model.material, rotation, timings)
             coupled = couple(fe, model.interface)
             start = time.perf_counter()
             solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
             timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
             coupled = dataclasses.replace(coupled, stress=stress.result())
-            found = None if frequencies is not None else beside.submit(_timed_frequencies, solver, timings)
-            if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
-                start = time.perf_counter()
-                save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material,
-                                                          rotation=rotation), cache_dir=cache_dir)
-                timings["stiffening_seconds"] = time.perf_counter() - start
-            if found is not None:
-                frequencies = found.result()
+        stiffen = stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir)
+        if frequencies is None:
+            start = time.perf_counter()
+            # the stiffening's fixed-interface modes beside them, the solves of the three made together
+            frequencies = solver.reference_frequencies(PINNED_FIXED_MODES if stiffen else 0)
+            timings["frequency_seconds"] = time.perf_counter() - start
+        if stiffen:
+            start = time.perf_counter()
+            save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
+                            cache_dir=cache_dir)
+            timings["stiffening_seconds"] = time.perf_counter() - start
         return coupled, solver, frequencies, timings
 
     return cached_reductions(model.fingerprint(), _decider(modes), excitations_hz, prepare, cache_dir=cache_dir,
