@@ -14,11 +14,8 @@ serial run would. Ctrl-C or SIGTERM of the parent stops the workers (see
 cache file it was writing is removed.
 
 Workers are forked: they start at once with the parent's modules (those
-that reduce a link imported once, before the fork) and its logging. The
-largest job, which decides when the workers are done, runs at the parent's
-priority; a worker takes the others at a lower one, so that the largest
-job's second thread (:func:`flexbodies.link.reduce_link_set`) finds a core.
-Where ``fork`` is unavailable, or the cache cannot be written, the links are
+that reduce a link imported once, before the fork) and its logging. Where
+``fork`` is unavailable, or the cache cannot be written, the links are
 reduced in the calling process only.
 """
 from __future__ import annotations
@@ -43,8 +40,6 @@ log = logging.getLogger(__name__)
 
 #: Seconds between the parent's looks at its workers' progress.
 _POLL_SECONDS = 0.05
-#: Niceness a worker adds for the jobs after the largest.
-_LATER_JOBS_NICENESS = 5
 
 
 @dataclass(frozen=True)
@@ -102,16 +97,12 @@ def _work(jobs: list, next_job, finished) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's: it stops the workers
     signal.signal(signal.SIGTERM, _unwind)        # unwinding removes a cache file being written
     end_with_parent()
-    lowered = False
     while True:
         with next_job.get_lock():
             index = next_job.value
             next_job.value += 1
         if index >= len(jobs):
             return
-        if index > 0 and not lowered:  # the largest job first, at full priority
-            os.nice(_LATER_JOBS_NICENESS)
-            lowered = True
         try:
             jobs[index].reduce()
         except Exception as error:  # noqa: BLE001 - the serial pass meets it again and reports it
