@@ -16,14 +16,14 @@ from __future__ import annotations
 
 import threading
 from concurrent.futures import ThreadPoolExecutor
-from typing import Callable, Sequence
+from typing import Callable, Protocol, Sequence
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 __all__ = ["factorize", "nested_dissection", "natural_frequencies", "free_dofs", "lowest_modes", "start_vector",
-           "SharedSolves", "solved_together"]
+           "PlainSolver", "SharedSolves", "solved_together"]
 
 
 #: Relative residual below which a solve is not refined.
@@ -114,6 +114,17 @@ class _Factor:
         return spla.LinearOperator(self.shape, matvec=self.solve_plain, dtype=float)
 
 
+class PlainSolver(Protocol):
+    """What solves with a factorisation for an eigen-solver: a :func:`factorize` result, or a
+    :class:`SharedSolves` party."""
+
+    shape: tuple
+
+    def solve_plain(self, rhs: np.ndarray) -> np.ndarray: ...
+
+    def as_operator(self) -> spla.LinearOperator: ...
+
+
 class SharedSolves:
     """The single solves that several threads ask of one factorisation, made together.
 
@@ -184,7 +195,7 @@ class _Party:
         return spla.LinearOperator(self.shape, matvec=self.solve_plain, dtype=float)
 
 
-def solved_together(factor: _Factor, problems: Sequence[Callable]) -> list:
+def solved_together(factor: _Factor, problems: Sequence[Callable[[PlainSolver], object]]) -> list:
     """Run problems that solve with one factorisation side by side, their solves shared.
 
     Parameters

@@ -27,7 +27,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .eigen import factorize, lowest_modes, solved_together, start_vector
+from .eigen import PlainSolver, factorize, lowest_modes, solved_together, start_vector
 from .frequencies import mounted_constraint_basis
 from .interfaces import rigid_motion_rows
 
@@ -103,7 +103,7 @@ class InteriorSolver:
         vectors[self.masters, np.arange(len(self.masters))] = 1.0
         return vectors
 
-    def fixed_interface_modes(self, count: int, factor=None):
+    def fixed_interface_modes(self, count: int, factor: PlainSolver | None = None):
         """The lowest ``count`` fixed-interface modes: frequencies (Hz) and mass-normalised shapes in ``q``.
 
         The modes are nested, so the largest set computed so far serves every
@@ -120,7 +120,7 @@ class InteriorSolver:
         freqs, vectors = self._fixed
         return freqs[:count], vectors[:, :count]
 
-    def _bordered(self, basis: np.ndarray, factor):
+    def _bordered(self, basis: np.ndarray, factor: PlainSolver):
         """Solver of the stiffness with master motion ``basis @ r``, in ``[interior, r]`` coordinates
         (``factor`` solves with ``K_ii``)."""
         n_i = len(self.interior)
@@ -142,7 +142,7 @@ class InteriorSolver:
         lift = sp.bmat([[sp.identity(n_i, format="csr"), None], [None, sp.csr_matrix(basis)]], format="csr")
         return (lift.T @ self.stiffness @ lift).tocsr(), (lift.T @ self.mass @ lift).tocsr()
 
-    def mounted_frequencies(self, count: int = 3, factor=None) -> np.ndarray:
+    def mounted_frequencies(self, count: int = 3, factor: PlainSolver | None = None) -> np.ndarray:
         """Frequencies with both bore centres pinned and the spin about the link axis held, Hz
         (``factor`` as for :meth:`fixed_interface_modes`)."""
         basis = mounted_constraint_basis(self.coupling)
@@ -162,7 +162,7 @@ class InteriorSolver:
             blocks.append(np.hstack([np.zeros((3, 3)), np.eye(3)]))
         return np.vstack(blocks)
 
-    def free_free_frequencies(self, count: int = 6, factor=None) -> np.ndarray:
+    def free_free_frequencies(self, count: int = 6, factor: PlainSolver | None = None) -> np.ndarray:
         """First elastic frequencies of the free link, Hz (its six rigid-body modes skipped; ``factor``
         as for :meth:`fixed_interface_modes`)."""
         n_i, n_q = len(self.interior), self.n_q
