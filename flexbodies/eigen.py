@@ -209,7 +209,9 @@ def solved_together(factor: _Factor, problems: Sequence[Callable[[PlainSolver], 
     Returns
     -------
     list
-        Each problem's result, in order; the first exception any of them raised is raised.
+        Each problem's result, in order. A problem that raises leaves the others
+        running; once all are done, the exception of the first (in order) that
+        raised is raised.
     """
     shared = SharedSolves(factor, len(problems))
 
