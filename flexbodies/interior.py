@@ -15,7 +15,10 @@ In coupled coordinates ``q = [interior, masters]`` the interior stiffness
   elastic modes.
 
 Each eigenproblem then runs shift-invert Lanczos on the full coupled model:
-the frequencies are those of the FE model, not of a reduced one.
+the frequencies are those of the FE model, not of a reduced one. The
+reference frequencies' two eigenproblems, and the fixed-interface one when
+asked for, run side by side, their solves made together
+(:func:`~flexbodies.eigen.solved_together`).
 """
 from __future__ import annotations
 
@@ -24,7 +27,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .eigen import factorize, lowest_modes, start_vector
+from .eigen import PlainSolver, factorize, lowest_modes, solved_together, start_vector
 from .frequencies import mounted_constraint_basis
 from .interfaces import rigid_motion_rows
 
@@ -77,9 +80,21 @@ class InteriorSolver:
     def n_q(self) -> int:
         return self.stiffness.shape[0]
 
-    def reference_frequencies(self) -> dict:
-        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz."""
-        return {"free_free_hz": self.free_free_frequencies(6), "mounted_hz": self.mounted_frequencies(3)}
+    def reference_frequencies(self, fixed_modes: int = 0) -> dict:
+        """``free_free_hz`` (6 elastic) and ``mounted_hz`` (3) of the coupled FE model, Hz.
+
+        Parameters
+        ----------
+        fixed_modes : int
+            Also compute the lowest so many fixed-interface modes (kept for
+            :meth:`fixed_interface_modes`), side by side with the frequencies.
+        """
+        problems = [lambda factor: self.free_free_frequencies(6, factor),
+                    lambda factor: self.mounted_frequencies(3, factor)]
+        if fixed_modes:
+            problems.append(lambda factor: self.fixed_interface_modes(fixed_modes, factor))
+        free_free, mounted = solved_together(self.factor, problems)[:2]
+        return {"free_free_hz": free_free, "mounted_hz": mounted}
 
     def static_modes(self) -> np.ndarray:
         """Static modes in coupled coordinates, shape (n_q, n_masters): unit value at one master DOF."""
@@ -88,15 +103,16 @@ class InteriorSolver:
         vectors[self.masters, np.arange(len(self.masters))] = 1.0
         return vectors
 
-    def fixed_interface_modes(self, count: int):
+    def fixed_interface_modes(self, count: int, factor: PlainSolver | None = None):
         """The lowest ``count`` fixed-interface modes: frequencies (Hz) and mass-normalised shapes in ``q``.
 
         The modes are nested, so the largest set computed so far serves every
         smaller request (the stress stiffening's pinned model and the
-        reduction ask for them in turn).
+        reduction ask for them in turn). ``factor`` solves with ``K_ii``
+        (default: this solver's factorisation; see :meth:`reference_frequencies`).
         """
         if self._fixed is None or len(self._fixed[0]) < count:
-            freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, self.factor, tol=_TOLERANCE,
+            freqs, phi = lowest_modes(self.K_ii, self.M_ii, count, 0.0, factor or self.factor, tol=_TOLERANCE,
                                       ncv=2 * count + 5)
             vectors = np.zeros((self.n_q, phi.shape[1]))
             vectors[self.interior] = phi
@@ -104,8 +120,9 @@ class InteriorSolver:
         freqs, vectors = self._fixed
         return freqs[:count], vectors[:, :count]
 
-    def _bordered(self, basis: np.ndarray):
-        """Solver of the stiffness with master motion ``basis @ r``, in ``[interior, r]`` coordinates."""
+    def _bordered(self, basis: np.ndarray, factor: PlainSolver):
+        """Solver of the stiffness with master motion ``basis @ r``, in ``[interior, r]`` coordinates
+        (``factor`` solves with ``K_ii``)."""
         n_i = len(self.interior)
         coupling = self.K_ib @ basis            # K_ib N
         psi_n = self.psi @ basis                # -K_ii^-1 K_ib N
@@ -113,7 +130,7 @@ class InteriorSolver:
 
         def solve(f):
             f = np.asarray(f, dtype=float)
-            y = self.factor.solve_plain(f[:n_i])
+            y = factor.solve_plain(f[:n_i])
             r = sla.cho_solve(schur, f[n_i:] - coupling.T @ y)
             return np.concatenate([y + psi_n @ r, r])
 
@@ -125,11 +142,12 @@ class InteriorSolver:
         lift = sp.bmat([[sp.identity(n_i, format="csr"), None], [None, sp.csr_matrix(basis)]], format="csr")
         return (lift.T @ self.stiffness @ lift).tocsr(), (lift.T @ self.mass @ lift).tocsr()
 
-    def mounted_frequencies(self, count: int = 3) -> np.ndarray:
-        """Frequencies with both bore centres pinned and the spin about the link axis held, Hz."""
+    def mounted_frequencies(self, count: int = 3, factor: PlainSolver | None = None) -> np.ndarray:
+        """Frequencies with both bore centres pinned and the spin about the link axis held, Hz
+        (``factor`` as for :meth:`fixed_interface_modes`)."""
         basis = mounted_constraint_basis(self.coupling)
         K, M = self._bordered_matrices(basis)
-        solve = self._bordered(basis)
+        solve = self._bordered(basis, factor or self.factor)
         operator = spla.LinearOperator(K.shape, matvec=solve, dtype=float)
         lam, _ = spla.eigsh(K, k=count, M=M, sigma=0.0, which="LM", OPinv=operator, v0=start_vector(K.shape[0]),
                             tol=_TOLERANCE, ncv=min(max(_VECTORS_MOUNTED, 2 * count + 1), K.shape[0] - 1))
@@ -144,11 +162,12 @@ class InteriorSolver:
             blocks.append(np.hstack([np.zeros((3, 3)), np.eye(3)]))
         return np.vstack(blocks)
 
-    def free_free_frequencies(self, count: int = 6) -> np.ndarray:
-        """First elastic frequencies of the free link, Hz (its six rigid-body modes skipped)."""
+    def free_free_frequencies(self, count: int = 6, factor: PlainSolver | None = None) -> np.ndarray:
+        """First elastic frequencies of the free link, Hz (its six rigid-body modes skipped; ``factor``
+        as for :meth:`fixed_interface_modes`)."""
         n_i, n_q = len(self.interior), self.n_q
         held, others = self.masters[:6], self.masters[6:]
-        solve = self._bordered(np.eye(len(self.masters))[:, 6:])  # held at the first master
+        solve = self._bordered(np.eye(len(self.masters))[:, 6:], factor or self.factor)  # held at the first master
         rigid = self.static_modes() @ self._rigid_masters()
         rigid = rigid @ np.linalg.inv(np.linalg.cholesky(rigid.T @ (self.mass @ rigid))).T
         mass_rigid = self.mass @ rigid

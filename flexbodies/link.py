@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
+import importlib
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,8 +38,11 @@ from .selection import decide_modes
 
 # The modules that mesh (gmsh, meshio), assemble (scikit-fem) and reduce a link are imported where a
 # link is reduced: a run whose links are all in the cache never loads them.
+_REDUCTION_MODULES = ("gmsh", "pymetis", "flexbodies.meshing", "flexbodies.assembly", "flexbodies.stress",
+                      "flexbodies.interior", "flexbodies.reduction", "flexbodies.geometric_stiffness")
 
-__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "is_reduced", "build_fe_model", "default_cache_dir"]
+__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "is_reduced", "build_fe_model", "default_cache_dir",
+           "load_reduction_modules"]
 
 @dataclass(frozen=True)
 class MeshSource:
@@ -209,6 +214,13 @@ def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = No
     return link
 
 
+def load_reduction_modules() -> None:
+    """Import the modules that reduce a link (gmsh, scikit-fem, SciPy's solvers, METIS): a process about to
+    fork workers that reduce links imports them once for all of them (0.5 s each)."""
+    for name in _REDUCTION_MODULES:
+        importlib.import_module(name)
+
+
 def _decider(modes):
     """The mode decision of a link for one excitation, judged on its first mounted frequency."""
     return lambda frequencies, excitation_hz: decide_modes(modes, frequencies["mounted_hz"][0], excitation_hz)
@@ -239,6 +251,16 @@ def is_reduced(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_
     return has_stiffening(model, cache_dir=cache_dir)
 
 
+def _timed_stress_operator(link_mesh, material, rotation, timings: dict):
+    """The link's nodal stress operator; its time in ``timings["stress_operator_seconds"]``, s."""
+    from .stress import nodal_stress_operator
+
+    start = time.perf_counter()
+    stress = nodal_stress_operator(link_mesh, material, rotation)
+    timings["stress_operator_seconds"] = time.perf_counter() - start
+    return stress
+
+
 def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, cache_dir=None,
                     use_cache: bool = True, stiffening: bool = False) -> tuple:
     """Reduce a link for several excitations at once: one FE model, every decision served from it.
@@ -266,28 +288,29 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         One per excitation, in order, each carrying its own decision.
     """
     def prepare(frequencies):
-        from .geometric_stiffness import coupled_stiffening, has_stiffening, save_stiffening
+        from .geometric_stiffness import PINNED_FIXED_MODES, coupled_stiffening, has_stiffening, save_stiffening
         from .interior import InteriorSolver
         from .reduction import couple
-        from .stress import nodal_stress_operator
 
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
-        start = time.perf_counter()
-        stress = nodal_stress_operator(link_mesh, model.material, rotation)
-        coupled = dataclasses.replace(couple(fe, model.interface), stress=stress)
-        timings["stress_operator_seconds"] = time.perf_counter() - start
-        start = time.perf_counter()
-        solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
-        timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
-        if stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir):
+        with ThreadPoolExecutor(max_workers=1) as beside:  # SuperLU and NumPy release the GIL
+            stress = beside.submit(_timed_stress_operator, link_mesh, model.material, rotation, timings)
+            coupled = couple(fe, model.interface)
+            start = time.perf_counter()
+            solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
+            timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
+            coupled = dataclasses.replace(coupled, stress=stress.result())
+        stiffen = stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir)
+        if frequencies is None:
+            start = time.perf_counter()
+            # the stiffening's fixed-interface modes beside them, the solves of the three made together
+            frequencies = solver.reference_frequencies(PINNED_FIXED_MODES if stiffen else 0)
+            timings["frequency_seconds"] = time.perf_counter() - start
+        if stiffen:
             start = time.perf_counter()
             save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
                             cache_dir=cache_dir)
             timings["stiffening_seconds"] = time.perf_counter() - start
-        if frequencies is None:
-            start = time.perf_counter()
-            frequencies = solver.reference_frequencies()
-            timings["frequency_seconds"] = time.perf_counter() - start
         return coupled, solver, frequencies, timings
 
     return cached_reductions(model.fingerprint(), _decider(modes), excitations_hz, prepare, cache_dir=cache_dir,

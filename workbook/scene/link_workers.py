@@ -13,9 +13,10 @@ serial run would. Ctrl-C or SIGTERM of the parent stops the workers (see
 :mod:`workbook.processes`); a worker stopped by SIGTERM unwinds, so the
 cache file it was writing is removed.
 
-Workers are forked: they start at once with the parent's modules and its
-logging. Where ``fork`` is unavailable, or the cache cannot be written, the
-links are reduced in the calling process only.
+Workers are forked: they start at once with the parent's modules (those
+that reduce a link imported once, before the fork) and its logging. Where
+``fork`` is unavailable, or the cache cannot be written, the links are
+reduced in the calling process only.
 """
 from __future__ import annotations
 
@@ -30,7 +31,7 @@ from typing import Any, Callable
 
 from flexbodies.cache import BodyCache
 from flexbodies.geometry import default_element_size
-from flexbodies.link import LinkModel, is_reduced, reduce_link_set
+from flexbodies.link import LinkModel, is_reduced, load_reduction_modules, reduce_link_set
 from workbook.processes import end_with_parent, stop_workers
 
 __all__ = ["LinkJob", "reduce_in_workers", "available_cores"]
@@ -146,6 +147,7 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
     pending = sorted((job for job in jobs if not job.cached()), key=LinkJob.expected_work, reverse=True)
     if len(pending) < 2:
         return 0
+    load_reduction_modules()
     context = multiprocessing.get_context("fork")
     next_job, finished = context.Value("i", 0), context.SimpleQueue()
     processes = [context.Process(target=_work, args=(pending, next_job, finished), daemon=True,
