@@ -172,7 +172,7 @@ def run_workbook(args) -> int:
 
 
 #: Allocations between two runs of Python's youngest garbage collection while a workbook is run (default 700).
-_YOUNG_COLLECTION = 10_000
+_YOUNG_COLLECTION = 50_000
 
 
 @contextlib.contextmanager
