@@ -160,6 +160,23 @@ target stays out of reach: the thrust rod alone needs about 7 s of CPU
 time one step after the other (meshing 0.6 s, assembly 0.55 s,
 factorisation and static modes 2.4 s, the three Lanczos runs 2.1 s, the
 reductions 0.9 s).
+The case workbook without pandas (its result tables plain rows, the printed
+summary laid out as pandas lays it out), each report picture drawn as soon as
+its run is done, the garbage collector run seldom while the workbook is read,
+run and written, with ``env -u OPENBLAS_NUM_THREADS python
+benchmarks/bench_warm_paths.py --before 1471351 --repeats 5 --cold-repeats 0``
+(load average 2.5 at the start, 2.0 at the end)::
+
+    | what                                                      | before              | now                 | target |
+    | warm `mountwb run`                                        | 0.87 s (CPU 0.87 s) | 0.94 s (CPU 0.93 s) | 1 s    |
+    | warm `mountwb run cases/reference.xlsx --report r.xlsx`   | 2.98 s (CPU 3.99 s) | 2.45 s (CPU 3.42 s) | 2 s    |
+    | the same again, on the workbook holding the first results | 3.27 s (CPU 4.23 s) | 2.65 s (CPU 3.26 s) | 2 s    |
+
+The workbook's runs take 0.5 to 0.6 s less; at this load they stay above
+2 s. Of the command's own CPU time (about 2 s): imports 0.45 s, the three
+runs 0.8 s (their three scenes prepared, 0.63 s), the results written 0.34 s
+(openpyxl's save of the hinge sheet most of it), the report 0.07 s; the
+interpreter's exit adds 0.2 s of wall time.
 
 Run from the repository's root::
 

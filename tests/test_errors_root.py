@@ -52,7 +52,6 @@ PLAIN_RAISES = {
     ("workbook/answers/results.py", "MountResult.run"): "a run name asked for in Python",
     ("workbook/answers/results.py", "MountResult._table_rows"): "a quantity asked for in Python (MountResult.to_pandas, to_text)",
     ("workbook/answers/text_table.py", "text_table"): "rows and columns the package built",
-    ("workbook/excel/pictures.py", "Pictures.result"): "the package's own calls out of order (draw before result)",
     ("workbook/answers/results.py", "MountResult.plot_time_histories"): "a plot asked for in Python",
     ("workbook/solve/four_pole.py", "FourPole.direction_values"): "a quantity asked for in Python",
     ("workbook/studies/accuracy.py", "run_study"): "a ladder given in Python",

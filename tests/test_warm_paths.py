@@ -3,8 +3,9 @@ once, units need no pint.
 
 The guards of the warm paths: ``mountwb run`` on
 a JSON case (or the reference mount) loads neither pandas nor pint,
-matplotlib, openpyxl, scikit-fem, meshio or gmsh; its tables, printed
-without pandas, are pandas' own text; the factors of the unit table are
+matplotlib, openpyxl, scikit-fem, meshio or gmsh, and on a case workbook
+with its report not pandas; their tables, printed without pandas, are
+pandas' own text; the factors of the unit table are
 pint's to the last bit; the writer adds its sheets to the workbook the
 reader opened.
 """
@@ -56,6 +57,17 @@ def test_run_of_a_rigid_case_imports_only_what_it_uses(tmp_path):
     out, imported = _run(["run", "--rigid", "--no-progress"], tmp_path / "cache")
     assert "pylon isolation efficiency" in out
     assert imported == []
+
+
+@pytest.mark.slow  # the links are reduced first, unless an earlier test of the session did
+def test_a_workbook_run_with_its_report_imports_no_pandas(tmp_path, cache_dir):
+    """``mountwb run CASE.xlsx --report R.xlsx`` prints and writes its tables without pandas; matplotlib is the
+    picture process's."""
+    case = tmp_path / "reference.xlsx"
+    case.write_bytes((ROOT / "cases" / "reference.xlsx").read_bytes())
+    out, imported = _run(["run", str(case), "--report", str(tmp_path / "report.xlsx"), "--no-progress"], cache_dir)
+    assert "Pylon isolation efficiency" in out and (tmp_path / "report.xlsx").exists()
+    assert [name for name in imported if name in ("pandas", "pyarrow", "matplotlib")] == []
 
 
 def test_help_the_cache_listing_and_a_workbook_check_load_no_numerics(tmp_path):
@@ -122,6 +134,31 @@ def test_printed_tables_are_pandas_text():
         float_format = generator.choice(formats)
         frame = pd.DataFrame.from_dict(rows, orient="index", columns=columns).rename_axis("run")
         assert text_table("run", rows, columns, float_format) == frame.to_string(float_format=float_format)
+
+
+def test_the_printed_summary_of_a_workbook_is_pandas_text():
+    """The efficiency table ``mountwb run CASE.xlsx`` prints is the text of pandas' pivot table of it."""
+    from workbook.cli.workbooks import _summary_text
+    from workbook.excel.writer import ResultTable
+
+    generator = random.Random(7)
+    for _ in range(100):
+        rows = []
+        for run in generator.sample(["LP rotor", "HP rotor", "sweep", "a run of a longer name"], generator.randint(1, 3)):
+            points = generator.randint(1, 4)
+            for i in range(points):
+                frequency = generator.choice([5.0, 59.0, 248.5, 5.930071, 1234.5678])
+                name = run if points == 1 else f"{run} @ {frequency:g} Hz {i}"
+                for direction in "xyz":
+                    eta = generator.uniform(-1, 1) * generator.choice([1, 100, 1e4, 1e6])
+                    missing = direction == "y" and len(rows) > 3 and generator.random() < 0.3   # pandas: NaN
+                    rows.append((run, name, frequency, direction, float("nan") if missing else eta))
+        table = ResultTable(("run", "point", "frequency Hz", "direction", "eta %"), rows)
+        frame = pd.DataFrame(rows, columns=list(table.columns))
+        frame["frequency Hz"] = frame["frequency Hz"].map("{:.6g}".format)
+        pivot = frame.pivot_table(index=["run", "point", "frequency Hz"], columns="direction", values="eta %",
+                                  sort=False)
+        assert _summary_text(table) == pivot.to_string(float_format=lambda v: f"{v:8.2f}")
 
 
 def test_tables_pandas_lays_out_by_its_own_rules_are_left_to_it():
@@ -192,7 +229,8 @@ def test_pictures_drawn_in_a_second_process_are_those_drawn_here():
 
     runs = _picture_runs()
     pictures = start_pictures()
-    pictures.draw(runs)
+    for run in runs:
+        pictures.add(run)
     try:
         drawn = pictures.result()
     finally:
@@ -215,7 +253,8 @@ def test_pictures_not_taken_stop_their_process():
     from workbook.excel.pictures import start_pictures
 
     pictures = start_pictures()
-    pictures.draw(_picture_runs())
+    for run in _picture_runs():
+        pictures.add(run)
     process = pictures._process
     pictures.close()
     assert process is None or not process.is_alive()

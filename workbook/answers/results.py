@@ -22,10 +22,12 @@ if TYPE_CHECKING:
     from workbook.answers.model_card import ModelCard
     from workbook.solve.preload import Preload
 
-__all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM"]
+__all__ = ["ExcitationResult", "MountResult", "PylonAnswers", "PYLON_SUM", "LONG_COLUMNS"]
 
 #: Row label of the pylon sum in the tables.
 PYLON_SUM = "pylon sum"
+#: Columns of the answers in long form (:meth:`MountResult.long_rows`, ``MountResult.to_pandas("all")``).
+LONG_COLUMNS = ("run", "frequency Hz", "location", "pylon side", "direction", "amplitude N", "T", "eta %", "dB")
 
 
 class PylonAnswers:
@@ -223,20 +225,24 @@ class MountResult:
         table = self.to_pandas(quantity)
         return (table if frequency else table.drop(columns="frequency Hz")).to_string(float_format=float_format)
 
-    def _long_frame(self):
-        """Every answer in long form (``to_pandas("all")``)."""
-        import pandas as pd
-
+    def long_rows(self) -> list[tuple]:
+        """Every answer in long form, one row per run, location (hinge or pylon sum) and direction, of
+        plain Python values (:data:`LONG_COLUMNS`): the rows of ``to_pandas("all")``, without pandas."""
         rows = []
         for run in self.runs:
             for location, amplitude in run.amplitudes().items():
                 for axis, value in zip(DIRECTIONS, amplitude, strict=True):
                     t = transmissibility(value, run.excitation_amplitude)
-                    rows.append((run.name, run.frequency_hz, location, location == PYLON_SUM
-                                 or location in run.pylon_hinges, axis, value, t,
+                    rows.append((run.name, float(run.frequency_hz), location, bool(location == PYLON_SUM
+                                 or location in run.pylon_hinges), axis, float(value), float(t),
                                  float(efficiency(t)), float(level_db(t))))
-        return pd.DataFrame(rows, columns=["run", "frequency Hz", "location", "pylon side", "direction",
-                                           "amplitude N", "T", "eta %", "dB"])
+        return rows
+
+    def _long_frame(self):
+        """Every answer in long form (``to_pandas("all")``)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.long_rows(), columns=list(LONG_COLUMNS))
 
     table = renamed("table", "to_pandas(quantity)", lambda self, *a, **k: self.to_pandas(*a, **k))
     table_text = renamed("table_text", "to_text(quantity)", lambda self, *a, **k: self.to_text(*a, **k))

@@ -7,6 +7,8 @@ written), 1 numerical trouble or a file that could not be saved. Messages are pl
 from __future__ import annotations
 
 import argparse
+import contextlib
+import gc
 import sys
 from typing import Callable
 
@@ -77,15 +79,52 @@ def add_run_arguments(parser: argparse.ArgumentParser) -> None:
                              "transfer dynamic stiffness per direction (as mountwb four-pole with its defaults)")
 
 
-def _print_summary(runs, frames: dict) -> None:
-    """Print the efficiency table of *runs* (their result tables *frames*, :func:`~workbook.excel.writer.result_frames`)
+def _summary_text(efficiency) -> str:
+    """The pylon isolation efficiency of the runs as a table: one row per run, point and frequency, one column per
+    direction.
+
+    Laid out as pandas lays out ``to_string(float_format=lambda v: f"{v:8.2f}")`` of the pivot table of
+    *efficiency* (its ``eta %`` by run, point and frequency, its ``6g`` text, against direction, in the order
+    met), without pandas.
+
+    Parameters
+    ----------
+    efficiency : workbook.excel.writer.ResultTable
+        The efficiency table of :func:`~workbook.excel.writer.result_tables`.
+    """
+    names = ("run", "point", "frequency Hz")
+    values: dict[tuple, dict[str, float]] = {}
+    directions: dict[str, None] = {}
+    for record in efficiency.records():
+        key = (record["run"], record["point"], f"{record['frequency Hz']:.6g}")
+        values.setdefault(key, {})[record["direction"]] = record["eta %"]
+        directions[record["direction"]] = None
+
+    def shown(value: float | None) -> str:
+        return "NaN" if value is None or value != value else f"{value:8.2f}"
+
+    cells = {key: [shown(row.get(d)) for d in directions] for key, row in values.items()}
+    levels = [max([len(name), *(len(key[i]) for key in values)]) for i, name in enumerate(names)]
+    index = sum(levels) + len(levels) - 1
+    widths = [max([len(d), *(len(row[j]) for row in cells.values())]) for j, d in enumerate(directions)]
+    lines = ["direction".ljust(index) + "".join(" " + d.rjust(w) for d, w in zip(directions, widths, strict=True)),
+             " ".join(name.ljust(w) for name, w in zip(names, levels, strict=True)) + " " * sum(w + 1 for w in widths)]
+    previous: tuple = ()
+    for key, row in cells.items():
+        # pandas leaves out a level's label where it and the levels before it repeat the row above (not the last)
+        labels = [label if i == len(key) - 1 or key[:i + 1] != previous[:i + 1] else ""
+                  for i, label in enumerate(key)]
+        lines.append(" ".join(label.ljust(w) for label, w in zip(labels, levels, strict=True))
+                     + "".join(" " + text.rjust(w) for text, w in zip(row, widths, strict=True)))
+        previous = key
+    return "\n".join(lines)
+
+
+def _print_summary(runs, tables: dict) -> None:
+    """Print the efficiency table of *runs* (their result tables *tables*, :func:`~workbook.excel.writer.result_tables`)
     and their warnings."""
-    frame = frames["efficiency"].copy()
-    frame["frequency Hz"] = frame["frequency Hz"].map("{:.6g}".format)
-    table = frame.pivot_table(index=["run", "point", "frequency Hz"], columns="direction", values="eta %",
-                              sort=False)
     print("Pylon isolation efficiency eta = (1 - T) x 100 %:")
-    print(table.to_string(float_format=lambda v: f"{v:8.2f}"))
+    print(_summary_text(tables["efficiency"]))
     from workbook.answers.warning_groups import warning_lines
 
     for run in runs:
@@ -115,20 +154,42 @@ def run_workbook(args) -> int:
     if args.four_pole and not args.report:
         print("mountwb run: --four-pole adds a sheet to the report: give --report OUT.xlsx", file=sys.stderr)
         return EXIT_BAD_INPUT
+    with _seldom_collections():
+        try:
+            book = read_workbook(args.case)
+            selected = select_runs(book, args.runs)
+        except WorkbookError as error:
+            return _report_problems(error)
+        progress = None if getattr(args, "no_progress", False) else progress_factory()
+        # the report's pictures: a second process imports matplotlib while the runs are computed, and
+        # draws each run's as it is done (the last while this one writes the results)
+        pictures = start_pictures() if args.report else None
+        try:
+            return _run_and_write(args, book, selected, progress, pictures)
+        finally:
+            if pictures is not None:
+                pictures.close()
+
+
+#: Allocations between two runs of Python's youngest garbage collection while a workbook is run (default 700).
+_YOUNG_COLLECTION = 50_000
+
+
+@contextlib.contextmanager
+def _seldom_collections():
+    """Run Python's cyclic garbage collector seldom meanwhile.
+
+    openpyxl makes an object per cell (and its style) of the workbook read
+    and of the sheets written, which live until the file is saved: at the
+    default thresholds the collector walks them again and again, a tenth of
+    the command's time for nothing to collect.
+    """
+    thresholds = gc.get_threshold()
+    gc.set_threshold(_YOUNG_COLLECTION, *thresholds[1:])
     try:
-        book = read_workbook(args.case)
-        selected = select_runs(book, args.runs)
-    except WorkbookError as error:
-        return _report_problems(error)
-    progress = None if getattr(args, "no_progress", False) else progress_factory()
-    # the report's pictures: a second process imports matplotlib while the runs are computed, and
-    # draws them while this one writes the results
-    pictures = start_pictures() if args.report else None
-    try:
-        return _run_and_write(args, book, selected, progress, pictures)
+        yield
     finally:
-        if pictures is not None:
-            pictures.close()
+        gc.set_threshold(*thresholds)
 
 
 def _solved_loads(case):
@@ -165,10 +226,10 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     from workbook.errors import SimulationError
     from workbook.excel.execute import run_book
     from workbook.excel.report import write_report
-    from workbook.excel.writer import result_frames, write_results
+    from workbook.excel.writer import result_tables, write_results
     from workbook.solve.pipeline import report_four_pole
 
-    runs, failures = run_book(book, selected, progress=progress)
+    runs, failures = run_book(book, selected, progress=progress, finished=None if pictures is None else pictures.add)
     for failure in failures:
         print(f"mountwb run: {failure}", file=sys.stderr)
     if any(failure.bad_input for failure in failures) or not runs:
@@ -182,13 +243,11 @@ def _run_and_write(args, book, selected, progress, pictures) -> int:
     except SimulationError as error:
         print(f"mountwb run: numerical trouble: {error}; nothing was written", file=sys.stderr)
         return EXIT_TROUBLE
-    if pictures is not None:
-        pictures.draw(runs)
-    frames = result_frames(runs, book.tests)
-    _print_summary(runs, frames)
+    tables = result_tables(runs, book.tests)
+    _print_summary(runs, tables)
     try:
         outcome = write_results(book.path, book.sha256, runs, book.tests, opened=book.opened, loads=loads,
-                                fatigue=fatigue, frames=frames)
+                                fatigue=fatigue, tables=tables)
     except OSError as error:
         print(f"mountwb run: the results could not be saved ({error}); {book.path.name} is unchanged",
               file=sys.stderr)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
-from typing import Iterable
+from typing import Callable, Iterable
 
 from workbook.errors import Problem, SimulationError, WorkbookError, interruption
 from workbook.excel.reader import CaseBook
@@ -59,7 +59,8 @@ class RunFailure:
         return f"run '{self.spec.name}' (excitation '{self.spec.excitation}') failed, {trouble}: {self.error}"
 
 
-def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> tuple[list[RunResult], list[RunFailure]]:
+def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None,
+             finished: Callable[[RunResult], None] | None = None) -> tuple[list[RunResult], list[RunFailure]]:
     """Run each of *runs* of *book*; a run that fails does not stop the runs after it.
 
     Parameters
@@ -68,6 +69,8 @@ def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> tuple[lis
     runs : list of RunSpec
     progress : callable, optional
         Progress factory of :func:`workbook.solve.pipeline.run_case`.
+    finished : callable, optional
+        Called with each run that finished, at once (the report's pictures start from it).
 
     Returns
     -------
@@ -84,10 +87,14 @@ def run_book(book: CaseBook, runs: list[RunSpec], *, progress=None) -> tuple[lis
     for spec in runs:
         log.info("run %s (%s)", spec.name, spec.excitation)
         try:
-            results.append(RunResult(spec, run_case(book.run_case(spec), progress=progress)))
+            result = RunResult(spec, run_case(book.run_case(spec), progress=progress))
         except (SimulationError, ValueError, OSError) as error:    # what the command line reports as such
             if interruption(error) is not None:
                 raise
             log.info("run %s failed: %s", spec.name, error)
             failures.append(RunFailure(spec, error))
+            continue
+        results.append(result)
+        if finished is not None:
+            finished(result)
     return results, failures

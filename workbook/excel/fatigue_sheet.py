@@ -15,7 +15,10 @@ alternating or a life without damage.
 """
 from __future__ import annotations
 
-import pandas as pd
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["NOTE", "QUANTITIES", "fatigue_frame"]
 
@@ -35,6 +38,8 @@ QUANTITIES = {**dict.fromkeys(_STRESSES, "number"), "Goodman": "margin", "Gerber
 
 def fatigue_frame(result) -> pd.DataFrame:
     """The table of *result* (a :class:`~workbook.solve.fatigue.FatigueResult`)."""
+    import pandas as pd
+
     rows = []
     for answer in result.excitations:
         for name, f in answer.links.items():

@@ -9,7 +9,10 @@ link has no stress field, a mesh link no shank area).
 """
 from __future__ import annotations
 
-import pandas as pd
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["NOTE", "QUANTITIES", "loads_frame"]
 
@@ -29,6 +32,8 @@ def _mpa(value: float | None) -> float | None:
 
 def loads_frame(results) -> pd.DataFrame:
     """The table of *results* (a list of LoadCaseResult), one row per load case and link."""
+    import pandas as pd
+
     rows = []
     for result in results:
         load_case = result.load_case

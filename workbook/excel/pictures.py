@@ -3,13 +3,13 @@
 Importing matplotlib and drawing the pictures take about as long as
 writing the results into the case workbook. :func:`start_pictures` forks a
 process before the runs are computed, which imports matplotlib on the
-second core meanwhile; :meth:`Pictures.draw` sends it what the pictures
-show once the runs are done, and it draws them while this process writes
-the results; :meth:`Pictures.result` collects them. Where no process can be
-forked (no ``fork``, one core, inside a worker process), or the drawing
-process fails, the pictures are drawn in this process: the same bytes
-either way. A time-domain run's picture (its force histories) is always
-drawn here.
+second core meanwhile; :meth:`Pictures.add` sends it what the picture of a
+run shows as soon as that run is done, and it draws it while the next runs
+are computed (and the last one's while this process writes the results);
+:meth:`Pictures.result` collects them. Where no process can be forked (no
+``fork``, one core, inside a worker process), or the drawing process
+fails, the pictures are drawn in this process: the same bytes either way.
+A time-domain run's picture (its force histories) is always drawn here.
 """
 from __future__ import annotations
 
@@ -84,21 +84,28 @@ def _draw(fig, picture: _Picture) -> None:
     ax.set_title(f"{picture.case_name}: {picture.run_name}", y=1.0)   # placed: matplotlib's search costs a third
 
 
-def _draw_all(pictures: list) -> list:
-    """The PNG of each picture (None where the picture is None)."""
+def _figure():
+    """The figure the pictures are drawn on, one after the other (Agg)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     fig = Figure()
     FigureCanvasAgg(fig)
-    drawn: list[bytes | None] = []
-    for picture in pictures:
-        if picture is None:
-            drawn.append(None)
-            continue
-        _draw(fig, picture)
-        drawn.append(_png(fig))
-    return drawn
+    return fig
+
+
+def _drawn(fig, picture: _Picture | None) -> bytes | None:
+    """The PNG of *picture* drawn on *fig* (None for None)."""
+    if picture is None:
+        return None
+    _draw(fig, picture)
+    return _png(fig)
+
+
+def _draw_all(pictures: list) -> list:
+    """The PNG of each picture (None where the picture is None)."""
+    fig = _figure()
+    return [_drawn(fig, picture) for picture in pictures]
 
 
 def _png(fig) -> bytes:
@@ -145,25 +152,34 @@ def _cores() -> int:
         return os.cpu_count() or 1
 
 
+#: What :meth:`Pictures.result` sends the drawing process when every picture has been sent.
+_END = "end"
+
+
 def _draw_and_send(connection) -> None:
-    """In the forked process: import matplotlib, wait for the pictures, draw and send them (None if
-    drawing failed)."""
+    """In the forked process: import matplotlib, draw each picture as it comes, send them all at the end
+    (None if drawing failed)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's: it stops this process
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # stopped by the parent: end quietly, not as the parent's handler does
     end_with_parent()
+    drawn: list[bytes | None] | None = None
     try:
-        import matplotlib.backends.backend_agg  # noqa: F401 - the import is the work done while the runs are computed
-        import matplotlib.figure  # noqa: F401
+        fig = _figure()  # the import of matplotlib is the work done while the first run is computed
+        drawn = []
     except Exception:  # noqa: BLE001 - the parent draws the pictures and meets the error itself
         pass
-    try:
-        pictures = connection.recv()
-    except (EOFError, OSError):  # the parent has no pictures for this process
-        return
-    try:
-        drawn = _draw_all(pictures)
-    except Exception:  # noqa: BLE001 - the parent draws them again and meets the error itself
-        drawn = None
+    while True:
+        try:
+            picture = connection.recv()
+        except (EOFError, OSError):  # the parent has no (more) pictures for this process
+            return
+        if picture == _END:
+            break
+        if drawn is not None:
+            try:
+                drawn.append(_drawn(fig, picture))
+            except Exception:  # noqa: BLE001 - the parent draws them again and meets the error itself
+                drawn = None
     connection.send(drawn)
     connection.close()
 
@@ -171,12 +187,12 @@ def _draw_and_send(connection) -> None:
 class Pictures:
     """A forked process that draws the pictures of runs (or, failing that, they are drawn here).
 
-    Made by :func:`start_pictures` before the runs; :meth:`draw` hands it the runs,
+    Made by :func:`start_pictures` before the runs; :meth:`add` hands it each run as it is done,
     :meth:`result` gives their pictures, :meth:`close` stops the process.
     """
 
     def __init__(self):
-        self._runs: list | None = None
+        self._runs: list = []
         self._process = None
         self._connection = None
         if _cores() < 2 or "fork" not in multiprocessing.get_all_start_methods() \
@@ -194,22 +210,21 @@ class Pictures:
             there.close()
         self._process, self._connection = process, here
 
-    def draw(self, runs) -> None:
-        """Have the pictures of *runs* drawn (list of workbook.excel.writer.RunResult)."""
-        self._runs = list(runs)
+    def add(self, run) -> None:
+        """Have the picture of *run* (a workbook.excel.writer.RunResult) drawn, after those added before."""
+        self._runs.append(run)
         if self._connection is not None:
             try:
-                self._connection.send([_picture(run) for run in self._runs])
+                self._connection.send(_picture(run))
             except OSError:
                 self.close()
 
     def result(self) -> list[bytes]:
-        """The PNG of each run given to :meth:`draw`, in order: from the forked process, or drawn here."""
-        if self._runs is None:
-            raise RuntimeError("Pictures.result before Pictures.draw")
+        """The PNG of each run given to :meth:`add`, in order: from the forked process, or drawn here."""
         drawn = None
         if self._connection is not None:
             try:
+                self._connection.send(_END)
                 drawn = self._connection.recv()
             except (EOFError, OSError):
                 drawn = None
@@ -234,7 +249,7 @@ def start_pictures() -> Pictures:
     Returns
     -------
     Pictures
-        Hand it the runs with :meth:`Pictures.draw`, take the PNGs with
+        Hand it each run with :meth:`Pictures.add`, take the PNGs with
         :meth:`Pictures.result`; call :meth:`Pictures.close` when they will
         not be taken (an error on the way).
     """

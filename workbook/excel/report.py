@@ -46,7 +46,7 @@ from workbook.excel.files import new_file_target, save_atomic, signed, untouched
 from workbook.excel.pictures import draw_pictures
 from workbook.excel.reader import CaseBook
 from workbook.excel.styling import FORMATS, print_setup, style_series, write_frame, write_text_lines
-from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_frames
+from workbook.excel.writer import RunResult, WriteOutcome, card_lines, result_tables
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["write_report", "is_report", "four_pole_sheet", "FOUR_POLE_SHEET", "PACKAGES", "REPORT_KEYWORDS"]
@@ -163,11 +163,12 @@ def _summary(ws, book: CaseBook, runs: list[RunResult]) -> None:
 def _validation(ws, runs: list[RunResult], tests: tuple) -> None:
     _title(ws, "Validation: pylon transmissibility, simulation against test",
            "error = (sim - test) / test x 100 %")
-    frame = result_frames(runs, tests)["efficiency"]
-    frame = frame[frame["test amplitude N"].notna()]
-    t_test = frame["T"] * frame["test amplitude N"] / frame["amplitude N"]
-    rows = [[row["run"], row["frequency Hz"], row["direction"], row["T"], t, row["error %"], row["eta %"],
-             efficiency(t), row["dB"], float(level_db(t))] for (_, row), t in zip(frame.iterrows(), t_test, strict=True)]
+    rows = []
+    for row in result_tables(runs, tests)["efficiency"].records():
+        if row["test amplitude N"] is not None:
+            t = row["T"] * row["test amplitude N"] / row["amplitude N"]
+            rows.append([row["run"], row["frequency Hz"], row["direction"], row["T"], t, row["error %"], row["eta %"],
+                         efficiency(t), row["dB"], float(level_db(t))])
     _table(ws, 3, [("run", "text"), ("frequency (Hz)", "Hz"), ("direction", "text"), ("T sim (-)", "T"),
                    ("T test (-)", "T"), ("error (%)", "error"), ("eta sim (%)", "eta"), ("eta test (%)", "eta"),
                    ("level sim (dB)", "dB"), ("level test (dB)", "dB")], rows)

@@ -6,16 +6,18 @@ written back into a case workbook, the report workbook and the template.
 from __future__ import annotations
 
 import textwrap
+from copy import copy
 
 from openpyxl.cell.cell import Cell
 from openpyxl.chart import Series
 from openpyxl.styles import Alignment, Font, PatternFill
+from openpyxl.styles.cell_style import StyleArray
 from openpyxl.utils import get_column_letter
 from openpyxl.worksheet.pagebreak import Break
 from openpyxl.worksheet.properties import PageSetupProperties
 
 __all__ = ["FORMATS", "DIRECTION_COLOURS", "quantity_of", "print_setup", "style_series", "write_text_lines",
-           "write_frame"]
+           "write_table", "write_frame"]
 
 #: Number format of each quantity: eta and errors in %, T in four decimals (scientific below 0.01),
 #: levels in dB with one decimal, frequencies in Hz with two, forces in N, dynamic stiffness in N/m
@@ -131,48 +133,60 @@ def write_text_lines(ws, lines: list[str], top: int = 1) -> None:
     lines); a monospaced font keeps the columns of tabular lines aligned; a
     line starting with ``Run '`` is bold.
     """
+    styles: dict[bool, StyleArray] = {}     # of the plain and the bold lines, each made once and shared
     for row, line in enumerate(lines, start=top):
         line = _unwrapped(line)
-        indent = " " * (len(line) - len(line.lstrip()) + 2)
-        paragraph = textwrap.wrap(line, _TEXT_CHARACTERS, subsequent_indent=indent, drop_whitespace=False) or [""]
+        if len(line) <= _TEXT_CHARACTERS and line.isprintable():
+            paragraph = [line]              # as textwrap gives it, which takes longer to find out
+        else:
+            indent = " " * (len(line) - len(line.lstrip()) + 2)
+            paragraph = textwrap.wrap(line, _TEXT_CHARACTERS, subsequent_indent=indent, drop_whitespace=False) or [""]
         cell = ws.cell(row, 1, "\n".join(part.rstrip() for part in paragraph))
-        cell.font = Font(name="Consolas", size=_TEXT_SIZE, bold=line.startswith("Run '"))
-        cell.alignment = Alignment(wrap_text=True, vertical="top")
+        bold = line.startswith("Run '")
+        if bold in styles:
+            cell._style = copy(styles[bold])
+        else:
+            cell.font = Font(name="Consolas", size=_TEXT_SIZE, bold=bold)
+            cell.alignment = Alignment(wrap_text=True, vertical="top")
+            styles[bold] = copy(cell._style)
         if len(paragraph) > 1:
             ws.row_dimensions[row].height = _TEXT_LINE_HEIGHT * len(paragraph)
     ws.column_dimensions["A"].width = _TEXT_WIDTH
 
 
-def write_frame(ws, frame, top: int = 1, fill: PatternFill | None = None, quantities: dict | None = None) -> None:
-    """Write a table (a pandas DataFrame) with its header in row *top*, each number formatted by its quantity.
+def write_table(ws, columns, rows, top: int = 1, fill: PatternFill | None = None,
+                quantities: dict | None = None) -> None:
+    """Write a table with its header in row *top*, each number formatted by its quantity.
 
     The header is bold (on *fill*), frozen and repeated on every printed
     page; each column is as wide as its header and its texts; a missing
-    value is an empty cell. The rows below *top* are to be empty: the table's
-    rows are appended after its header.
+    value (None or NaN) is an empty cell. The rows below *top* are to be
+    empty: the table's rows are appended after its header.
 
     Parameters
     ----------
+    columns : sequence of str
+        The column headers.
+    rows : sequence of sequence
+        One value per column each.
     quantities : dict of str to str, optional
         :data:`FORMATS` key per column header, where :func:`quantity_of` does not tell it.
     """
-    import pandas as pd
-
-    formats = [FORMATS.get((quantities or {}).get(name) or quantity_of(name) or "") for name in frame.columns]
-    for col, name in enumerate(frame.columns, start=1):
+    formats = [FORMATS.get((quantities or {}).get(name) or quantity_of(name) or "") for name in columns]
+    for col, name in enumerate(columns, start=1):
         cell = ws.cell(top, col, name)
         cell.font = Font(bold=True)
         if fill is not None:
             cell.fill = fill
-        texts = [str(v) for v in frame[name] if isinstance(v, str)]
+        texts = [str(values[col - 1]) for values in rows if isinstance(values[col - 1], str)]
         ws.column_dimensions[get_column_letter(col)].width = max([11, len(str(name)) + 2, *(len(t) + 2 for t in texts)])
     # a column's number cells share the style of its first (setting each cell's format looks it up again: the
     # most of the time of a long table)
     styles: list = [None] * len(formats)
-    for values in frame.itertuples(index=False):
+    for values in rows:
         cells = []
         for col, value in enumerate(values):
-            if isinstance(value, float) and not pd.notna(value):
+            if isinstance(value, float) and value != value:     # NaN: no value
                 value = None
             elif hasattr(value, "item"):
                 value = value.item()
@@ -184,3 +198,8 @@ def write_frame(ws, frame, top: int = 1, fill: PatternFill | None = None, quanti
             cells.append(cell)
         ws.append(cells)
     print_setup(ws, header_rows=top)
+
+
+def write_frame(ws, frame, top: int = 1, fill: PatternFill | None = None, quantities: dict | None = None) -> None:
+    """Write a pandas DataFrame as :func:`write_table` writes a table (its columns and rows, not its index)."""
+    write_table(ws, list(frame.columns), list(frame.itertuples(index=False, name=None)), top, fill, quantities)

@@ -40,13 +40,12 @@ import logging
 from dataclasses import dataclass
 from pathlib import Path
 
-import pandas as pd
 from openpyxl import Workbook
 from openpyxl.styles import Font, PatternFill
 
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
-from workbook.answers.results import PYLON_SUM, MountResult
+from workbook.answers.results import LONG_COLUMNS, PYLON_SUM, MountResult
 from workbook.excel import fatigue_sheet, loads_sheet
 from workbook.excel.files import (
     ChangedOnDisk,
@@ -64,10 +63,10 @@ from workbook.excel.files import (
 )
 from workbook.excel.runs import RunSpec, TestPoint
 from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_values
-from workbook.excel.styling import print_setup, write_frame, write_text_lines
+from workbook.excel.styling import print_setup, write_frame, write_table, write_text_lines
 from workbook.model.case import DIRECTIONS
 
-__all__ = ["RunResult", "WriteOutcome", "result_frames", "write_results", "add_result_sheets", "card_lines",
+__all__ = ["RunResult", "WriteOutcome", "ResultTable", "result_tables", "write_results", "add_result_sheets", "card_lines",
            "MARKER", "MARKER_CELL"]
 
 log = logging.getLogger(__name__)
@@ -117,28 +116,47 @@ def _match_test(tests: list[TestPoint], frequency: float):
     return None
 
 
-def _long_frame(runs: list[RunResult], tests: tuple) -> pd.DataFrame:
-    """Every answer, one row per run, point, location and direction, with the test comparison."""
-    frames = []
-    for run in runs:
-        frame = run.result.to_pandas("all").rename(columns={"run": "point"})
-        frame.insert(0, "run", run.spec.name)
-        frames.append(frame)
-    frame = pd.concat(frames, ignore_index=True)
-    test_amplitude, test_error = [], []
+@dataclass(frozen=True)
+class ResultTable:
+    """A result table: its column headers and its rows of plain values (None: no value).
+
+    Attributes
+    ----------
+    columns : tuple of str
+    rows : list of tuple
+        One value per column each.
+    """
+
+    columns: tuple[str, ...]
+    rows: list[tuple]
+
+    def records(self) -> list[dict]:
+        """The rows as ``{column: value}``."""
+        return [dict(zip(self.columns, row, strict=True)) for row in self.rows]
+
+
+#: Columns of the long table of every answer (a point of a run, its location and direction) with the test
+#: comparison; the efficiency table has the pylon sum's rows without location and pylon side.
+_LONG_COLUMNS = ("run", "point", *LONG_COLUMNS[1:], "test amplitude N", "error %")
+_PYLON_COLUMNS = tuple(column for column in _LONG_COLUMNS if column not in ("location", "pylon side"))
+
+
+def _long_rows(runs: list[RunResult], tests: tuple) -> list[tuple]:
+    """Every answer, one row per run, point, location and direction, with the test comparison (:data:`_LONG_COLUMNS`)."""
     by_key: dict = {}
     for test in tests:
         by_key.setdefault((test.run, test.location, test.direction), []).append(test)
-    for row in frame.to_dict("records"):
-        test = _match_test(by_key.get((row["run"], row["location"], row["direction"]), []), row["frequency Hz"])
-        test_amplitude.append(None if test is None else test.amplitude)
-        test_error.append(None if test is None else float(relative_error(row["amplitude N"], test.amplitude)))
-    frame["test amplitude N"] = test_amplitude
-    frame["error %"] = test_error
-    return frame
+    rows = []
+    for run in runs:
+        for point, frequency, location, side, direction, amplitude, *answers in run.result.long_rows():
+            test = _match_test(by_key.get((run.spec.name, location, direction), []), frequency)
+            rows.append((run.spec.name, point, frequency, location, side, direction, amplitude, *answers,
+                         None if test is None else test.amplitude,
+                         None if test is None else float(relative_error(amplitude, test.amplitude))))
+    return rows
 
 
-def result_frames(runs: list[RunResult], tests: tuple = ()) -> dict[str, pd.DataFrame]:
+def result_tables(runs: list[RunResult], tests: tuple = ()) -> dict[str, ResultTable]:
     """The result tables, by sheet name (without the ``Result`` prefix).
 
     - ``efficiency``: pylon force per run, point and direction: amplitude,
@@ -146,20 +164,22 @@ def result_frames(runs: list[RunResult], tests: tuple = ()) -> dict[str, pd.Data
     - ``hinges``: the same for every hinge;
     - ``sweep``: T and eta per direction against frequency, for sweep runs.
     """
-    frame = _long_frame(runs, tests)
-    pylon = frame[frame["location"] == PYLON_SUM].drop(columns=["location", "pylon side"])
-    hinges = frame[frame["location"] != PYLON_SUM]
-    frames = {"efficiency": pylon.reset_index(drop=True), "hinges": hinges.reset_index(drop=True)}
+    rows = _long_rows(runs, tests)
+    location = _LONG_COLUMNS.index("location")
+    kept = [i for i, column in enumerate(_LONG_COLUMNS) if column in _PYLON_COLUMNS]
+    tables = {"efficiency": ResultTable(_PYLON_COLUMNS, [tuple(row[i] for i in kept) for row in rows
+                                                         if row[location] == PYLON_SUM]),
+              "hinges": ResultTable(_LONG_COLUMNS, [row for row in rows if row[location] != PYLON_SUM])}
     sweeps = [run for run in runs if len(run.result.runs) > 1]
     if sweeps:
-        rows = []
+        sweep = []
         for run in sweeps:
             for point in run.result.runs:
                 t = point.transmissibility
-                rows.append([run.spec.name, point.frequency_hz, *t, *efficiency(t)])
-        frames["sweep"] = pd.DataFrame(rows, columns=["run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS),
-                                                      *(f"eta % {d}" for d in DIRECTIONS)])
-    return frames
+                sweep.append((run.spec.name, float(point.frequency_hz), *map(float, t), *map(float, efficiency(t))))
+        tables["sweep"] = ResultTable(("run", "frequency Hz", *(f"T {d}" for d in DIRECTIONS),
+                                       *(f"eta % {d}" for d in DIRECTIONS)), sweep)
+    return tables
 
 
 def _model_part(card) -> tuple:
@@ -212,9 +232,9 @@ def is_result_sheet(ws) -> bool:
     return value == _marker(ws.title) or value == MARKER
 
 
-def _write_frame(ws, frame: pd.DataFrame, note: str) -> None:
+def _write_table(ws, table: ResultTable, note: str) -> None:
     ws.cell(1, 1, note).font = Font(italic=True)
-    write_frame(ws, frame, top=2, fill=_HEADER_FILL)
+    write_table(ws, table.columns, table.rows, top=2, fill=_HEADER_FILL)
     _mark(ws)
 
 
@@ -234,9 +254,9 @@ FATIGUE_SHEET = _sheet_title("fatigue")
 RESULT_SHEETS = (*(_sheet_title(name) for name in (*_NOTES, "model card")), LOADS_SHEET, FATIGUE_SHEET)
 
 
-def result_sheet_names(frames: dict, loads=None, fatigue=None) -> list[str]:
+def result_sheet_names(tables: dict, loads=None, fatigue=None) -> list[str]:
     """Titles of the result sheets a write creates (with *loads* or *fatigue*, a table: its sheet too)."""
-    return ([_sheet_title(name) for name in frames] + [_sheet_title("model card")]
+    return ([_sheet_title(name) for name in tables] + [_sheet_title("model card")]
             + [title for title, table in ((LOADS_SHEET, loads), (FATIGUE_SHEET, fatigue)) if table is not None])
 
 
@@ -287,14 +307,14 @@ def _kept_note(earlier: list[tuple], computed: set[str]) -> str:
     return f"; the results of {', '.join(repr(run) for run in kept)} are from an earlier run" if kept else ""
 
 
-def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, frames: dict | None = None,
+def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str, tables: dict | None = None,
                       loads=None, fatigue=None) -> list[str]:
     """Add the result sheets of *runs* to an openpyxl *workbook*.
 
     The result sheets a write made before are rewritten: the rows and model
     cards of the runs just computed are replaced, those of every other run
-    are kept as they were (the sheet's note names them). *frames* are
-    ``result_frames(runs, tests)`` when the caller has them already.
+    are kept as they were (the sheet's note names them). *tables* are
+    ``result_tables(runs, tests)`` when the caller has them already.
     *loads* (:func:`~workbook.excel.loads_sheet.loads_frame`) replaces the
     loads sheet whole; without it an earlier loads sheet is kept; *fatigue*
     (:func:`~workbook.excel.fatigue_sheet.fatigue_frame`) likewise the fatigue sheet.
@@ -308,39 +328,39 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
     earlier = {ws.title: ws for ws in workbook.worksheets if is_result_sheet(ws)
                and (ws.title not in whole or whole[ws.title][0] is not None)}
     computed = {run.spec.name for run in runs}
-    frames = result_frames(runs, tests) if frames is None else frames
-    tables = {}
+    tables = result_tables(runs, tests) if tables is None else tables
+    merged = {}
     for name, note in _NOTES.items():
         title = _sheet_title(name)
         header, rows = _earlier_rows(earlier[title]) if title in earlier else ([], [])
-        frame = frames.get(name)
-        columns = header if frame is None else list(frame.columns)
-        fresh = [] if frame is None else [(record["run"], record) for record in frame.to_dict("records")]
+        table = tables.get(name)
+        columns = header if table is None else list(table.columns)
+        fresh = [] if table is None else [(record["run"], record) for record in table.records()]
         records = _merged(rows, fresh, computed)
         if records:
             # a table without fresh rows keeps the note of the write that made it
             note = f"{note}. {stamp}{_kept_note(rows, computed)}" if fresh else peek(earlier[title], "A1")
-            tables[title] = (pd.DataFrame([[record.get(column) for column in columns] for record in records],
-                                          columns=columns), note)
+            merged[title] = (ResultTable(tuple(columns), [tuple(record.get(column) for column in columns)
+                                                          for record in records]), note)
     title = _sheet_title("model card")
     cards = _earlier_cards(earlier[title]) if title in earlier else []
     fresh = [(run.spec.name, card_lines([run])) for run in runs]
     lines = [line for block in _merged(cards, fresh, computed) for line in block]
     for ws in earlier.values():
         workbook.remove(ws)
-    for title, (frame, note) in tables.items():
-        _write_frame(workbook.create_sheet(title), frame, note)
+    for title, (table, note) in merged.items():
+        _write_table(workbook.create_sheet(title), table, note)
     ws = workbook.create_sheet(_sheet_title("model card"))
     write_text_lines(ws, lines, top=2)
     ws.cell(1, 1, stamp + _kept_note(cards, computed)).font = Font(italic=True)
     print_setup(ws)
     _mark(ws)
-    written = [*tables, ws.title]
-    for title, (table, module) in whole.items():
-        if table is not None:
+    written = [*merged, ws.title]
+    for title, (frame, module) in whole.items():
+        if frame is not None:
             ws = workbook.create_sheet(title)
             ws.cell(1, 1, f"{module.NOTE}. {stamp}").font = Font(italic=True)
-            write_frame(ws, table, top=2, fill=_HEADER_FILL, quantities=module.QUANTITIES)
+            write_frame(ws, frame, top=2, fill=_HEADER_FILL, quantities=module.QUANTITIES)
             _mark(ws)
             written.append(title)
     return written
@@ -393,7 +413,7 @@ def _cached_formula_values(workbook, values: CachedValues) -> dict[int, dict[str
 
 
 def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: tuple = (), *,
-                  opened=None, loads=None, fatigue=None, frames: dict | None = None) -> WriteOutcome:
+                  opened=None, loads=None, fatigue=None, tables: dict | None = None) -> WriteOutcome:
     """Write the result sheets into the case workbook at *path*, or beside it.
 
     Parameters
@@ -411,8 +431,8 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         The solved load cases (:func:`~workbook.excel.loads_sheet.loads_frame`): the loads sheet.
     fatigue : pandas.DataFrame, optional
         The links' fatigue (:func:`~workbook.excel.fatigue_sheet.fatigue_frame`): the fatigue sheet.
-    frames : dict of str to pandas.DataFrame, optional
-        ``result_frames(runs, tests)`` when the caller has them already.
+    tables : dict of str to ResultTable, optional
+        ``result_tables(runs, tests)`` when the caller has them already.
 
     Returns
     -------
@@ -420,13 +440,13 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
     """
     path = Path(path)
     stamp = f"Written by mountwb on {datetime.datetime.now():%Y-%m-%d %H:%M} from {path.name}"
-    frames = result_frames(runs, tests) if frames is None else frames
-    titles = result_sheet_names(frames, loads, fatigue)
+    tables = result_tables(runs, tests) if tables is None else tables
+    titles = result_sheet_names(tables, loads, fatigue)
     with held(path):
         reason, workbook, values = _reason_not_to_overwrite(path, sha256, titles, opened)
         if reason is None:
             log.info("building the new %s with the results", path.name)
-            add_result_sheets(workbook, runs, tests, stamp, frames, loads, fatigue)
+            add_result_sheets(workbook, runs, tests, stamp, tables, loads, fatigue)
             data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(workbook, values))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
@@ -437,7 +457,7 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
                 reason = "it changed on disk while the results were being written (another save landed)"
     separate = Workbook()
     separate.remove(separate.active)
-    add_result_sheets(separate, runs, tests, stamp, frames, loads, fatigue)
+    add_result_sheets(separate, runs, tests, stamp, tables, loads, fatigue)
     target = save_atomic(separate, name_beside(path, "results"))
     log.info("%s not overwritten: %s; results written to %s", path.name, reason, target.name)
     return WriteOutcome(target, reason)
