@@ -160,6 +160,7 @@ target stays out of reach: the thrust rod alone needs about 7 s of CPU
 time one step after the other (meshing 0.6 s, assembly 0.55 s,
 factorisation and static modes 2.4 s, the three Lanczos runs 2.1 s, the
 reductions 0.9 s).
+
 The case workbook without pandas (its result tables plain rows, the printed
 summary laid out as pandas lays it out), each report picture drawn as soon as
 its run is done, the garbage collector run seldom while the workbook is read,
