@@ -4,13 +4,13 @@ Without its force channels a scene's bodies do not couple (the blocks of
 :class:`~workbook.design.expansion.RestBlocks`), and the Euler-parameter
 constraints only mix a node's own coordinates; so every term of the
 projected linear model but the channels' ``J^T Z J`` is a matrix of one
-body, of 6 to 17 independent coordinates where the whole mount has about a
-hundred. :class:`BodyLayout` says where each body's coordinates sit among
+body (on the reference mount, of 6 to 17 independent coordinates where the
+whole mount has about a hundred). :class:`BodyLayout` says where each body's coordinates sit among
 the full and the independent coordinates, projects the bodies' blocks
 (:meth:`BodyLayout.project`) and places them in the whole matrix when one
 is needed (:meth:`BodyLayout.dense`). :func:`channel_solve` solves the
-harmonic response of designs together on the blocks (module text of
-``docs/design-evaluation.md``).
+harmonic response of designs together on the blocks
+(``docs/design-evaluation.md``).
 """
 from __future__ import annotations
 
@@ -100,13 +100,10 @@ class BodyLayout:
         out[..., nodes[:, None, None], rows[:, :, None], columns[:, None, :]] = tangents
         return out
 
-    def project(self, blocks: np.ndarray, basis: np.ndarray, right: np.ndarray | None = None) -> np.ndarray:
-        """``B_k^T A_k B_k`` of the blocks *blocks* (..., K, b, b) on the *basis* (:meth:`basis`; *right*: another
-        on the right), (..., K, w, w)."""
-        width = blocks.shape[-1]
-        left = basis[..., :width, :]
-        other = left if right is None else right[..., :width, :]
-        return left.swapaxes(-1, -2) @ blocks @ other
+    def project(self, blocks: np.ndarray, basis: np.ndarray) -> np.ndarray:
+        """``B_k^T A_k B_k`` of the blocks *blocks* (..., K, b, b) on the *basis* (:meth:`basis`), (..., K, w, w)."""
+        frame = basis[..., :blocks.shape[-1], :]
+        return frame.swapaxes(-1, -2) @ blocks @ frame
 
     def dense(self, blocks: np.ndarray) -> np.ndarray:
         """The projected blocks (..., K, w, w) placed in the whole matrix (..., n, n)."""
@@ -228,10 +225,10 @@ class ChannelCoupling:
     ----------
     moving : ndarray of int, shape (P,)
         The channels' points that move with a body (the others are on the ground), among all 2 C.
-    bodies : ndarray of int, shape (K, P)
-        1 where a moving point is on a body.
-    channels : ndarray of int, shape (C, P)
-        1 where a moving point is a channel's.
+    bodies : ndarray, shape (K, P)
+        1 where a moving point is on a body, 0 elsewhere (sums over a body's points by a product).
+    channels : ndarray, shape (C, P)
+        1 where a moving point is a channel's, 0 elsewhere.
     coupled : ndarray of int, shape (2 L,)
         The moving points (positions in *moving*) of the L channels with both points moving: their first
         points, then their second.
