@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import dataclasses
 import hashlib
-import importlib
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -38,11 +37,8 @@ from .selection import decide_modes
 
 # The modules that mesh (gmsh, meshio), assemble (scikit-fem) and reduce a link are imported where a
 # link is reduced: a run whose links are all in the cache never loads them.
-_REDUCTION_MODULES = ("gmsh", "pymetis", "flexbodies.meshing", "flexbodies.assembly", "flexbodies.stress",
-                      "flexbodies.interior", "flexbodies.reduction", "flexbodies.geometric_stiffness")
 
-__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "is_reduced", "build_fe_model", "default_cache_dir",
-           "load_reduction_modules"]
+__all__ = ["MeshSource", "LinkModel", "reduce_link", "reduce_link_set", "is_reduced", "build_fe_model", "default_cache_dir"]
 
 @dataclass(frozen=True)
 class MeshSource:
@@ -212,13 +208,6 @@ def reduce_link(model: LinkModel, modes="auto", excitation_hz: float | None = No
     """
     (link,) = reduce_link_set(model, modes, [excitation_hz], cache_dir=cache_dir, use_cache=use_cache)
     return link
-
-
-def load_reduction_modules() -> None:
-    """Import the modules that reduce a link (gmsh, scikit-fem, SciPy's solvers, METIS): a process about to
-    fork workers that reduce links imports them once for all of them (0.5 s each)."""
-    for name in _REDUCTION_MODULES:
-        importlib.import_module(name)
 
 
 def _decider(modes):

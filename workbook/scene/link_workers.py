@@ -31,7 +31,7 @@ from typing import Any, Callable
 
 from flexbodies.cache import BodyCache
 from flexbodies.geometry import default_element_size
-from flexbodies.link import LinkModel, is_reduced, load_reduction_modules, reduce_link_set
+from flexbodies.link import LinkModel, is_reduced, reduce_link_set
 from workbook.processes import end_with_parent, stop_workers
 
 __all__ = ["LinkJob", "reduce_in_workers", "available_cores"]
@@ -147,7 +147,6 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
     pending = sorted((job for job in jobs if not job.cached()), key=LinkJob.expected_work, reverse=True)
     if len(pending) < 2:
         return 0
-    load_reduction_modules()
     context = multiprocessing.get_context("fork")
     next_job, finished = context.Value("i", 0), context.SimpleQueue()
     processes = [context.Process(target=_work, args=(pending, next_job, finished), daemon=True,
