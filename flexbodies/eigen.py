@@ -147,17 +147,21 @@ class SharedSolves:
         self.factor = factor
         self._running = set(range(parties))
         self._asked: dict[int, np.ndarray] = {}
-        self._answers: dict[int, np.ndarray] = {}
+        self._answers: dict[int, np.ndarray | Exception] = {}
         self._round = threading.Condition()
 
     def solve_plain(self, party: int, rhs: np.ndarray) -> np.ndarray:
-        """Solve for one vector as ``party``, without refinement; returns once its round is solved."""
+        """Solve for one vector as ``party``, without refinement; returns once its round is solved (raises
+        what the round's solve raised)."""
         with self._round:
             self._asked[party] = np.asarray(rhs, dtype=float)
             self._solve_round()
             while party not in self._answers:
                 self._round.wait()
-            return self._answers.pop(party)
+            answer = self._answers.pop(party)
+        if isinstance(answer, Exception):
+            raise answer
+        return answer
 
     def leave(self, party: int) -> None:
         """``party`` asks for no more solves."""
@@ -169,11 +173,12 @@ class SharedSolves:
         if not self._asked or not self._running <= self._asked.keys():
             return
         parties = sorted(self._asked)
-        if len(parties) == 1:
-            self._answers[parties[0]] = self.factor.solve_plain(self._asked.pop(parties[0]))
-        else:
-            solved = self.factor.solve_plain(np.column_stack([self._asked.pop(party) for party in parties]))
+        block = np.column_stack([self._asked.pop(party) for party in parties])
+        try:
+            solved = self.factor.solve_plain(block[:, 0] if len(parties) == 1 else block).reshape(block.shape)
             self._answers.update((party, solved[:, i]) for i, party in enumerate(parties))
+        except Exception as error:      # every party of the round raises it, none waits on
+            self._answers.update((party, error) for party in parties)
         self._round.notify_all()
 
     def party(self, party: int) -> "_Party":

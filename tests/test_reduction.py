@@ -154,6 +154,39 @@ def test_solves_made_together_are_those_of_each_party_alone():
         solved_together(factor, [asking(0, 5), failing, asking(1, 3)])
 
 
+def test_a_block_solve_that_fails_reaches_every_party_of_its_round():
+    """A factorisation whose block solve raises (say, out of memory) makes every party of that round raise,
+    instead of leaving the others waiting for answers that never come."""
+    import threading
+
+    import scipy.sparse as sp
+
+    from flexbodies.eigen import solved_together
+
+    factor = factorize(sp.identity(50, format="csc") * 2.0)
+
+    class Failing:
+        shape = factor.shape
+
+        def solve_plain(self, rhs):
+            if rhs.ndim == 2:
+                raise MemoryError("no room for the block")
+            return factor.solve_plain(rhs)
+
+    outcome: list = []
+
+    def run():
+        try:
+            solved_together(Failing(), [lambda solver: solver.solve_plain(np.ones(50))] * 3)
+        except MemoryError as error:
+            outcome.append(error)
+
+    thread = threading.Thread(target=run, daemon=True)
+    thread.start()
+    thread.join(timeout=30)
+    assert not thread.is_alive() and len(outcome) == 1
+
+
 @pytest.mark.slow
 def test_one_reduction_serves_every_excitation():
     from flexbodies import reduce_link, reduce_link_set
