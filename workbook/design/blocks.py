@@ -21,18 +21,54 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import sparse
 
+from workbook.design.channel_set import scatter_sum
 from workbook.errors import SimulationError
 
 if TYPE_CHECKING:
     from workbook.design.channel_set import ChannelSet, ChannelState
     from workbook.design.expansion import SceneExpansion
 
-__all__ = ["BodyLayout", "body_layout", "ChannelCoupling", "channel_solve", "BACKWARD_ERROR"]
+__all__ = ["BlockPlacement", "BodyLayout", "body_layout", "ChannelCoupling", "channel_solve", "BACKWARD_ERROR"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 
 #: Largest relative backward error of the body-by-body solve of a design; a design above it is solved whole.
 BACKWARD_ERROR = 1e-12
+
+
+@dataclass(frozen=True)
+class BlockPlacement:
+    """Where stacked blocks' entries go in a whole matrix.
+
+    Attributes
+    ----------
+    size : int
+        The whole matrix's order.
+    positions : ndarray of int
+        The flat positions in the whole matrix of the blocks' kept entries.
+    kept : ndarray of int
+        The blocks' flat entries that are placed (the others fall on the padding).
+    """
+
+    size: int
+    positions: np.ndarray
+    kept: np.ndarray
+
+    @classmethod
+    def of(cls, index: np.ndarray, size: int) -> "BlockPlacement":
+        """The placement of blocks on the coordinates *index* (K, w) of a whole matrix of order *size*, padded
+        with *size* (each coordinate in one block)."""
+        rows = np.broadcast_to(index[:, :, None], index.shape + index.shape[-1:]).ravel()
+        columns = np.broadcast_to(index[:, None, :], index.shape + index.shape[-1:]).ravel()
+        kept = np.flatnonzero((rows < size) & (columns < size))
+        return cls(size, rows[kept] * size + columns[kept], kept)
+
+    def place(self, blocks: np.ndarray) -> np.ndarray:
+        """The blocks (..., K, w, w) placed in the whole matrix (..., size, size)."""
+        batch = blocks.shape[:-3]
+        out = np.zeros(batch + (self.size * self.size,), dtype=blocks.dtype)
+        out[..., self.positions] = blocks.reshape(batch + (-1,))[..., self.kept]
+        return out.reshape(batch + (self.size, self.size))
 
 
 @dataclass(frozen=True)
@@ -107,11 +143,7 @@ class BodyLayout:
 
     def dense(self, blocks: np.ndarray) -> np.ndarray:
         """The projected blocks (..., K, w, w) placed in the whole matrix (..., n, n)."""
-        batch = blocks.shape[:-3]
-        placement, kept = self._placement
-        out = np.zeros(batch + (self.count * self.count,), dtype=blocks.dtype)
-        out[..., placement] = blocks.reshape(batch + (-1,))[..., kept]
-        return out.reshape(batch + (self.count, self.count))
+        return self._placement.place(blocks)
 
     def vector(self, blocks: np.ndarray) -> np.ndarray:
         """Vectors per block (..., K, w) as whole vectors (..., n)."""
@@ -120,13 +152,8 @@ class BodyLayout:
         return out[..., :self.count]
 
     @functools.cached_property
-    def _placement(self) -> tuple[np.ndarray, np.ndarray]:
-        """Where the projected blocks' entries go in a flat n x n matrix, and which of the blocks' flat entries
-        they are (the others are padding)."""
-        rows = np.broadcast_to(self.independent[:, :, None], self.independent.shape + (self.width,)).ravel()
-        columns = np.broadcast_to(self.independent[:, None, :], self.independent.shape + (self.width,)).ravel()
-        kept = np.flatnonzero((rows < self.count) & (columns < self.count))
-        return rows[kept] * self.count + columns[kept], kept
+    def _placement(self) -> "BlockPlacement":
+        return BlockPlacement.of(self.independent, self.count)
 
     def add_point_terms(self, out: np.ndarray, terms: np.ndarray) -> None:
         """Add the channels' points' terms *terms* (..., P, M, M) to the blocks *out* (..., K, b, b), in place
@@ -162,9 +189,7 @@ class BodyLayout:
         columns = self.independent[blocks]                                 # (P, w)
         rows = 3 * (np.arange(2 * count) // 2)[:, None, None] + np.arange(3)[None, :, None]   # (P, 3, 1)
         index = np.broadcast_to(rows * (self.count + 1) + columns[:, None, :], points.shape[-3:]).ravel()
-        flat = int(np.prod(batch, dtype=int))
-        shifted = (index[None, :] + 3 * count * (self.count + 1) * np.arange(flat)[:, None]).ravel()
-        summed = np.bincount(shifted, points.reshape(-1), flat * 3 * count * (self.count + 1))
+        summed = scatter_sum(index, points.reshape(batch + (-1,)), 3 * count * (self.count + 1))
         return summed.reshape(batch + (3 * count, self.count + 1))[..., :self.count]
 
 

@@ -21,7 +21,7 @@ import numpy as np
 
 from workbook.design.kinematics import EULER, PointKinematics
 
-__all__ = ["ChannelSet", "ChannelState", "spring_rows", "spring_matrix"]
+__all__ = ["ChannelSet", "ChannelState", "spring_rows", "spring_matrix", "scatter_sum"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 _EULER_ROWS = EULER.reshape(36, 4)                                # (a b i, j)
@@ -65,10 +65,15 @@ class ChannelState:
     ----------
     separation : ndarray, shape (..., C, 3)
         d of every channel, m.
-    jacobian : ndarray, shape (..., 2 C, 3, M)
-        Each marker's position Jacobian on its padded coordinates (formed when first read).
-    hessian : ndarray, shape (..., 2 C, 3, M, M), or None
-        Formed when first read; None when not asked for.
+    points : ChannelSet
+        The channels' points.
+    poses : tuple of _Pose
+        The points of each rotation kind at the state.
+    second : bool
+        Whether the Hessians were asked for.
+
+    Its :attr:`jacobian` (..., 2 C, 3, M) and :attr:`hessian` (..., 2 C, 3, M, M; None unless *second*) on
+    the points' padded coordinates are formed when first read.
     """
 
     separation: np.ndarray
@@ -76,11 +81,15 @@ class ChannelState:
     poses: tuple = field(repr=False)          # _Pose of each rotation kind
     second: bool = field(repr=False)
 
+    @property
+    def _count(self) -> int:
+        """The designs (states), all leading axes together."""
+        return int(np.prod(self.separation.shape[:-2], dtype=int))
+
     @functools.cached_property
     def jacobian(self) -> np.ndarray:
         """Each marker's position Jacobian, (..., 2 C, 3, M)."""
-        count = int(np.prod(self.separation.shape[:-2], dtype=int))
-        points, width = self.points.coordinates.shape
+        count, (points, width) = self._count, self.points.coordinates.shape
         jacobian = np.zeros((count, points, 3, width))
         jacobian[:, :, :, :3] = np.eye(3)
         jacobian[:, self.points.kinds["ground"]] = 0.0
@@ -95,8 +104,7 @@ class ChannelState:
         """Each marker's position Hessian, (..., 2 C, 3, M, M), or None when not asked for."""
         if not self.second:
             return None
-        count = int(np.prod(self.separation.shape[:-2], dtype=int))
-        points, width = self.points.coordinates.shape
+        count, (points, width) = self._count, self.points.coordinates.shape
         hessian = np.zeros((count, points, 3, width, width))
         for pose in self.poses:
             assert pose.seconds is not None
@@ -110,8 +118,7 @@ class ChannelState:
     def generalised(self, on_points: np.ndarray) -> np.ndarray:
         """``f_p . J_p`` of forces *on_points* (..., 2 C, 3) on each point, on its padded coordinates:
         (..., 2 C, M), without forming J."""
-        count = int(np.prod(self.separation.shape[:-2], dtype=int))
-        points, width = self.points.coordinates.shape
+        count, (points, width) = self._count, self.points.coordinates.shape
         force = on_points.reshape(count, points, 3)
         out = np.zeros((count, points, width))
         out[:, :, :3] = force
@@ -218,7 +225,7 @@ class ChannelSet:
         """``sum_c J_c^T S_c d_c`` (..., N) for the springs *stiffness* (..., C, 3, 3), N/m."""
         generalised = state.generalised(_on_points((stiffness @ state.separation[..., None])[..., 0]))
         flat = generalised.reshape(generalised.shape[:-2] + (-1,))
-        return _scatter(self.coordinates.ravel(), flat, self.size + 1)[..., :self.size]
+        return scatter_sum(self.coordinates.ravel(), flat, self.size + 1)[..., :self.size]
 
     def jacobian(self, state: ChannelState) -> np.ndarray:
         """The Jacobians of the separations d of every channel stacked, ``J_c``: shape (..., 3 C, N)."""
@@ -226,7 +233,7 @@ class ChannelSet:
         rows = 3 * np.arange(self.count).reshape(-1, 1, 1, 1) + np.arange(3).reshape(1, 1, 3, 1)
         columns = self.coordinates.reshape(self.count, 2, 1, -1)
         index = np.broadcast_to(rows * (self.size + 1) + columns, jacobian.shape[-4:]).ravel()
-        full = _scatter(index, jacobian.reshape(jacobian.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
+        full = scatter_sum(index, jacobian.reshape(jacobian.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
         return full.reshape(jacobian.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
 
     def curvature(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
@@ -264,7 +271,7 @@ def _on_points(channel_force: np.ndarray) -> np.ndarray:
     return (channel_force[..., :, None, :] * _SIGNS[:, None]).reshape(channel_force.shape[:-2] + (-1, 3))
 
 
-def _scatter(index: np.ndarray, values: np.ndarray, length: int) -> np.ndarray:
+def scatter_sum(index: np.ndarray, values: np.ndarray, length: int) -> np.ndarray:
     """Sums of *values* (..., K) at the positions *index* (K,) in [0, length): shape (..., length)."""
     batch = values.shape[:-1]
     count = int(np.prod(batch, dtype=int))

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import sparse
 
-from workbook.design.blocks import BodyLayout, ChannelCoupling, body_layout
+from workbook.design.blocks import BlockPlacement, BodyLayout, ChannelCoupling, body_layout
 from workbook.design.channel_set import ChannelSet
 from workbook.design.kinematics import PointKinematics, identify
 from workbook.errors import OutsideDesignModel, SimulationError
@@ -139,21 +139,11 @@ class RestBlocks:
 
     def full(self, blocks: np.ndarray) -> np.ndarray:
         """The blocks (..., B, b, b) scattered into a full matrix (..., N, N)."""
-        batch = blocks.shape[:-3]
-        placement, kept = self._placement
-        full = np.zeros(batch + (self.size * self.size,))
-        full[..., placement] = blocks.reshape(batch + (-1,))[..., kept]
-        return full.reshape(batch + (self.size, self.size))
+        return self._placement.place(blocks)
 
     @functools.cached_property
-    def _placement(self) -> tuple[np.ndarray, np.ndarray]:
-        """Where the blocks' entries go in a flat N x N matrix, and which of the blocks' flat entries they
-        are (the others fall on the padding coordinate N; each coordinate is in one block)."""
-        rows = np.broadcast_to(self.coordinates[:, :, None], self.coordinates.shape + self.coordinates.shape[-1:])
-        columns = np.broadcast_to(self.coordinates[:, None, :], rows.shape)
-        rows, columns = rows.ravel(), columns.ravel()
-        kept = np.flatnonzero((rows < self.size) & (columns < self.size))
-        return rows[kept] * self.size + columns[kept], kept
+    def _placement(self) -> BlockPlacement:
+        return BlockPlacement.of(self.coordinates, self.size)
 
     @functools.cached_property
     def _operators(self) -> dict:
