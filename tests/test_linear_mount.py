@@ -284,7 +284,7 @@ def test_channels_tangent_is_the_derivative_of_their_forces(mount):
         blocks[np.arange(channels.count), :, np.arange(channels.count), :] = springs
         tangent = jacobian.T @ blocks.reshape(3 * channels.count, -1) @ jacobian
         bodies = np.zeros(expansion.rest.stiffness.shape)
-        expansion.layout.add_point_terms(bodies, channels.curvature(state, springs))
+        expansion.layout.add_curvature(bodies, channels.curvature(state, springs))
         curvature = expansion.rest.full(bodies)
         assert np.abs(curvature).max() > 1e-6 * np.abs(tangent).max()      # the curvature term counts
         tangent += curvature

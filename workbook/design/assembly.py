@@ -234,7 +234,7 @@ def add_tangent_terms(expansion: SceneExpansion, dq: np.ndarray, blocks: np.ndar
     (:func:`normal_components`) to the bodies' stiffness blocks *blocks* (..., K, b, b), in place (contiguous):
     with the channels' ``J^T S J``, the tangent stiffness."""
     channels, layout = expansion.channels, expansion.layout
-    layout.add_point_terms(blocks, channels.curvature(state, springs.stiffness))
+    layout.add_curvature(blocks, channels.curvature(state, springs.stiffness))
     _, normal = normal_components(expansion, dq, channels.force(state, springs.stiffness))
     theta = total(expansion, dq)[..., expansion.euler_blocks]
     nodes, positions, _ = layout.euler

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import sparse
 
 from workbook.design.channel_set import scatter_sum
 from workbook.errors import SimulationError
@@ -91,10 +90,11 @@ class BodyLayout:
         (blocks, positions, columns) of the free coordinates: the basis's unit entries.
     euler : tuple of ndarray of int
         (blocks (E,), positions (E, 4), columns (E, 3)) of the Euler-parameter nodes.
-    curvature : tuple of (ndarray of int, scipy.sparse.csr_array)
-        The distinct positions in the flat blocks (K b b) of the channels' points' curvature terms
-        (:meth:`~workbook.design.channel_set.ChannelSet.curvature`), and the sparse sum (positions, terms)
-        onto them (terms on the padding dropped).
+    curvature : dict of str to (ndarray of int, ndarray of int)
+        Per rotation kind, where the channels' curvature terms
+        (:meth:`~workbook.design.channel_set.ChannelSet.curvature`) go: positions in the flat blocks (K b b)
+        and the terms' flat entries placed there (a body's rotation and modal block twice, as it is and
+        transposed; the entries of padded modes dropped).
     """
 
     size: int
@@ -105,7 +105,7 @@ class BodyLayout:
     independent: np.ndarray
     free: tuple
     euler: tuple
-    curvature: tuple
+    curvature: dict
 
     @property
     def width(self) -> int:
@@ -155,13 +155,14 @@ class BodyLayout:
     def _placement(self) -> "BlockPlacement":
         return BlockPlacement.of(self.independent, self.count)
 
-    def add_point_terms(self, out: np.ndarray, terms: np.ndarray) -> None:
-        """Add the channels' points' terms *terms* (..., P, M, M) to the blocks *out* (..., K, b, b), in place
-        (contiguous)."""
-        positions, summing = self.curvature
+    def add_curvature(self, out: np.ndarray, terms: dict[str, np.ndarray]) -> None:
+        """Add the channels' curvature *terms* (:meth:`~workbook.design.channel_set.ChannelSet.curvature`) to
+        the blocks *out* (..., K, b, b), in place (contiguous)."""
         target = out.reshape((-1, out.shape[-3] * out.shape[-2] * out.shape[-1]))
         assert np.may_share_memory(target, out), "the sums need a contiguous out"
-        target[:, positions] += (summing @ terms.reshape((len(target), -1)).T).T
+        for kind, values in terms.items():
+            positions, entries = self.curvature[kind]
+            target[:, positions] += values.reshape((len(target), -1))[:, entries]
 
     @functools.cached_property
     def padding(self) -> np.ndarray:
@@ -227,19 +228,30 @@ def body_layout(expansion: "SceneExpansion") -> BodyLayout:
     parts = np.array(free_parts, dtype=int).reshape(-1, 3)
     return BodyLayout(size, count, coordinates, block, position, independent, (parts[:, 0], parts[:, 1], parts[:, 2]),
                       (euler_blocks, position[euler] if len(euler) else np.zeros((0, 4), dtype=int), euler_columns),
-                      _curvature_summing(expansion.channels.coordinates, block, position, width))
+                      _curvature_places(expansion.channels, block, position, width))
 
 
-def _curvature_summing(points: np.ndarray, block: np.ndarray, position: np.ndarray, width: int
-                       ) -> tuple[np.ndarray, sparse.csr_array]:
-    """:attr:`BodyLayout.curvature` of the points on the padded coordinates *points* (P, M)."""
-    rows = np.broadcast_to(points[:, :, None], points.shape + points.shape[-1:]).ravel()
-    columns = np.broadcast_to(points[:, None, :], points.shape + points.shape[-1:]).ravel()
-    kept = np.flatnonzero((position[rows] < width) & (position[columns] < width))
-    flat = (block[rows[kept]] * width + position[rows[kept]]) * width + position[columns[kept]]
-    positions, target = np.unique(flat, return_inverse=True)
-    summing = sparse.csr_array((np.ones(len(kept)), (target, kept)), shape=(len(positions), len(rows)))
-    return positions, summing
+def _curvature_places(channels: "ChannelSet", block: np.ndarray, position: np.ndarray, width: int) -> dict:
+    """:attr:`BodyLayout.curvature` of the channels' points, on the bodies' blocks of *width*."""
+    out = {}
+    for kind, (rotations, body) in channels.rotation_bodies.items():
+        if not len(body):
+            continue
+        bodies, turn = rotations.shape
+        modes = channels.modal.shape[-1]
+        first = np.array([channels.kinds[kind][body == g][0] for g in range(bodies)])   # a point of each body
+        turned = position[rotations]                                                     # (G, r)
+        modal = position[channels.coordinates[first, 3 + turn:3 + turn + modes]]          # (G, K), padding: width
+        base = (block[rotations[:, 0]] * width)[:, None, None]
+        both = (base + turned[:, :, None]) * width + turned[:, None, :]                   # (G, r, r)
+        across = (base + turned[:, :, None]) * width + modal[:, None, :]                  # (G, r, K)
+        back = (base + modal[:, None, :]) * width + turned[:, :, None]
+        entry = np.arange(bodies * turn * (turn + modes)).reshape(bodies, turn * (turn + modes))
+        own, mixed = entry[:, :turn * turn].reshape(bodies, turn, turn), entry[:, turn * turn:].reshape(bodies, turn, modes)
+        kept = np.broadcast_to(modal[:, None, :] < width, mixed.shape)
+        out[kind] = (np.concatenate([both.ravel(), across[kept], back[kept]]),
+                     np.concatenate([own.ravel(), mixed[kept], mixed[kept]]))
+    return out
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,8 @@ length with a spare coordinate (index N, always zero) that collects the
 padding. A channel with stiffness S (3x3) adds ``J^T S d`` to the
 generalised force, ``J^T S J + (S d) . H`` to the tangent stiffness and
 ``S J`` to its force output. The channels' Jacobians J (3 rows each) are
-scattered into the full coordinates by one ``bincount``, the curvature
-terms onto the bodies' blocks (:mod:`workbook.design.blocks`); the
+scattered into the full coordinates by one ``bincount``; the curvature
+terms, summed per body, go onto the bodies' blocks (:mod:`workbook.design.blocks`); the
 products with the springs (:func:`spring_rows`, :func:`spring_matrix`) are
 then formed on J as it is, or on J projected on the independent
 coordinates (fewer columns, no N x N scatter).
@@ -33,6 +33,8 @@ class _Pose:
 
     Attributes
     ----------
+    kind : str
+        ``"euler"`` or ``"rxyz"``.
     index : ndarray of int, shape (p,)
         The points, among all.
     turned : int
@@ -44,17 +46,24 @@ class _Pose:
     rotation : ndarray, shape (c, p, 3, 3)
     firsts : ndarray, shape (c, p, r, 3, 3)
         The rotation's derivatives with respect to its r coordinates.
-    seconds : ndarray, shape (c, p, r, r, 3, 3), or None
+    body : ndarray of int, shape (p,)
+        Each point's body among the G bodies of this kind (the points of a body share its rotation).
+    body_firsts : ndarray, shape (c, G, r, 3, 3)
+        The derivatives of each body's rotation.
+    body_seconds : ndarray, shape (c, G, r, r, 3, 3), or None
         Its second derivatives, when asked for.
     """
 
+    kind: str
     index: np.ndarray
     turned: int
     shapes: np.ndarray
     local: np.ndarray
     rotation: np.ndarray
     firsts: np.ndarray
-    seconds: np.ndarray | None
+    body: np.ndarray
+    body_firsts: np.ndarray
+    body_seconds: np.ndarray | None
 
 
 @dataclass(frozen=True)
@@ -70,10 +79,9 @@ class ChannelState:
     poses : tuple of _Pose
         The points of each rotation kind at the state.
     second : bool
-        Whether the Hessians were asked for.
+        Whether the rotations' second derivatives were asked for (:meth:`ChannelSet.curvature` needs them).
 
-    Its :attr:`jacobian` (..., 2 C, 3, M) and :attr:`hessian` (..., 2 C, 3, M, M; None unless *second*) on
-    the points' padded coordinates are formed when first read.
+    Its :attr:`jacobian` (..., 2 C, 3, M) on the points' padded coordinates is formed when first read.
     """
 
     separation: np.ndarray
@@ -98,22 +106,6 @@ class ChannelState:
             jacobian[:, pose.index, :, 3:turned] = (pose.firsts @ pose.local[:, :, None, :, None])[..., 0].swapaxes(-1, -2)
             jacobian[:, pose.index, :, turned:turned + modes] = pose.rotation @ pose.shapes
         return jacobian.reshape(self.separation.shape[:-2] + (points, 3, width))
-
-    @functools.cached_property
-    def hessian(self) -> np.ndarray | None:
-        """Each marker's position Hessian, (..., 2 C, 3, M, M), or None when not asked for."""
-        if not self.second:
-            return None
-        count, (points, width) = self._count, self.points.coordinates.shape
-        hessian = np.zeros((count, points, 3, width, width))
-        for pose in self.poses:
-            assert pose.seconds is not None
-            turned, modes = pose.turned, pose.shapes.shape[-1]
-            hessian[:, pose.index, :, 3:turned, 3:turned] = np.einsum("cpijab,cpb->cpaij", pose.seconds, pose.local)
-            mixed = np.einsum("cpiab,pbk->cpaik", pose.firsts, pose.shapes)
-            hessian[:, pose.index, :, 3:turned, turned:turned + modes] = mixed
-            hessian[:, pose.index, :, turned:turned + modes, 3:turned] = mixed.swapaxes(-1, -2)
-        return hessian.reshape(self.separation.shape[:-2] + (points, 3, width, width))
 
     def generalised(self, on_points: np.ndarray) -> np.ndarray:
         """``f_p . J_p`` of forces *on_points* (..., 2 C, 3) on each point, on its padded coordinates:
@@ -182,8 +174,9 @@ class ChannelSet:
         return len(self.coordinates) // 2
 
     def state(self, q: np.ndarray, *, second: bool = True) -> ChannelState:
-        """Separations and the points' poses (Jacobians and, with *second*, Hessians formed when read) at the
-        total coordinates *q* (..., N): any leading axes are designs, answered at once."""
+        """Separations and the points' poses (Jacobians formed when read; with *second*, what
+        :meth:`curvature` needs) at the total coordinates *q* (..., N): any leading axes are designs, answered
+        at once."""
         batch = q.shape[:-1]
         count = int(np.prod(batch, dtype=int))
         points = len(self.coordinates)
@@ -198,21 +191,21 @@ class ChannelSet:
             index = self.kinds[kind]
             if not len(index):
                 continue
-            rotations, group = self._rotations[kind]
+            rotations, group = self.rotation_bodies[kind]
             shapes = self.modal[index]
             turned = 3 + rotations.shape[1]
             modal = values[:, index, turned:turned + shapes.shape[-1]]
             local = self.local[index] + (shapes @ modal[..., None])[..., 0]         # w of every point, (c, p, 3)
             rotation, firsts, seconds = moved(padded[:, rotations], second)
-            pose = _Pose(index, turned, shapes, local, rotation[:, group], firsts[:, group],
-                         None if seconds is None else seconds[:, group])
+            pose = _Pose(kind, index, turned, shapes, local, rotation[:, group], firsts[:, group], group, firsts,
+                         seconds)
             position[:, index] = values[:, index, :3] + (pose.rotation @ local[..., None])[..., 0]
             poses.append(pose)
         placed = position.reshape(batch + (points, 3))
         return ChannelState(placed[..., 1::2, :] - placed[..., 0::2, :], self, tuple(poses), second)
 
     @functools.cached_property
-    def _rotations(self) -> dict:
+    def rotation_bodies(self) -> dict:
         """Per rotation kind (``"euler"``, ``"rxyz"``): the rotation coordinates of each distinct body (G, r)
         and each point's body among them (p,): the points of a body share its rotation."""
         out = {}
@@ -236,15 +229,31 @@ class ChannelSet:
         full = scatter_sum(index, jacobian.reshape(jacobian.shape[:-4] + (-1,)), 3 * self.count * (self.size + 1))
         return full.reshape(jacobian.shape[:-4] + (3 * self.count, self.size + 1))[..., :self.size]
 
-    def curvature(self, state: ChannelState, stiffness: np.ndarray) -> np.ndarray:
-        """``(S_c d_c) . H`` of every point, the tangent stiffness's term of the markers' curvature for the
-        springs *stiffness* (..., C, 3, 3), on each point's padded coordinates: shape (..., 2 C, M, M)
-        (:meth:`workbook.design.blocks.BodyLayout.add_point_terms` sums them onto the bodies' blocks)."""
-        assert state.hessian is not None, "the curvature needs the Hessians"
-        on_points = _on_points((stiffness @ state.separation[..., None])[..., 0])
-        hessian = state.hessian
-        terms = on_points[..., None, :] @ hessian.reshape(hessian.shape[:-2] + (-1,))      # (..., 2 C, 1, M M)
-        return terms.reshape(hessian.shape[:-3] + hessian.shape[-2:])
+    def curvature(self, state: ChannelState, stiffness: np.ndarray) -> dict[str, np.ndarray]:
+        """``sum_c (S_c d_c) . H``, the tangent stiffness's term of the markers' curvature for the springs
+        *stiffness* (..., C, 3, 3), summed per body: by rotation kind, each body's terms on its rotation
+        coordinates and its rotation and modal ones, (..., G, r r + r K) (the r x r block, then the r x K
+        one; :meth:`workbook.design.blocks.BodyLayout.add_curvature` places them on the bodies' blocks).
+
+        A point's position ``r + A w`` has second derivatives only in the rotation: ``A'' w`` and
+        ``A' Phi``; a body's points share A, so their forces are summed with their w and Phi first."""
+        count = state._count
+        on_points = _on_points((stiffness @ state.separation[..., None])[..., 0]).reshape(count, -1, 3)
+        out = {}
+        for pose in state.poses:
+            assert pose.body_seconds is not None, "the curvature needs the rotations' second derivatives"
+            bodies, rotations = pose.body_firsts.shape[1:3]
+            modes = pose.shapes.shape[-1]
+            force = on_points[:, pose.index]                                          # (c, p, 3)
+            summing = np.zeros((bodies, len(pose.index)))
+            summing[pose.body, np.arange(len(pose.index))] = 1.0
+            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, -1, 9)
+            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, -1, 9 * modes)
+            turning = pose.body_seconds.reshape(count, bodies, rotations * rotations, 9) @ with_place[..., None]
+            mixed = pose.body_firsts.reshape(count, bodies, rotations, 9) @ with_shape.reshape(count, bodies, 9, modes)
+            terms = np.concatenate([turning.reshape(count, bodies, -1), mixed.reshape(count, bodies, -1)], axis=-1)
+            out[pose.kind] = terms.reshape(state.separation.shape[:-2] + terms.shape[-2:])
+        return out
 
     def _channel_jacobians(self, state: ChannelState) -> np.ndarray:
         """Each channel's two marker Jacobians with the sign of d: shape (..., C, 2, 3, M)."""
