@@ -26,7 +26,7 @@ PUBLIC_MODULES = ("workbook", "workbook.errors", "flexbodies", "flexbodies.error
 INTERNAL_MODULES = (
     "workbook.design", "workbook.design.assembly", "workbook.design.blocks", "workbook.design.channel_set",
     "workbook.design.equilibrium", "workbook.design.expansion", "workbook.design.harmonic_model",
-    "workbook.design.pinned_shift",
+    "workbook.design.pinned_shift", "workbook.design.memory",
     "workbook.design.kinematics", "workbook.design.sensitivity",
     "workbook.design.linear_mount", "workbook.design.optimise", "workbook.design.bands", "workbook.design.link_fatigue",
     "workbook.design.link_margins", "workbook.design.section_search",

@@ -50,6 +50,7 @@ from workbook.design.channel_set import spring_matrix, spring_rows
 from workbook.design.equilibrium import ChordStiffness, PreparedTangent, prepared_tangent, static_state
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.design.harmonic_model import BodyHarmonic, Harmonic
+from workbook.design.memory import keep_freed_memory
 from workbook.design.pinned_shift import ShiftBracket
 from workbook.errors import BucklingError, OutsideDesignModel, ResonanceError, SimulationError, UnstablePreloadError
 from workbook.model.case import Case, Engine, Gravity, Link, Simultaneous, Sweep
@@ -377,6 +378,7 @@ class LinearMount:
             ``seconds`` is its share of the batch's wall time.
         """
         start = time.perf_counter()
+        keep_freed_memory()
         outcomes: list = [None] * len(cases)
         rows = []
         for k, case in enumerate(cases):
