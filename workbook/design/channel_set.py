@@ -244,14 +244,15 @@ class ChannelSet:
             assert pose.body_seconds is not None, "the curvature needs the rotations' second derivatives"
             bodies, rotations = pose.body_firsts.shape[1:3]
             modes = pose.shapes.shape[-1]
-            force = on_points[:, pose.index]                                          # (c, p, 3)
-            summing = np.zeros((bodies, len(pose.index)))
-            summing[pose.body, np.arange(len(pose.index))] = 1.0
-            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, -1, 9)
-            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, -1, 9 * modes)
+            force, points = on_points[:, pose.index], len(pose.index)                 # (c, p, 3)
+            summing = np.zeros((bodies, points))
+            summing[pose.body, np.arange(points)] = 1.0
+            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, points, 9)
+            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, points, 9 * modes)
             turning = pose.body_seconds.reshape(count, bodies, rotations * rotations, 9) @ with_place[..., None]
             mixed = pose.body_firsts.reshape(count, bodies, rotations, 9) @ with_shape.reshape(count, bodies, 9, modes)
-            terms = np.concatenate([turning.reshape(count, bodies, -1), mixed.reshape(count, bodies, -1)], axis=-1)
+            terms = np.concatenate([turning.reshape(count, bodies, rotations * rotations),
+                                    mixed.reshape(count, bodies, rotations * modes)], axis=-1)
             out[pose.kind] = terms.reshape(state.separation.shape[:-2] + terms.shape[-2:])
         return out
 

@@ -72,7 +72,7 @@ ROWS_PER_WORKER = 200
 #: memory (the bound is for Exudyn's runs), and each fresh pool costs seconds of start-up.
 DESIGN_ROWS_PER_WORKER = 5000
 #: Rows the prepared linear mount answers together, in one NumPy batch (one task of a worker).
-BATCH_ROWS = 32
+BATCH_ROWS = 128
 #: The row was answered by the prepared linear mount in NumPy.
 NUMPY_PATH = "NumPy"
 #: The row was answered by the Exudyn pipeline.
