@@ -298,9 +298,10 @@ def test_channels_tangent_is_the_derivative_of_their_forces(mount):
 
 
 def test_body_by_body_response_is_the_whole_solve(mount, monkeypatch):
-    """Designs together are answered body by body (each body held by its channels, the channels between
-    bodies by the Woodbury identity): their channel forces equal the solve of the whole matrices to 1e-10,
-    and the designs the body-by-body solve does not trust go to that whole solve."""
+    """Designs together are answered body by body (each body held by its channels to the ground, the channels
+    between bodies by the Woodbury identity): their channel forces equal the solve of the whole matrices to
+    1e-10 (1e-8 at 0.5 Hz, where the engine is held by its inertia alone), and the designs the body-by-body
+    solve does not trust go to that whole solve."""
     import workbook.design.blocks as blocks
     from workbook.design.linear_mount import _solve_item
 
@@ -308,13 +309,14 @@ def test_body_by_body_response_is_the_whole_solve(mount, monkeypatch):
     designs = mount._designs([_design(mount.case, rng) for _ in range(4)])
     for item in mount.case.excitations:
         model = _solve_item(designs, mount.items[item.name]).model
-        omega = 2 * np.pi * rng.uniform(20.0, 300.0, 4)
         loads = rng.standard_normal(model.mass.shape[:2] + model.mass.shape[-1:]) * (
             model.layout.padding.diagonal(axis1=-2, axis2=-1) == 0)
-        forces, singular = model.respond(omega, loads.astype(complex))
-        whole, _ = model.dense().respond(omega, model.layout.vector(loads).astype(complex))
-        assert not singular.any()
-        assert _normwise(forces, whole) < 1e-10
+        # the engine, on no channel to the ground, is held by its inertia alone: at 0.5 Hz barely
+        for omega, within in ((2 * np.pi * rng.uniform(20.0, 300.0, 4), 1e-10), (np.full(4, np.pi), 1e-8)):
+            forces, singular = model.respond(omega, loads.astype(complex))
+            whole, _ = model.dense().respond(omega, model.layout.vector(loads).astype(complex))
+            assert not singular.any()
+            assert _normwise(forces, whole) < within
         monkeypatch.setattr(blocks, "BACKWARD_ERROR", -1.0)      # every design to the whole solve
         again, _ = model.respond(omega, loads.astype(complex))
         monkeypatch.undo()

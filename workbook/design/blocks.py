@@ -269,14 +269,17 @@ class ChannelCoupling:
     coupled : ndarray of int, shape (2 L,)
         The moving points (positions in *moving*) of the L channels with both points moving: their first
         points, then their second.
+    grounded : ndarray of int
+        The other moving points: of the channels to the ground.
     same_body : ndarray, shape (6 L, 6 L)
-        1 where two of these points' rows (three each) are on the same body.
+        1 where two of the coupled points' rows (three each) are on the same body.
     """
 
     moving: np.ndarray
     bodies: np.ndarray
     channels: np.ndarray
     coupled: np.ndarray
+    grounded: np.ndarray
     same_body: np.ndarray
 
     @classmethod
@@ -293,7 +296,7 @@ class ChannelCoupling:
         by_channel = np.zeros((channels.count, len(moving)))
         by_channel[moving // 2, np.arange(len(moving))] = 1.0
         same = np.repeat(np.repeat((on[:, None] == on[None, :]).astype(float), 3, axis=0), 3, axis=1)
-        return cls(moving, bodies, by_channel, coupled, same)
+        return cls(moving, bodies, by_channel, coupled, np.setdiff1d(np.arange(len(moving)), coupled), same)
 
 
 def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.ndarray, impedance: np.ndarray,
@@ -301,15 +304,14 @@ def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.nda
     """The channels' separation phasors of designs' harmonic responses, body by body.
 
     The whole dynamic stiffness is the bodies' blocks plus every channel's
-    ``J_c^T Z_c J_c``, ``J_c`` the sum of its two points' Jacobians. Each
-    point's own term ``J_p^T Z_c J_p`` is added to its body's block (the body
-    held by its channels' springs, so that each block stays regular away from
-    the whole mount's own resonances); the terms joining the two points of a
-    channel between moving bodies, ``J_a^T Z J_b + J_b^T Z J_a``, are
-    ``U^T W U`` and solved by the Woodbury identity, a system of 6 per such
-    channel. A design whose solution leaves a backward error above
-    :data:`BACKWARD_ERROR` (a body near a resonance of its own), or whose
-    matrices are singular, is marked for a solve of the whole matrix.
+    ``J_c^T Z_c J_c``, ``J_c`` the sum of its two points' Jacobians. A channel
+    to the ground adds its term to its body's block (the body held by it); a
+    channel between two moving bodies is a rank-3 update ``U_c^T Z_c U_c``
+    (``U_c = J_c``, on both bodies), solved by the Woodbury identity: a
+    system of 3 per such channel. A design whose solution leaves a backward
+    error above :data:`BACKWARD_ERROR` (a body near a resonance of its own),
+    or whose matrices are singular, is marked for a solve of the whole
+    matrix.
 
     Parameters
     ----------
@@ -333,40 +335,45 @@ def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.nda
     count = len(dynamic)
     jacobian = points[:, coupling.moving]                                    # (D, P, 3, w)
     transposed = jacobian.swapaxes(-1, -2)
-    on_points = coupling.channels.T @ impedance.reshape(count, impedance.shape[1], 9)        # (D, P, 9)
-    own = transposed @ (on_points.reshape(on_points.shape[:-1] + (3, 3)) @ jacobian)           # (D, P, w, w)
-    held = dynamic + (coupling.bodies @ own.reshape(count, own.shape[1], -1)).reshape(dynamic.shape)
+    on_points = (coupling.channels.T @ impedance.reshape(count, impedance.shape[1], 9)).reshape(
+        count, len(coupling.moving), 3, 3)                                  # Z of each point's channel
+    grounded = coupling.grounded
+    own = transposed[:, grounded] @ (on_points[:, grounded] @ jacobian[:, grounded])        # (D, G, w, w)
+    held = dynamic + (coupling.bodies[:, grounded] @ own.reshape(count, len(grounded), -1)).reshape(dynamic.shape)
     failed = np.ones(count, dtype=bool)
     try:
         inverse = np.linalg.inv(held)
     except np.linalg.LinAlgError:
         return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
     body = coupling.bodies.argmax(axis=0)                                    # each moving point's body
-    coupled = coupling.coupled
-    reach = inverse[:, body[coupled]] @ transposed[:, coupled]               # (D, 2 L, w, 3)
     free = (inverse @ loads[..., None])[..., 0]                              # (D, K, w)
-    links = len(coupled) // 2
-    # G = U A^-1 U^T: the products of points on different bodies are not G's (other coordinates): masked
-    receptance = (jacobian[:, coupled].reshape(count, 6 * links, -1)
-                  @ reach.transpose(0, 2, 1, 3).reshape(count, -1, 6 * links)) * coupling.same_body
-    spring = impedance[:, coupling.moving[coupled[:links]] // 2]                  # (D, L, 3, 3)
-    weight = np.concatenate([spring, spring], axis=1)                            # W's blocks, (D, 2 L, 3, 3)
-    swap = np.concatenate([np.arange(links, 2 * links), np.arange(links)])     # W pairs the two halves
-    moved = jacobian[:, coupled] @ free[:, body[coupled], :, None]              # U x_free, (D, 2 L, 3, 1)
     motion = free
+    coupled = coupling.coupled
+    links = len(coupled) // 2
     if links:
-        product = weight @ receptance.reshape(count, 2 * links, 3, 6 * links)[:, swap]      # W G
+        reach = inverse[:, body[coupled]] @ transposed[:, coupled]           # (D, 2 L, w, 3)
+        # G = U A^-1 U^T, U_c the sum of a channel's two points' rows: the products of points on different
+        # bodies are not G's (other coordinates), masked
+        points_receptance = (jacobian[:, coupled].reshape(count, 6 * links, -1)
+                             @ reach.transpose(0, 2, 1, 3).reshape(count, -1, 6 * links)) * coupling.same_body
+        receptance = points_receptance.reshape(count, 2, 3 * links, 2, 3 * links).sum(axis=(1, 3))
+        springs = np.zeros((count, links, 3, links, 3), dtype=complex)           # Z_c of the L channels, block diagonal
+        springs[:, np.arange(links), :, np.arange(links), :] = \
+            impedance[:, coupling.moving[coupled[:links]] // 2].transpose(1, 0, 2, 3)
+        spring = springs.reshape(count, 3 * links, 3 * links)
+        moved = (jacobian[:, coupled] @ free[:, body[coupled], :, None]).reshape(count, 2, 3 * links).sum(axis=1)
         try:
-            spread = np.linalg.solve(np.eye(6 * links) + product.reshape(count, 6 * links, 6 * links),
-                                     (weight @ moved[:, swap]).reshape(count, 6 * links, 1))
+            spread = np.linalg.solve(np.eye(3 * links) + spring @ receptance, (spring @ moved[..., None]))
         except np.linalg.LinAlgError:
             return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
-        spread = spread.reshape(count, 2 * links, 3, 1)
-        motion = free - coupling.bodies[:, coupled] @ (reach @ spread)[..., 0]   # (D, K, w)
+        both = np.concatenate([spread, spread], axis=1).reshape(count, 2 * links, 3, 1)   # U^T: on both points
+        motion = free - coupling.bodies[:, coupled] @ (reach @ both)[..., 0]   # (D, K, w)
     on_moving = (jacobian @ motion[:, body, :, None])[..., 0]                # (D, P, 3)
     separation = coupling.channels @ on_moving                               # (D, C, 3)
-    force = (on_points.reshape(on_points.shape[:-1] + (3, 3)) @ (coupling.channels.T @ separation)[..., None])
+    force = on_points @ (coupling.channels.T @ separation)[..., None]
     residual = (dynamic @ motion[..., None])[..., 0] + coupling.bodies @ (transposed @ force)[..., 0] - loads
-    scale = np.abs(held).max(axis=(1, 2, 3)) * np.abs(motion).max(axis=(1, 2)) + np.abs(loads).max(axis=(1, 2))
+    matrices = np.abs(held).max(axis=(1, 2, 3)) + np.abs(on_points).max(axis=(1, 2, 3)) * np.abs(jacobian).max(
+        axis=(1, 2, 3)) ** 2
+    scale = matrices * np.abs(motion).max(axis=(1, 2)) + np.abs(loads).max(axis=(1, 2))
     error = np.abs(residual).max(axis=(1, 2)) / np.where(scale > 0, scale, 1.0)
     return separation, ~np.isfinite(error) | (error > BACKWARD_ERROR)
