@@ -10,6 +10,7 @@ into elastic modes and compute the floating-frame invariants
 from __future__ import annotations
 
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -208,7 +209,8 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     one eigen-solve up to the highest need of all decisions serves each of
     them, truncated to what it keeps; the same factorisation gives the
     static modes, and one block solve the residual mass of each
-    (:class:`InertiaFlexibility`).
+    (:class:`InertiaFlexibility`). The decisions' reductions then run side
+    by side in threads.
 
     Parameters
     ----------
@@ -243,10 +245,11 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
                                 fixed_hz[:max(keeps)])
     flexibility = InertiaFlexibility(coupled, solver, largest)
     shared = time.perf_counter() - start
-    links = []
-    for decision, keep, info in zip(decisions, keeps, infos, strict=True):
+
+    def reduced(decision: ModeDecision, keep: int, info: dict) -> ReducedBody:
         cb = CraigBamptonBasis(largest.vectors[:, :largest.n_static + keep], solver.masters, fixed_hz[:keep])
-        links.append(reduce_coupled(coupled, cb, decision, frequencies,
-                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared},
-                                    flexibility))
-    return links
+        return reduce_coupled(coupled, cb, decision, frequencies,
+                              {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared}, flexibility)
+
+    with ThreadPoolExecutor(max_workers=2) as threads:  # the decisions side by side: NumPy's products release the GIL
+        return list(threads.map(reduced, decisions, keeps, infos))
