@@ -47,7 +47,8 @@ def nested_dissection(matrix: sp.spmatrix) -> np.ndarray:
     Parameters
     ----------
     matrix : scipy.sparse matrix, shape (n, n)
-        Its pattern is symmetrised.
+        Its nodes are its consecutive rows (or columns, for CSC) of one
+        pattern; the graph of the nodes is symmetrised.
 
     Returns
     -------
@@ -56,12 +57,15 @@ def nested_dissection(matrix: sp.spmatrix) -> np.ndarray:
     """
     import pymetis
 
-    pattern = sp.csr_matrix(matrix, copy=True)
-    pattern.data = np.ones_like(pattern.data)
-    pattern = (pattern + pattern.T).tocsr()
+    # the rows of a CSC matrix's arrays are its columns: either way the pattern of the matrix or of its
+    # transpose, without a conversion; the node graph, far smaller, is symmetrised
+    compressed = matrix if sp.issparse(matrix) and matrix.format in ("csr", "csc") else sp.csr_matrix(matrix)
+    pattern = sp.csr_matrix((np.ones(len(compressed.indices)), compressed.indices, compressed.indptr),
+                            shape=compressed.shape)
     group = _supervariables(pattern)
     members = sp.csr_matrix((np.ones(len(group)), (group, np.arange(len(group)))))
-    graph = (members @ pattern @ members.T).tocsr()
+    graph = members @ pattern @ members.T
+    graph = (graph + graph.T).tocsr()
     graph.setdiag(0)
     graph.eliminate_zeros()
     order, _ = pymetis.nested_dissection(adjacency=pymetis.CSRAdjacency(graph.indptr, graph.indices),

@@ -60,7 +60,7 @@ if TYPE_CHECKING:  # SciPy, scikit-fem and gmsh: imported where a link's geometr
     from .interior import InteriorSolver
     from .meshing import BodyMesh
 
-__all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement",
+__all__ = ["LinkStiffening", "stress_field", "geometric_stiffness", "unit_tension_displacement", "unit_tension_stiffness",
            "mesh_stiffening", "coupled_stiffening", "link_stiffening", "has_stiffening", "save_stiffening", "stiffened",
            "PINNED_FIXED_MODES"]
 
@@ -290,8 +290,29 @@ def mesh_stiffening(link_mesh: BodyMesh, material: Material, interface: str = "R
     return coupled_stiffening(link_mesh, coupled, solver, material, fixed_modes)
 
 
+def unit_tension_stiffness(link_mesh: BodyMesh, coupled, solver: InteriorSolver, material: Material,
+                           rotation=None) -> sp.csr_matrix:
+    """``G`` of a link's unit tension (:func:`geometric_stiffness` of its stress field), from its coupled
+    model and the factorisation of its interior.
+
+    Parameters
+    ----------
+    link_mesh, coupled, solver, material, rotation
+        As for :func:`coupled_stiffening`.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, shape (n, n)
+        (N/m) per N of tension, on the mesh's nodes.
+    """
+    displacement = coupled.coupling.transform @ unit_tension_displacement(solver)
+    if rotation is not None:
+        displacement = (displacement.reshape(-1, 3) @ np.asarray(rotation, dtype=float)).ravel()
+    return geometric_stiffness(link_mesh, stress_field(link_mesh, displacement, material))
+
+
 def coupled_stiffening(link_mesh: BodyMesh, coupled, solver: InteriorSolver, material: Material,
-                       fixed_modes: int = PINNED_FIXED_MODES, rotation=None) -> LinkStiffening:
+                       fixed_modes: int = PINNED_FIXED_MODES, rotation=None, scalar=None) -> LinkStiffening:
     """The geometric stiffness of a link per newton of tension, from its coupled model and the
     factorisation of its interior (those of its reduction, when the FE model is in the mesh's frame).
 
@@ -309,6 +330,8 @@ def coupled_stiffening(link_mesh: BodyMesh, coupled, solver: InteriorSolver, mat
         *coupled*'s frame against the mesh's: a vector v of the mesh is
         ``rotation @ v`` in *coupled* (default: the same frame). The stress
         is taken in the mesh's frame; ``K_G = G (x) I3`` is the same in both.
+    scalar : scipy.sparse.csr_matrix, optional
+        ``G`` of these arguments, when made already (:func:`unit_tension_stiffness`).
 
     Returns
     -------
@@ -317,10 +340,8 @@ def coupled_stiffening(link_mesh: BodyMesh, coupled, solver: InteriorSolver, mat
     from .frequencies import mounted_constraint_basis
 
     transform = coupled.coupling.transform
-    displacement = transform @ unit_tension_displacement(solver)
-    if rotation is not None:
-        displacement = (displacement.reshape(-1, 3) @ np.asarray(rotation, dtype=float)).ravel()
-    scalar = geometric_stiffness(link_mesh, stress_field(link_mesh, displacement, material))
+    if scalar is None:
+        scalar = unit_tension_stiffness(link_mesh, coupled, solver, material, rotation)
     _, fixed = solver.fixed_interface_modes(fixed_modes)
     basis = np.hstack([solver.static_modes() @ mounted_constraint_basis(coupled.coupling), fixed])
 

@@ -277,29 +277,32 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         One per excitation, in order, each carrying its own decision.
     """
     def prepare(frequencies):
-        from .geometric_stiffness import PINNED_FIXED_MODES, coupled_stiffening, has_stiffening, save_stiffening
+        from .geometric_stiffness import PINNED_FIXED_MODES, coupled_stiffening, has_stiffening, save_stiffening, unit_tension_stiffness
         from .interior import InteriorSolver
         from .reduction import couple
 
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
+        stiffen = stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir)
         with ThreadPoolExecutor(max_workers=1) as beside:  # SuperLU and NumPy release the GIL
             stress = beside.submit(_timed_stress_operator, link_mesh, model.material, rotation, timings)
             coupled = couple(fe, model.interface)
             start = time.perf_counter()
             solver = InteriorSolver(coupled.stiffness, coupled.mass, coupled.coupling)
             timings["reduction_seconds"] = time.perf_counter() - start  # the factorisation; the reduction adds its own
+            # the unit tension's geometric stiffness beside the eigen-solves (it needs only the static modes)
+            tension = (beside.submit(unit_tension_stiffness, link_mesh, coupled, solver, model.material, rotation)
+                       if stiffen else None)
+            if frequencies is None:
+                start = time.perf_counter()
+                # the stiffening's fixed-interface modes beside them, the solves of the three made together
+                frequencies = solver.reference_frequencies(PINNED_FIXED_MODES if stiffen else 0)
+                timings["frequency_seconds"] = time.perf_counter() - start
             coupled = dataclasses.replace(coupled, stress=stress.result())
-        stiffen = stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir)
-        if frequencies is None:
-            start = time.perf_counter()
-            # the stiffening's fixed-interface modes beside them, the solves of the three made together
-            frequencies = solver.reference_frequencies(PINNED_FIXED_MODES if stiffen else 0)
-            timings["frequency_seconds"] = time.perf_counter() - start
-        if stiffen:
-            start = time.perf_counter()
-            save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation),
-                            cache_dir=cache_dir)
-            timings["stiffening_seconds"] = time.perf_counter() - start
+            if tension is not None:
+                start = time.perf_counter()
+                save_stiffening(model, coupled_stiffening(link_mesh, coupled, solver, model.material, rotation=rotation,
+                                                          scalar=tension.result()), cache_dir=cache_dir)
+                timings["stiffening_seconds"] = time.perf_counter() - start
         return coupled, solver, frequencies, timings
 
     return cached_reductions(model.fingerprint(), _decider(modes), excitations_hz, prepare, cache_dir=cache_dir,

@@ -10,6 +10,7 @@ into elastic modes and compute the floating-frame invariants
 from __future__ import annotations
 
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -137,7 +138,7 @@ class InertiaFlexibility:
 
 
 def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeDecision, frequencies: dict,
-                   info: dict, flexibility: InertiaFlexibility | None = None) -> ReducedBody:
+                   info: dict, flexibility: InertiaFlexibility | Future[InertiaFlexibility] | None = None) -> ReducedBody:
     """The reduced link of a Craig-Bampton basis: elastic modes, node-wise basis, floating-frame invariants.
 
     Parameters
@@ -151,9 +152,10 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     info : dict
         JSON-able facts about the inputs, stored with the link; reduction
         timings and sizes are added.
-    flexibility : InertiaFlexibility, optional
+    flexibility : InertiaFlexibility or Future of one, optional
         Of ``cb`` or a larger basis of the same factorisation: the link then
-        keeps its residual mass (:meth:`InertiaFlexibility.residual_mass`).
+        keeps its residual mass (:meth:`InertiaFlexibility.residual_mass`);
+        a future being made in another thread is waited for last.
 
     Returns
     -------
@@ -170,13 +172,14 @@ def reduce_coupled(coupled: CoupledModel, cb: CraigBamptonBasis, decision: ModeD
     mode_basis = np.vstack([coupling.transform @ modes_q, modes_q[masters_t.ravel()]])
     nodes = np.vstack([fe.nodes, coupling.centres])
     invariants = ffrf_invariants(nodes, _padded(fe.mass, 3 * n_if), _padded(fe.stiffness, 3 * n_if), mode_basis)
-    residual = (np.zeros((0, 0)) if flexibility is None
-                else flexibility.residual_mass(len(cb.fixed_interface_hz), coefficients))
     stress_modes = np.zeros((0, 6, 0))
     if coupled.stress is not None:
         stress_start = time.perf_counter()
         stress_modes = coupled.stress.of(mode_basis)
         info = {**info, "stress_shape_seconds": time.perf_counter() - stress_start}
+    flexible = flexibility.result() if isinstance(flexibility, Future) else flexibility
+    residual = (np.zeros((0, 0)) if flexible is None
+                else flexible.residual_mass(len(cb.fixed_interface_hz), coefficients))
     info = dict(info)
     info.update(
         coupling=coupling.kind,
@@ -208,7 +211,8 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     one eigen-solve up to the highest need of all decisions serves each of
     them, truncated to what it keeps; the same factorisation gives the
     static modes, and one block solve the residual mass of each
-    (:class:`InertiaFlexibility`).
+    (:class:`InertiaFlexibility`). The decisions' reductions run side by
+    side in threads, beside that block solve.
 
     Parameters
     ----------
@@ -241,12 +245,16 @@ def reduce_for_decisions(coupled: CoupledModel, solver: InteriorSolver, decision
     keeps = [kept_count(fixed_hz, decision.count, decision.cutoff_hz) for decision in decisions]
     largest = CraigBamptonBasis(np.hstack([solver.static_modes(), fixed[:, :max(keeps)]]), solver.masters,
                                 fixed_hz[:max(keeps)])
-    flexibility = InertiaFlexibility(coupled, solver, largest)
     shared = time.perf_counter() - start
-    links = []
-    for decision, keep, info in zip(decisions, keeps, infos, strict=True):
-        cb = CraigBamptonBasis(largest.vectors[:, :largest.n_static + keep], solver.masters, fixed_hz[:keep])
-        links.append(reduce_coupled(coupled, cb, decision, frequencies,
-                                    {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared},
-                                    flexibility))
-    return links
+    # the residual flexibility's block solve beside the decisions' reductions, which wait for it last
+    # (SuperLU and NumPy's products release the GIL)
+    with ThreadPoolExecutor(max_workers=1 + len(decisions)) as threads:
+        flexibility = threads.submit(InertiaFlexibility, coupled, solver, largest)
+        running = [threads.submit(reduce_coupled, coupled,
+                                  CraigBamptonBasis(largest.vectors[:, :largest.n_static + keep], solver.masters,
+                                                    fixed_hz[:keep]),
+                                  decision, frequencies,
+                                  {**info, "reduction_seconds": info.get("reduction_seconds", 0.0) + shared},
+                                  flexibility)
+                   for decision, keep, info in zip(decisions, keeps, infos, strict=True)]
+        return [link.result() for link in running]

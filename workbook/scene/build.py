@@ -439,6 +439,15 @@ def _served_frequency(case: Case, excitation: SingleFrequencyExcitation | Simult
     return max(served) if served else _reduction_frequency(case, excitation)
 
 
+def _import_multibody(flexible: bool) -> None:
+    """Import Exudyn, and its FEM module for flexible links, which the scene needs once the links are
+    reduced: done while a link worker still runs, on the core another has left idle."""
+    import exudyn  # noqa: F401
+
+    if flexible:
+        import exudyn.FEM  # noqa: F401
+
+
 def reduce_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneous | None = None,
                  progress: Callable[[int], None] | None = None) -> dict:
     """Reduce every link of *case* (cached on disk and in memory by :mod:`flexbodies`).
@@ -479,7 +488,9 @@ def reduce_links(case: Case, excitation: SingleFrequencyExcitation | Simultaneou
             shown = count
             progress(count)
 
-    reduce_in_workers(list(jobs), done=lambda job: show(shown + len(jobs[job])))
+    flexible = any(case.link_is_flexible(link.name) for link in case.links)
+    reduce_in_workers(list(jobs), done=lambda job: show(shown + len(jobs[job])),
+                      spare=lambda: _import_multibody(flexible))
     reduced = {}
     for job, names in jobs.items():
         try:

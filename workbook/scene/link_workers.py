@@ -121,7 +121,8 @@ def _report(finished, pending: list, done) -> int:
     return count
 
 
-def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, workers: int | None = None) -> int:
+def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, workers: int | None = None,
+                      spare: Callable[[], None] | None = None) -> int:
     """Reduce the jobs the cache lacks in worker processes, side by side.
 
     Parameters
@@ -133,6 +134,10 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
     workers : int, optional
         Most worker processes (default: the cores available). Fewer than two
         jobs to compute, or one worker, run nothing here.
+    spare : callable, optional
+        Called once in this process on the core the first worker to run out
+        of jobs leaves idle while another still works: work the caller needs
+        next (it must not raise).
 
     Returns
     -------
@@ -159,6 +164,9 @@ def reduce_in_workers(jobs, done: Callable[[LinkJob], None] | None = None, worke
         reported = 0
         while reported < len(pending) and any(p.is_alive() for p in processes):
             reported += _report(finished, pending, done)
+            if spare is not None and reported < len(pending) and not all(p.is_alive() for p in processes):
+                spare()
+                spare = None
             time.sleep(_POLL_SECONDS)
         for process in processes:
             process.join()
