@@ -35,24 +35,31 @@ def _normwise(fast, exact):
 
 
 def _compare(mount, case):
-    fast = mount.evaluate(case).result
+    """Per excitation item: the largest normwise differences of T, of the hinge force amplitudes and of the
+    static hinge forces of the design evaluation from the pipeline's."""
+    answer = mount.evaluate(case)
     exact = run_case(case)
-    for f, e in zip(fast.runs, exact.runs, strict=True):
+    for f, e in zip(answer.result.runs, exact.runs, strict=True):
         assert f.name == e.name
+        static, preload = answer.static_hinge_forces[f.name], e.preload.hinge_forces
         yield _normwise(f.transmissibility, e.transmissibility), max(
-            _normwise(f.hinge_amplitudes[name], e.hinge_amplitudes[name]) for name in e.hinge_amplitudes)
+            _normwise(f.hinge_amplitudes[name], e.hinge_amplitudes[name]) for name in e.hinge_amplitudes), \
+            max(np.abs(static[name] - preload[name]).max() for name in preload) / max(
+                np.abs(force).max() for force in preload.values())
 
 
 def test_prepared_design_is_the_pipeline_answer(mount):
-    for t_error, hinge_error in _compare(mount, mount.case):
-        assert t_error < 1e-6 and hinge_error < 2e-6
+    for t_error, hinge_error, static_error in _compare(mount, mount.case):
+        assert t_error < 1e-7 and hinge_error < 1e-7 and static_error < 1e-10
 
 
 def test_random_hinge_designs_agree_with_the_pipeline(mount):
+    """Hinge springs 1 to 4 times stiffer: the preload moves, and both paths follow it with the derivative
+    of Exudyn's equations (its own Jacobian left the static forces 1e-5 and T 1e-6 apart)."""
     rng = np.random.default_rng(25)
     for _ in range(2):
-        for t_error, hinge_error in _compare(mount, _design(mount.case, rng)):
-            assert t_error < 5e-6 and hinge_error < 1e-5
+        for t_error, hinge_error, static_error in _compare(mount, _design(mount.case, rng)):
+            assert t_error < 1e-7 and hinge_error < 2e-7 and static_error < 2e-8
 
 
 def test_engine_mass_and_excitation_amplitude(mount):
@@ -60,8 +67,9 @@ def test_engine_mass_and_excitation_amplitude(mount):
     engine = dataclasses.replace(case.engine, mass=1.1 * case.engine.mass,
                                  inertia=tuple(tuple(1.2 * v for v in row) for row in case.engine.inertia))
     excitations = tuple(dataclasses.replace(e, amplitude=2.0 * e.amplitude) for e in case.excitations)
-    for t_error, hinge_error in _compare(mount, dataclasses.replace(case, engine=engine, excitations=excitations)):
-        assert t_error < 5e-6 and hinge_error < 1e-5
+    for t_error, hinge_error, static_error in _compare(mount, dataclasses.replace(case, engine=engine,
+                                                                                  excitations=excitations)):
+        assert t_error < 1e-7 and hinge_error < 2e-7 and static_error < 2e-8
 
 
 def test_many_designs_at_once_are_each_design_alone(mount):
@@ -91,7 +99,7 @@ def test_many_designs_at_once_are_each_design_alone(mount):
                 assert _normwise(answers[k].static_hinge_forces[item][name], force) < 1e-8
     exact = run_case(heavier)
     for fast, e in zip(answers[2].result.runs, exact.runs, strict=True):
-        assert _normwise(fast.transmissibility, e.transmissibility) < 5e-6
+        assert _normwise(fast.transmissibility, e.transmissibility) < 1e-7
 
 
 def test_a_change_it_cannot_follow_is_named(mount):
@@ -118,7 +126,7 @@ def test_study_rows_on_the_prepared_mount_equal_the_pipeline_rows(mount):
         for f_run, e_run in zip(f.runs, e.runs, strict=True):
             t_fast = np.array([f_run[f"T {d}"] for d in "xyz"])
             t_exact = np.array([e_run[f"T {d}"] for d in "xyz"])
-            assert _normwise(t_fast, t_exact) < 5e-6
+            assert _normwise(t_fast, t_exact) < 1e-7
 
 
 def test_design_derivatives_equal_differences_of_evaluations(mount):

@@ -15,8 +15,9 @@ the parts the design sets and the parts it does not:
   ``S`` and damping ``S_d`` of the design;
 - the rest of the scene (bodies, static loads, rotors, the links' spin
   restraints, a flexible engine's bearings and spin restraint) is the system
-  with every channel's spring and damper set to zero: Exudyn's M, K and D of
-  it and their first derivatives with respect to the coordinates of each
+  with every channel's spring and damper set to zero: M, K and D of it as
+  the pipeline linearises (:func:`workbook.solve.modes.linearized_matrices`:
+  K the central differences of Exudyn's equations) and their first derivatives with respect to the coordinates of each
   block of bodies (a body alone, or the bodies the rest joins: a flexible
   engine's core and casing; blocks do not couple, so one round of central
   differences serves every block), and K's second derivatives with respect
@@ -300,8 +301,8 @@ def _position_expansion(set_state, base: np.ndarray, positions, coordinates: lis
     return [(centre[k], jacobians[k], hessians[k]) for k in range(len(sizes))]
 
 
-def _rest_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    return linearized_matrices(mbs)[:3]
+def _rest_matrices(scene: Scene, blocks: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    return linearized_matrices(scene, blocks)[:3]
 
 
 def _channels_released(scene: Scene):
@@ -354,7 +355,7 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
     restore = _channels_released(scene)
     try:
         set_state(base)
-        at_base = _rest_matrices(scene.mbs)
+        at_base = _rest_matrices(scene)
         blocks = _coupled_blocks(list(_body_coordinates(scene).values()), at_base)
         width = max(len(block) for block in blocks)
         coordinates = np.full((len(blocks), width), size, dtype=int)
@@ -377,7 +378,7 @@ def _rest_blocks(scene: Scene, set_state, base: np.ndarray) -> RestBlocks:
                     if i < len(block):
                         state[block[i]] += sign * MATRIX_STEP
                 set_state(state)
-                shifted.append([padded(m) for m in _rest_matrices(scene.mbs)])
+                shifted.append([padded(m) for m in _rest_matrices(scene, coordinates)])
             for m in range(3):
                 slopes[m][:, :, :, i] = (shifted[0][m] - shifted[1][m]) / (2 * MATRIX_STEP)
         turning = _turning(blocks, _rotation_coordinates(scene), width)
@@ -428,7 +429,7 @@ def _stiffness_curvature(scene: Scene, set_state, base: np.ndarray, coordinates:
                 if position < width:
                     state[block[position]] += step
         set_state(state)
-        return padded(_rest_matrices(scene.mbs)[1])
+        return padded(_rest_matrices(scene, coordinates)[1])
 
     for s in range(count):
         curvature[..., s, s] = (at({s: h}) - 2 * stiffness + at({s: -h})) / h ** 2
@@ -442,7 +443,7 @@ def _euler_blocks(scene: Scene) -> np.ndarray:
     mbs = scene.mbs
     if mbs.systemData.AEsize() == 0:
         return np.zeros((0, 4), dtype=int)
-    jacobian = linearized_matrices(mbs)[3]
+    jacobian = linearized_matrices(scene)[3]
     blocks = []
     for row in jacobian.T:  # Exudyn gives it transposed: (coordinates, constraints)
         support = np.flatnonzero(row)

@@ -37,12 +37,13 @@ the preloaded state and not to the engine's inertia.
 Reciprocity. The condensation keeps the symmetry of what it is given: from
 the symmetric part of S the set is reciprocal, ``K12 = K21^T``, to 1e-14 of
 its largest entry. The linearisation itself is not quite symmetric: at the
-preload, Exudyn's central differences in the bodies' Euler parameters give
-K a skew part (on the coarse reference mount with flexible links 3.4e-6 of
-its largest entry, 0.5 % of one link's rotation entry; 2e-9 without the
-preload), which the set carries: K12 and K21^T differ by up to 1.2e-6 of
-the largest entry (3e-4 of a small one), by an amount that follows the
-round-off of the static solve and of the differences, machine to machine.
+preload, the derivative of Exudyn's equations in the bodies' Euler
+parameters has a skew part (on the coarse reference mount with flexible
+links 3.4e-6 of its largest entry, 0.5 % of one link's rotation entry;
+1.6e-12 without the preload), which the set carries: K12 and K21^T
+differ by 9.4e-8 of the largest entry (1.2e-6 with Exudyn's own Jacobian,
+:mod:`workbook.solve.modes`), by an amount that follows the round-off of
+the static solve and of the differences, machine to machine.
 
 On a pylon of point dynamic stiffness ``Z_p`` (per pin, force on the pylon
 per pin motion) the engine moves by

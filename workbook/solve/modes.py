@@ -1,7 +1,17 @@
 """Linearised modes of a scene: free motions (mechanisms) and mounted modes.
 
-Exudyn linearises the system at its initial state (its static solver's mass
-matrix and Jacobians, as ``ComputeLinearizedSystem`` takes them: M, K, D). K holds the geometric stiffness of the preload for the bodies'
+The system is linearised at its initial state: M, D and the constraint
+Jacobian are Exudyn's (its static solver's, as ``ComputeLinearizedSystem``
+takes them); K is the central difference of Exudyn's ODE2 right-hand side,
+the derivative of the equations Exudyn solves. Exudyn's own Jacobian
+leaves out part of the connectors' second-order terms on rotation nodes
+(the hinge forces turning with the engine's Tait-Bryan angles, the links'
+spin restraints): on the reference mount some of its entries are 4e-6 off,
+which moved T by up to 1e-6 and, carried over a design's change of preload
+by the design evaluation's expansion (:mod:`workbook.design.expansion`),
+its static hinge forces by up to 1e-4 (``tests/test_linear_mount.py``).
+The mechanism and stability checks take Exudyn's own K (``exact=False``,
+20 times cheaper: the sign of a mode does not see it). K holds the geometric stiffness of the preload for the bodies'
 rigid-body motion (the hinge forces turning with a link or the engine); a
 flexible link's modal coordinates have the stiffness of its reduced body,
 which holds its own stress stiffening only when that effect built it in
@@ -40,7 +50,7 @@ from workbook.model.case import ENGINE
 from workbook.scene.build import Scene
 from workbook.solve.guards import solver_output
 
-__all__ = ["Linearization", "Mode", "linearize", "linearized_matrices",
+__all__ = ["Linearization", "Mode", "linearize", "linearized_matrices", "STIFFNESS_STEP",
            "body_coordinates", "eigenpairs", "modes_from", "modes_of", "free_motions", "unstable_modes", "mounted_modes",
            "describe_engine_motion", "FREE_FREQUENCY_HZ", "ENGINE_MOTIONS"]
 
@@ -52,6 +62,8 @@ ENGINE_MOTIONS = ("heading translation (x)", "lateral translation (y)", "vertica
                   "roll (rotation about x)", "pitch (rotation about y)", "yaw (rotation about z)")
 #: A mode is a mounted mode when at least this share of its kinetic energy is in the engine.
 ENGINE_SHARE = 0.5
+#: Coordinate step of the stiffness's central differences (m, rad, Euler parameters, modal coordinates).
+STIFFNESS_STEP = 1e-6
 
 
 @dataclass(frozen=True)
@@ -154,25 +166,43 @@ def body_coordinates(scene: Scene) -> dict[str, np.ndarray]:
     return indices
 
 
-def linearized_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def linearized_matrices(scene: Scene, blocks: np.ndarray | None = None, *, exact: bool = True
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """M, K, D and the constraint Jacobian ``C`` (ODE2 rows, one column per algebraic equation) of
-    *mbs* at its initial state.
+    *scene* at its initial state, the excitation paused.
 
-    The calls of Exudyn's ``ComputeLinearizedSystem(returnConstraintJacobian=True)``, which imports
-    SciPy for a null space it is not asked for.
+    M, D and C are Exudyn's (its static solver's mass matrix and Jacobians, as
+    ``ComputeLinearizedSystem(returnConstraintJacobian=True)`` takes them). K
+    is ``-df/dq`` by central differences (step :data:`STIFFNESS_STEP`) of
+    Exudyn's ODE2 right-hand side f: the derivative of the equations Exudyn
+    solves (see the module text).
+
+    Parameters
+    ----------
+    scene : Scene
+    blocks : ndarray of int, shape (B, b), optional
+        Coordinates of bodies that no force couples, padded with N: the
+        same position of every block is differenced at once (2 b evaluations
+        of f instead of 2 N), and K has no entries between blocks.
+    exact : bool
+        False takes Exudyn's own K (20 times cheaper, 1e-6 of some entries
+        off: enough for the sign of a mode, as the mechanism and stability
+        checks ask it).
     """
     import exudyn as exu
 
+    mbs = scene.mbs
     settings = exu.SimulationSettings()
     settings.solution.file.write = False
     settings.solution.sensors.active = False
     settings.staticSolver.verboseMode = 0
     solver: Any = exu.MainSolverStatic()    # Any: Exudyn's stubs declare the solver's methods without self
-    with solver_output():
+    with solver_output(), scene.excitation_paused():
         solver.InitializeSolver(mbs, settings)
         ode2, ode1 = solver.GetODE2size(), solver.GetODE1size()
         solver.ComputeMassMatrix(mbs)
         mass = np.asarray(solver.GetSystemMassMatrix())[:ode2, :ode2]
+        # the ODE2 part first: it sets up the system Jacobian the constraints' part is added to
         solver.ComputeJacobianODE2RHS(mbs, scalarFactor_ODE2=-1, scalarFactor_ODE2_t=0, scalarFactor_ODE1=0)
         if solver.GetAEsize() > 0:
             solver.ComputeJacobianAE(mbs, scalarFactor_ODE2=1.0, scalarFactor_ODE2_t=0.0, scalarFactor_ODE1=0.0,
@@ -180,20 +210,63 @@ def linearized_matrices(mbs) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.nda
         jacobian = np.asarray(solver.GetSystemJacobian())
         solver.ComputeJacobianODE2RHS(mbs, scalarFactor_ODE2=0, scalarFactor_ODE2_t=-1, scalarFactor_ODE1=0)
         damping = np.asarray(solver.GetSystemJacobian())[:ode2, :ode2]
+        stiffness = _stiffness(mbs, solver, ode2, blocks) if exact else jacobian[:ode2, :ode2]
         solver.FinalizeSolver(mbs, settings)
-    return mass, jacobian[:ode2, :ode2], damping, jacobian[:ode2, ode2 + ode1:]
+    return mass, stiffness, damping, jacobian[:ode2, ode2 + ode1:]
 
 
-def linearize(scene: Scene) -> Linearization:
+def _stiffness(mbs, solver: Any, size: int, blocks: np.ndarray | None) -> np.ndarray:
+    """``-df/dq`` (size, size) of Exudyn's ODE2 right-hand side f at the current state by central differences;
+    *blocks* as :func:`linearized_matrices` takes them (None: every coordinate alone)."""
+    import exudyn as exu
+
+    data = mbs.systemData
+    current = exu.ConfigurationType.Current
+    base = np.array(data.GetODE2Coordinates(configuration=current))
+    groups = np.arange(size)[:, None] if blocks is None else np.asarray(blocks).T     # (positions, blocks)
+    owner = np.full(size + 1, -1)
+    if blocks is not None:
+        for k, block in enumerate(np.asarray(blocks)):
+            owner[block] = k
+        owner[size] = -1
+
+    def force(state: np.ndarray) -> np.ndarray:
+        data.SetODE2Coordinates(list(state), configuration=current)
+        solver.ComputeODE2RHS(mbs)
+        return np.array(solver.GetSystemResidual())[:size]
+
+    stiffness = np.zeros((size, size))
+    try:
+        for columns in groups:
+            columns = columns[columns < size]
+            shifted = []
+            for sign in (1.0, -1.0):
+                state = base.copy()
+                state[columns] += sign * STIFFNESS_STEP
+                shifted.append(force(state))
+            change = -(shifted[0] - shifted[1]) / (2 * STIFFNESS_STEP)
+            if blocks is None:
+                stiffness[:, columns[0]] = change
+            else:
+                for column in columns:
+                    rows = owner[:size] == owner[column]
+                    stiffness[rows, column] = change[rows]
+    finally:
+        data.SetODE2Coordinates(list(base), configuration=current)
+    return stiffness
+
+
+def linearize(scene: Scene, *, exact: bool = True) -> Linearization:
     """Linearise *scene* at its initial state (after a static solve with
-    ``updateInitialValues=True``: the preloaded state).
+    ``updateInitialValues=True``: the preloaded state); *exact* as
+    :func:`linearized_matrices` takes it.
 
     With rotors built (``scene.gyroscopics``), the gyroscopic matrix is the
     skew-symmetric part of Exudyn's D in the engine's rotation coordinates
     (the only skew-symmetric damping of the scene: hinge and Rayleigh damping
     are symmetric).
     """
-    mass, stiffness, damping, jacobian = linearized_matrices(scene.mbs)
+    mass, stiffness, damping, jacobian = linearized_matrices(scene, exact=exact)
     size = mass.shape[0]
     if jacobian.shape[1] > 0:
         left, singular, _ = np.linalg.svd(jacobian)

@@ -39,7 +39,7 @@ from workbook.solve.four_pole import REPORT_GRID, FourPole, checked_frequencies,
 from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
-from workbook.solve.modes import Mode, linearize, modes_of, mounted_modes
+from workbook.solve.modes import STIFFNESS_STEP, Mode, linearize, modes_of, mounted_modes
 from workbook.solve.preload import Preload, solve_preload
 from workbook.solve.simultaneous import extract_simultaneous, plan_simultaneous
 from workbook.solve.stages import ProgressFactory, link_warnings, timed
@@ -252,7 +252,8 @@ def _frequency_solver(case: Case, model: HarmonicModel) -> dict:
     return {
         "analysis": "frequency domain: (K - w^2 M + i w D + i H) z = B f per frequency (dense complex solve), "
                     "F_hinge = (C_k + i C_h + i w C_d) z",
-        "linearisation": "Exudyn ComputeLinearizedSystem at the preloaded state (geometric stiffness of the preload for "
+        "linearisation": "at the preloaded state: Exudyn's M and D, K by central differences of Exudyn's equations "
+                         f"(coordinate step {STIFFNESS_STEP:g}; geometric stiffness of the preload for "
                          "the rigid-body motion of the engine and the links; the links' elastic modes stiffened by "
                          "their axial preload only where the stress-stiffening effect is on); "
                          "Euler-parameter constraints projected out (null space by SVD)",

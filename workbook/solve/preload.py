@@ -207,7 +207,7 @@ def check_mechanism(scene: Scene) -> list[Mode]:
     """
     # a clearance restrains once its gap closes: check with the gaps closed
     with scene.gaps_closed():
-        modes = modes_of(linearize(scene), gyroscopic=False)
+        modes = modes_of(linearize(scene, exact=False), gyroscopic=False)
     _stop_on_free_motions(scene, modes)
     return modes
 
@@ -289,7 +289,7 @@ def check_preloaded_stability(scene: Scene, forces: dict) -> list[Mode]:
     MechanismError
         A free motion at the preload.
     """
-    modes = modes_of(linearize(scene), gyroscopic=False)
+    modes = modes_of(linearize(scene, exact=False), gyroscopic=False)
     unstable = unstable_modes(modes)
     if unstable:
         case = scene.case
