@@ -614,13 +614,19 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
             shapes = reduced.stress_modes
             stressed[link.name] = StressedLink(
                 link, np.arange(first, first + shapes.shape[2]), reduced, np.asarray(scene.links[link.name].rotation),
-                np.ascontiguousarray(shapes.transpose(1, 0, 2)), np.linalg.norm(shapes, ord=2, axis=(1, 2)))
+                np.ascontiguousarray(shapes.transpose(1, 0, 2)), _spectral_norms(shapes))
     unstiffened = StateLoads(_link_stiffness(flexible, np.zeros((1, len(flexible)))), [], np.zeros((1, size)))
     tangent = prepared_tangent(expansion, base_springs, unstiffened.take(0))
     return _Item(item.name, expansion, size, sign, base_force, compression, flexible, engine,
                  [names.index(link.name) for link in flexible], points, warnings,
                  prepared.modes, case.engine, seconds + time.perf_counter() - start, stressed,
                  _prepared_casing(case, scene), tangent)
+
+
+def _spectral_norms(shapes: np.ndarray) -> np.ndarray:
+    """The spectral norm of each of the matrices *shapes* (n, r, c), r <= c: the square root of the largest
+    eigenvalue of its ``S S^T`` (half the time of their SVDs)."""
+    return np.sqrt(np.maximum(np.linalg.eigvalsh(shapes @ shapes.swapaxes(1, 2))[:, -1], 0.0))
 
 
 def _prepared_casing(case: Case, scene: Scene) -> _Casing | None:

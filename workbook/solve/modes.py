@@ -11,7 +11,7 @@ which moved T by up to 1e-6 and, carried over a design's change of preload
 by the design evaluation's expansion (:mod:`workbook.design.expansion`),
 its static hinge forces by up to 1e-4 (``tests/test_linear_mount.py``).
 The mechanism and stability checks take Exudyn's own K (``exact=False``,
-20 times cheaper: the sign of a mode does not see it). K holds the geometric stiffness of the preload for the bodies'
+about 15 times cheaper: the sign of a mode does not see it). K holds the geometric stiffness of the preload for the bodies'
 rigid-body motion (the hinge forces turning with a link or the engine); a
 flexible link's modal coordinates have the stiffness of its reduced body,
 which holds its own stress stiffening only when that effect built it in
@@ -185,7 +185,7 @@ def linearized_matrices(scene: Scene, blocks: np.ndarray | None = None, *, exact
         same position of every block is differenced at once (2 b evaluations
         of f instead of 2 N), and K has no entries between blocks.
     exact : bool
-        False takes Exudyn's own K (20 times cheaper, 1e-6 of some entries
+        False takes Exudyn's own K (about 15 times cheaper, 4e-6 of some entries
         off: enough for the sign of a mode, as the mechanism and stability
         checks ask it).
     """
