@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 import skfem
+from skfem.quadrature import get_quadrature
 
 from .errors import TangledElements
 from .materials import Material
@@ -115,10 +116,9 @@ def assemble(link_mesh: BodyMesh, material: Material, intorder: int | None = Non
     k_order, m_order = INTEGRATION_ORDERS[type(mesh)] if intorder is None else (intorder, intorder)
     k_basis = skfem.Basis(mesh, mesh.elem(), intorder=k_order)
     _check_orientation(k_basis, link_mesh.source)
-    m_basis = k_basis if m_order == k_order else skfem.Basis(mesh, mesh.elem(), intorder=m_order)
     pattern = _BlockPattern(k_basis.element_dofs, k_basis.N)
     stiffness = pattern.blocks(_element_stiffness(k_basis, material))
-    mass = sp.kron(pattern.scalars(_element_mass(m_basis, material.density)), sp.identity(3), format="csr")
+    mass = sp.kron(pattern.scalars(_element_mass(mesh, m_order, material.density)), sp.identity(3), format="csr")
     nodes = np.ascontiguousarray(link_mesh.nodes)
     description = f"{link_mesh.element_name}, {nodes.shape[0]} nodes, {3 * nodes.shape[0]} DOF"
     logger.info("assembled %s, material %s", description, material.name)
@@ -170,10 +170,18 @@ def _element_stiffness(basis: skfem.CellBasis, material: Material) -> np.ndarray
     return stiffness
 
 
-def _element_mass(basis: skfem.CellBasis, density: float) -> np.ndarray:
-    """Element mass of one displacement component, ``int rho a b``, shape (elements, functions, functions), kg."""
-    values = np.stack([np.asarray(field[0]) for field in basis.basis], axis=2)  # (elements, points, functions)
-    element = density * np.matmul(np.swapaxes(values * basis.dx[:, :, None], 1, 2), values)
+def _element_mass(mesh: skfem.Mesh, intorder: int, density: float) -> np.ndarray:
+    """Element mass of one displacement component, ``int rho a b``, shape (elements, functions, functions), kg.
+
+    The shape functions' values at the integration points are the reference element's (the map moves
+    the points, not the values), so no basis is made: only the Jacobian determinants are the elements'
+    (a basis's shape-function gradients took 0.14 s on the 9,300 elements of the reference thrust rod).
+    """
+    points, weights = get_quadrature(mesh.elem().refdom, intorder)
+    dx = np.abs(mesh.mapping().detDF(points)) * weights                        # (elements, points)
+    values = np.stack([np.broadcast_to(mesh.elem().lbasis(points, j)[0], dx.shape)
+                       for j in range(mesh.elem().doflocs.shape[0])], axis=2)  # (elements, points, functions)
+    element = density * np.matmul(np.swapaxes(values * dx[:, :, None], 1, 2), values)
     return 0.5 * (element + np.swapaxes(element, 1, 2))
 
 

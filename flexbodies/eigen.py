@@ -78,7 +78,8 @@ class _Factor:
 
     def __init__(self, matrix: sp.spmatrix):
         self.shape = matrix.shape
-        self._matrix = sp.csc_matrix(matrix)
+        # CSR or CSC as given: SuperLU's CSC is made once, of the reordered matrix
+        self._matrix = matrix if sp.issparse(matrix) and matrix.format in ("csr", "csc") else sp.csc_matrix(matrix)
         self._order = nested_dissection(self._matrix)
         self._lu = spla.splu(
             self._matrix[self._order][:, self._order].tocsc(),
