@@ -15,12 +15,13 @@ the parts the design sets and the parts it does not:
   ``S`` and damping ``S_d`` of the design;
 - the rest of the scene (bodies, static loads, rotors, the links' spin
   restraints, a flexible engine's bearings and spin restraint) is the system
-  with every channel's spring and damper set to zero: M, K and D of it as
-  the pipeline linearises (:func:`workbook.solve.modes.linearized_matrices`:
-  K the central differences of Exudyn's equations) and their first derivatives with respect to the coordinates of each
-  block of bodies (a body alone, or the bodies the rest joins: a flexible
-  engine's core and casing; blocks do not couple, so one round of central
-  differences serves every block), and K's second derivatives with respect
+  with every channel's spring and damper set to zero: its M, K and D as the
+  pipeline linearises it (:func:`workbook.solve.modes.linearized_matrices`:
+  K the central differences of Exudyn's equations, so that a design's
+  preload is Exudyn's) and their first derivatives with respect to the
+  coordinates of each block of bodies (a body alone, or the bodies the rest
+  joins: a flexible engine's core and casing; blocks do not couple, so one
+  round of central differences serves every block), and K's second derivatives with respect
   to the blocks' Euler parameters (the links' spin restraints turn with
   them);
 - the engine's excitation points keep their position Jacobians and Hessians.

@@ -624,8 +624,8 @@ def _prepare_item(case: Case, item, scene: Scene, prepared, channels: list[str],
 
 
 def _spectral_norms(shapes: np.ndarray) -> np.ndarray:
-    """The spectral norm of each of the matrices *shapes* (n, r, c), r <= c: the square root of the largest
-    eigenvalue of its ``S S^T`` (half the time of their SVDs)."""
+    """The spectral norm of each of the matrices *shapes* (n, r, c): the square root of the largest eigenvalue
+    of its ``S S^T`` (r by r: for the 6 stress components, half the time of the SVDs)."""
     return np.sqrt(np.maximum(np.linalg.eigvalsh(shapes @ shapes.swapaxes(1, 2))[:, -1], 0.0))
 
 
