@@ -233,8 +233,7 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
     mbs = scene.mbs
     data = mbs.systemData
     current = exu.ConfigurationType.Current
-    with scene.excitation_paused():
-        lin = linearize(scene)
+    lin = linearize(scene)                # the excitation paused there
     q0 = np.array(data.GetODE2Coordinates(configuration=current))
     v0 = np.array(data.GetODE2Coordinates_t(configuration=current))
     channels = scene.force_channels
