@@ -229,16 +229,25 @@ def test_sparse_slopes_are_the_dense_expansion(mount):
         assert np.abs(got).max() > 0.0
 
 
-def test_chord_is_the_prepared_tangent_with_each_designs_springs(mount):
+@pytest.mark.parametrize("varied", ["all", "front"])
+def test_chord_is_the_prepared_tangent_with_each_designs_springs(mount, varied):
     """The chord iteration's matrix of designs together, solved by the Woodbury identity, is the prepared
     tangent plus every channel's ``J_c^T (S_c - S_0,c) J_c`` on the prepared Jacobian, summed here channel by
-    channel and solved densely; a design whose chord was renewed is solved with its own inverse."""
+    channel and solved densely; a design whose chord was renewed is solved with its own inverse. Designs that
+    change only the front hinges update only their channels' coordinates."""
     rng = np.random.default_rng(3)
-    designs = mount._designs([_design(mount.case, rng) for _ in range(3)])
+    cases = [_design(mount.case, rng) for _ in range(3)]
+    if varied == "front":
+        cases = [dataclasses.replace(case, hinges=tuple(h if h.name.startswith("front") else base for h, base in
+                                                        zip(case.hinges, mount.case.hinges, strict=True)))
+                 for case in cases]
+    designs = mount._designs(cases)
+    moved = [c for c, name in enumerate(mount.channels) if varied == "all" or name.startswith("front")]
     for item in mount.items.values():
         prepared = item.tangent
         size = len(prepared.inverse)
         chord = ChordStiffness.of(prepared, designs.springs)
+        assert np.array_equal(chord.changed, (3 * np.array(moved)[:, None] + np.arange(3)).ravel())
         residual = rng.standard_normal((3, size))
         channels = prepared.jacobian.reshape(-1, 3, size)
         expected = []

@@ -92,12 +92,19 @@ def prepared_tangent(expansion: SceneExpansion, springs: ChannelSprings, loads: 
 class ChordStiffness:
     """The chord matrices of B designs: the prepared tangent with each design's springs, or its own tangent.
 
+    Only the channels whose springs some design changes enter the Woodbury
+    update (a study that varies the front hinges updates their 12
+    coordinates, not all 3 C).
+
     Attributes
     ----------
     prepared : PreparedTangent
-    capacitance : ndarray, shape (B, 3 C, 3 C)
-        ``(I + dS G)^-1 dS`` of each design's spring change ``dS = S - S_0`` and ``G = J_0 T_0^-1 J_0^T``:
-        the chord's inverse is ``T_0^-1 - T_0^-1 J_0^T capacitance J_0 T_0^-1`` (Woodbury).
+    changed : ndarray of int
+        The channels' coordinates (of the 3 C) whose springs any of the designs changes.
+    capacitance : ndarray, shape (B, m, m)
+        ``(I + dS G)^-1 dS`` of each design's spring change ``dS = S - S_0`` and ``G = J_0 T_0^-1 J_0^T``, on
+        the *changed* coordinates (m of them): the chord's inverse is ``T_0^-1 - T_0^-1 J_0^T capacitance J_0
+        T_0^-1`` (Woodbury).
     own : dict of int to ndarray, shape (n, n)
         The inverse tangent of each design renewed at its own state, by its position.
     singular : ndarray of bool, shape (B,)
@@ -105,6 +112,7 @@ class ChordStiffness:
     """
 
     prepared: PreparedTangent
+    changed: np.ndarray
     capacitance: np.ndarray
     own: dict
     singular: np.ndarray
@@ -113,17 +121,20 @@ class ChordStiffness:
     def of(cls, prepared: PreparedTangent, springs: ChannelSprings) -> "ChordStiffness":
         """The chords of designs with the channel springs *springs* (leading axis B)."""
         change = springs.stiffness - prepared.springs
-        count, channels = change.shape[:2]
+        moved = np.flatnonzero(np.any(change != 0.0, axis=(0, 2, 3)))        # the channels some design changes
+        count, channels = len(change), len(moved)
         blocks = np.zeros((count, channels, 3, channels, 3))
-        blocks[:, np.arange(channels), :, np.arange(channels), :] = change.transpose(1, 0, 2, 3)
+        blocks[:, np.arange(channels), :, np.arange(channels), :] = change[:, moved].transpose(1, 0, 2, 3)
         spring_change = blocks.reshape(count, 3 * channels, 3 * channels)
-        capacitance, singular = solve_each(np.eye(3 * channels) + spring_change @ prepared.coupling, spring_change)
-        return cls(prepared, capacitance, {}, singular)
+        changed = (3 * moved[:, None] + np.arange(3)).ravel()
+        capacitance, singular = solve_each(np.eye(3 * channels) + spring_change @ prepared.coupling[np.ix_(changed, changed)],
+                                           spring_change)
+        return cls(prepared, changed, capacitance, {}, singular)
 
     def take(self, rows: np.ndarray) -> "ChordStiffness":
         """The designs *rows*."""
         own = {k: self.own[int(row)] for k, row in enumerate(rows) if int(row) in self.own}
-        return ChordStiffness(self.prepared, self.capacitance[rows], own, self.singular[rows])
+        return ChordStiffness(self.prepared, self.changed, self.capacitance[rows], own, self.singular[rows])
 
     def put(self, rows: np.ndarray, part: "ChordStiffness") -> None:
         """Keep the renewals of the chords *part* of the designs *rows*."""
@@ -131,10 +142,10 @@ class ChordStiffness:
 
     def solve(self, rows: np.ndarray, residual: np.ndarray) -> np.ndarray:
         """The chord's solution for the designs *rows* with the right-hand sides *residual* (len(rows), n)."""
-        prepared = self.prepared
+        prepared, changed = self.prepared, self.changed
         plain = residual @ prepared.inverse.T
-        spread = (self.capacitance[rows] @ (plain @ prepared.jacobian.T)[..., None])[..., 0]
-        solution = plain - spread @ prepared.reach.T
+        spread = (self.capacitance[rows] @ (plain @ prepared.jacobian[changed].T)[..., None])[..., 0]
+        solution = plain - spread @ prepared.reach[:, changed].T
         for k, row in enumerate(rows):
             if int(row) in self.own:
                 solution[k] = self.own[int(row)] @ residual[k]
