@@ -14,10 +14,10 @@ time per design of :data:`BATCH` designs answered together
 alternating rounds, and the largest difference between them; and beside
 them the floor of this way of evaluating: the LAPACK solves alone that a
 design needs together with others (per rotor, the chord's solve of the size
-of its channels' coordinates; the inverses of its bodies' held dynamic
-stiffness, of their independent coordinates; the Woodbury solve of the
-channels between moving bodies, three per channel), timed on matrices of
-those sizes. Run with
+of its channels' coordinates; the solves of its bodies' held dynamic
+stiffness, bodies of one width together, for their loads and their points
+on channels between moving bodies; the Woodbury solve of those channels,
+three unknowns per channel), timed on matrices of those sizes. Run with
 ``OPENBLAS_NUM_THREADS=1 python benchmarks/bench_design_evaluation.py [designs]``.
 """
 import dataclasses
@@ -128,8 +128,9 @@ def _batch(case, mount, rng) -> None:
     print(f"{'its LAPACK solves alone':<24}{floor:>16.4f}{1 / floor:>11.1f}")
     for name, item in mount.items.items():
         layout = item.expansion.layout
-        print(f"{name}: {layout.count} independent coordinates in {len(layout.coordinates)} bodies of at most "
-              f"{layout.width}; {3 * len(item.expansion.coupling.coupled) // 2} Woodbury unknowns")
+        widths = ", ".join(f"{len(g.blocks)} of {g.width}" for g in item.expansion.coupling.groups)
+        print(f"{name}: {layout.count} independent coordinates in {len(layout.coordinates)} bodies ({widths}); "
+              f"{3 * len(item.expansion.coupling.coupled) // 2} Woodbury unknowns")
     print(f"speed-up {one / many:.1f}x; largest difference of T {difference:.1e}")
 
 
@@ -140,15 +141,19 @@ def _solves_alone(mount) -> float:
     for _ in range(REPEATS):
         total = 0.0
         for item in mount.items.values():
-            layout, unknowns = item.expansion.layout, 3 * len(item.expansion.coupling.coupled) // 2
+            unknowns = 3 * len(item.expansion.coupling.coupled) // 2
             channels = 3 * len(mount.channels)
             chord = rng.standard_normal((BATCH_ROWS, channels, channels)) + channels * np.eye(channels)
-            shape = (BATCH_ROWS, len(layout.coordinates), layout.width, layout.width)
-            bodies = rng.standard_normal(shape) + layout.width * np.eye(layout.width) + 1j * rng.standard_normal(shape)
+            bodies = []
+            for group in item.expansion.coupling.groups:
+                shape = (BATCH_ROWS, len(group.blocks), group.width, group.width)
+                matrices = rng.standard_normal(shape) + group.width * np.eye(group.width) + 1j * rng.standard_normal(shape)
+                bodies.append((matrices, matrices[..., :1 + 3 * group.points.shape[1]]))
             woodbury = rng.standard_normal((BATCH_ROWS, unknowns, unknowns)) + unknowns * np.eye(unknowns) + 0j
             start = time.perf_counter()
             np.linalg.solve(chord, chord)
-            np.linalg.inv(bodies)
+            for matrices, right in bodies:
+                np.linalg.solve(matrices, right)
             np.linalg.solve(woodbury, woodbury[..., :1])
             total += time.perf_counter() - start
         times.append(total / BATCH_ROWS)

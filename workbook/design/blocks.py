@@ -27,7 +27,8 @@ if TYPE_CHECKING:
     from workbook.design.channel_set import ChannelSet, ChannelState
     from workbook.design.expansion import SceneExpansion
 
-__all__ = ["BlockPlacement", "BodyLayout", "body_layout", "ChannelCoupling", "channel_solve", "BACKWARD_ERROR"]
+__all__ = ["BlockPlacement", "BodyLayout", "body_layout", "ChannelCoupling", "SolveGroup", "channel_solve",
+           "BACKWARD_ERROR"]
 
 _SIGNS = np.array([-1.0, 1.0])   # d = p_1 - p_0
 
@@ -271,8 +272,8 @@ class ChannelCoupling:
         points, then their second.
     grounded : ndarray of int
         The other moving points: of the channels to the ground.
-    same_body : ndarray, shape (6 L, 6 L)
-        1 where two of the coupled points' rows (three each) are on the same body.
+    groups : tuple of SolveGroup
+        The bodies by their own number of independent coordinates, solved together.
     """
 
     moving: np.ndarray
@@ -280,7 +281,7 @@ class ChannelCoupling:
     channels: np.ndarray
     coupled: np.ndarray
     grounded: np.ndarray
-    same_body: np.ndarray
+    groups: tuple
 
     @classmethod
     def of(cls, layout: BodyLayout, channels: "ChannelSet") -> "ChannelCoupling":
@@ -295,8 +296,93 @@ class ChannelCoupling:
         bodies[blocks[moving], np.arange(len(moving))] = 1.0
         by_channel = np.zeros((channels.count, len(moving)))
         by_channel[moving // 2, np.arange(len(moving))] = 1.0
-        same = np.repeat(np.repeat((on[:, None] == on[None, :]).astype(float), 3, axis=0), 3, axis=1)
-        return cls(moving, bodies, by_channel, coupled, np.setdiff1d(np.arange(len(moving)), coupled), same)
+        widths = (layout.independent < layout.count).sum(axis=1)
+        groups = tuple(SolveGroup.of(np.flatnonzero(widths == width), int(width), on)
+                       for width in np.unique(widths))
+        return cls(moving, bodies, by_channel, coupled, np.setdiff1d(np.arange(len(moving)), coupled), groups)
+
+
+@dataclass(frozen=True)
+class SolveGroup:
+    """Bodies of the same number of independent coordinates, and the coupled points on each.
+
+    Attributes
+    ----------
+    blocks : ndarray of int, shape (G,)
+        The bodies' blocks.
+    width : int
+        Their independent coordinates (a block's first; the rest is padding).
+    points : ndarray of int, shape (G, m)
+        Per body, the coupled points on it (positions among the 2 L coupled points), padded with -1.
+    size : int
+        3 L, the order of the L channels' receptance.
+    targets : ndarray of int, shape (G, 3 m, 3 m)
+        Where the products of two of a body's points' rows go in the flat receptance (a padding point's: one
+        past its end).
+    """
+
+    blocks: np.ndarray
+    width: int
+    points: np.ndarray
+    size: int
+    targets: np.ndarray
+
+    @classmethod
+    def of(cls, blocks: np.ndarray, width: int, on: np.ndarray) -> "SolveGroup":
+        """The group of the bodies *blocks* of *width* coordinates, *on* the body of each coupled point."""
+        found = [np.flatnonzero(on == block) for block in blocks]
+        points = np.full((len(blocks), max((len(f) for f in found), default=0)), -1, dtype=int)
+        for k, mine in enumerate(found):
+            points[k, :len(mine)] = mine
+        links = len(on) // 2                                   # point p is on channel p mod L
+        rows = np.where(points[..., None] >= 0, 3 * (points[..., None] % max(links, 1)) + np.arange(3), -1)
+        rows = rows.reshape(len(blocks), -1)                   # (G, 3 m), -1: padding
+        size = 3 * links
+        targets = np.where((rows[:, :, None] >= 0) & (rows[:, None, :] >= 0),
+                           rows[:, :, None] * size + rows[:, None, :], size * size)
+        return cls(blocks, width, points, size, targets)
+
+    def solve(self, held: np.ndarray, loads: np.ndarray, transposed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Each body's response to its loads and to unit forces at its coupled points.
+
+        Parameters
+        ----------
+        held : ndarray, complex, shape (D, K, w, w)
+            Every body's held dynamic stiffness.
+        loads : ndarray, complex, shape (D, K, w)
+        transposed : ndarray, shape (D, 2 L, w, 3)
+            The coupled points' Jacobians, transposed.
+
+        Returns
+        -------
+        free : ndarray, complex, shape (D, G, width)
+            ``A^-1 f`` of the group's bodies.
+        reach : ndarray, complex, shape (D, G, width, 3 m)
+            ``A^-1 J_p^T`` of their coupled points, three columns each (of the padding: meaningless).
+        """
+        count, (bodies, points), width = len(held), self.points.shape, self.width
+        right = np.zeros((count, bodies, width, 1 + 3 * points), dtype=complex)
+        right[..., 0] = loads[:, self.blocks, :width]
+        forces = transposed[:, self.points, :width]          # (D, G, m, w, 3); the padding's solved, not kept
+        right[..., 1:] = forces.transpose(0, 1, 3, 2, 4).reshape(count, bodies, width, 3 * points)
+        solved = np.linalg.solve(held[:, self.blocks, :width, :width], right)
+        return solved[..., 0], solved[..., 1:]
+
+    def receptance(self, transposed: np.ndarray, reach: np.ndarray) -> np.ndarray:
+        """The group's part of the L channels' receptance ``G = U A^-1 U^T``, flat: (D, 9 L^2).
+
+        Parameters
+        ----------
+        transposed : ndarray, shape (D, 2 L, w, 3)
+            The coupled points' Jacobians, transposed.
+        reach : ndarray, complex, shape (D, G, width, 3 m)
+            From :meth:`solve`.
+        """
+        count, (bodies, points), width = len(reach), self.points.shape, self.width
+        rows = transposed[:, self.points, :width].transpose(0, 1, 2, 4, 3).reshape(count, bodies, 3 * points, width)
+        products = (rows @ reach).reshape(count, -1)
+        flat, length = self.targets.ravel(), self.size * self.size + 1
+        return (scatter_sum(flat, products.real, length) + 1j * scatter_sum(flat, products.imag, length))[:, :-1]
 
 
 def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.ndarray, impedance: np.ndarray,
@@ -341,22 +427,28 @@ def channel_solve(coupling: ChannelCoupling, dynamic: np.ndarray, points: np.nda
     own = transposed[:, grounded] @ (on_points[:, grounded] @ jacobian[:, grounded])        # (D, G, w, w)
     held = dynamic + (coupling.bodies[:, grounded] @ own.reshape(count, len(grounded), -1)).reshape(dynamic.shape)
     failed = np.ones(count, dtype=bool)
-    try:
-        inverse = np.linalg.inv(held)
-    except np.linalg.LinAlgError:
-        return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
-    body = coupling.bodies.argmax(axis=0)                                    # each moving point's body
-    free = (inverse @ loads[..., None])[..., 0]                              # (D, K, w)
-    motion = free
     coupled = coupling.coupled
     links = len(coupled) // 2
+    free = np.zeros(loads.shape, dtype=complex)                              # A^-1 f, (D, K, w)
+    reach = np.zeros((count, 2 * links) + transposed.shape[-2:], dtype=complex)   # A^-1 J^T, (D, 2 L, w, 3)
+    at_coupled = transposed[:, coupled]
+    flat_receptance = np.zeros((count, 9 * links * links), dtype=complex)
+    for group in coupling.groups:
+        try:
+            free[:, group.blocks, :group.width], on_bodies = group.solve(held, loads, at_coupled)
+        except np.linalg.LinAlgError:
+            return np.zeros((count, impedance.shape[1], 3), dtype=complex), failed
+        kept = group.points >= 0
+        columns = on_bodies.reshape(on_bodies.shape[:3] + (-1, 3)).transpose(0, 1, 3, 2, 4)    # (D, G, m, w, 3)
+        reach[:, group.points[kept], :group.width] = columns[:, kept]
+        if links:
+            flat_receptance += group.receptance(at_coupled, on_bodies)
+    body = coupling.bodies.argmax(axis=0)                                    # each moving point's body
+    motion = free
     if links:
-        reach = inverse[:, body[coupled]] @ transposed[:, coupled]           # (D, 2 L, w, 3)
-        # G = U A^-1 U^T, U_c the sum of a channel's two points' rows: the products of points on different
-        # bodies are not G's (other coordinates), masked
-        points_receptance = (jacobian[:, coupled].reshape(count, 6 * links, -1)
-                             @ reach.transpose(0, 2, 1, 3).reshape(count, -1, 6 * links)) * coupling.same_body
-        receptance = points_receptance.reshape(count, 2, 3 * links, 2, 3 * links).sum(axis=(1, 3))
+        # G = U A^-1 U^T, U_c the sum of a channel's two points' rows: summed body by body (the products of
+        # points on different bodies are not G's)
+        receptance = flat_receptance.reshape(count, 3 * links, 3 * links)
         springs = np.zeros((count, links, 3, links, 3), dtype=complex)           # Z_c of the L channels, block diagonal
         springs[:, np.arange(links), :, np.arange(links), :] = \
             impedance[:, coupling.moving[coupled[:links]] // 2].transpose(1, 0, 2, 3)
