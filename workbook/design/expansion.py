@@ -65,29 +65,45 @@ CURVATURE_STEP = 1e-3
 
 @dataclass(frozen=True)
 class _BlockOperator:
-    """Tensors (K, r, m), mostly zero, as a sparse operator from vectors (..., K, m) to the K r products
-    ``tensors[k] @ vectors[..., k, :]``, of which it keeps the rows that are not zero.
+    """Tensors (K, b b, m), mostly zero, as a sparse operator from vectors (..., K, m) to the K products
+    ``tensors[k] @ vectors[..., k, :]``, each a (b, b) matrix, of which it keeps the entries that are not zero.
 
     The slopes and the curvature of the bodies' matrices are mostly zero: few entries of a body's matrices
     change with few of its coordinates.
     """
 
-    rows: np.ndarray              # the rows kept, among K r
+    rows: np.ndarray              # the entries kept, among K b b
     operator: sparse.csr_array    # (rows, K m)
+    columns: sparse.csr_array     # (rows, K b): picks the coordinate of each kept entry's column
+    sums: sparse.csr_array        # (K b, rows): sums each kept entry into its row
 
     @classmethod
     def of(cls, tensors: np.ndarray) -> "_BlockOperator":
         whole = sparse.csr_array(sparse.block_diag(list(tensors), format="csr"))
         whole.eliminate_zeros()
         rows = np.flatnonzero(np.diff(whole.indptr))
-        return cls(rows, whole[rows])
+        blocks, width = len(tensors), int(round(np.sqrt(tensors.shape[1])))
+        block, entry = np.divmod(rows, width * width)
+        ones, kept = np.ones(len(rows)), np.arange(len(rows))
+        columns = sparse.csr_array((ones, (kept, block * width + entry % width)), shape=(len(rows), blocks * width))
+        sums = sparse.csr_array((ones, (block * width + entry // width, kept)), shape=(blocks * width, len(rows)))
+        return cls(rows, whole[rows], columns, sums)
+
+    def products(self, vectors: np.ndarray) -> np.ndarray:
+        """The kept entries of the products with *vectors* (..., K, m): (len(rows), prod(...))."""
+        return self.operator @ vectors.reshape((-1, vectors.shape[-2] * vectors.shape[-1])).T
 
     def add_to(self, out: np.ndarray, vectors: np.ndarray, weight: float) -> None:
-        """Add *weight* times the products with *vectors* (..., K, m) to *out* (..., K r) (its kept rows)."""
-        flat = vectors.reshape((-1, vectors.shape[-2] * vectors.shape[-1]))
+        """Add *weight* times the products with *vectors* (..., K, m) to *out* (..., K b b) (its kept entries)."""
         target = out.reshape((-1, out.shape[-1]))
         assert np.may_share_memory(target, out), "the sums need a contiguous out"
-        target[:, self.rows] += weight * (self.operator @ flat.T).T
+        target[:, self.rows] += weight * self.products(vectors).T
+
+    def applied(self, vectors: np.ndarray, local: np.ndarray) -> np.ndarray:
+        """The products with *vectors* (..., K, m), each a (b, b) matrix, applied to *local* (..., K, b):
+        (K b, prod(...))."""
+        flat = local.reshape((-1, local.shape[-2] * local.shape[-1])).T
+        return self.sums @ (self.products(vectors) * (self.columns @ flat))
 
 
 @dataclass(frozen=True)
@@ -130,14 +146,17 @@ class RestBlocks:
         """*dq* (..., N) per block: (..., B, b)."""
         return np.concatenate([dq, np.zeros(dq.shape[:-1] + (1,))], axis=-1)[..., self.coordinates]
 
-    def _curved(self, out: np.ndarray, local: np.ndarray, weight: float) -> None:
-        """Add *weight* times the curvature term of K along the Euler parameters of *local* (..., B, b) to the
-        blocks *out* (..., B, b, b)."""
+    def _pairs(self, local: np.ndarray) -> np.ndarray:
+        """The products of every two Euler parameters of each block of *local* (..., B, b): (..., B, S S)."""
         blocks = len(self.coordinates)
         padded = np.concatenate([local, np.zeros(local.shape[:-1] + (1,))], axis=-1)
         turned = padded[..., np.arange(blocks)[:, None], self.turning]
-        pairs = (turned[..., :, None] * turned[..., None, :]).reshape(local.shape[:-2] + (blocks, -1))
-        self._operators["curvature"].add_to(out.reshape(out.shape[:-3] + (-1,)), pairs, weight)
+        return (turned[..., :, None] * turned[..., None, :]).reshape(local.shape[:-2] + (blocks, -1))
+
+    def _curved(self, out: np.ndarray, local: np.ndarray, weight: float) -> None:
+        """Add *weight* times the curvature term of K along the Euler parameters of *local* (..., B, b) to the
+        blocks *out* (..., B, b, b)."""
+        self._operators["curvature"].add_to(out.reshape(out.shape[:-3] + (-1,)), self._pairs(local), weight)
 
     def full(self, blocks: np.ndarray) -> np.ndarray:
         """The blocks (..., B, b, b) scattered into a full matrix (..., N, N)."""
@@ -177,9 +196,10 @@ class RestBlocks:
     def force_change(self, dq: np.ndarray) -> np.ndarray:
         """The change of the rest's internal force over *dq* (..., N): ``(K + K' dq / 2 + K'' dq dq / 6) dq``."""
         local = self._local(dq)
-        stiffness = self._sloped("stiffness", local, 0.5)
-        self._curved(stiffness, local, 1.0 / 6.0)
-        change = (stiffness @ local[..., None])[..., 0]
+        operators = self._operators
+        terms = 0.5 * operators["stiffness"].applied(local, local) \
+            + operators["curvature"].applied(self._pairs(local), local) / 6.0
+        change = np.einsum("kij,...kj->...ki", self.stiffness, local) + terms.T.reshape(local.shape)
         out = np.zeros(dq.shape[:-1] + (self.size + 1,))
         out[..., self.coordinates] = change           # each coordinate is in one block; the padding goes to N
         return out[..., :self.size]
