@@ -176,12 +176,64 @@ class BodyLayout:
         positions = self.position[channels.coordinates]
         return self.block[channels.coordinates[:, 0]], positions
 
-    def point_jacobians(self, channels: "ChannelSet", state: "ChannelState", basis: np.ndarray) -> np.ndarray:
+    def point_jacobians(self, channels: "ChannelSet", state: "ChannelState", tangents: np.ndarray) -> np.ndarray:
         """Each of the channels' points' position Jacobian on its block's independent coordinates, with the
-        sign of the separation d: shape (..., P, 3, w)."""
+        sign of the separation d: shape (..., P, 3, w).
+
+        ``J B`` on the block's basis (:meth:`basis`) for the Euler-parameter nodes' *tangents* (..., E, 4, 3):
+        a free coordinate's column is moved to its independent one, a node's four are turned by its tangent.
+        """
+        jacobian = state.jacobian                                            # (..., P, 3, M)
+        batch, points = jacobian.shape[:-3], jacobian.shape[-3]
+        count = int(np.prod(batch, dtype=int))
+        source = jacobian.reshape(count, -1)
+        out = np.zeros((count, points * 3 * self.width))
+        moved, turned = self._point_columns(channels)
+        out[:, moved[1]] = source[:, moved[0]]
+        if len(turned[0]):
+            picked, nodes, targets = turned
+            rows = source[:, picked].reshape(count, len(nodes), 3, 4)
+            turns = np.broadcast_to(tangents, batch + tangents.shape[-3:]).reshape((count,) + tangents.shape[-3:])
+            out[:, targets] = (rows @ turns[:, nodes]).reshape(count, -1)
+        signs = np.tile(_SIGNS, points // 2)[:, None, None]
+        return signs * out.reshape(batch + (points, 3, self.width))
+
+    @functools.cached_property
+    def _columns_of(self) -> dict:
+        """:meth:`_point_columns` of each point set asked, by its id (with the set: the id is its own)."""
+        return {}
+
+    def _point_columns(self, channels: "ChannelSet") -> tuple[tuple, tuple]:
+        """Flat positions for :meth:`point_jacobians`: the free coordinates' (in the Jacobian (P, 3, M), in the
+        result (P, 3, w)), and for each point on an Euler-parameter node its four columns' (P', 3, 4), its node
+        (P',) and the node's three independent columns' (P', 3, 3); made once per point set."""
+        known = self._columns_of.get(id(channels))
+        if known is None or known[0] is not channels:
+            known = self._columns_of[id(channels)] = (channels, self._find_columns(channels))
+        return known[1]
+
+    def _find_columns(self, channels: "ChannelSet") -> tuple[tuple, tuple]:
         blocks, positions = self.marker_rows(channels)
-        rows = basis[..., blocks[:, None], positions, :]                  # (..., P, M, w)
-        return np.tile(_SIGNS, len(blocks) // 2)[:, None, None] * (state.jacobian @ rows)
+        points, width = positions.shape
+        free = np.full((len(self.coordinates), self.coordinates.shape[1] + 1), -1)
+        free[self.free[0], self.free[1]] = self.free[2]
+        column = free[blocks[:, None], positions]                          # (P, M): -1 where not free
+        point, entry = np.nonzero(column >= 0)
+        rows = (3 * point[:, None] + np.arange(3))                         # (F, 3)
+        moved = ((rows * width + entry[:, None]).ravel(), (rows * self.width + column[point, entry][:, None]).ravel())
+        node_blocks, node_positions, node_columns = self.euler
+        on, nodes, picked, targets = [], [], [], []
+        for p in range(points):
+            for e in np.flatnonzero(node_blocks == blocks[p]):
+                where = [np.flatnonzero(positions[p] == position) for position in node_positions[e]]
+                if all(len(found) for found in where):
+                    places = np.array([found[0] for found in where])
+                    prows = 3 * p + np.arange(3)
+                    on.append(p)
+                    nodes.append(e)
+                    picked.append((prows[:, None] * width + places).ravel())
+                    targets.append((prows[:, None] * self.width + node_columns[e]).ravel())
+        return moved, (np.array(picked, dtype=int).ravel(), np.array(nodes, dtype=int), np.array(targets, dtype=int).ravel())
 
     def channel_jacobian(self, channels: "ChannelSet", points: np.ndarray) -> np.ndarray:
         """The channels' stacked Jacobian ``J_c`` (..., 3 C, n) from their points' (:meth:`point_jacobians`)."""

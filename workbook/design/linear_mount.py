@@ -854,10 +854,10 @@ def linear_model(prepared: _Item, springs: ChannelSprings, state: _State, casing
             basis, {key: basis.rows(inputs[..., 3 * k:3 * k + 3, :].swapaxes(-1, -2))
                     for k, key in enumerate(expansion.points)})
     frames = layout.basis(basis.tangents)
-    on_points = layout.point_jacobians(points, points_state, frames)
+    on_points = layout.point_jacobians(points, points_state, basis.tangents)
     bodies = layout.marker_rows(points)[0]
     return BodyHarmonic(
         layout, channels, expansion.coupling, layout.project(mass, frames), layout.project(stiffness, frames),
         layout.project(damping, frames), layout.project(structural, frames),
-        layout.point_jacobians(channels, at, frames), springs, prepared.sign, basis,
+        layout.point_jacobians(channels, at, basis.tangents), springs, prepared.sign, basis,
         {key: (int(bodies[2 * k + 1]), on_points[..., 2 * k + 1, :, :]) for k, key in enumerate(expansion.points)})
