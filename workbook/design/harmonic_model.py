@@ -131,8 +131,13 @@ class BodyHarmonic:
         w = np.asarray(omega, dtype=float)
         springs = self.springs
         frequency = w[:, None, None, None]
-        dynamic = (self.stiffness - frequency ** 2 * self.mass + 1j * (frequency * self.damping + self.structural)
-                   + self.layout.padding)
+        # K - w^2 M + i (w D + H), its parts in place
+        dynamic = np.empty(np.broadcast_shapes(frequency.shape, self.stiffness.shape), dtype=complex)
+        np.multiply(-frequency ** 2, self.mass, out=dynamic.real)
+        dynamic.real += self.stiffness
+        dynamic.real += self.layout.padding
+        np.multiply(frequency, self.damping, out=dynamic.imag)
+        dynamic.imag += self.structural
         impedance = springs.stiffness + 1j * (frequency * springs.damping + self.sign * springs.structural)
         separation, trouble = channel_solve(self.coupling, dynamic, self.points, impedance, loads)
         output = springs.stiffness + 1j * (springs.structural + frequency * springs.damping)
