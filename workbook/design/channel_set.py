@@ -44,12 +44,10 @@ class _Pose:
     local : ndarray, shape (c, p, 3)
         ``w + Phi q_f``, each point's place in its body's frame.
     rotation : ndarray, shape (c, p, 3, 3)
-    firsts : ndarray, shape (c, p, r, 3, 3)
-        The rotation's derivatives with respect to its r coordinates.
     body : ndarray of int, shape (p,)
         Each point's body among the G bodies of this kind (the points of a body share its rotation).
     body_firsts : ndarray, shape (c, G, r, 3, 3)
-        The derivatives of each body's rotation.
+        The derivatives of each body's rotation with respect to its r coordinates.
     body_seconds : ndarray, shape (c, G, r, r, 3, 3), or None
         Its second derivatives, when asked for.
     """
@@ -60,10 +58,26 @@ class _Pose:
     shapes: np.ndarray
     local: np.ndarray
     rotation: np.ndarray
-    firsts: np.ndarray
     body: np.ndarray
     body_firsts: np.ndarray
     body_seconds: np.ndarray | None
+
+    @functools.cached_property
+    def firsts(self) -> np.ndarray:
+        """The derivatives of each point's rotation, (c, p, r, 3, 3)."""
+        return self.body_firsts[:, self.body]
+
+    @functools.cached_property
+    def summing(self) -> np.ndarray:
+        """1 where a point (column) is on a body (row), (G, p): sums over a body's points by a product."""
+        out = np.zeros((self.body_firsts.shape[1], len(self.index)))
+        out[self.body, np.arange(len(self.index))] = 1.0
+        return out
+
+    @functools.cached_property
+    def first_points(self) -> np.ndarray:
+        """A point of each body (positions among all points), (G,)."""
+        return self.index[np.unique(self.body, return_index=True)[1]]
 
 
 @dataclass(frozen=True)
@@ -109,7 +123,8 @@ class ChannelState:
 
     def generalised(self, on_points: np.ndarray) -> np.ndarray:
         """``f_p . J_p`` of forces *on_points* (..., 2 C, 3) on each point, on its padded coordinates:
-        (..., 2 C, M), without forming J."""
+        (..., 2 C, M), without forming J. The terms on a body's rotation coordinates, which its points
+        share, are summed over its points and given to one of them (``f^T A' w = A' : f w^T``)."""
         count, (points, width) = self._count, self.points.coordinates.shape
         force = on_points.reshape(count, points, 3)
         out = np.zeros((count, points, width))
@@ -117,9 +132,12 @@ class ChannelState:
         out[:, self.points.kinds["ground"]] = 0.0
         for pose in self.poses:
             turned, modes = pose.turned, pose.shapes.shape[-1]
-            own = force[:, pose.index, None, None, :]                                    # (c, p, 1, 1, 3)
-            out[:, pose.index, 3:turned] = (own @ pose.firsts @ pose.local[:, :, None, :, None])[..., 0, 0]
-            out[:, pose.index, turned:turned + modes] = (own[:, :, 0] @ pose.rotation @ pose.shapes)[:, :, 0]
+            own = force[:, pose.index]                                                   # (c, p, 3)
+            bodies, rotations = pose.body_firsts.shape[1:3]
+            with_place = pose.summing @ (own[..., :, None] * pose.local[..., None, :]).reshape(count, -1, 9)
+            out[:, pose.first_points, 3:turned] = \
+                (pose.body_firsts.reshape(count, bodies, rotations, 9) @ with_place[..., None])[..., 0]
+            out[:, pose.index, turned:turned + modes] = (own[:, :, None, :] @ pose.rotation @ pose.shapes)[:, :, 0]
         return out.reshape(self.separation.shape[:-2] + (points, width))
 
 
@@ -197,8 +215,7 @@ class ChannelSet:
             modal = values[:, index, turned:turned + shapes.shape[-1]]
             local = self.local[index] + (shapes @ modal[..., None])[..., 0]         # w of every point, (c, p, 3)
             rotation, firsts, seconds = moved(padded[:, rotations], second)
-            pose = _Pose(kind, index, turned, shapes, local, rotation[:, group], firsts[:, group], group, firsts,
-                         seconds)
+            pose = _Pose(kind, index, turned, shapes, local, rotation[:, group], group, firsts, seconds)
             position[:, index] = values[:, index, :3] + (pose.rotation @ local[..., None])[..., 0]
             poses.append(pose)
         placed = position.reshape(batch + (points, 3))
@@ -244,11 +261,9 @@ class ChannelSet:
             assert pose.body_seconds is not None, "the curvature needs the rotations' second derivatives"
             bodies, rotations = pose.body_firsts.shape[1:3]
             modes = pose.shapes.shape[-1]
-            force, points = on_points[:, pose.index], len(pose.index)                 # (c, p, 3)
-            summing = np.zeros((bodies, points))
-            summing[pose.body, np.arange(points)] = 1.0
-            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, points, 9)
-            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, points, 9 * modes)
+            force, summing = on_points[:, pose.index], pose.summing                   # (c, p, 3), (G, p)
+            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, -1, 9)
+            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, -1, 9 * modes)
             turning = pose.body_seconds.reshape(count, bodies, rotations * rotations, 9) @ with_place[..., None]
             mixed = pose.body_firsts.reshape(count, bodies, rotations, 9) @ with_shape.reshape(count, bodies, 9, modes)
             terms = np.concatenate([turning.reshape(count, bodies, rotations * rotations),
