@@ -369,6 +369,10 @@ class LinearMount:
     def evaluate_many(self, cases: Sequence[Case]) -> list[DesignAnswer | SimulationError]:
         """Answer many designs at once (NumPy on all of them together: much faster per design).
 
+        The first call has the C allocator keep freed arrays of up to 32 MB in
+        the process for the next batch (:func:`~workbook.design.memory.keep_freed_memory`):
+        the process's memory stays near its peak.
+
         Returns
         -------
         list of DesignAnswer or SimulationError
