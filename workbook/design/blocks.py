@@ -222,14 +222,13 @@ class BodyLayout:
         rows = (3 * point[:, None] + np.arange(3))                         # (F, 3)
         moved = ((rows * width + entry[:, None]).ravel(), (rows * self.width + column[point, entry][:, None]).ravel())
         node_blocks, node_positions, node_columns = self.euler
-        on, nodes, picked, targets = [], [], [], []
+        nodes, picked, targets = [], [], []
         for p in range(points):
             for e in np.flatnonzero(node_blocks == blocks[p]):
                 where = [np.flatnonzero(positions[p] == position) for position in node_positions[e]]
                 if all(len(found) for found in where):
                     places = np.array([found[0] for found in where])
                     prows = 3 * p + np.arange(3)
-                    on.append(p)
                     nodes.append(e)
                     picked.append((prows[:, None] * width + places).ravel())
                     targets.append((prows[:, None] * self.width + node_columns[e]).ravel())
