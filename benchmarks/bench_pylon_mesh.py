@@ -34,7 +34,7 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from bench_warm_paths import ROOT, source_tree
 
 
 def _run(tree: Path, case: Path, cache: Path) -> float:
@@ -44,14 +44,6 @@ def _run(tree: Path, case: Path, cache: Path) -> float:
     subprocess.run([sys.executable, "-m", "workbook.cli.main", "run", str(case), "--no-progress"], check=True,
                    cwd=case.parent, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     return time.perf_counter() - start
-
-
-def _source_tree(revision: str, folder: Path) -> Path:
-    """The files of git revision *revision* of this repository, unpacked into *folder*."""
-    folder.mkdir()
-    archive = subprocess.run(["git", "archive", revision], cwd=ROOT, check=True, capture_output=True).stdout
-    subprocess.run(["tar", "-x", "-C", str(folder)], input=archive, check=True)
-    return folder
 
 
 def main() -> None:
@@ -70,7 +62,7 @@ def main() -> None:
         case.write_text(to_json(_plate_case(folder)))
         trees = {"now": ROOT}
         if args.before:
-            trees = {"before": _source_tree(args.before, folder / "before"), **trees}
+            trees = {"before": source_tree(args.before, folder / "before"), **trees}
         first = {tree: _run(path, case, folder / f"cache-{tree}") for tree, path in trees.items()}
         later: dict[str, list[float]] = {tree: [] for tree in trees}
         for _ in range(args.repeats):  # interleaved: a change of the machine's load hits every tree alike

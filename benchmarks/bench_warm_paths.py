@@ -314,7 +314,7 @@ def measure(trees: dict[str, Path], repeats: int, cold_repeats: int, folder: Pat
                    "imports": _imported(trees[name], caches[name], pycache, folder)} for name in trees}
 
 
-def _source_tree(revision: str, folder: Path) -> Path:
+def source_tree(revision: str, folder: Path) -> Path:
     """The files of git revision *revision* of this repository, unpacked into *folder*."""
     folder.mkdir()
     archive = subprocess.run(["git", "archive", revision], cwd=ROOT, check=True, capture_output=True).stdout
@@ -332,7 +332,7 @@ def main(argv=None):
     try:
         trees = {"now": ROOT}
         if args.before:
-            trees = {"before": _source_tree(args.before, folder / "before"), **trees}
+            trees = {"before": source_tree(args.before, folder / "before"), **trees}
         results = measure(trees, args.repeats, args.cold_repeats, folder)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
