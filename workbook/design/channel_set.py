@@ -134,7 +134,7 @@ class ChannelState:
             turned, modes = pose.turned, pose.shapes.shape[-1]
             own = force[:, pose.index]                                                   # (c, p, 3)
             bodies, rotations = pose.body_firsts.shape[1:3]
-            with_place = pose.summing @ (own[..., :, None] * pose.local[..., None, :]).reshape(count, -1, 9)
+            with_place = pose.summing @ (own[..., :, None] * pose.local[..., None, :]).reshape(count, len(pose.index), 9)
             out[:, pose.first_points, 3:turned] = \
                 (pose.body_firsts.reshape(count, bodies, rotations, 9) @ with_place[..., None])[..., 0]
             out[:, pose.index, turned:turned + modes] = (own[:, :, None, :] @ pose.rotation @ pose.shapes)[:, :, 0]
@@ -261,9 +261,9 @@ class ChannelSet:
             assert pose.body_seconds is not None, "the curvature needs the rotations' second derivatives"
             bodies, rotations = pose.body_firsts.shape[1:3]
             modes = pose.shapes.shape[-1]
-            force, summing = on_points[:, pose.index], pose.summing                   # (c, p, 3), (G, p)
-            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, -1, 9)
-            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, -1, 9 * modes)
+            force, summing, points = on_points[:, pose.index], pose.summing, len(pose.index)   # (c, p, 3), (G, p)
+            with_place = summing @ (force[..., :, None] * pose.local[..., None, :]).reshape(count, points, 9)
+            with_shape = summing @ (force[..., :, None, None] * pose.shapes[:, None]).reshape(count, points, 9 * modes)
             turning = pose.body_seconds.reshape(count, bodies, rotations * rotations, 9) @ with_place[..., None]
             mixed = pose.body_firsts.reshape(count, bodies, rotations, 9) @ with_shape.reshape(count, bodies, 9, modes)
             terms = np.concatenate([turning.reshape(count, bodies, rotations * rotations),
