@@ -170,6 +170,22 @@ def test_cli_exits_2_on_a_bad_record(record_file, capsys):
     assert "too short" in capsys.readouterr().err
 
 
+def test_a_record_saved_with_a_byte_order_mark_is_read_and_one_not_in_utf8_is_refused_by_line(record_file, tmp_path,
+                                                                                               capsys):
+    text = record_file.read_text()
+    marked = tmp_path / "marked.csv"
+    marked.write_text(text, encoding="utf-8-sig")  # as a spreadsheet saves "CSV UTF-8"
+    np.testing.assert_array_equal(read_record(marked).transducers["front-left"],
+                                  read_record(record_file).transducers["front-left"])
+    latin = tmp_path / "latin.csv"
+    latin.write_text(text.replace("# run:", "# bench: Prüfstand 3\n# run:"), encoding="latin-1")
+    with pytest.raises(RecordError, match=r"latin.csv, line 2: not UTF-8 text") as error:
+        read_record(latin)
+    assert error.value.line == 2
+    assert main(["rig", "measure", str(CASES / "reference.xlsx")]) == 2
+    assert "reference.xlsx, line 1: not UTF-8 text" in capsys.readouterr().err
+
+
 def _workbook_with_record(folder: Path, run_row: int, periods=50) -> Path:
     """The reference workbook with short rigid runs and a Test data row naming the committed record."""
     import shutil
