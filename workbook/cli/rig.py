@@ -42,6 +42,7 @@ from workbook.answers.results import ExcitationResult
 from workbook.answers.saving import save_csv
 from workbook.cli.loading import load_case
 from workbook.cli.outputs import check_output, write_output
+from workbook.cli.params import at_least_one
 from workbook.errors import UsageError
 from workbook.model.case import AnalysisSettings, Case
 
@@ -146,7 +147,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                                          "measured against simulated T")
     for sub in (measure, compare, plot):
         sub.add_argument("record", help="rig record: CSV, or UFF dataset 58 time histories (.uff, .unv)")
-        sub.add_argument("--periods", type=int, default=_DEFAULT_PERIODS,
+        sub.add_argument("--periods", type=at_least_one, default=_DEFAULT_PERIODS,
                          help=f"whole rotor periods per window (default {_DEFAULT_PERIODS})")
         sub.add_argument("--map", metavar="MAP.json",
                          help="channel map of a lab's CSV: channel -> sensor, direction, unit, sign (docs/rig-correlation.md)")
