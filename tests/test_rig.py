@@ -170,6 +170,28 @@ def test_cli_exits_2_on_a_bad_record(record_file, capsys):
     assert "too short" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(("args", "message"), [
+    (["synthesize", "out.csv", "--noise", "-0.01"], "argument --noise: expected a number >= 0, found '-0.01'"),
+    (["synthesize", "out.csv", "--duration", "0"], "argument --duration: expected a number > 0, found '0'"),
+    (["synthesize", "out.csv", "--rate", "nan"], "argument --rate: expected a number > 0, found 'nan'"),
+    (["frf", str(CASES / "reference-lp-rig.csv"), "--segment", "0"], "argument --segment: expected a number > 0"),
+    (["order", str(CASES / "reference-lp-rig.csv"), "--frame", "-1"], "argument --frame: expected a number > 0"),
+])
+def test_a_length_rate_or_noise_out_of_range_is_refused_before_any_work(args, message, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as stopped:
+        main(["rig", *args])
+    assert stopped.value.code == 2 and message in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_synthesize_refuses_a_sample_rate_its_record_could_not_be_measured_at(tmp_path, capsys):
+    assert main(["rig", "synthesize", str(tmp_path / "slow.csv"), "--rigid", "--rate", "500"]) == 2
+    assert ("--rate 500: 8.47 samples per period of 'LP rotor' at 59 Hz; a record needs at least 10 (a rate of "
+            "590 Hz or more)") in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_record_saved_with_a_byte_order_mark_is_read_and_one_not_in_utf8_is_refused_by_line(record_file, tmp_path,
                                                                                                capsys):
     text = record_file.read_text()
