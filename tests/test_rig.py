@@ -176,8 +176,10 @@ def test_cli_exits_2_on_a_bad_record(record_file, capsys):
     (["synthesize", "out.csv", "--rate", "nan"], "argument --rate: expected a number > 0, found 'nan'"),
     (["frf", str(CASES / "reference-lp-rig.csv"), "--segment", "0"], "argument --segment: expected a number > 0"),
     (["order", str(CASES / "reference-lp-rig.csv"), "--frame", "-1"], "argument --frame: expected a number > 0"),
+    (["modes", "--record", str(CASES / "reference-lp-rig.csv"), "--upper", "-1"],
+     "argument --upper: expected a number > 0, found '-1'"),
 ])
-def test_a_length_rate_or_noise_out_of_range_is_refused_before_any_work(args, message, tmp_path, monkeypatch, capsys):
+def test_a_number_out_of_range_is_refused_before_any_work(args, message, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(SystemExit) as stopped:
         main(["rig", *args])

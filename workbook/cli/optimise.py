@@ -24,6 +24,7 @@ import os
 from typing import TYPE_CHECKING, Callable
 
 from workbook.cli.loading import is_workbook, load_case
+from workbook.cli.outputs import output_folder
 from workbook.cli.params import at_least_one, parse_ranges
 from workbook.design.bands import BAND_POINTS, band_text
 from workbook.design.section_search import SECTION, SECTION_STEP
@@ -73,7 +74,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                              "worst/EXCITATION, displacement, sag or rotation)")
     parser.add_argument("--population", type=at_least_one, default=50, help="--pareto: designs per generation (default 50)")
     parser.add_argument("--generations", type=at_least_one, default=20, help="--pareto: generations (default 20)")
-    parser.add_argument("--output", metavar="DIR", help="write the optimised case, the table, history and plot here")
+    parser.add_argument("--output", type=output_folder, metavar="DIR", help="write the optimised case, the table, history and plot here")
     parser.add_argument("--json", action="store_true", help="print the table and the starts as JSON")
     return run
 

@@ -279,7 +279,7 @@ def _correlation_arguments(modes) -> None:
     modal.add_argument("--map", metavar="MAP.json", help="channel map of the record (a lab's CSV)")
     modal.add_argument("--segment", type=positive, default=1.0, help="Welch segment of the record's H1, s (1)")
     modal.add_argument("--rigid", action="store_true", help="make every link rigid")
-    modal.add_argument("--upper", type=float, default=None,
+    modal.add_argument("--upper", type=positive, default=None,
                        help="highest frequency, Hz (default: 1.5 x the highest test mode)")
     modal.add_argument("--output", metavar="MAC.png", help="plot the MAC matrix (test modes with shapes)")
     modal.add_argument("--csv", metavar="OUT.csv", help="also write the pairing table")
