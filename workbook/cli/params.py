@@ -250,10 +250,12 @@ def run_parameter_study(args) -> int:
     matplotlib.use("Agg")
 
     from workbook.studies.parallel import NUMPY_PATH
+    from workbook.studies.parametric import check_parameters
     from workbook.studies.sensitivity import StudyTable, new_study_table, read_finished, table_path, write_study
 
     rows = parse_vary(args.vary, args.lhs, args.seed)
     case = load_case(args.case, run=args.run, rigid=args.rigid)
+    check_parameters(case, rows[0])
     path = table_path(args.output, args.format) if args.resume else new_study_table(args.output, args.format)
     finished = read_finished(path, rows) if args.resume else {}
     table = StudyTable(path, rows, finished)
