@@ -166,6 +166,18 @@ def test_cache_command_lists_verifies_and_clears(tmp_path, capsys):
     assert load_reduced_body(path).input_hash == link.input_hash
 
 
+@pytest.mark.parametrize("action", ["info", "verify", "clear"])
+def test_cache_command_refuses_a_folder_that_is_a_file_and_names_a_missing_one(tmp_path, capsys, action):
+    not_a_folder = tmp_path / "cache.txt"
+    not_a_folder.write_text("a file, not a folder")
+    assert main(["cache", action, "--folder", str(not_a_folder)]) == 2
+    assert f"--folder {not_a_folder}: a file; expected the cache folder" in capsys.readouterr().err
+    assert not_a_folder.read_text() == "a file, not a folder"
+    assert main(["cache", action, "--folder", str(tmp_path / "nowhere")]) == 0
+    assert f"{tmp_path / 'nowhere'}: no such folder, nothing stored" in capsys.readouterr().out
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cache.txt"]
+
+
 def test_cache_command_lists_checks_and_clears_the_geometric_stiffness_files(tmp_path, capsys):
     """The links' geometric stiffness files beside the reduced bodies are the store's too: listed, an
     unreadable one named by verify, every one (and a temporary file a killed writer left) removed by

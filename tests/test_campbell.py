@@ -85,6 +85,10 @@ def test_the_command_writes_its_files_and_refuses_bad_options(tmp_path, capsys):
         assert main(["campbell", str(path), "--points", "3", *bad]) == EXIT_BAD_INPUT
         assert words in capsys.readouterr().err
     assert not (tmp_path / "c.pdf").exists()
+    with pytest.raises(SystemExit) as stopped:
+        main(["campbell", str(path), "--up-to", "-3"])
+    assert stopped.value.code == EXIT_BAD_INPUT
+    assert "argument --up-to: expected a number > 0, found '-3'" in capsys.readouterr().err
     table.write_text("a table of the user's")              # an existing file of the output's name is kept
     assert main(["campbell", str(path), "--to", "1000", "--points", "3", "--csv", str(table)]) == 0
     assert table.read_text() == "a table of the user's"

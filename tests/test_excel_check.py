@@ -414,6 +414,10 @@ BAD_INPUTS = {
                                   ["sheet 'Links'", "cell AP3", "column 'modal damping'", "found 1", "< 1"]),
     "unknown time-domain start": (_edit({("Case", "start", 3): "sometimes"}),
                                   ["sheet 'Case'", "column 'start'", "sometimes", "steady"]),
+    "negative element size": (_edit({("Links", "element size", 4): -1}),
+                              ["sheet 'Links'", "cell R4", "column 'element size'", "found -1", "a mesh size > 0"]),
+    "zero element size": (_edit({("Links", "element size", 3): 0}),
+                          ["sheet 'Links'", "cell R3", "column 'element size'", "found 0", "a mesh size > 0"]),
 }
 
 

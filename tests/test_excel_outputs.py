@@ -282,6 +282,26 @@ def test_a_second_study_keeps_the_first(folder, capsys):
     assert str(output / "parameter-study-2.csv") in capsys.readouterr().out
 
 
+@pytest.mark.parametrize("argv", [
+    ["study", "accuracy", "--output", "{file}"],
+    ["study", "params", "--vary", "hinge_stiffness=1e7,2e7", "--output", "{file}"],
+    ["study", "uq", "--param", "hinge_stiffness=uniform:1e7:2e7", "--output", "{file}"],
+    ["update", "--record", "rig.csv", "--vary", "hinge_stiffness/front=1e7:5e7", "--output", "{file}"],
+    ["optimise", "--vary", "hinge_stiffness/all=1e7:5e7", "--output", "{file}"],
+    ["links", "--export", "{file}"],
+    ["stress", "--vtu", "{file}"],
+    ["stress", "--png", "{file}"],
+], ids=lambda argv: " ".join(argv[:2]))
+def test_an_output_folder_that_is_a_file_is_refused_before_anything_runs(folder, capsys, argv):
+    notes = folder / "notes.txt"
+    notes.write_text("the user's notes\n")
+    with pytest.raises(SystemExit) as stopped:
+        main([str(notes) if arg == "{file}" else arg for arg in argv])
+    assert stopped.value.code == EXIT_BAD_INPUT
+    assert f"argument {argv[-2]}: {notes} is a file; expected a folder" in capsys.readouterr().err
+    assert notes.read_text() == "the user's notes\n" and _names(folder) == ["notes.txt"]
+
+
 def test_workbook_options_are_refused_for_a_json_case(folder, capsys):
     case = _json_case(folder)
     assert main(["run", str(case), "--report", str(folder / "R.xlsx"), "--run", "LP rotor"]) == EXIT_BAD_INPUT

@@ -295,6 +295,14 @@ def test_unknown_run_name_is_bad_input(cheap, capsys):
     assert sha256(cheap) == digest
 
 
+@pytest.mark.parametrize("option", [["--time-budget", "0"], ["--time-budget", "-5"], ["--rigid"]])
+def test_an_option_of_json_cases_is_refused_for_a_workbook(cheap, capsys, option):
+    digest = sha256(cheap)
+    assert main(["run", str(cheap), "--no-progress", "--run", "LP rotor", *option]) == 2
+    assert "--json, --rigid, --method and --time-budget are for JSON cases" in capsys.readouterr().err
+    assert sha256(cheap) == digest
+
+
 def test_report_never_replaces_the_case(cheap, tmp_path, capsys):
     path = tmp_path / "case.xlsx"
     shutil.copyfile(cheap, path)

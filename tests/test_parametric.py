@@ -162,6 +162,23 @@ def test_a_section_too_wide_for_the_eyes_is_a_case_error_of_its_row(base):
     assert isinstance(cases[1], CaseError) and "shank width" in str(cases[1])
 
 
+@pytest.mark.parametrize(("option", "message"), [
+    ("--vary=hinge_damping/middle=1,2", "field 'hinge_damping/middle': found 'middle', expected the start of hinge names"),
+    ("--vary=transducer_stiffness=1e8,2e8", "field 'transducer_stiffness': found 'reference mount', expected a case "
+                                            "with test-rig force transducers"),
+    ("--vary=casing_modulus=1e11,2e11", "expected a case with a flexible engine casing"),
+    ("--param=transducer_stiffness=uniform:1e8:2e8", "expected a case with test-rig force transducers"),
+])
+def test_a_parameter_no_row_of_the_case_can_take_is_refused_before_any_row(base, tmp_path, capsys, option, message):
+    case_file = tmp_path / "case.json"
+    case_file.write_text(to_json(base))
+    kind = "params" if option.startswith("--vary") else "uq"
+    argv = ["study", kind, str(case_file), "--output", str(tmp_path / "out"), "--workers", "1", option]
+    assert main(argv) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_long_study_prints_the_ends_of_its_table_and_writes_every_row(base, tmp_path, capsys):
     """70 rows on the fast path: the table printed is its first and last 30 rows with a line saying where the
     rest is; the table file holds every row, and the rows answered in NumPy equal the batch's own answers."""

@@ -170,6 +170,46 @@ def test_cli_exits_2_on_a_bad_record(record_file, capsys):
     assert "too short" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(("args", "message"), [
+    (["synthesize", "out.csv", "--noise", "-0.01"], "argument --noise: expected a number >= 0, found '-0.01'"),
+    (["synthesize", "out.csv", "--duration", "0"], "argument --duration: expected a number > 0, found '0'"),
+    (["synthesize", "out.csv", "--rate", "nan"], "argument --rate: expected a number > 0, found 'nan'"),
+    (["frf", str(CASES / "reference-lp-rig.csv"), "--segment", "0"], "argument --segment: expected a number > 0"),
+    (["order", str(CASES / "reference-lp-rig.csv"), "--frame", "-1"], "argument --frame: expected a number > 0"),
+    (["modes", "--record", str(CASES / "reference-lp-rig.csv"), "--upper", "-1"],
+     "argument --upper: expected a number > 0, found '-1'"),
+])
+def test_a_number_out_of_range_is_refused_before_any_work(args, message, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as stopped:
+        main(["rig", *args])
+    assert stopped.value.code == 2 and message in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_synthesize_refuses_a_sample_rate_its_record_could_not_be_measured_at(tmp_path, capsys):
+    assert main(["rig", "synthesize", str(tmp_path / "slow.csv"), "--rigid", "--rate", "500"]) == 2
+    assert ("--rate 500: 8.47 samples per period of 'LP rotor' at 59 Hz; a record needs at least 10 (a rate of "
+            "590 Hz or more)") in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_record_saved_with_a_byte_order_mark_is_read_and_one_not_in_utf8_is_refused_by_line(record_file, tmp_path,
+                                                                                               capsys):
+    text = record_file.read_text()
+    marked = tmp_path / "marked.csv"
+    marked.write_text(text, encoding="utf-8-sig")  # as a spreadsheet saves "CSV UTF-8"
+    np.testing.assert_array_equal(read_record(marked).transducers["front-left"],
+                                  read_record(record_file).transducers["front-left"])
+    latin = tmp_path / "latin.csv"
+    latin.write_text(text.replace("# run:", "# bench: Prüfstand 3\n# run:"), encoding="latin-1")
+    with pytest.raises(RecordError, match=r"latin.csv, line 2: not UTF-8 text") as error:
+        read_record(latin)
+    assert error.value.line == 2
+    assert main(["rig", "measure", str(CASES / "reference.xlsx")]) == 2
+    assert "reference.xlsx, line 1: not UTF-8 text" in capsys.readouterr().err
+
+
 def _workbook_with_record(folder: Path, run_row: int, periods=50) -> Path:
     """The reference workbook with short rigid runs and a Test data row naming the committed record."""
     import shutil

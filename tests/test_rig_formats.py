@@ -195,6 +195,20 @@ def test_a_wrong_channel_map_is_refused_naming_the_channel(tmp_path, changes, cs
         read_mapped_record(*_lab_files(tmp_path, csv_text, **changes))
 
 
+def test_a_lab_csv_or_map_not_in_utf8_is_refused_naming_the_file(tmp_path):
+    from workbook.rig.channel_map import read_mapped_record
+
+    record, channel_map = _lab_files(tmp_path)
+    record.write_text(LAB_CSV.replace("bench 3", "Prüfstand 3"), encoding="cp1252")
+    with pytest.raises(RecordError, match=r"lab.csv, line 1: not UTF-8 text"):
+        read_mapped_record(record, channel_map)
+    record.write_text(LAB_CSV, encoding="utf-8-sig")
+    assert read_mapped_record(record, channel_map).run == "LP rotor"
+    channel_map.write_text(channel_map.read_text().replace("LP rotor", "LP-Rotor µ"), encoding="cp1252")
+    with pytest.raises(RecordError, match=r"map.json, line 1: not UTF-8 text"):
+        read_mapped_record(record, channel_map)
+
+
 def test_rig_measure_reads_the_committed_record_as_a_lab_writes_it(tmp_path, capsys):
     """The committed record renamed as the seed study's lab names its channels, in kN with the rear y reversed."""
     import json

@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -227,6 +228,16 @@ def test_pairing_recovers_the_case_modes_from_a_perturbed_shuffled_test_set(refe
     # without shapes, by frequency: right where the perturbation keeps the order
     by_frequency = pair_modes(dataclasses.replace(test, shapes=None), frequencies)
     assert len(by_frequency.pairs) == 6 and by_frequency.mac is None
+
+
+@pytest.mark.parametrize(("band", "message"), [
+    (["200", "10"], "--band 200 10: expected LOW < HIGH"),
+    (["2000", "3000"], "--band 2000 3000: no frequency of the H1 in it; it has 1 to 1024 Hz"),
+])
+def test_rig_frf_refuses_a_band_without_frequencies(band, message, capsys):
+    record = Path(__file__).resolve().parents[1] / "cases" / "reference-lp-rig.csv"
+    assert main(["rig", "frf", str(record), "--band", *band]) == 2
+    assert message in capsys.readouterr().err
 
 
 def test_rig_frf_and_modes_commands(reference_modes, tmp_path, capsys):

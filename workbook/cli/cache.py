@@ -1,7 +1,8 @@
 """``mountwb cache {info,verify,clear} [--folder DIR]``: the store of reduced bodies (links, casing, mesh pylon)
 and of the links' geometric stiffness.
 
-``info`` lists the folder, its entries and their size; ``verify`` checks
+``info`` lists the folder, its entries and their size (a folder that does
+not exist holds nothing; a file of its name is a usage error); ``verify`` checks
 every entry's key and checksum and names each corrupt one (exit 1 when
 there is one; a run would recompute and replace it anyway); ``clear``
 removes every entry, lock file and temporary file of the store, and
@@ -11,6 +12,8 @@ from __future__ import annotations
 
 import argparse
 from typing import Callable
+
+from workbook.errors import UsageError
 
 __all__ = ["arguments"]
 
@@ -30,6 +33,12 @@ def cache(args) -> int:
     from flexbodies.cache import BodyCache
 
     store = BodyCache(args.folder)
+    if store.folder.exists() and not store.folder.is_dir():
+        named = f"--folder {store.folder}" if args.folder else f"{store.folder} ($MOUNTWB_CACHE)"
+        raise UsageError(f"{named}: a file; expected the cache folder")
+    if not store.folder.exists():
+        print(f"{store.folder}: no such folder, nothing stored")
+        return 0
     if args.action == "clear":
         print(f"{store.folder}: removed {store.clear()} file(s)")
         return 0

@@ -18,6 +18,7 @@ from typing import Callable
 
 from workbook.cli.loading import load_case
 from workbook.cli.outputs import check_output, write_output
+from workbook.cli.params import positive
 from workbook.errors import UsageError
 
 __all__ = ["arguments"]
@@ -33,7 +34,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="highest speed, rpm (default 1.25 x the rotor's speed in the case)")
     parser.add_argument("--points", type=int, default=200, help="speeds, evenly spaced (200)")
     parser.add_argument("--orders", default="1", metavar="1,2", help="engine orders drawn for every rotor (1)")
-    parser.add_argument("--up-to", dest="upper", type=float, metavar="HZ",
+    parser.add_argument("--up-to", dest="upper", type=positive, metavar="HZ",
                         help="highest frequency shown, Hz (default: the top of the highest order line)")
     parser.add_argument("--operating", metavar="LOW:HIGH", help="the rotor's operating range, rpm: shaded")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")

@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
-from workbook.cli.outputs import check_output, write_output
+from workbook.cli.outputs import check_output, output_folder, write_output
 from workbook.errors import UsageError
 
 __all__ = ["arguments"]
@@ -26,7 +26,7 @@ __all__ = ["arguments"]
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
     parser.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
-    parser.add_argument("--export", metavar="FOLDER",
+    parser.add_argument("--export", type=output_folder, metavar="FOLDER",
                         help="also write each reduced link in Exudyn's own format (FOLDER/<link>.npz; an existing "
                              "file is kept: a new name)")
     parser.add_argument("--verify", action="store_true",

@@ -24,6 +24,7 @@ import os
 from typing import TYPE_CHECKING, Callable
 
 from workbook.cli.loading import is_workbook, load_case
+from workbook.cli.outputs import output_folder
 from workbook.cli.params import at_least_one, parse_ranges
 from workbook.design.bands import BAND_POINTS, band_text
 from workbook.design.section_search import SECTION, SECTION_STEP
@@ -66,14 +67,14 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="processes the starts run in (default: every core); the result is the same as with 1")
     parser.add_argument("--section-step", type=float, default=SECTION_STEP, metavar="S",
                         help=f"section_scale: the largest step between the scales tried (default {SECTION_STEP:g})")
-    parser.add_argument("--iterations", type=int, default=ITERATIONS, metavar="N",
+    parser.add_argument("--iterations", type=at_least_one, default=ITERATIONS, metavar="N",
                         help=f"SLSQP iterations per start at most (default {ITERATIONS})")
     parser.add_argument("--pareto", nargs="?", const="worst,displacement", metavar="A,B",
                         help="also the NSGA-II front of two objectives (default worst,displacement; each worst, "
                              "worst/EXCITATION, displacement, sag or rotation)")
-    parser.add_argument("--population", type=int, default=50, help="--pareto: designs per generation (default 50)")
-    parser.add_argument("--generations", type=int, default=20, help="--pareto: generations (default 20)")
-    parser.add_argument("--output", metavar="DIR", help="write the optimised case, the table, history and plot here")
+    parser.add_argument("--population", type=at_least_one, default=50, help="--pareto: designs per generation (default 50)")
+    parser.add_argument("--generations", type=at_least_one, default=20, help="--pareto: generations (default 20)")
+    parser.add_argument("--output", type=output_folder, metavar="DIR", help="write the optimised case, the table, history and plot here")
     parser.add_argument("--json", action="store_true", help="print the table and the starts as JSON")
     return run
 

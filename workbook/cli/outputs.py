@@ -4,6 +4,9 @@
   ``--report OUT.xlsx``, ...) and may not be an input of the command (the
   case file, a rig record): :func:`check_output` refuses it before anything
   is computed (exit 2, nothing written).
+- An output folder (``--output DIR``, ``--export FOLDER``) may be new or an
+  existing folder, not a file: :func:`output_folder` refuses a file as
+  the command line is read.
 - An existing file is replaced only when this program wrote it and nobody
   changed it since (a signed workbook, :func:`~workbook.excel.files.untouched`);
   any other file of that name is kept and the new file goes to a new name
@@ -12,12 +15,13 @@
 """
 from __future__ import annotations
 
+import argparse
 from pathlib import Path
 from typing import Callable
 
 from workbook.errors import UsageError
 
-__all__ = ["check_output", "print_written", "write_output"]
+__all__ = ["check_output", "output_folder", "print_written", "write_output"]
 
 
 def check_output(option: str, path: str | None, suffixes: tuple[str, ...], inputs=()) -> None:
@@ -48,6 +52,14 @@ def check_output(option: str, path: str | None, suffixes: tuple[str, ...], input
     for source in inputs:
         if source is not None and Path(source).exists() and Path(path).exists() and Path(path).samefile(source):
             raise UsageError(f"{option} {path}: that is an input of this command ({source}); give a new file name")
+
+
+def output_folder(text: str) -> str:
+    """An option's output folder, new or existing, or argparse's usage error when a file has that name."""
+    if Path(text).exists() and not Path(text).is_dir():
+        raise argparse.ArgumentTypeError(f"{text} is a file; expected a folder for the files written (a new "
+                                         "name makes one)")
+    return text
 
 
 def print_written(named, what: str, target, reason: str | None) -> None:

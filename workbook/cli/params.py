@@ -28,6 +28,7 @@ hold. A study whose rows all ran but some failed exits with
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import sys
 
@@ -60,6 +61,26 @@ def at_least_one(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 1, found {text!r}") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number >= 1, found {value}")
+    return value
+
+
+def positive(text: str) -> float:
+    """An option's number > 0 (a length of time, a rate), or argparse's usage error naming what was found."""
+    return _bounded(text, strict=True)
+
+
+def not_negative(text: str) -> float:
+    """An option's number >= 0 (a noise level), or argparse's usage error naming what was found."""
+    return _bounded(text, strict=False)
+
+
+def _bounded(text: str, strict: bool) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < 0 or (strict and value == 0):
+        raise argparse.ArgumentTypeError(f"expected a number {'>' if strict else '>='} 0, found {text!r}")
     return value
 
 
@@ -229,10 +250,12 @@ def run_parameter_study(args) -> int:
     matplotlib.use("Agg")
 
     from workbook.studies.parallel import NUMPY_PATH
+    from workbook.studies.parametric import check_parameters
     from workbook.studies.sensitivity import StudyTable, new_study_table, read_finished, table_path, write_study
 
     rows = parse_vary(args.vary, args.lhs, args.seed)
     case = load_case(args.case, run=args.run, rigid=args.rigid)
+    check_parameters(case, rows[0])
     path = table_path(args.output, args.format) if args.resume else new_study_table(args.output, args.format)
     finished = read_finished(path, rows) if args.resume else {}
     table = StudyTable(path, rows, finished)

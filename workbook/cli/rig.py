@@ -42,6 +42,7 @@ from workbook.answers.results import ExcitationResult
 from workbook.answers.saving import save_csv
 from workbook.cli.loading import load_case
 from workbook.cli.outputs import check_output, write_output
+from workbook.cli.params import at_least_one, not_negative, positive
 from workbook.errors import UsageError
 from workbook.model.case import AnalysisSettings, Case
 
@@ -146,7 +147,7 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                                          "measured against simulated T")
     for sub in (measure, compare, plot):
         sub.add_argument("record", help="rig record: CSV, or UFF dataset 58 time histories (.uff, .unv)")
-        sub.add_argument("--periods", type=int, default=_DEFAULT_PERIODS,
+        sub.add_argument("--periods", type=at_least_one, default=_DEFAULT_PERIODS,
                          help=f"whole rotor periods per window (default {_DEFAULT_PERIODS})")
         sub.add_argument("--map", metavar="MAP.json",
                          help="channel map of a lab's CSV: channel -> sensor, direction, unit, sign (docs/rig-correlation.md)")
@@ -165,13 +166,13 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     synthesize.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     synthesize.add_argument("--run", default="LP rotor", help="excitation to simulate (default 'LP rotor')")
     synthesize.add_argument("--rigid", action="store_true", help="make every link rigid")
-    synthesize.add_argument("--noise", type=float, default=0.005, help="noise / transducer amplitude (0.005)")
+    synthesize.add_argument("--noise", type=not_negative, default=0.005, help="noise / transducer amplitude (0.005)")
     synthesize.add_argument("--drift", type=float, default=0.002, help="relative speed drift (0.002)")
     synthesize.add_argument("--seed", type=int, default=0, help="noise seed (0)")
-    synthesize.add_argument("--rate", type=float, default=None,
+    synthesize.add_argument("--rate", type=positive, default=None,
                             help="sample rate, Hz (default: the power of two that samples the case's highest rotor "
                                  "frequency at least 12.5 times a period; 4096 for the reference mount)")
-    synthesize.add_argument("--duration", type=float, default=4.0, help="record length, s (4)")
+    synthesize.add_argument("--duration", type=positive, default=4.0, help="record length, s (4)")
 
     _correlation_arguments(modes)
 
@@ -226,19 +227,25 @@ def _plot(args, record: RigRecord, table) -> int:
 
 
 def _synthesize(args) -> int:
+    from workbook.rig.correlation import MIN_SAMPLES_PER_PERIOD
     from workbook.rig.records import write_record
     from workbook.rig.synthetic import REFERENCE_TRANSDUCERS, default_sample_rate, synthetic_record
     from workbook.rig.uff import UFF_SUFFIXES
 
     check_output("output", args.output, (".csv", *UFF_SUFFIXES), [args.case])
     case = load_case(args.case, rigid=args.rigid)
+    # a record of any run of the case can be compared (MIN_SAMPLES_PER_PERIOD at its highest frequency)
+    rate = args.rate if args.rate is not None else default_sample_rate(e.frequency_hz for e in case.single_frequency_excitations())
+    frequency = _excitation(case, args.run).frequency_hz
+    if rate < MIN_SAMPLES_PER_PERIOD * frequency:
+        raise UsageError(f"--rate {rate:g}: {rate / frequency:.3g} samples per period of {args.run!r} at "
+                         f"{frequency:g} Hz; a record needs at least {MIN_SAMPLES_PER_PERIOD} (a rate of "
+                         f"{MIN_SAMPLES_PER_PERIOD * frequency:g} Hz or more)")
     result = simulate_run(case, args.run, histories=True)
     pylon = sorted(h.name for h in case.pylon_hinges)
     reference = sorted(h for hinges in REFERENCE_TRANSDUCERS.values() for h in hinges)
     # the seed study's rig on the reference mount, else one transducer per pylon-side hinge
     transducers = REFERENCE_TRANSDUCERS if pylon == reference else {name: (name,) for name in pylon}
-    # a record of any run of the case can be compared (MIN_SAMPLES_PER_PERIOD at its highest frequency)
-    rate = args.rate if args.rate is not None else default_sample_rate(e.frequency_hz for e in case.single_frequency_excitations())
     record = synthetic_record(result, transducers, sample_rate_hz=rate, duration=args.duration,
                               noise=args.noise, drift=args.drift, seed=args.seed)
     write_output(args.output, "rig record", "rig", lambda target: write_record(target, record))
@@ -260,19 +267,19 @@ def _correlation_arguments(modes) -> None:
         sub.add_argument("--points", type=int, default=40, help="frequencies of the simulated sweep (40)")
         sub.add_argument("--output", metavar="OUT.png", help="also plot T (and coherence) to this PNG")
         sub.add_argument("--json", action="store_true", help="print the curves as JSON")
-    frf.add_argument("--segment", type=float, default=1.0, help="Welch segment, s: resolution 1/S Hz (1)")
+    frf.add_argument("--segment", type=positive, default=1.0, help="Welch segment, s: resolution 1/S Hz (1)")
     frf.add_argument("--band", type=float, nargs=2, metavar=("LOW", "HIGH"),
                      help="frequencies shown, Hz (default: 1/S up to 0.4 x the sample rate)")
-    order.add_argument("--frame", type=float, default=1.0, help="frame length, s (1); frames overlap by half")
+    order.add_argument("--frame", type=positive, default=1.0, help="frame length, s (1); frames overlap by half")
     modal = modes.add_parser("modes", help="the case's mounted modes against test modes: frequency errors and MAC")
     modal.add_argument("case", nargs="?", help="case file (JSON or .xlsx workbook); default: the reference mount")
     source = modal.add_mutually_exclusive_group(required=True)
     source.add_argument("--test", metavar="MODES.uff", help="test modes: UFF datasets 55 and 15 (node coordinates, m)")
     source.add_argument("--record", metavar="RECORD", help="identify test modes by peak picking on a record's H1")
     modal.add_argument("--map", metavar="MAP.json", help="channel map of the record (a lab's CSV)")
-    modal.add_argument("--segment", type=float, default=1.0, help="Welch segment of the record's H1, s (1)")
+    modal.add_argument("--segment", type=positive, default=1.0, help="Welch segment of the record's H1, s (1)")
     modal.add_argument("--rigid", action="store_true", help="make every link rigid")
-    modal.add_argument("--upper", type=float, default=None,
+    modal.add_argument("--upper", type=positive, default=None,
                        help="highest frequency, Hz (default: 1.5 x the highest test mode)")
     modal.add_argument("--output", metavar="MAC.png", help="plot the MAC matrix (test modes with shapes)")
     modal.add_argument("--csv", metavar="OUT.csv", help="also write the pairing table")
@@ -306,7 +313,12 @@ def _frf_or_order(args) -> int:
     if args.mode == "frf":
         answer = frfs.record_frf(record, args.segment)
         low, high = args.band if args.band else (1.0 / answer.segment_s, 0.4 * record.sample_rate_hz)
+        if low >= high:
+            raise UsageError(f"--band {low:g} {high:g}: expected LOW < HIGH, Hz")
         shown = answer.band(low, high)
+        if not shown.any():
+            raise UsageError(f"--band {low:g} {high:g}: no frequency of the H1 in it; it has "
+                             f"{answer.frequencies_hz[1]:g} to {answer.frequencies_hz[-1]:g} Hz")
         frequencies, measured = answer.frequencies_hz[shown], answer.transmissibility[shown]
     else:
         track = frfs.order_track(record, args.frame)

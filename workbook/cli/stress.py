@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
-from workbook.errors import UsageError
+from workbook.cli.outputs import output_folder
 
 __all__ = ["arguments", "print_bore_convergence", "print_bore_fatigue", "print_fatigue_factors"]
 
@@ -31,8 +31,8 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
     from workbook.cli.loads import add_load_case_arguments
 
     add_load_case_arguments(parser)
-    parser.add_argument("--vtu", metavar="DIR", help="write each link's mesh with its stress fields as DIR/<link>.vtu")
-    parser.add_argument("--png", metavar="DIR", help="draw each link's stress fields on its shape as DIR/<link>.png")
+    parser.add_argument("--vtu", type=output_folder, metavar="DIR", help="write each link's mesh with its stress fields as DIR/<link>.vtu")
+    parser.add_argument("--png", type=output_folder, metavar="DIR", help="draw each link's stress fields on its shape as DIR/<link>.png")
     return run
 
 
@@ -43,10 +43,6 @@ def run(args) -> int:
     from workbook.solve.fatigue import solve_fatigue
     from workbook.solve.load_cases import solve_load_cases
 
-    for option, folder in (("--vtu", args.vtu), ("--png", args.png)):
-        if folder and Path(folder).exists() and not Path(folder).is_dir():
-            raise UsageError(f"{option} {folder}: a file of that name is there; give a folder for the "
-                             "files, one per link")
     case = load_case(args.case, run=args.run)
     chosen = chosen_load_cases(case, args.load_case)
     fatigue = solve_fatigue(case)

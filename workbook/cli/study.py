@@ -18,6 +18,7 @@ from typing import Callable
 
 from workbook.cli import params, uq
 from workbook.cli.loading import load_case
+from workbook.cli.outputs import output_folder
 from workbook.errors import UsageError
 
 __all__ = ["arguments"]
@@ -26,7 +27,7 @@ __all__ = ["arguments"]
 def _case_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", nargs="?", help="case workbook (.xlsx) or JSON case; default: the reference mount")
     parser.add_argument("--run", metavar="R", help="case workbook: study this row of the Runs sheet")
-    parser.add_argument("--output", default=".", metavar="DIR",
+    parser.add_argument("--output", type=output_folder, default=".", metavar="DIR",
                         help="folder for the files written (existing files are kept: new names)")
 
 

@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import Callable
 
 from workbook.cli.loading import load_case
-from workbook.cli.params import parse_ranges
+from workbook.cli.outputs import output_folder
+from workbook.cli.params import at_least_one, parse_ranges
 from workbook.errors import UnwritableCase
 
 __all__ = ["arguments"]
@@ -43,9 +44,9 @@ def arguments(parser: argparse.ArgumentParser) -> Callable:
                         help="a parameter to fit within bounds (SI units; repeatable), e.g. "
                              "hinge_stiffness/front=1e7:5e7 or transducer_stiffness=1e7:1e9")
     parser.add_argument("--rigid", action="store_true", help="make every link rigid")
-    parser.add_argument("--periods", type=int, default=None,
+    parser.add_argument("--periods", type=at_least_one, default=None,
                         help="whole rotor periods per measured window (default: the case's)")
-    parser.add_argument("--output", metavar="DIR", help="write the updated case, the tables and the plot in DIR")
+    parser.add_argument("--output", type=output_folder, metavar="DIR", help="write the updated case, the tables and the plot in DIR")
     parser.add_argument("--json", action="store_true", help="print the fit as JSON (SI units) instead of tables")
     return run
 

@@ -80,6 +80,7 @@ def run_uq_study(args) -> int:
 
     matplotlib.use("Agg")
 
+    from workbook.studies.parametric import check_parameters
     from workbook.studies.sensitivity import StudyTable, new_study_table
     from workbook.studies.uncertainty import UQ_STEM, UncertaintyResult, sample_rows
 
@@ -89,6 +90,7 @@ def run_uq_study(args) -> int:
     except InputError as error:
         raise UsageError(f"--samples {args.samples}: {error}") from None
     case = load_case(args.case, run=args.run, rigid=args.rigid)
+    check_parameters(case, distributions)
     table = StudyTable(new_study_table(args.output, args.format, UQ_STEM), rows)
     where = f"Dask scheduler {args.dask}" if args.dask else f"{args.workers} local process(es)"
     print(f"{case.name}: {len(rows)} uncertainty rows on {where}", file=sys.stderr)

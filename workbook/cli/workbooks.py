@@ -145,8 +145,8 @@ def run_workbook(args) -> int:
     from workbook.excel.pictures import start_pictures
     from workbook.excel.reader import read_workbook
 
-    if getattr(args, "json", False) or getattr(args, "rigid", False) or getattr(args, "time_budget", None) \
-            or getattr(args, "method", None):
+    if getattr(args, "json", False) or getattr(args, "rigid", False) \
+            or getattr(args, "time_budget", None) is not None or getattr(args, "method", None):
         print("mountwb run: --json, --rigid, --method and --time-budget are for JSON cases; a workbook sets its "
               "runs' fidelity in its Runs sheet and its method and time budget in its Case sheet", file=sys.stderr)
         return EXIT_BAD_INPUT

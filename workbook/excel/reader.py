@@ -223,7 +223,12 @@ class _CaseReader(SheetReader):
         material = self.material(record)
         if material is None:
             return None
-        common = dict(material=material, element_size=record.get("element_size"),
+        element_size = record.get("element_size")
+        if element_size is not None and not element_size > 0:
+            self.record_problem(record, ("element_size",), record.typed(("element_size",), element_size),
+                                "a mesh size > 0 (empty: the default)")
+            return None
+        common = dict(material=material, element_size=element_size,
                       interface=record.get("interface", "RBE2"))
         if record.get("mesh_file") is not None:
             mesh = self.mesh(record)

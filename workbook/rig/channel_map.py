@@ -39,7 +39,7 @@ import numpy as np
 from workbook.errors import RecordError, UnitProblem
 from workbook.model.case import DIRECTIONS
 from workbook.model.units import si_factor
-from workbook.rig.records import EXCITATION_CHANNEL, RigRecord, check_sampling, table_values
+from workbook.rig.records import EXCITATION_CHANNEL, RigRecord, check_sampling, record_text, table_values
 
 __all__ = ["read_mapped_record", "read_channel_map", "ChannelMap"]
 
@@ -89,16 +89,14 @@ def read_channel_map(path: str | Path) -> ChannelMap:
     Raises
     ------
     RecordError
-        Not JSON, an unknown or missing entry, a channel with an unknown
+        Not UTF-8 text or not JSON, an unknown or missing entry, a channel with an unknown
         sensor, direction, sign or a unit that is not a force, a direction
         of a sensor twice or missing, or a transducer without channels;
         naming the channel or sensor.
     """
     path = Path(path)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise RecordError(path, f"cannot read: {error.strerror}") from None
+        data = json.loads(record_text(path))
     except json.JSONDecodeError as error:
         raise RecordError(path, f"not JSON: {error.msg}", line=error.lineno) from None
     if not isinstance(data, dict) or set(data) - _KEYS:
@@ -172,10 +170,7 @@ def read_mapped_record(path: str | Path, channel_map: str | Path | ChannelMap) -
     """
     mapping = channel_map if isinstance(channel_map, ChannelMap) else read_channel_map(channel_map)
     path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8-sig").splitlines()
-    except OSError as error:
-        raise RecordError(path, f"cannot read: {error.strerror}") from None
+    lines = record_text(path).splitlines()
     start = next((number for number, text in enumerate(lines, start=1) if text.strip() and not text.startswith("#")),
                  None)
     if start is None:

@@ -33,7 +33,7 @@ from workbook.answers.saving import save_text
 from workbook.errors import RecordError
 from workbook.model.case import DIRECTIONS, TRANSDUCER_PREFIX
 
-__all__ = ["RigRecord", "read_record", "write_record", "parse_header_line", "table_values",
+__all__ = ["RigRecord", "read_record", "record_text", "write_record", "parse_header_line", "table_values",
            "check_sampling", "EXCITATION_CHANNEL",
            "SAMPLE_RATE_TOLERANCE"]
 
@@ -120,7 +120,7 @@ def read_record(path: str | Path) -> RigRecord:
     Raises
     ------
     RecordError
-        Missing or bad header line, unknown unit, missing channel, a cell
+        A file that is not UTF-8 text, missing or bad header line, unknown unit, missing channel, a cell
         that is not a number, time not uniformly sampled, or a sampled rate
         that differs from the stated one.
     """
@@ -129,10 +129,7 @@ def read_record(path: str | Path) -> RigRecord:
 
     if path.suffix.lower() in UFF_SUFFIXES:
         return read_uff_record(path)
-    try:
-        lines = path.read_text().splitlines()
-    except OSError as error:
-        raise RecordError(path, f"cannot read: {error.strerror}") from None
+    lines = record_text(path).splitlines()
     header, hinges, table_start = _read_header(path, lines)
     nominal = _header_number(path, header, "nominal frequency [Hz]")
     rate = _header_number(path, header, "sample rate [Hz]")
@@ -155,6 +152,26 @@ def read_record(path: str | Path) -> RigRecord:
     notes = {k: v for k, (v, _) in header.items() if k not in ("run", "nominal frequency [Hz]", "sample rate [Hz]")}
     excitation = channels.pop(EXCITATION_CHANNEL)
     return RigRecord(time, channels, excitation, hinges, rate, nominal, header["run"][0], str(path), notes)
+
+
+def record_text(path: Path) -> str:
+    """The text of the rig record or channel map at *path*: UTF-8, a byte-order mark (as a
+    spreadsheet saves "CSV UTF-8") dropped.
+
+    Raises
+    ------
+    RecordError
+        The file cannot be read, or is not UTF-8 text (naming the line).
+    """
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise RecordError(path, f"cannot read: {error.strerror}") from None
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        raise RecordError(path, f"not UTF-8 text (byte {data[error.start]:#04x}); save it as UTF-8 text "
+                          "(CSV UTF-8)", line=data.count(b"\n", 0, error.start) + 1) from None
 
 
 def _read_header(path, lines: list[str]) -> tuple[dict, dict, int]:

@@ -46,7 +46,7 @@ import numpy as np
 from workbook.errors import CaseError, InputError
 from workbook.model.case import Case, HarmonicForce, RotatingForce
 
-__all__ = ["Parameter", "PARAMETERS", "parameter", "parameter_value",
+__all__ = ["Parameter", "PARAMETERS", "parameter", "parameter_value", "check_parameters",
            "HINGE_DIRECTIONS", "grid", "linear_range", "latin_hypercube", "row_case", "study_cases",
            "MAX_STUDY_ROWS"]
 
@@ -117,10 +117,36 @@ def _hinge_values(case: Case, field_name: str, value: float, group: str, directi
     return dataclasses.replace(case, hinges=tuple(hinges))
 
 
+#: What a case needs for transducer_stiffness and casing_modulus to change.
+_NEEDS_RIG = "a case with test-rig force transducers"
+_NEEDS_CASING = "a case with a flexible engine casing (Engine.casing)"
+
+
+def check_parameters(case: Case, names) -> None:
+    """Refuse a parameter that no row of a study of *case* can take, whatever its value: a hinge group
+    without hinges, transducer_stiffness without a test rig, casing_modulus without a flexible casing.
+
+    Raises
+    ------
+    InputError
+        An unknown name (:func:`parameter`).
+    CaseError
+        Naming the parameter and what the case lacks.
+    """
+    for name in names:
+        parameter(name)
+        if name == "transducer_stiffness" and case.test_rig is None:
+            raise CaseError("study", name, case.name, _NEEDS_RIG)
+        if name == "casing_modulus" and case.engine.casing is None:
+            raise CaseError("study", name, case.name, _NEEDS_CASING)
+        if name not in PARAMETERS:
+            _group(case, _hinge_target(name)[1], name)
+
+
 def _casing_modulus(case: Case, modulus: float) -> Case:
     casing = case.engine.casing
     if casing is None:
-        raise CaseError("study", "casing_modulus", modulus, "a case with a flexible engine casing (Engine.casing)")
+        raise CaseError("study", "casing_modulus", modulus, _NEEDS_CASING)
     if not modulus > 0:
         raise CaseError("study", "casing_modulus", modulus, "a positive Young's modulus, Pa")
     material = dataclasses.replace(casing.material, youngs_modulus=float(modulus))
@@ -130,7 +156,7 @@ def _casing_modulus(case: Case, modulus: float) -> Case:
 
 def _transducers(case: Case, stiffness: float) -> Case:
     if case.test_rig is None:
-        raise CaseError("study", "transducer_stiffness", stiffness, "a case with test-rig force transducers")
+        raise CaseError("study", "transducer_stiffness", stiffness, _NEEDS_RIG)
     return dataclasses.replace(case, test_rig=dataclasses.replace(case.test_rig, stiffness=(float(stiffness),) * 3))
 
 
