@@ -159,6 +159,51 @@ def test_a_study_of_more_rows_than_its_workers_chunk_finishes(tmp_path):
     assert len(set(t_z)) == 9        # every row ran with its own stiffness
 
 
+#: Rows of a script read from standard input (``python -``), whose main module a spawned worker cannot import.
+_FROM_STDIN = textwrap.dedent("""
+    import dataclasses, json, sys
+    from workbook.model.reference import LP_ROTOR, reference_case
+    from workbook.studies.parallel import _run_processes, run_rows
+    from workbook.studies.parametric import grid, linear_range, study_cases
+
+    case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+    cases = study_cases(case, grid({"hinge_stiffness": linear_range(1e7, 3e7, 3)}))
+    if sys.argv[1] == "run_rows":
+        outcomes = run_rows(cases, workers=2)
+    else:                                  # the pool itself, as it would start its workers
+        outcomes = []
+        _run_processes(dict(enumerate(cases)), 2, outcomes.append, 2, None)
+    print(json.dumps([[o.index, o.status, o.error, o.runs[0]["T z"] if o.runs else None] for o in outcomes]))
+""")
+
+
+@pytest.mark.slow
+def test_a_study_from_standard_input_runs_its_rows_here_and_a_pool_that_cannot_start_ends(tmp_path):
+    """``python -`` has no main module file for spawned workers to import: the rows run in the process
+    itself, with the answers of a script file; a process pool whose workers cannot start reports its rows
+    failed instead of starting new pools for ever."""
+    script = tmp_path / "chunked.py"
+    script.write_text(_CHUNKED_STUDY.replace("linear_range(1e7, 3e7, 9)", "linear_range(1e7, 3e7, 3)"))
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1"}
+    from_file = subprocess.run([sys.executable, str(script), "2"], env=environment, capture_output=True, text=True,
+                               timeout=300)
+    assert from_file.returncode == 0, from_file.stderr
+    expected = [t for _, t in json.loads(from_file.stdout.strip().splitlines()[-1])]
+    here = subprocess.run([sys.executable, "-", "run_rows"], input=_FROM_STDIN, env=environment, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert here.returncode == 0, here.stderr
+    assert "cannot be imported by a worker process: the rows run in this process" in here.stderr
+    rows = json.loads(here.stdout.strip().splitlines()[-1])
+    assert [status for _, status, _, _ in rows] == ["ok"] * 3 and [t for *_, t in rows] == expected
+    pool = subprocess.run([sys.executable, "-", "pool"], input=_FROM_STDIN, env=environment, cwd=tmp_path,
+                          capture_output=True, text=True, timeout=120)
+    assert pool.returncode == 0, pool.stderr
+    rows = json.loads(pool.stdout.strip().splitlines()[-1])
+    assert sorted(index for index, *_ in rows) == [0, 1, 2]
+    assert all(status == "failed" and error.startswith("WorkerDied: no worker process could start a row")
+               for _, status, error, _ in rows)
+
+
 def _busy(pid: int, exclude=()) -> list[psutil.Process]:
     """Workers of *pid* not in *exclude* that have used more CPU time than their start-up takes."""
     busy = []

@@ -41,6 +41,7 @@ import logging
 import multiprocessing
 import os
 import signal
+import sys
 import threading
 import time
 import traceback
@@ -341,7 +342,8 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
             pending[index] = item
     if dask is not None:
         _run_dask(pending, dask, done, design_model)
-    elif workers <= SERIAL or len(pending) <= 1 or (design_model is not None and len(pending) <= BATCH_ROWS):
+    elif workers <= SERIAL or len(pending) <= 1 or (design_model is not None and len(pending) <= BATCH_ROWS) \
+            or not _main_importable():
         with _signals_seen() as seen, _using(design_model):
             for batch in batches(pending, design_model):
                 answered = run_batch(batch)
@@ -353,6 +355,20 @@ def run_rows(cases: list[Case | BaseException], *, workers: int = SERIAL, dask: 
         chunk = rows_per_worker if design_model is None else max(rows_per_worker, DESIGN_ROWS_PER_WORKER)
         _run_processes(pending, workers, done, chunk, design_model)
     return [outcomes[i] for i in range(total)]
+
+
+def _main_importable() -> bool:
+    """Whether a worker process can be started: it imports this process's main module again (a script read
+    from standard input, ``python -``, cannot be; the rows then run in this process)."""
+    main = sys.modules.get("__main__")
+    if getattr(getattr(main, "__spec__", None), "name", None):
+        return True
+    path = getattr(main, "__file__", None)
+    started_in = getattr(multiprocessing.process, "ORIGINAL_DIR", None) or os.getcwd()   # where spawn looks
+    if path is None or os.path.isfile(os.path.join(started_in, path)):
+        return True
+    log.warning("the main module (%s) cannot be imported by a worker process: the rows run in this process", path)
+    return False
 
 
 @contextlib.contextmanager
@@ -496,6 +512,11 @@ def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker:
         chunk = dict(itertools.islice(pending.items(), workers * rows_per_worker))
         later = {i: case for i, case in pending.items() if i not in chunk}
         lost, unstarted, _ = _pool_round(chunk, workers, done, context, design_model)
+        if len(unstarted) == len(chunk):     # the pool broke before any row started: its workers cannot start
+            for index in sorted({**unstarted, **later}):
+                done(RowOutcome(index, [], "failed", "WorkerDied: no worker process could start a row (the "
+                                                     "process pool broke before any row ran)"))
+            return
         pending = {**unstarted, **later}
         if lost:
             log.warning("a worker process died; rows %s, which were running, are retried one at a time",
