@@ -154,12 +154,3 @@ def test_the_stress_command_names_a_missing_endurance_strength(coarse_reference,
     path.write_text(text)
     assert main(["stress", str(path)]) == EXIT_BAD_INPUT
     assert "material.endurance_strength" in capsys.readouterr().err
-
-
-@pytest.mark.parametrize("option", ["--png", "--vtu"])
-def test_a_file_where_the_stress_fields_folder_should_be_is_refused_untouched(tmp_path, capsys, option):
-    there = tmp_path / "fields"
-    there.write_text("the user's file")
-    assert main(["stress", option, str(there)]) == EXIT_BAD_INPUT
-    assert "give a folder" in capsys.readouterr().err
-    assert there.read_text() == "the user's file"
