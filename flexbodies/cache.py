@@ -207,12 +207,18 @@ class BodyCache:
                     pass
         return sorted(found)
 
-    def _write(self, path: Path, write) -> None:
+    def write(self, path: Path, write) -> bool:
+        """Write the entry *path* of the folder atomically by ``write(temporary_path)``; False (with the
+        store's one warning) when the folder cannot be written."""
+        if not self.writable():
+            return False
         try:
             with replacing(path) as temporary:
                 write(temporary)
         except OSError as error:
             self._give_up(error)
+            return False
+        return True
 
     # -- frequency summaries ----------------------------------------------------------------
 
@@ -239,7 +245,7 @@ class BodyCache:
         values = {name: np.asarray(v, dtype=float).tolist() for name, v in frequencies.items()}
         record = {"schema": SUMMARY_SCHEMA, "key": key, "frequencies": values,
                   "checksum": _digest(json.dumps(values, sort_keys=True))}
-        self._write(self.summary_path(key), lambda temporary: temporary.write_text(json.dumps(record)))
+        self.write(self.summary_path(key), lambda temporary: temporary.write_text(json.dumps(record)))
 
     # -- reduced bodies ---------------------------------------------------------------------
 
@@ -287,7 +293,7 @@ class BodyCache:
         if not self.enabled:
             return
         if self.writable():
-            self._write(path, lambda temporary: write(entry, temporary))
+            self.write(path, lambda temporary: write(entry, temporary))
         self._remember(path, entry)
 
     def _remember(self, path: Path, entry) -> None:

@@ -50,7 +50,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .atomic import replacing
-from .cache import MEMORY_ENTRIES, default_cache_dir, file_signature
+from .cache import MEMORY_ENTRIES, BodyCache, default_cache_dir, file_signature
 from .materials import Material
 from .reduced import ReducedBody
 
@@ -423,23 +423,26 @@ def has_stiffening(model, *, cache_dir=None) -> bool:
     return _path(model, cache_dir).is_file()
 
 
-def save_stiffening(model, stiffening: LinkStiffening, *, cache_dir=None) -> Path:
+def save_stiffening(model, stiffening: LinkStiffening, *, cache_dir=None) -> Path | None:
     """Keep *stiffening*, the geometric stiffness of the link model *model*, in the cache.
 
     Returns
     -------
-    Path
-        The cache file.
+    Path or None
+        The cache file, or None when the cache folder cannot be written (the
+        store warns once and the run goes on without it).
     """
     path = _path(model, cache_dir)
-    path.parent.mkdir(parents=True, exist_ok=True)
     data, indices, indptr = stiffening.csr
-    with replacing(path) as temporary, open(temporary, "wb") as handle:
-        np.savez(handle, data=data, indices=indices, indptr=indptr,
-                 shape=np.array([stiffening.nodes] * 2), pinned_stiffness=stiffening.pinned_stiffness,
-                 pinned_mass=stiffening.pinned_mass, pinned_geometric=stiffening.pinned_geometric,
-                 buckling_load=np.float64(stiffening.buckling_load))
-    return path
+
+    def write(temporary: Path) -> None:
+        with open(temporary, "wb") as handle:
+            np.savez(handle, data=data, indices=indices, indptr=indptr,
+                     shape=np.array([stiffening.nodes] * 2), pinned_stiffness=stiffening.pinned_stiffness,
+                     pinned_mass=stiffening.pinned_mass, pinned_geometric=stiffening.pinned_geometric,
+                     buckling_load=np.float64(stiffening.buckling_load))
+
+    return path if BodyCache(path.parent).write(path, write) else None
 
 
 #: (id of a geometric stiffness, id of a mode basis) -> (the two, ``K_G,r``), most recent last: the links that

@@ -282,7 +282,8 @@ def reduce_link_set(model: LinkModel, modes="auto", excitations_hz=(None,), *, c
         from .reduction import couple
 
         fe, link_mesh, rotation, timings = _meshed_fe_model(model)
-        stiffen = stiffening and use_cache and not has_stiffening(model, cache_dir=cache_dir)
+        stiffen = (stiffening and use_cache and BodyCache(cache_dir).writable()
+                   and not has_stiffening(model, cache_dir=cache_dir))
         with ThreadPoolExecutor(max_workers=1) as beside:  # SuperLU and NumPy release the GIL
             stress = beside.submit(_timed_stress_operator, link_mesh, model.material, rotation, timings)
             coupled = couple(fe, model.interface)

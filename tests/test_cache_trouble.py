@@ -13,8 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flexbodies import LinkGeometry, LinkModel, load_reduced_body, reduce_link
+from flexbodies import LinkGeometry, LinkModel, load_reduced_body, reduce_link, reduce_link_set
 from flexbodies.cache import STALE_SECONDS
+from flexbodies.geometric_stiffness import link_stiffening
 from workbook.cli.main import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -52,6 +53,18 @@ def test_a_cache_path_naming_a_file_warns_once_and_the_run_goes_on(tmp_path):
     assert not result["hit"] and result["mass"] > 0
     assert len(warnings) == 1, warnings
     assert str(not_a_folder) in warnings[0] and "without caching" in warnings[0]
+    assert not_a_folder.read_text() == "a file, not a folder"
+
+
+def test_a_cache_path_naming_a_file_leaves_out_the_geometric_stiffness_as_well(tmp_path, caplog):
+    not_a_folder = tmp_path / "cache.txt"
+    not_a_folder.write_text("a file, not a folder")
+    with caplog.at_level(logging.WARNING, logger="flexbodies"):
+        link, = reduce_link_set(MODEL, "static", cache_dir=not_a_folder, stiffening=True)
+        stiffening = link_stiffening(MODEL, cache_dir=not_a_folder)
+    assert stiffening.cache_file is None and stiffening.nodes == int(link.master_nodes[0])
+    warnings = [record.getMessage() for record in caplog.records if record.levelno == logging.WARNING]
+    assert len(warnings) == 1 and str(not_a_folder) in warnings[0] and "without caching" in warnings[0], warnings
     assert not_a_folder.read_text() == "a file, not a folder"
 
 
