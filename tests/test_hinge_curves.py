@@ -6,10 +6,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from workbook.answers.hinge_curves import hinge_curves, select_hinges
+from workbook.answers.hinge_curves import HingeCurves, hinge_curves, select_hinges
 from workbook.answers.warning_groups import group_warnings, warning_lines
 from workbook.cli.main import main
-from workbook.errors import CaseError
+from workbook.errors import InputError
 from workbook.model.case import RunUp, Sweep
 from workbook.model.codec import to_json
 from workbook.solve.pipeline import run_case
@@ -35,9 +35,15 @@ def test_selection_by_name_prefix_and_pylon():
     assert select_hinges(names, "front") == ["front"]                       # an exact name wins
     assert select_hinges(names, "front-") == ["front-up-left", "front-down-left"]
     assert select_hinges(names, "pylon", pylon=["rear-up-left", "front-up-left"]) == ["front-up-left", "rear-up-left"]
-    with pytest.raises(CaseError, match="--hinges.*'aft'.*rear-up-left"):
-        select_hinges(names, "aft")
+    with pytest.raises(InputError, match="^--hinges 'aft': expected a hinge name.*rear-up-left"):
+        select_hinges(names, "aft", option="--hinges")
 
+
+
+def test_the_force_of_hinges_together_needs_their_phases():
+    curves = HingeCurves("front", ("run",), np.array([59.0]), ("front-up-left",), np.ones((1, 1, 3)), np.ones(1), None)
+    with pytest.raises(InputError, match="^the force of hinges 'front' together: expected frequency-domain runs"):
+        curves.group_force()
 
 @pytest.fixture(scope="module")
 def swept(coarse_reference):

@@ -10,7 +10,7 @@ from conftest import COARSE_ELEMENT_SIZE
 
 from workbook.cli.main import main
 from workbook.cli.params import parse_vary
-from workbook.errors import EXIT_FAILED_ROWS, CaseError
+from workbook.errors import EXIT_FAILED_ROWS, CaseError, UsageError
 from workbook.model.case import AnalysisSettings
 from workbook.model.codec import to_json
 from workbook.model.reference import HINGE_STIFFNESS, LP_ROTOR, reference_case
@@ -61,6 +61,20 @@ def test_grid_range_and_latin_hypercube_rows():
     with pytest.raises(ValueError, match="unknown study parameter"):
         grid({"stiffness": [1.0]})
 
+
+
+@pytest.mark.parametrize("spec, lhs, words", [
+    ("hinge_stiffness=a,b", None, "found 'a', expected a finite number"),
+    ("hinge_stiffness=inf,2e7", None, "found 'inf', expected a finite number"),
+    ("hinge_stiffness=1e7:nan:3", None, "found 'nan', expected a finite number"),
+    ("hinge_stiffness=1e7:2e7:2.5", None, "found '2.5' points, expected a whole number"),
+    ("hinge_stiffness=1e7:2e7:0", None, "a range needs at least one point, got 0"),
+    ("hinge_stiffness=x:2e7", 5, "found 'x', expected a finite number"),
+])
+def test_a_malformed_vary_option_is_named_with_what_was_found(spec, lhs, words):
+    with pytest.raises(UsageError) as raised:
+        parse_vary([spec], lhs)
+    assert str(raised.value) == f"--vary {spec!r}: {words}"
 
 def test_row_case_sets_every_parameter(base):
     row = {"hinge_stiffness": 3e7, "hinge_damping": 500.0, "clearance": 1e-4, "section_scale": 1.2,

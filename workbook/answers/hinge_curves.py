@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workbook.errors import CaseError
+from workbook.errors import InputError
 from workbook.model.case import DIRECTIONS
 
 __all__ = ["HingeCurves", "hinge_curves", "select_hinges", "PYLON_GROUP"]
@@ -21,7 +21,7 @@ __all__ = ["HingeCurves", "hinge_curves", "select_hinges", "PYLON_GROUP"]
 PYLON_GROUP = "pylon"
 
 
-def select_hinges(names, selection: str, pylon=(), option: str = "--hinges") -> list[str]:
+def select_hinges(names, selection: str, pylon=(), option: str = "hinge selection") -> list[str]:
     """The hinges a selection names: the hinge of that name, or those whose name starts with it.
 
     Parameters
@@ -33,11 +33,11 @@ def select_hinges(names, selection: str, pylon=(), option: str = "--hinges") -> 
     pylon : sequence of str
         The pylon-side channels (what ``pylon`` selects).
     option : str
-        Named in the error.
+        What gave the selection (a command-line option), named in the error.
 
     Raises
     ------
-    CaseError
+    InputError
         Nothing matches; the message lists the hinges.
     """
     names = list(names)
@@ -47,8 +47,8 @@ def select_hinges(names, selection: str, pylon=(), option: str = "--hinges") -> 
         return [name for name in names if name in set(pylon)]
     chosen = [name for name in names if name.startswith(selection)] if selection else []
     if not chosen:
-        raise CaseError("the answers", option, selection,
-                        f"a hinge name, the start of hinge names or {PYLON_GROUP!r}; hinges: {', '.join(names)}")
+        raise InputError(f"{option} {selection!r}: expected a hinge name, the start of hinge names or "
+                         f"{PYLON_GROUP!r}; hinges: {', '.join(names)}")
     return chosen
 
 
@@ -85,8 +85,8 @@ class HingeCurves:
     def group_force(self) -> np.ndarray:
         """The complex sum of the selected hinges' forces, shape (f, 3), N (frequency-domain runs only)."""
         if self.phasors is None:
-            raise CaseError("the answers", "--hinges", self.selection,
-                            "frequency-domain runs for a group's vector sum (a time-domain run keeps amplitudes)")
+            raise InputError(f"the force of hinges {self.selection!r} together: expected frequency-domain runs (a "
+                             f"time-domain run keeps amplitudes, not phases)")
         return self.phasors.sum(axis=1)
 
     def to_pandas(self):

@@ -100,8 +100,15 @@ def add_run_arguments(parser: argparse.ArgumentParser, seed_help: str) -> None:
                              "by the case's linear mount in NumPy, equal to 1e-6)")
 
 
-def _value(text: str, numeric: bool):
-    return float(text) if numeric else text.strip()
+def _number(spec: str, text: str) -> float:
+    """A number of the ``--vary`` option *spec*, or the usage error naming what was found."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise UsageError(f"--vary {spec!r}: found {text.strip()!r}, expected a finite number")
+    return value
 
 
 def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, ...]:
@@ -109,38 +116,42 @@ def parse_vary(specs: list[str], lhs: int | None, seed: int = 0) -> tuple[dict, 
 
     Raises
     ------
-    ValueError
+    UsageError
         A malformed option, naming it.
     """
     from workbook.studies.parametric import grid, latin_hypercube, linear_range, parameter
 
     if not specs:
         raise UsageError("a parameter study needs at least one --vary NAME=SPEC")
-    values, bounds = {}, {}
+    values: dict[str, list] = {}
+    bounds: dict[str, tuple[float, float]] = {}
     for spec in specs:
         name, sep, text = spec.partition("=")
         name = name.strip()
         if not sep:
             raise UsageError(f"--vary {spec!r}: expected NAME=SPEC")
         try:
-            parameter(name)
+            numeric = parameter(name).numeric
         except InputError as error:
             raise UsageError(f"--vary {spec!r}: {error}") from None
-        numeric = parameter(name).numeric
-        try:
-            parts = text.split(":")
-            if lhs is not None:
-                if len(parts) != 2:
-                    raise UsageError("with --lhs give bounds low:high")
-                bounds[name] = (float(parts[0]), float(parts[1]))
-            elif len(parts) == 3 and numeric:
-                values[name] = linear_range(float(parts[0]), float(parts[1]), int(parts[2]))
-            elif len(parts) == 1:
-                values[name] = [_value(v, numeric) for v in text.split(",")]
-            else:
-                raise UsageError("expected a,b,c or low:high:points")
-        except ValueError as error:
-            raise UsageError(f"--vary {spec!r}: {error}") from None
+        parts = text.split(":")
+        if lhs is not None:
+            if len(parts) != 2:
+                raise UsageError(f"--vary {spec!r}: with --lhs give bounds low:high")
+            bounds[name] = (_number(spec, parts[0]), _number(spec, parts[1]))
+        elif len(parts) == 3 and numeric:
+            points = _number(spec, parts[2])
+            if not points.is_integer():
+                raise UsageError(f"--vary {spec!r}: found {parts[2].strip()!r} points, expected a whole number")
+            low, high = _number(spec, parts[0]), _number(spec, parts[1])
+            try:
+                values[name] = linear_range(low, high, int(points))
+            except InputError as error:
+                raise UsageError(f"--vary {spec!r}: {error}") from None
+        elif len(parts) == 1:
+            values[name] = [_number(spec, v) if numeric else v.strip() for v in text.split(",")]
+        else:
+            raise UsageError(f"--vary {spec!r}: expected a,b,c or low:high:points")
     return latin_hypercube(bounds, lhs, seed) if lhs is not None else grid(values)
 
 

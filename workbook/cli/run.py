@@ -107,7 +107,7 @@ def run(args) -> int:
     if args.hinges:
         from workbook.answers.hinge_curves import select_hinges
 
-        select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges])
+        select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges], "--hinges")
     steps = []
     if args.accuracy:
         from workbook.solve.truncation import run_to_accuracy

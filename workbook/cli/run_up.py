@@ -22,10 +22,13 @@ from typing import Callable, cast
 from workbook.answers.saving import save_csv, save_figure
 from workbook.cli.loading import load_case
 from workbook.cli.outputs import check_output, write_output
-from workbook.errors import UsageError
+from workbook.errors import CaseError, UsageError
 from workbook.model.case import SPEED_UNITS, Case, RotatingForce, RunUp, SingleFrequencyExcitation
 
 __all__ = ["arguments"]
+
+#: The options that give a run-up's fields (:meth:`RunUp.speeds`).
+_OPTIONS = {"start": "--from", "stop": "--to", "points": "--points", "speed_unit": "--unit"}
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
@@ -74,7 +77,17 @@ def _run_ups(case: Case, args) -> list[RunUp]:
             raise UsageError(f"--unbalance: {args.excitation!r} is not a rotating force; give its planes' unbalance "
                              f"in the case")
         template = dataclasses.replace(template, amplitude=None, unbalance=args.unbalance)
-    return [RunUp.speeds(f"{args.excitation} run-up", cast(SingleFrequencyExcitation, template), args.start, args.stop, args.points, args.unit)]
+    try:
+        return [RunUp.speeds(f"{args.excitation} run-up", cast(SingleFrequencyExcitation, template), args.start,
+                             args.stop, args.points, args.unit)]
+    except CaseError as error:  # named by the option that gave it, not by the run-up's field
+        if error.field == "unbalance":
+            raise UsageError(f"--excitation {args.excitation!r}: found no unbalance, expected {error.expected}; or "
+                             f"give --unbalance KG_M") from None
+        if error.field not in _OPTIONS:
+            raise
+        found = f"{error.value:g}" if isinstance(error.value, float) else repr(error.value)
+        raise UsageError(f"{_OPTIONS[error.field]} {found}: expected {error.expected}") from None
 
 
 def run(args) -> int:
@@ -90,7 +103,7 @@ def run(args) -> int:
     if args.hinges:
         from workbook.answers.hinge_curves import select_hinges
 
-        select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges])
+        select_hinges([h.name for h in case.hinges], args.hinges, [h.name for h in case.pylon_hinges], "--hinges")
     items = _run_ups(case, args)
     if (args.csv or args.plot or args.hinges_plot) and len(items) > 1:
         raise UsageError(f"--csv/--plot/--hinges-plot write one run-up; the case has {len(items)}: choose one with "
