@@ -1,11 +1,13 @@
 """Run-ups: an unbalance over a speed range, force U w^2, against closed forms and single runs."""
 import dataclasses
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from test_sdof import NATURAL_HZ, ZETA, closed_form, sdof_case
 
+from workbook.answers.warning_groups import warning_lines
 from workbook.model.case import RotatingForce, RunUp
 from workbook.model.reference import HP_ROTOR, LP_ROTOR
 from workbook.solve.pipeline import run_case
@@ -36,6 +38,18 @@ def test_single_dof_run_up_follows_u_omega_squared_times_the_closed_form(sdof_ru
     np.testing.assert_allclose(frame["T z"], frame["F z N"] / frame["excitation N"], rtol=1e-12)
     np.testing.assert_allclose(frame["frequency Hz"], speeds / 60, rtol=1e-12)
 
+
+
+def test_run_up_points_are_named_and_their_warnings_placed_in_its_speed_unit():
+    rotor = RotatingForce("rotor", (0.0, 0.0, 0.0), rpm=600.0, unbalance=UNBALANCE)
+    points = RunUp.speeds("run-up", rotor, 600.0, 1200.0, 3, unit="rpm").expand()
+    assert [point.name for point in points] == ["run-up @ 600 rpm", "run-up @ 900 rpm", "run-up @ 1200 rpm"]
+    np.testing.assert_allclose([point.frequency_hz for point in points], [10.0, 15.0, 20.0], rtol=1e-15)
+    runs = [SimpleNamespace(name=point.name, frequency_hz=point.frequency_hz, warnings=["all", "one"][: i + 1])
+            for i, point in enumerate(points[:2])]
+    assert warning_lines(runs, unit="rpm") == ["WARNING 2 points from 600 to 900 rpm: all",
+                                               "WARNING run-up @ 900 rpm: one"]
+    assert warning_lines(runs)[0] == "WARNING 2 points from 10 to 15 Hz: all"
 
 def test_former_run_up_table_names_warn_and_give_the_same_tables(sdof_run_up):
     with pytest.warns(DeprecationWarning, match=r"RunUpAnswer.frame\(\) is now to_pandas"):

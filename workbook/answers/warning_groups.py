@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from workbook.model.case import SPEED_UNITS, SpeedUnit
+
 __all__ = ["WarningGroup", "group_warnings", "warning_lines"]
 
 
@@ -32,12 +34,12 @@ class WarningGroup:
         """How many runs raised it."""
         return len(self.names)
 
-    def where(self) -> str:
-        """The run, or the count and the frequency range, in words."""
+    def where(self, unit: SpeedUnit = "Hz") -> str:
+        """The run, or the count and the frequency range in *unit* (Hz, or rpm for a run-up), in words."""
         if self.count == 1:
             return self.names[0]
-        low, high = min(self.frequencies_hz), max(self.frequencies_hz)
-        span = f"at {low:.6g} Hz" if low == high else f"from {low:.6g} to {high:.6g} Hz"
+        low, high = (bound / SPEED_UNITS[unit] for bound in (min(self.frequencies_hz), max(self.frequencies_hz)))
+        span = f"at {low:.6g} {unit}" if low == high else f"from {low:.6g} to {high:.6g} {unit}"
         return f"{self.count} points {span}"
 
 
@@ -64,7 +66,7 @@ def group_warnings(runs) -> list[WarningGroup]:
     return [WarningGroup(text, tuple(names), tuple(frequencies)) for text, (names, frequencies) in seen.items()]
 
 
-def warning_lines(runs, label: str = "") -> list[str]:
+def warning_lines(runs, label: str = "", unit: SpeedUnit = "Hz") -> list[str]:
     """One ``WARNING`` line per distinct warning of *runs*, with its count and frequency range.
 
     Parameters
@@ -73,10 +75,12 @@ def warning_lines(runs, label: str = "") -> list[str]:
         As for :func:`group_warnings`.
     label : str
         Put before where the warning arose (e.g. a workbook run's name).
+    unit : {"Hz", "rpm"}
+        Unit of the frequency ranges (a run-up's speed unit).
 
     Returns
     -------
     list of str
     """
     prefix = f"{label} / " if label else ""
-    return [f"WARNING {prefix}{group.where()}: {group.text}" for group in group_warnings(runs)]
+    return [f"WARNING {prefix}{group.where(unit)}: {group.text}" for group in group_warnings(runs)]

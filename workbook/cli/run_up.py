@@ -122,7 +122,7 @@ def run(args) -> int:
         print(answer.to_pandas().to_string(float_format=lambda v: f"{v:10.4g}"))
         print("\nmodes (marked on the plot at the speed equal to their frequency):")
         print(answer.modes.to_pandas().to_string(float_format=lambda v: f"{v:8.2f}"))
-        for line in warning_lines(answer.result.runs):
+        for line in warning_lines(answer.result.runs, unit=answer.speed_unit):
             print("\n" + line)
         if curves is not None:
             print("\n" + curves[answers.index(answer)].to_text())

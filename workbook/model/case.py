@@ -826,6 +826,11 @@ class RunUp(Sweep):
         """The speeds in :attr:`speed_unit`."""
         return np.asarray(self.frequencies_hz) / SPEED_UNITS[self.speed_unit]
 
+    def expand(self) -> tuple[SingleFrequencyExcitation, ...]:
+        """The single-speed excitations of the run-up, named ``"<name> @ <speed> <unit>"``."""
+        return tuple(dataclasses.replace(point, name=f"{self.name} @ {speed:.6g} {self.speed_unit}")
+                     for point, speed in zip(super().expand(), self.speed_values, strict=True))
+
 
 @documented
 @dataclass(frozen=True)

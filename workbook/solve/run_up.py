@@ -18,7 +18,7 @@ import numpy as np
 
 from workbook._renamed import renamed
 from workbook.answers.results import PYLON_SUM
-from workbook.model.case import DIRECTIONS, SPEED_UNITS, Case, RunUp
+from workbook.model.case import DIRECTIONS, SPEED_UNITS, Case, RunUp, SpeedUnit
 from workbook.solve.sweep import SweepAnswer, run_sweep
 
 __all__ = ["RunUpAnswer", "run_up"]
@@ -30,7 +30,7 @@ class RunUpAnswer(SweepAnswer):
     whose points are speeds (``sweep`` is the :class:`RunUp`)."""
 
     @property
-    def speed_unit(self) -> str:
+    def speed_unit(self) -> SpeedUnit:
         return cast(RunUp, self.sweep).speed_unit
 
     @property
