@@ -122,6 +122,20 @@ def test_one_link_removed_is_a_mechanism(reference):
     with pytest.raises(MechanismError, match="thrust-left") as error:
         solve_preload(build_scene(case))
     assert len(error.value.motions) == 2          # the dangling rod swings in two planes
+    assert "too soft" not in str(error.value)
+
+
+def test_a_hinge_too_soft_to_hold_its_link_is_named_in_the_mechanism(reference):
+    # 50 N/m holds the rear-left link (a few kg) above the free-motion limit (0.05 Hz), though not the engine it joins
+    soft, firm = "front-up-left", "rear-down-left"
+    stiffness = {soft: 1e-3, firm: 50.0}
+    hinges = tuple(dataclasses.replace(h, stiffness=stiffness.get(h.name, h.stiffness)) for h in reference.hinges)
+    case = dataclasses.replace(reference, hinges=hinges).with_rigid_links()
+    with pytest.raises(MechanismError) as error:
+        solve_preload(build_scene(case))
+    assert ("Hinges too soft to hold the lighter body they join (it alone would move on them below the "
+            f"free-motion limit): '{soft}' (0.001 N/m); check") in str(error.value)
+    assert firm not in str(error.value)
 
 
 def test_engine_without_thrust_rods_is_free_to_move_forward(reference):

@@ -247,10 +247,19 @@ class MechanismError(SimulationError):
         Description of each free motion.
     """
 
-    def __init__(self, case_name: str, motions: list[str], loose_eyes: list[str] | tuple[str, ...] = ()):
+    #: Free motions the message lists; the rest are counted.
+    LISTED = 12
+
+    def __init__(self, case_name: str, motions: list[str], loose_eyes: list[str] | tuple[str, ...] = (),
+                 soft_hinges: list[str] | tuple[str, ...] = ()):
         self.motions = motions
-        listing = "; ".join(f"({i + 1}) {m}" for i, m in enumerate(motions))
+        listing = "; ".join(f"({i + 1}) {m}" for i, m in enumerate(motions[:self.LISTED]))
+        if len(motions) > self.LISTED:
+            listing += f"; and {len(motions) - self.LISTED} more"
         hint = f" Eyes without a hinge: {', '.join(loose_eyes)}." if loose_eyes else ""
+        if soft_hinges:
+            hint += (f" Hinges too soft to hold the lighter body they join (it alone would move on them below the "
+                     f"free-motion limit): {', '.join(soft_hinges)}; check their stiffness and its unit.")
         super().__init__(f"case {case_name!r} is a mechanism: {len(motions)} free motion(s) without "
                          f"stiffness: {listing}.{hint} Add or restore the link or hinge that restrains it.")
 

@@ -45,7 +45,7 @@ from workbook.errors import EquilibriumError, MechanismError, UnstablePreloadErr
 from workbook.model.case import DIRECTIONS, ENGINE, Gravity, PointForce, PointMoment
 from workbook.scene.build import Scene, marker_bodies
 from workbook.solve.guards import solver_output
-from workbook.solve.modes import Mode, free_motions, linearize, modes_of, unstable_modes
+from workbook.solve.modes import FREE_FREQUENCY_HZ, Mode, free_motions, linearize, modes_of, unstable_modes
 
 __all__ = ["Preload", "applied_static_force", "check_mechanism", "check_preloaded_stability", "link_compression",
            "static_failure_message", "LOAD_STEPS",
@@ -220,7 +220,23 @@ def _stop_on_free_motions(scene: Scene, modes: list[Mode]) -> None:
                   if body in case.link_map}
         loose = [f"link {link.name!r} eye {eye.upper()} at {getattr(link, 'end_' + eye)} m"
                  for link in case.links for eye in ("a", "b") if (link.name, eye) not in hinged]
-        raise MechanismError(case.name, [mode.description for mode in free], loose)
+        raise MechanismError(case.name, [mode.description for mode in free], loose, _soft_hinges(scene))
+
+
+def _soft_hinges(scene: Scene) -> list[str]:
+    """The hinges with a stiffness above 0 on which the lighter body they join would alone move below
+    :data:`~workbook.solve.modes.FREE_FREQUENCY_HZ`, each with that stiffness (N/m)."""
+    masses = {name: link.mass for name, link in scene.links.items()}
+    masses[ENGINE] = scene.case.engine.mass
+    limit = (2 * np.pi * FREE_FREQUENCY_HZ) ** 2
+    soft = []
+    for hinge in scene.case.hinges:
+        mass = min(masses.get(body, np.inf) for body in hinge.bodies)  # the pylon holds still
+        stiffness = hinge.values("stiffness")
+        too_soft = stiffness[(stiffness > 0) & (stiffness < limit * mass)]
+        if too_soft.size:
+            soft.append(f"{hinge.name!r} ({too_soft.min():.3g} N/m)")
+    return soft
 
 
 def link_compression(scene: Scene, forces: dict) -> dict:
