@@ -65,8 +65,9 @@ CURVATURE_STEP = 1e-3
 
 @dataclass(frozen=True)
 class _BlockOperator:
-    """Tensors (K, b b, m), mostly zero, as a sparse operator from vectors (..., K, m) to the K products
-    ``tensors[k] @ vectors[..., k, :]``, each a (b, b) matrix, of which it keeps the entries that are not zero.
+    """Tensors (K, b, b, ...), mostly zero, as a sparse operator from vectors (..., K, m) (m: the tensors'
+    trailing axes flattened) to the K products ``tensors[k] @ vectors[..., k, :]``, each a (b, b) matrix, of
+    which it keeps the entries that are not zero.
 
     The slopes and the curvature of the bodies' matrices are mostly zero: few entries of a body's matrices
     change with few of its coordinates.
@@ -79,10 +80,11 @@ class _BlockOperator:
 
     @classmethod
     def of(cls, tensors: np.ndarray) -> "_BlockOperator":
-        whole = sparse.csr_array(sparse.block_diag(list(tensors), format="csr"))
+        """The operator of *tensors* (K, b, b, ...)."""
+        blocks, width = tensors.shape[:2]
+        whole = sparse.csr_array(sparse.block_diag(list(tensors.reshape(blocks, width * width, -1)), format="csr"))
         whole.eliminate_zeros()
         rows = np.flatnonzero(np.diff(whole.indptr))
-        blocks, width = len(tensors), int(round(np.sqrt(tensors.shape[1])))
         block, entry = np.divmod(rows, width * width)
         ones, kept = np.ones(len(rows)), np.arange(len(rows))
         columns = sparse.csr_array((ones, (kept, block * width + entry % width)), shape=(len(rows), blocks * width))
@@ -169,10 +171,8 @@ class RestBlocks:
     @functools.cached_property
     def _operators(self) -> dict:
         """The slopes and the curvature of K as :class:`_BlockOperator`, by name."""
-        blocks, width = self.coordinates.shape
-        operators = {name: _BlockOperator.of(getattr(self, f"{name}_slope").reshape(blocks, width * width, width))
-                     for name in ("mass", "stiffness", "damping")}
-        operators["curvature"] = _BlockOperator.of(self.stiffness_curvature.reshape(blocks, width * width, -1))
+        operators = {name: _BlockOperator.of(getattr(self, f"{name}_slope")) for name in ("mass", "stiffness", "damping")}
+        operators["curvature"] = _BlockOperator.of(self.stiffness_curvature)
         return operators
 
     def _sloped(self, name: str, local: np.ndarray, weight: float = 1.0) -> np.ndarray:
