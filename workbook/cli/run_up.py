@@ -28,7 +28,7 @@ from workbook.model.case import SPEED_UNITS, Case, RotatingForce, RunUp, SingleF
 __all__ = ["arguments"]
 
 #: The options that give a run-up's fields (:meth:`RunUp.speeds`).
-_OPTIONS = {"start": "--from", "stop": "--to", "points": "--points", "speed_unit": "--unit"}
+_OPTIONS = {"start": "--from", "stop": "--to", "points": "--points"}
 
 
 def arguments(parser: argparse.ArgumentParser) -> Callable:
