@@ -22,6 +22,7 @@ from flexbodies.meshing import BodyMesh
 from workbook.errors import MechanismError, ResonanceError, RoundOffError, SimulationError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
+from workbook.solve.campbell import campbell
 from workbook.solve.guards import singular_solve_guard
 from workbook.solve.method import choose_method
 from workbook.solve.modes import FREE_FREQUENCY_HZ, modes_of, mounted_modes
@@ -253,6 +254,17 @@ def test_a_heavy_fast_rotor_is_no_mechanism_and_keeps_the_stiffness_determinant(
     # the slow backward whirl is a real mounted mode: listed, not dropped as if it were free
     assert mounted_modes(prepared.modes)[0].frequency_hz < FREE_FREQUENCY_HZ
     assert np.sum(np.log(whirl)) == pytest.approx(np.sum(np.log(still)), rel=1e-6)
+
+
+def test_a_campbell_diagram_to_an_extreme_speed_says_which_branch_it_loses(cache_dir):
+    """The reference rotors from 1e5 to 1e7 rpm: at 5e6 rpm the gyroscopic moment has slowed the
+    backward whirl (1.4 Hz at 1e5 rpm) below the 0.05 Hz the diagram follows, so one branch has no
+    continuation (before: an IndexError from an uninitialised index, or, when the garbage index
+    happened to lie in range, a branch silently continued by another mode)."""
+    case = reference_case(rotors=True, element_size=COARSE_ELEMENT_SIZE).with_rigid_links()
+    with pytest.raises(SimulationError, match=r"cannot follow the branch of engine yaw.*at 1\.40\d Hz at 100000 "
+                                              r"rpm\) to 5\.05e\+06 rpm"):
+        campbell(case, start_rpm=1e5, stop_rpm=1e7, points=3)
 
 
 # --- 10. an undamped link mode -------------------------------------------------------------------------------
