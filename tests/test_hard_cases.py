@@ -9,6 +9,7 @@ preload), they are flexible.
 """
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,9 +20,11 @@ from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
 from flexbodies.meshing import BodyMesh
-from workbook.errors import MechanismError, ResonanceError, RoundOffError, SimulationError
+from workbook.errors import MechanismError, RecordError, ResonanceError, RoundOffError, SimulationError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
+from workbook.rig.correlation import measure
+from workbook.rig.records import read_record
 from workbook.solve.campbell import campbell
 from workbook.solve.guards import singular_solve_guard
 from workbook.solve.method import choose_method
@@ -62,6 +65,9 @@ def test_hinge_stiffness_1e10_converges_and_matches_the_frequency_domain(rigid):
     assert np.all(np.isfinite(coarse.transmissibility)) and coarse.steady
     assert fine.transmissibility == pytest.approx(coarse.transmissibility, rel=5e-3)
     assert fine.transmissibility == pytest.approx(linear.transmissibility, rel=5e-3)
+
+
+REFERENCE_RECORD = Path(__file__).parents[1] / "cases" / "reference-lp-rig.csv"
 
 
 def _one_hinge(case, stiffness):
@@ -265,6 +271,18 @@ def test_a_campbell_diagram_to_an_extreme_speed_says_which_branch_it_loses(cache
     with pytest.raises(SimulationError, match=r"cannot follow the branch of engine yaw.*at 1\.40\d Hz at 100000 "
                                               r"rpm\) to 5\.05e\+06 rpm"):
         campbell(case, start_rpm=1e5, stop_rpm=1e7, points=3)
+
+
+@pytest.mark.parametrize("excitation", [0.0, 5.0, "noise"], ids=["zero", "constant", "noise only"])
+def test_a_rig_record_without_an_excitation_to_divide_by_is_refused(excitation):
+    """The reference rig record measures T_x 0.0351 (its simulation: 0.03511); with its excitation
+    channels at zero, constant, or holding noise alone, T was NaN, infinite, 2.8e15 or noise, exit 0."""
+    record = read_record(REFERENCE_RECORD)
+    assert measure(record, 20).transmissibility[0] == pytest.approx(0.03511, rel=0.01)
+    signal = (np.random.default_rng(0).normal(0.0, 10.0, record.excitation.shape) if excitation == "noise"
+              else np.full(record.excitation.shape, excitation))
+    with pytest.raises(RecordError, match="no excitation at the rotor frequency to divide by"):
+        measure(dataclasses.replace(record, excitation=signal), 20)
 
 
 # --- 10. an undamped link mode -------------------------------------------------------------------------------
