@@ -20,11 +20,12 @@ from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
 from flexbodies.meshing import BodyMesh
-from workbook.errors import MechanismError, RecordError, ResonanceError, RoundOffError, SimulationError
+from workbook.errors import MechanismError, RecordError, ResonanceError, RoundOffError, SimulationError, UsageError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
 from workbook.rig.correlation import measure
 from workbook.rig.records import read_record
+from workbook.rig.updating import update_to_transmissibility
 from workbook.solve.campbell import campbell
 from workbook.solve.guards import singular_solve_guard
 from workbook.solve.method import choose_method
@@ -283,6 +284,15 @@ def test_a_rig_record_without_an_excitation_to_divide_by_is_refused(excitation):
               else np.full(record.excitation.shape, excitation))
     with pytest.raises(RecordError, match="no excitation at the rotor frequency to divide by"):
         measure(dataclasses.replace(record, excitation=signal), 20)
+
+
+def test_updating_to_a_measured_t_of_zero_or_nan_is_refused_naming_it(rigid):
+    """The fit compares ln T: a record whose pylon channels are dead measures T = 0 (before: an internal
+    error, "Residuals are not finite in the initial point")."""
+    measured = [[0.035, 0.0004, 0.017], [0.0, 0.0016, math.nan]]
+    with pytest.raises(UsageError, match=r"measured dead T x = 0, dead T z = nan: the fit compares ln T"):
+        update_to_transmissibility(rigid, ["LP rotor", "HP rotor"], measured, {"hinge_stiffness": (1e6, 1e8)},
+                                   labels=["good", "dead"])
 
 
 # --- 10. an undamped link mode -------------------------------------------------------------------------------
