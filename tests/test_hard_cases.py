@@ -20,7 +20,7 @@ from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
 from flexbodies.meshing import BodyMesh
-from workbook.errors import MechanismError, RecordError, ResonanceError, RoundOffError, SimulationError, UsageError
+from workbook.errors import FourPoleError, MechanismError, RecordError, ResonanceError, RoundOffError, SimulationError, UsageError
 from workbook.model.case import HarmonicForce, Rotor
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
 from workbook.rig.correlation import measure
@@ -28,9 +28,10 @@ from workbook.rig.records import read_record
 from workbook.rig.updating import update_to_transmissibility
 from workbook.solve.campbell import campbell
 from workbook.solve.guards import singular_solve_guard
+from workbook.solve.harmonic import excitation_phasor
 from workbook.solve.method import choose_method
 from workbook.solve.modes import FREE_FREQUENCY_HZ, modes_of, mounted_modes
-from workbook.solve.pipeline import prepare, run_case, run_excitation, solve_frequencies
+from workbook.solve.pipeline import four_pole, prepare, run_case, run_excitation, solve_frequencies
 
 
 @pytest.fixture(scope="module")
@@ -100,6 +101,21 @@ def test_undamped_mount_at_a_mounted_resonance_stops_in_both_domains(rigid):
         _frequency(undamped, on_mode)
     with pytest.raises(ResonanceError, match="never decays"):
         _time(undamped, on_mode)
+
+
+def test_the_four_pole_set_of_an_undamped_mount_refuses_its_rigid_pylon_answer_on_a_mounted_mode(rigid):
+    """Loss factor 0: on the 4.72 Hz mounted mode the engine on its mount on a rigid pylon has no steady
+    state (before: T_y = 3.3e11 from a matrix singular but for round-off); at 59 Hz the set's T is the
+    full solve's."""
+    undamped = _hinges(rigid, loss_factor=0.0)
+    modes = mounted_modes(prepare(undamped, LP_ROTOR).modes)
+    poles = four_pole(undamped, [modes[0].frequency_hz, 59.0])
+    force = excitation_phasor(LP_ROTOR)
+    with pytest.raises(FourPoleError, match=r"singular at 4.72\d* Hz: the engine on its mount on a rigid pylon .*"
+                                            r"the mode at 4.72\d* Hz \(engine roll"):
+        poles.transmissibility(force, LP_ROTOR.point)
+    off = four_pole(undamped, [59.0]).transmissibility(force, LP_ROTOR.point)[0]
+    assert off == pytest.approx(_frequency(undamped).transmissibility, rel=1e-6)
 
 
 def test_undamped_mount_off_resonance_warns_and_agrees_with_the_frequency_domain(rigid):

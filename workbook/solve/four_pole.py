@@ -66,6 +66,7 @@ from workbook._renamed import renamed
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
 from workbook.scene.hinge_laws import law_of, nonlinear_hinges
+from workbook.solve.guards import RESONANCE_BAND, undamped_mode_near
 
 __all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
            "REPORT_GRID"]
@@ -115,8 +116,11 @@ def checked_frequencies(frequencies_hz) -> np.ndarray:
     return frequencies
 
 
-def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) -> np.ndarray:
-    """``matrix^-1 rhs``, or a FourPoleError naming *what* is singular at *frequency_hz*."""
+def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float, modes=()) -> np.ndarray:
+    """``matrix^-1 rhs``, or a FourPoleError naming *what* is singular at *frequency_hz*: its pivots
+    vanish, or *frequency_hz* lies on one of *modes* (*what*'s own) that is undamped
+    (:func:`~workbook.solve.guards.undamped_mode_near`, :data:`~workbook.solve.guards.RESONANCE_BAND`),
+    where round-off alone keeps the pivots apart from zero (T of 3e11 on the reference mount)."""
     import scipy.linalg as sla  # here: the command line's parser takes this module's defaults
     if matrix.size == 0:
         return np.zeros((0, rhs.shape[1]), dtype=complex)
@@ -125,9 +129,13 @@ def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) 
         lu, pivots = sla.lu_factor(matrix, check_finite=False)
     norm = np.abs(matrix).sum(axis=0).max()
     diagonal = np.abs(np.diag(lu))
-    if not np.all(np.isfinite(lu)) or diagonal.min() <= SINGULAR_RCOND * max(norm, np.finfo(float).tiny):
+    mode = undamped_mode_near(frequency_hz, modes, RESONANCE_BAND)
+    if (mode is not None or not np.all(np.isfinite(lu))
+            or diagonal.min() <= SINGULAR_RCOND * max(norm, np.finfo(float).tiny)):
+        which = "" if mode is None else f", the mode at {mode.frequency_hz:.6g} Hz ({mode.description})"
         raise FourPoleError(f"the four-pole set is singular at {frequency_hz:g} Hz: {what} has no inverse "
-                            f"(an undamped resonance exactly at this frequency); move the frequency or add damping")
+                            f"(an undamped resonance exactly at this frequency{which}); move the frequency or add "
+                            "damping")
     return sla.lu_solve((lu, pivots), rhs, check_finite=False)
 
 
@@ -185,6 +193,10 @@ class FourPole:
         engine coordinate.
     engine_center : ndarray, shape (3,)
         The engine's centre of gravity, m.
+    modes : tuple of workbook.solve.modes.Mode
+        The modes of the engine on its mount on a rigid pylon (the scene the
+        set was formed from), whose undamped ones :meth:`respond` on a rigid
+        pylon refuses (empty: not known).
     """
 
     case_name: str
@@ -199,6 +211,7 @@ class FourPole:
     pin_kinematics: np.ndarray
     engine_center: np.ndarray
     _point_inputs: dict
+    modes: tuple = ()
 
     def _input(self, point) -> np.ndarray:
         """Generalised engine force of a unit force in x, y, z at *point*, shape (6, 3)."""
@@ -274,7 +287,7 @@ class FourPole:
         workbook.errors.CaseError
             Both *pylon* and *compliance*, or a compliance of the wrong shape.
         workbook.errors.FourPoleError
-            A singular matrix at a frequency.
+            A singular matrix at a frequency (on a rigid pylon: one on an undamped mode of :attr:`modes`).
         """
         source = self._input(point) @ np.asarray(force, dtype=complex)
         if compliance is not None:
@@ -287,7 +300,7 @@ class FourPole:
             k11, k12, k21, k22 = self.k11[j], self.k12[j], self.k21[j], self.k22[j]
             if pylon_matrix is None:
                 engine = _solve(self.engine_stiffness[j] + k11, source[:, None],
-                                "the engine on its mount on a rigid pylon", frequency)[:, 0]
+                                "the engine on its mount on a rigid pylon", frequency, self.modes)[:, 0]
                 pins = np.zeros(k21.shape[0], dtype=complex)
                 loads = -k21 @ engine
             else:
@@ -443,7 +456,7 @@ def _engine_first(basis: np.ndarray, engine: np.ndarray) -> np.ndarray:
     return np.hstack([rows.T, sla.null_space(rows)])
 
 
-def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
+def condense(model, case: Case, frequencies_hz, *, points=(), modes=()) -> FourPole:
     """The four-pole set of the mount of *case* at *frequencies_hz* from the
     harmonic model of its preloaded scene.
 
@@ -459,6 +472,8 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
         Excitation points of the engine (m) whose force inputs the set
         keeps for :meth:`FourPole.respond`; the case's excitation points and
         the centre of gravity are always kept.
+    modes : sequence of workbook.solve.modes.Mode
+        The modes of that scene (:attr:`FourPole.modes`).
 
     Raises
     ------
@@ -525,4 +540,4 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
             inputs[key] = jacobian(point).T
     return FourPole(case.name, frequencies, [" + ".join(carried) for _, carried in pins],
                     np.array([position for position, _ in pins]), k11, k12, k21, k22, own, kinematics, center,
-                    inputs)
+                    inputs, tuple(modes))
