@@ -84,10 +84,16 @@ def test_one_hinge_far_stiffer_than_the_rest_is_refused_where_round_off_swamps_t
     1e18 N/m 1.4 instead of 0.055, without a word. Up to 1e14 the answer
     agrees with 1e12 (an effectively rigid hinge) to 1 % (measured 0.6 %)."""
     rigidly = _frequency(_one_hinge(rigid, 1e12))
-    assert _frequency(_one_hinge(rigid, 1e14)).transmissibility == pytest.approx(rigidly.transmissibility,
-                                                                                rel=0.01)
+    stiff = _frequency(_one_hinge(rigid, 1e14))
+    assert stiff.transmissibility == pytest.approx(rigidly.transmissibility, rel=0.01)
     with pytest.raises(RoundOffError, match=r"1e\+16 N/m.*round-off on forces whose largest pylon amplitude"):
         _frequency(_one_hinge(rigid, 1e16))
+    # the four-pole set, condensed from the same linearisation, likewise (1e16 N/m: T_z 0.028 before)
+    force = excitation_phasor(LP_ROTOR)
+    poles = four_pole(_one_hinge(rigid, 1e14), [59.0]).transmissibility(force, LP_ROTOR.point)[0]
+    assert poles == pytest.approx(stiff.transmissibility, rel=1e-6)
+    with pytest.raises(RoundOffError, match=r"1e\+16 N/m"):
+        four_pole(_one_hinge(rigid, 1e16), [59.0]).transmissibility(force, LP_ROTOR.point)
 
 
 # --- 2. no damping ----------------------------------------------------------------------------------

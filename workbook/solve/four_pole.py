@@ -67,6 +67,7 @@ from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
 from workbook.scene.hinge_laws import law_of, nonlinear_hinges
 from workbook.solve.guards import RESONANCE_BAND, undamped_mode_near
+from workbook.solve.harmonic import RoundOff
 
 __all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
            "REPORT_GRID"]
@@ -197,6 +198,9 @@ class FourPole:
         The modes of the engine on its mount on a rigid pylon (the scene the
         set was formed from), whose undamped ones :meth:`respond` on a rigid
         pylon refuses (empty: not known).
+    roundoff : workbook.solve.harmonic.RoundOff or None
+        The round-off of the linearisation the set was condensed from; :meth:`respond` refuses an answer
+        it could swamp (None: not checked).
     """
 
     case_name: str
@@ -212,6 +216,7 @@ class FourPole:
     engine_center: np.ndarray
     _point_inputs: dict
     modes: tuple = ()
+    roundoff: RoundOff | None = None
 
     def _input(self, point) -> np.ndarray:
         """Generalised engine force of a unit force in x, y, z at *point*, shape (6, 3)."""
@@ -288,6 +293,8 @@ class FourPole:
             Both *pylon* and *compliance*, or a compliance of the wrong shape.
         workbook.errors.FourPoleError
             A singular matrix at a frequency (on a rigid pylon: one on an undamped mode of :attr:`modes`).
+        workbook.errors.RoundOffError
+            An answer the linearisation's round-off could swamp (:attr:`roundoff`).
         """
         source = self._input(point) @ np.asarray(force, dtype=complex)
         if compliance is not None:
@@ -309,8 +316,18 @@ class FourPole:
                                 "the engine on its mount on the pylon", frequency)[:, 0]
                 pins = -coupled @ engine
                 loads = pylon_matrix[j] @ pins
-            responses.append(PylonResponse(float(frequency), engine, pins.reshape(-1, 3), loads.reshape(-1, 3)))
+            responses.append(self._response(frequency, engine, pins, loads))
         return responses
+
+    def _response(self, frequency_hz: float, engine: np.ndarray, pins: np.ndarray, loads: np.ndarray
+                  ) -> PylonResponse:
+        """The response of engine motion *engine* (6), pin motions *pins* and pin forces *loads* (3 p each),
+        checked against the round-off (:attr:`roundoff`)."""
+        response = PylonResponse(float(frequency_hz), engine, pins.reshape(-1, 3), loads.reshape(-1, 3))
+        if self.roundoff is not None:
+            amplitude = max(float(np.abs(engine).max()), float(np.abs(pins).max(initial=0.0)))
+            self.roundoff.check(frequency_hz, amplitude, response.pylon_force)
+        return response
 
     def _compliance_matrix(self, compliance) -> np.ndarray:
         """*compliance* checked: finite, complex, shape (f, 3 p, 3 p)."""
@@ -332,8 +349,7 @@ class FourPole:
             engine = _solve(self.engine_stiffness[j] + self.k11[j] - self.k12[j] @ g @ coupled, source[:, None],
                             "the engine on its mount on the pylon", frequency)[:, 0]
             loads = -coupled @ engine
-            responses.append(PylonResponse(float(frequency), engine, (g @ loads).reshape(-1, 3),
-                                           loads.reshape(-1, 3)))
+            responses.append(self._response(frequency, engine, g @ loads, loads))
         return responses
 
     def transmissibility(self, force, point, pylon=None) -> np.ndarray:
@@ -540,4 +556,4 @@ def condense(model, case: Case, frequencies_hz, *, points=(), modes=()) -> FourP
             inputs[key] = jacobian(point).T
     return FourPole(case.name, frequencies, [" + ".join(carried) for _, carried in pins],
                     np.array([position for position, _ in pins]), k11, k12, k21, k22, own, kinematics, center,
-                    inputs, tuple(modes))
+                    inputs, tuple(modes), model.roundoff)
