@@ -360,6 +360,10 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
         else:
             item_runs = [run_excitation(case, excitation, reduce_for=points[-1], progress=progress, method=chosen)
                          for excitation in points]
+            if isinstance(item, Sweep):        # the modes as the frequency domain counts their damping
+                prepared = prepare(case, points[0], reduce_for=highest)
+                with prepared.scene:
+                    add_grid_warnings(item, item_runs, prepared.modes)
         runs += item_runs
     log.info("%s: %d runs", case.name, len(runs))
     return MountResult(case.name, runs)
