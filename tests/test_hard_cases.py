@@ -9,6 +9,7 @@ preload), they are flexible.
 """
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,13 +20,18 @@ from flexbodies.assembly import assemble
 from flexbodies.eigen import natural_frequencies
 from flexbodies.materials import Material
 from flexbodies.meshing import BodyMesh
-from workbook.errors import MechanismError, ResonanceError, SimulationError
-from workbook.model.case import HarmonicForce, Rotor
+from workbook.errors import FourPoleError, MechanismError, RecordError, ResonanceError, RoundOffError, SimulationError, UsageError
+from workbook.model.case import HarmonicForce, Rotor, Sweep
 from workbook.model.reference import HINGE_DAMPING_TIME, HP_ROTOR, LP_ROTOR, reference_case
+from workbook.rig.correlation import measure
+from workbook.rig.records import read_record
+from workbook.rig.updating import update_to_transmissibility
+from workbook.solve.campbell import campbell
 from workbook.solve.guards import singular_solve_guard
-from workbook.solve.method import choose_method
+from workbook.solve.harmonic import excitation_phasor
+from workbook.solve.method import TIME, MethodChoice, choose_method
 from workbook.solve.modes import FREE_FREQUENCY_HZ, modes_of, mounted_modes
-from workbook.solve.pipeline import prepare, run_case, run_excitation, solve_frequencies
+from workbook.solve.pipeline import four_pole, prepare, run_case, run_excitation, solve_frequencies
 
 
 @pytest.fixture(scope="module")
@@ -63,6 +69,33 @@ def test_hinge_stiffness_1e10_converges_and_matches_the_frequency_domain(rigid):
     assert fine.transmissibility == pytest.approx(linear.transmissibility, rel=5e-3)
 
 
+REFERENCE_RECORD = Path(__file__).parents[1] / "cases" / "reference-lp-rig.csv"
+
+
+def _one_hinge(case, stiffness):
+    return dataclasses.replace(case, hinges=(dataclasses.replace(case.hinges[0], stiffness=stiffness),
+                                             *case.hinges[1:]))
+
+
+def test_one_hinge_far_stiffer_than_the_rest_is_refused_where_round_off_swamps_the_answer(rigid):
+    """One hinge of 1e16 N/m beside 2e7: its force, known only to 3.8 N at
+    these coordinates, enters the central differences of the linearisation
+    over steps of 1e-7 and 1e-6; T was 0.028 instead of 0.055 (z, 59 Hz), at
+    1e18 N/m 1.4 instead of 0.055, without a word. Up to 1e14 the answer
+    agrees with 1e12 (an effectively rigid hinge) to 1 % (measured 0.6 %)."""
+    rigidly = _frequency(_one_hinge(rigid, 1e12))
+    stiff = _frequency(_one_hinge(rigid, 1e14))
+    assert stiff.transmissibility == pytest.approx(rigidly.transmissibility, rel=0.01)
+    with pytest.raises(RoundOffError, match=r"1e\+16 N/m.*round-off on forces whose largest pylon amplitude"):
+        _frequency(_one_hinge(rigid, 1e16))
+    # the four-pole set, condensed from the same linearisation, likewise (1e16 N/m: T_z 0.028 before)
+    force = excitation_phasor(LP_ROTOR)
+    poles = four_pole(_one_hinge(rigid, 1e14), [59.0]).transmissibility(force, LP_ROTOR.point)[0]
+    assert poles == pytest.approx(stiff.transmissibility, rel=1e-6)
+    with pytest.raises(RoundOffError, match=r"1e\+16 N/m"):
+        four_pole(_one_hinge(rigid, 1e16), [59.0]).transmissibility(force, LP_ROTOR.point)
+
+
 # --- 2. no damping ----------------------------------------------------------------------------------
 
 
@@ -76,6 +109,21 @@ def test_undamped_mount_at_a_mounted_resonance_stops_in_both_domains(rigid):
         _time(undamped, on_mode)
 
 
+def test_the_four_pole_set_of_an_undamped_mount_refuses_its_rigid_pylon_answer_on_a_mounted_mode(rigid):
+    """Loss factor 0: on the 4.72 Hz mounted mode the engine on its mount on a rigid pylon has no steady
+    state (before: T_y = 3.3e11 from a matrix singular but for round-off); at 59 Hz the set's T is the
+    full solve's."""
+    undamped = _hinges(rigid, loss_factor=0.0)
+    modes = mounted_modes(prepare(undamped, LP_ROTOR).modes)
+    poles = four_pole(undamped, [modes[0].frequency_hz, 59.0])
+    force = excitation_phasor(LP_ROTOR)
+    with pytest.raises(FourPoleError, match=r"singular at 4.72\d* Hz: the engine on its mount on a rigid pylon .*"
+                                            r"the mode at 4.72\d* Hz \(engine roll"):
+        poles.transmissibility(force, LP_ROTOR.point)
+    off = four_pole(undamped, [59.0]).transmissibility(force, LP_ROTOR.point)[0]
+    assert off == pytest.approx(_frequency(undamped).transmissibility, rel=1e-6)
+
+
 def test_undamped_mount_off_resonance_warns_and_agrees_with_the_frequency_domain(rigid):
     undamped = dataclasses.replace(rigid, effects=dataclasses.replace(rigid.effects, hinge_damping=False))
     result, linear = _time(undamped), _frequency(undamped)
@@ -83,6 +131,21 @@ def test_undamped_mount_off_resonance_warns_and_agrees_with_the_frequency_domain
     # the free vibration left by the ramp leaks little into the 59 Hz bin
     # (measured: x 0.4 %, z 0.2 %; the nearly cancelled lateral force is 3 % off)
     assert result.transmissibility[[0, 2]] == pytest.approx(linear.transmissibility[[0, 2]], rel=0.01)
+
+
+def test_a_time_domain_sweep_warns_where_its_grid_steps_over_a_mounted_mode(rigid):
+    """3 points from 3 to 30 Hz step over all six mounted modes (4.7 to 25.8 Hz): the frequency domain
+    warned, the time domain (a clearance scene, or asked for) said nothing. Now both warn alike."""
+    sweep = Sweep.band("coarse", LP_ROTOR, 3.0, 30.0, 3)
+    swept = dataclasses.replace(rigid, excitations=(sweep,))
+    timed = run_case(swept, method=MethodChoice(TIME, "asked for")).runs
+    linear = run_case(swept).runs
+    # the same answers (measured: within 3 %, the integrator's period error next to the modes)
+    assert np.array([r.transmissibility for r in timed]) == pytest.approx(
+        np.array([r.transmissibility for r in linear]), rel=0.05)
+    grid = [[w for w in run.warnings if "the grid steps over the peak" in w] for run in timed]
+    assert grid == [[w for w in run.warnings if "the grid steps over the peak" in w] for run in linear]
+    assert sum(len(warned) for warned in grid) == 6
 
 
 # --- 3. clearance, closed by the preload; impacting without it ------------------------------------------
@@ -235,6 +298,38 @@ def test_a_heavy_fast_rotor_is_no_mechanism_and_keeps_the_stiffness_determinant(
     # the slow backward whirl is a real mounted mode: listed, not dropped as if it were free
     assert mounted_modes(prepared.modes)[0].frequency_hz < FREE_FREQUENCY_HZ
     assert np.sum(np.log(whirl)) == pytest.approx(np.sum(np.log(still)), rel=1e-6)
+
+
+def test_a_campbell_diagram_to_an_extreme_speed_says_which_branch_it_loses(cache_dir):
+    """The reference rotors from 1e5 to 1e7 rpm: at 5e6 rpm the gyroscopic moment has slowed the
+    backward whirl (1.4 Hz at 1e5 rpm) below the 0.05 Hz the diagram follows, so one branch has no
+    continuation (before: an IndexError from an uninitialised index, or, when the garbage index
+    happened to lie in range, a branch silently continued by another mode)."""
+    case = reference_case(rotors=True, element_size=COARSE_ELEMENT_SIZE).with_rigid_links()
+    with pytest.raises(SimulationError, match=r"cannot follow the branch of engine yaw.*at 1\.40\d Hz at 100000 "
+                                              r"rpm\) to 5\.05e\+06 rpm"):
+        campbell(case, start_rpm=1e5, stop_rpm=1e7, points=3)
+
+
+@pytest.mark.parametrize("excitation", [0.0, 5.0, "noise"], ids=["zero", "constant", "noise only"])
+def test_a_rig_record_without_an_excitation_to_divide_by_is_refused(excitation):
+    """The reference rig record measures T_x 0.0351 (its simulation: 0.03511); with its excitation
+    channels at zero, constant, or holding noise alone, T was NaN, infinite, 2.8e15 or noise, exit 0."""
+    record = read_record(REFERENCE_RECORD)
+    assert measure(record, 20).transmissibility[0] == pytest.approx(0.03511, rel=0.01)
+    signal = (np.random.default_rng(0).normal(0.0, 10.0, record.excitation.shape) if excitation == "noise"
+              else np.full(record.excitation.shape, excitation))
+    with pytest.raises(RecordError, match="no excitation at the rotor frequency to divide by"):
+        measure(dataclasses.replace(record, excitation=signal), 20)
+
+
+def test_updating_to_a_measured_t_of_zero_or_nan_is_refused_naming_it(rigid):
+    """The fit compares ln T: a record whose pylon channels are dead measures T = 0 (before: an internal
+    error, "Residuals are not finite in the initial point")."""
+    measured = [[0.035, 0.0004, 0.017], [0.0, 0.0016, math.nan]]
+    with pytest.raises(UsageError, match=r"measured dead T x = 0, dead T z = nan: the fit compares ln T"):
+        update_to_transmissibility(rigid, ["LP rotor", "HP rotor"], measured, {"hinge_stiffness": (1e6, 1e8)},
+                                   labels=["good", "dead"])
 
 
 # --- 10. an undamped link mode -------------------------------------------------------------------------------

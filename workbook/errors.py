@@ -30,7 +30,8 @@ from typing import Any
 __all__ = ["MountwbError", "InputError", "CaseFileError", "UnwritableCase",
            "CaseError", "UnitProblem", "Problem", "WorkbookError", "TableError", "RecordError", "SimulationError",
            "NewtonFailure", "DivergenceError", "TimeBudgetExceeded", "ResonanceError", "RunTooLong",
-           "MechanismError", "EquilibriumError", "FourPoleError", "OutsideDesignModel", "UnstablePreloadError", "BucklingError", "UsageError",
+           "MechanismError", "EquilibriumError", "RoundOffError",
+           "FourPoleError", "OutsideDesignModel", "UnstablePreloadError", "BucklingError", "UsageError",
            "InfeasibleProblem",
            "BAD_INPUT",
            "EXIT_OK", "EXIT_TROUBLE", "EXIT_BAD_INPUT",
@@ -232,6 +233,12 @@ class TimeBudgetExceeded(SimulationError):
 
 class ResonanceError(SimulationError):
     """The excitation frequency coincides with an undamped mounted mode."""
+
+
+class RoundOffError(SimulationError):
+    """An answer the round-off of the computation could have changed by a
+    large share of itself: a stiffness so large against the rest of the
+    mount that double precision cannot resolve its small motions."""
 
 
 class RunTooLong(SimulationError):

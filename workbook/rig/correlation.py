@@ -38,7 +38,7 @@ from workbook.model.case import DIRECTIONS
 from workbook.rig.records import RigRecord
 
 __all__ = ["Measurement", "measure", "peak_frequency", "force_amplitude", "comparison_frame",
-           "MIN_SAMPLES_PER_PERIOD", "PEAK_SEARCH"]
+           "MIN_SAMPLES_PER_PERIOD", "PEAK_SEARCH", "MIN_EXCITATION_SHARE", "MIN_EXCITATION_RESOLUTION"]
 
 log = logging.getLogger(__name__)
 
@@ -46,6 +46,11 @@ log = logging.getLogger(__name__)
 MIN_SAMPLES_PER_PERIOD = 10
 #: The peak is searched within this fraction of the nominal frequency.
 PEAK_SEARCH = 0.02
+#: Least share of the excitation channels' fluctuation (sqrt(2) times their RMS about the mean: the
+#: amplitude of a pure sinusoid) that ``|F_exc|`` at the rotor frequency must carry.
+MIN_EXCITATION_SHARE = 0.1
+#: ... and of their largest absolute value (a constant channel fluctuates by its round-off alone).
+MIN_EXCITATION_RESOLUTION = 1e-6
 
 
 @dataclass(frozen=True)
@@ -148,8 +153,9 @@ def measure(record: RigRecord, periods: int, *, nominal_hz: float | None = None,
     Raises
     ------
     RecordError
-        Sampled too coarsely for the rotor frequency, or too short for two
-        windows of *periods* periods.
+        Sampled too coarsely for the rotor frequency, too short for two
+        windows of *periods* periods, or without an excitation at the rotor
+        frequency to divide by (:data:`MIN_EXCITATION_SHARE`, :data:`MIN_EXCITATION_RESOLUTION`).
     """
     nominal = record.nominal_hz if nominal_hz is None else nominal_hz
     per_period = record.sample_rate_hz / nominal
@@ -175,6 +181,13 @@ def measure(record: RigRecord, periods: int, *, nominal_hz: float | None = None,
     # DFT would take in the negative-frequency image by an amount that depends on each channel's phase
     phasors = harmonic_amplitudes(record.time[window], signals[window], [frequency])[0]
     excitation = force_amplitude(phasors[3:6])
+    fluctuation = float(np.sqrt(2 * np.sum(np.var(record.excitation[window], axis=0))))
+    largest = float(np.abs(record.excitation[window]).max())
+    if not excitation > max(MIN_EXCITATION_SHARE * fluctuation, MIN_EXCITATION_RESOLUTION * largest):
+        raise RecordError(record.path, f"no excitation at the rotor frequency to divide by: |F_exc| at "
+                          f"{frequency:.6g} Hz is {excitation:.3g} N, against {fluctuation:.3g} N of fluctuation "
+                          f"(at least {MIN_EXCITATION_SHARE:g} of it needed) and values up to {largest:.3g} N in the "
+                          "excitation channels; check that they are connected, scaled and recorded")
     amplitudes = np.abs(phasors)
     log.info("%s: rotor at %.4f Hz (nominal %g Hz), windows differ by %.2f %%", record.run, frequency, nominal,
              100 * steady.relative_change)

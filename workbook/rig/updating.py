@@ -346,6 +346,12 @@ def update_to_transmissibility(case: Case, runs: list, measured: np.ndarray, var
         raise UsageError(f"run(s) {', '.join(unknown)} not in case {case.name!r}; it has {', '.join(case_runs)}")
     measured = np.asarray(measured, dtype=float).reshape(len(runs), 3)
     labels = list(runs) if labels is None else list(labels)
+    unusable = [f"{labels[i]} T {DIRECTIONS[d]} = {measured[i, d]:g}"
+                for i, d in zip(*np.nonzero(~(measured > 0) | ~np.isfinite(measured)), strict=True)]
+    if unusable:
+        raise UsageError(f"model updating: measured {', '.join(unusable)}: the fit compares ln T, so every "
+                         "measured T must be finite and above 0 (a direction whose pylon channels carry no force at "
+                         "the rotor frequency cannot be fitted: check those transducers)")
     if 3 * len(runs) <= len(names):
         raise UsageError(f"{len(runs)} record(s) give {3 * len(runs)} values of T for {len(names)} "
                          "parameters: the fit needs more values than parameters (more records, or fewer --vary)")

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from workbook.errors import CaseError
+from workbook.errors import CaseError, SimulationError
 from workbook.model.case import ENGINE, Case, HarmonicForce, Imbalance, RotatingForce
 from workbook.solve.modes import FREE_FREQUENCY_HZ, Linearization, Mode, eigenpairs, modes_from
 
@@ -317,13 +317,25 @@ class _Spectrum:
 
 
 def _follow(previous: np.ndarray, current: _Speed, mass: np.ndarray) -> np.ndarray:
-    """Index of the current candidate that continues each previous branch (one-to-one, largest MAC)."""
+    """Index of the current candidate that continues each previous branch (one-to-one, largest MAC);
+    -1 for a branch without one (fewer candidates than branches)."""
     from scipy.optimize import linear_sum_assignment
 
     rows, columns = linear_sum_assignment(-_mac(previous, current.vectors, mass))
-    order = np.empty(previous.shape[1], dtype=int)
+    order = np.full(previous.shape[1], -1)
     order[rows] = columns
     return order
+
+
+def _lost_branch(case: Case, spectrum: _Spectrum, description: str, last_hz: float, speeds: np.ndarray,
+                 k: int) -> SimulationError:
+    """The error for a branch that no candidate mode at ``speeds[k]`` (rpm) continues."""
+    return SimulationError(
+        f"case {case.name!r}: the Campbell diagram cannot follow the branch of {description} (at {last_hz:.4g} Hz "
+        f"at {speeds[k - 1]:.6g} rpm) to {speeds[k]:.6g} rpm: no mode between {FREE_FREQUENCY_HZ:g} Hz and "
+        f"{spectrum.limit:.4g} Hz continues it there (the gyroscopic moment, growing with the speed, slows a "
+        f"backward whirl towards 0 Hz and speeds a forward whirl up). Narrow the speed range, or raise the "
+        f"highest frequency shown")
 
 
 def campbell(case: Case, *, rotor: str | None = None, start_rpm: float = 0.0, stop_rpm: float | None = None,
@@ -437,6 +449,10 @@ def _trace(case: Case, spectrum: _Spectrum, reference: SpinningRotor, rotors: tu
     for k, s in enumerate(fractions):
         current = first if k == 0 or flat else spectrum.at(s)
         pick = np.array(branches) if k == 0 or flat else _follow(vectors, current, mass)
+        if (pick < 0).any():
+            lost = int(np.flatnonzero(pick < 0)[0])
+            raise _lost_branch(case, spectrum, first.modes[branches[lost]].description, frequencies[lost, k - 1],
+                               speeds, k)
         vectors = current.vectors[:, pick]
         states.append(vectors)
         for b, index in enumerate(pick):

@@ -66,6 +66,8 @@ from workbook._renamed import renamed
 from workbook.errors import CaseError, FourPoleError
 from workbook.model.case import DIRECTIONS, ENGINE, Case
 from workbook.scene.hinge_laws import law_of, nonlinear_hinges
+from workbook.solve.guards import RESONANCE_BAND, undamped_mode_near
+from workbook.solve.harmonic import RoundOff
 
 __all__ = ["FourPole", "PylonResponse", "checked_frequencies", "condense", "mount_case", "frequency_grid", "QUANTITIES",
            "REPORT_GRID"]
@@ -115,8 +117,11 @@ def checked_frequencies(frequencies_hz) -> np.ndarray:
     return frequencies
 
 
-def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) -> np.ndarray:
-    """``matrix^-1 rhs``, or a FourPoleError naming *what* is singular at *frequency_hz*."""
+def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float, modes=()) -> np.ndarray:
+    """``matrix^-1 rhs``, or a FourPoleError naming *what* is singular at *frequency_hz*: its pivots
+    vanish, or *frequency_hz* lies on one of *modes* (*what*'s own) that is undamped
+    (:func:`~workbook.solve.guards.undamped_mode_near`, :data:`~workbook.solve.guards.RESONANCE_BAND`),
+    where round-off alone keeps the pivots apart from zero (T of 3e11 on the reference mount)."""
     import scipy.linalg as sla  # here: the command line's parser takes this module's defaults
     if matrix.size == 0:
         return np.zeros((0, rhs.shape[1]), dtype=complex)
@@ -125,9 +130,13 @@ def _solve(matrix: np.ndarray, rhs: np.ndarray, what: str, frequency_hz: float) 
         lu, pivots = sla.lu_factor(matrix, check_finite=False)
     norm = np.abs(matrix).sum(axis=0).max()
     diagonal = np.abs(np.diag(lu))
-    if not np.all(np.isfinite(lu)) or diagonal.min() <= SINGULAR_RCOND * max(norm, np.finfo(float).tiny):
+    mode = undamped_mode_near(frequency_hz, modes, RESONANCE_BAND)
+    if (mode is not None or not np.all(np.isfinite(lu))
+            or diagonal.min() <= SINGULAR_RCOND * max(norm, np.finfo(float).tiny)):
+        which = "" if mode is None else f", the mode at {mode.frequency_hz:.6g} Hz ({mode.description})"
         raise FourPoleError(f"the four-pole set is singular at {frequency_hz:g} Hz: {what} has no inverse "
-                            f"(an undamped resonance exactly at this frequency); move the frequency or add damping")
+                            f"(an undamped resonance exactly at this frequency{which}); move the frequency or add "
+                            "damping")
     return sla.lu_solve((lu, pivots), rhs, check_finite=False)
 
 
@@ -185,6 +194,13 @@ class FourPole:
         engine coordinate.
     engine_center : ndarray, shape (3,)
         The engine's centre of gravity, m.
+    modes : tuple of workbook.solve.modes.Mode
+        The modes of the engine on its mount on a rigid pylon (the scene the
+        set was formed from), whose undamped ones :meth:`respond` on a rigid
+        pylon refuses (empty: not known).
+    roundoff : workbook.solve.harmonic.RoundOff or None
+        The round-off of the linearisation the set was condensed from; :meth:`respond` refuses an answer
+        it could swamp (None: not checked).
     """
 
     case_name: str
@@ -199,6 +215,8 @@ class FourPole:
     pin_kinematics: np.ndarray
     engine_center: np.ndarray
     _point_inputs: dict
+    modes: tuple = ()
+    roundoff: RoundOff | None = None
 
     def _input(self, point) -> np.ndarray:
         """Generalised engine force of a unit force in x, y, z at *point*, shape (6, 3)."""
@@ -274,7 +292,9 @@ class FourPole:
         workbook.errors.CaseError
             Both *pylon* and *compliance*, or a compliance of the wrong shape.
         workbook.errors.FourPoleError
-            A singular matrix at a frequency.
+            A singular matrix at a frequency (on a rigid pylon: one on an undamped mode of :attr:`modes`).
+        workbook.errors.RoundOffError
+            An answer the linearisation's round-off could swamp (:attr:`roundoff`).
         """
         source = self._input(point) @ np.asarray(force, dtype=complex)
         if compliance is not None:
@@ -287,7 +307,7 @@ class FourPole:
             k11, k12, k21, k22 = self.k11[j], self.k12[j], self.k21[j], self.k22[j]
             if pylon_matrix is None:
                 engine = _solve(self.engine_stiffness[j] + k11, source[:, None],
-                                "the engine on its mount on a rigid pylon", frequency)[:, 0]
+                                "the engine on its mount on a rigid pylon", frequency, self.modes)[:, 0]
                 pins = np.zeros(k21.shape[0], dtype=complex)
                 loads = -k21 @ engine
             else:
@@ -296,8 +316,18 @@ class FourPole:
                                 "the engine on its mount on the pylon", frequency)[:, 0]
                 pins = -coupled @ engine
                 loads = pylon_matrix[j] @ pins
-            responses.append(PylonResponse(float(frequency), engine, pins.reshape(-1, 3), loads.reshape(-1, 3)))
+            responses.append(self._response(frequency, engine, pins, loads))
         return responses
+
+    def _response(self, frequency_hz: float, engine: np.ndarray, pins: np.ndarray, loads: np.ndarray
+                  ) -> PylonResponse:
+        """The response of engine motion *engine* (6), pin motions *pins* and pin forces *loads* (3 p each),
+        checked against the round-off (:attr:`roundoff`)."""
+        response = PylonResponse(float(frequency_hz), engine, pins.reshape(-1, 3), loads.reshape(-1, 3))
+        if self.roundoff is not None:
+            amplitude = max(float(np.abs(engine).max()), float(np.abs(pins).max(initial=0.0)))
+            self.roundoff.check(frequency_hz, amplitude, response.pylon_force)
+        return response
 
     def _compliance_matrix(self, compliance) -> np.ndarray:
         """*compliance* checked: finite, complex, shape (f, 3 p, 3 p)."""
@@ -319,8 +349,7 @@ class FourPole:
             engine = _solve(self.engine_stiffness[j] + self.k11[j] - self.k12[j] @ g @ coupled, source[:, None],
                             "the engine on its mount on the pylon", frequency)[:, 0]
             loads = -coupled @ engine
-            responses.append(PylonResponse(float(frequency), engine, (g @ loads).reshape(-1, 3),
-                                           loads.reshape(-1, 3)))
+            responses.append(self._response(frequency, engine, g @ loads, loads))
         return responses
 
     def transmissibility(self, force, point, pylon=None) -> np.ndarray:
@@ -443,7 +472,7 @@ def _engine_first(basis: np.ndarray, engine: np.ndarray) -> np.ndarray:
     return np.hstack([rows.T, sla.null_space(rows)])
 
 
-def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
+def condense(model, case: Case, frequencies_hz, *, points=(), modes=()) -> FourPole:
     """The four-pole set of the mount of *case* at *frequencies_hz* from the
     harmonic model of its preloaded scene.
 
@@ -459,6 +488,8 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
         Excitation points of the engine (m) whose force inputs the set
         keeps for :meth:`FourPole.respond`; the case's excitation points and
         the centre of gravity are always kept.
+    modes : sequence of workbook.solve.modes.Mode
+        The modes of that scene (:attr:`FourPole.modes`).
 
     Raises
     ------
@@ -525,4 +556,4 @@ def condense(model, case: Case, frequencies_hz, *, points=()) -> FourPole:
             inputs[key] = jacobian(point).T
     return FourPole(case.name, frequencies, [" + ".join(carried) for _, carried in pins],
                     np.array([position for position, _ in pins]), k11, k12, k21, k22, own, kinematics, center,
-                    inputs)
+                    inputs, tuple(modes), model.roundoff)

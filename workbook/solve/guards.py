@@ -31,14 +31,17 @@ import numpy as np
 
 from workbook.errors import ResonanceError
 
-__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "singular_solve_guard", "checked_solve",
-           "RoundOffWarning", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS"]
+__all__ = ["run_label", "newton_cause", "check_undamped_resonance", "undamped_mode_near", "singular_solve_guard", "checked_solve",
+           "RoundOffWarning", "solver_output", "UNDAMPED_RATIO", "MAX_STEPS", "RESONANCE_BAND"]
 
 log = logging.getLogger(__name__)
 
 #: A mounted mode with a damping ratio below this counts as undamped (the
 #: linearisation of a scene without damping gives ratios of about 1e-15).
 UNDAMPED_RATIO = 1e-6
+#: Relative distance from an undamped mode at which a harmonic solution
+#: is refused (the dynamic matrix is singular on the mode).
+RESONANCE_BAND = 1e-6
 #: Planned time steps above which a run is refused as not meant (about a day
 #: of wall time for the reference mount with flexible links).
 MAX_STEPS = 50_000_000
@@ -126,15 +129,21 @@ def check_undamped_resonance(where: str, frequency_hz: float, modes, band: float
     ------
     ResonanceError
     """
-    for mode in modes:
-        if (mode.frequency_hz > 0 and mode.damping_ratio < UNDAMPED_RATIO
-                and abs(frequency_hz / mode.frequency_hz - 1.0) < band):
-            kind = "mounted mode" if mode.mounted else "mode"
-            raise ResonanceError(
-                f"{where}: the excitation at {frequency_hz:.6g} Hz is within {100 * band:.3g} % of the undamped "
-                f"{kind} at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
-                f"{mode.damping_ratio:.1e}): {consequence}. Give the hinges or links damping, or move the "
-                f"excitation frequency.")
+    mode = undamped_mode_near(frequency_hz, modes, band)
+    if mode is not None:
+        kind = "mounted mode" if mode.mounted else "mode"
+        raise ResonanceError(
+            f"{where}: the excitation at {frequency_hz:.6g} Hz is within {100 * band:.3g} % of the undamped "
+            f"{kind} at {mode.frequency_hz:.6g} Hz ({mode.description}; damping ratio "
+            f"{mode.damping_ratio:.1e}): {consequence}. Give the hinges or links damping, or move the "
+            f"excitation frequency.")
+
+
+def undamped_mode_near(frequency_hz: float, modes, band: float):
+    """The first of *modes* that is undamped (damping ratio below :data:`UNDAMPED_RATIO`) and lies within
+    *band* (relative, ``|f / f_n - 1|``) of *frequency_hz* (Hz), or None."""
+    return next((mode for mode in modes if mode.frequency_hz > 0 and mode.damping_ratio < UNDAMPED_RATIO
+                 and abs(frequency_hz / mode.frequency_hz - 1.0) < band), None)
 
 
 def checked_solve(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:

@@ -42,13 +42,16 @@ import numpy as np
 
 from workbook.answers.isolation import pylon_sum
 from workbook.answers.results import ExcitationResult
+from workbook.errors import RoundOffError
 from workbook.model.case import ENGINE, SingleFrequencyExcitation
 from workbook.scene.build import Scene, loss_factors
 from workbook.solve.guards import checked_solve
-from workbook.solve.modes import Linearization, linearize
+from workbook.solve.modes import STIFFNESS_STEP, Linearization, linearize
+from workbook.solve.preload import ROUNDOFF_MARGIN, spring_roundoff_force, stiffest_spring
 from workbook.solve.truncation import residual_stiffness
 
-__all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "point_phasors", "FrequencyResponse"]
+__all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "point_phasors", "FrequencyResponse",
+           "RoundOff", "ROUNDOFF_SHARE"]
 
 log = logging.getLogger(__name__)
 
@@ -56,6 +59,10 @@ log = logging.getLogger(__name__)
 #: modal coordinates: all of order 1 or below), and velocity step (m/s, ...).
 COORDINATE_STEP = 1e-7
 VELOCITY_STEP = 1e-3
+#: Largest share of the pylon force amplitude that the round-off of the
+#: central differences may reach (:meth:`RoundOff.check`, a bound 10 to 100
+#: times above the error measured on the reference mount).
+ROUNDOFF_SHARE = 0.25
 
 
 def point_phasors(excitation: SingleFrequencyExcitation) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -70,6 +77,52 @@ def excitation_phasor(excitation: SingleFrequencyExcitation) -> np.ndarray:
     """Complex force amplitude ``f_hat`` with ``F(t) = Re(f_hat exp(i w t))``, N, shape (3,)
     (of an imbalance of several planes: their resultant)."""
     return sum((phasor for _, phasor in point_phasors(excitation)), np.zeros(3, dtype=complex))
+
+
+@dataclass(frozen=True)
+class RoundOff:
+    """The round-off that the central differences of a linearisation carry.
+
+    Attributes
+    ----------
+    case_name : str
+        For the messages.
+    stiffest_spring : float
+        The stiffest spring of the scene (hinge, rig transducer or engine bearing), N/m.
+    force : float
+        Round-off of that spring's force at the scene's coordinates
+        (:func:`~workbook.solve.preload.spring_roundoff_force` without its margin), N.
+    """
+
+    case_name: str
+    stiffest_spring: float
+    force: float
+
+    @property
+    def stiffness(self) -> float:
+        """Bound of the round-off of an entry of K or of the force outputs, N/m: the force round-off
+        over the outputs' coordinate step (twice it) and over K's."""
+        return self.force * (1 / (2 * COORDINATE_STEP) + 1 / STIFFNESS_STEP)
+
+    def check(self, frequency_hz: float, amplitude: float, pylon_force: np.ndarray) -> None:
+        """Refuse an answer whose round-off bound, :attr:`stiffness` times the largest coordinate
+        amplitude *amplitude* (m, rad, ...), reaches :data:`ROUNDOFF_SHARE` of the largest amplitude of
+        *pylon_force* (N, complex, shape (3,)).
+
+        Raises
+        ------
+        RoundOffError
+        """
+        noise, largest = self.stiffness * amplitude, float(np.abs(pylon_force).max())
+        if not noise < ROUNDOFF_SHARE * largest:
+            raise RoundOffError(
+                f"case {self.case_name!r}: the frequency-domain answer at {frequency_hz:.6g} Hz cannot be "
+                f"trusted: the stiffest spring has {self.stiffest_spring:.3g} N/m, so its force is known only to "
+                f"{self.force:.2g} N at these coordinates, and the linearisation's central differences "
+                f"(coordinate steps {COORDINATE_STEP:g} and {STIFFNESS_STEP:g}) turn that into up to {noise:.3g} N "
+                f"of round-off on forces whose largest pylon amplitude is {largest:.3g} N. Lower the stiffest "
+                f"stiffness: a hinge far stiffer than the link it holds acts as rigid anyway (on the reference "
+                f"mount 1e12 N/m gives the same answer to 1e-3)")
 
 
 @dataclass(frozen=True)
@@ -120,6 +173,8 @@ class HarmonicModel:
     link_coordinates : dict of str to slice
         The elastic (modal) coordinates of each flexible link among the full
         coordinates: its modal coordinates are ``basis[rows] @ z``.
+    roundoff : RoundOff or None
+        The round-off its central differences carry (None: not known, not checked).
     """
 
     linearization: Linearization
@@ -131,6 +186,7 @@ class HarmonicModel:
     structural_output: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # None: zeros
     residual_mass: np.ndarray | None = field(default=None, repr=False)
     link_coordinates: dict = field(default_factory=dict, repr=False)
+    roundoff: RoundOff | None = None
     _inputs: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
@@ -182,11 +238,20 @@ class HarmonicModel:
         return {name: basis[rows] @ motion for name, rows in self.link_coordinates.items()}
 
     def _forces(self, frequency_hz: float, motion: np.ndarray) -> FrequencyResponse:
+        """The channel forces of *motion*.
+
+        Raises
+        ------
+        RoundOffError
+            :meth:`RoundOff.check`.
+        """
         omega = 2 * np.pi * frequency_hz
         outputs = self.stiffness_output + 1j * (self.structural_output + omega * self.damping_output)
         forces = (outputs @ motion).reshape(-1, 3)
         hinges = dict(zip(self.hinge_names, forces, strict=True))
         pylon = pylon_sum(hinges, self.pylon_hinges)
+        if self.roundoff is not None:
+            self.roundoff.check(frequency_hz, float(np.abs(self.linearization.basis @ motion).max()), pylon)
         return FrequencyResponse(frequency_hz, hinges, pylon)
 
     def result(self, excitation: SingleFrequencyExcitation, steady_tolerance: float) -> ExcitationResult:
@@ -271,8 +336,9 @@ def harmonic_model(scene: Scene) -> HarmonicModel:
              for name, items in scene.links.items() if items.flexible}
     log.info("harmonic model of %r: %d independent coordinates, %d force channels", scene.case.name,
              lin.mass.shape[0], len(names))
+    roundoff = RoundOff(scene.case.name, stiffest_spring(scene), spring_roundoff_force(scene) / ROUNDOFF_MARGIN)
     return HarmonicModel(lin, names, list(scene.pylon_channels), stiffness, damping, point_jacobian,
-                         structural_output, residual_stiffness(scene, lin.basis), links)
+                         structural_output, residual_stiffness(scene, lin.basis), links, roundoff)
 
 
 def _structural_damping(scene: Scene, lin: Linearization, stiffness_output: np.ndarray, names: list,

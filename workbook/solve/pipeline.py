@@ -36,7 +36,7 @@ from workbook.scene.build import Scene, build_scene, reduce_links
 from workbook.scene.hinge_laws import nonlinear_hinges
 from workbook.solve.flexible_pylon import pylon_at, refuse_time_domain, solve_on_pylon
 from workbook.solve.four_pole import REPORT_GRID, FourPole, checked_frequencies, condense, frequency_grid, mount_case
-from workbook.solve.guards import check_undamped_resonance, run_label, singular_solve_guard
+from workbook.solve.guards import RESONANCE_BAND, check_undamped_resonance, run_label, singular_solve_guard
 from workbook.solve.harmonic import COORDINATE_STEP, VELOCITY_STEP, HarmonicModel, harmonic_model
 from workbook.solve.method import FREQUENCY, TIME, MethodChoice, choose_method
 from workbook.solve.modes import STIFFNESS_STEP, Mode, linearize, modes_of, mounted_modes
@@ -50,13 +50,10 @@ from workbook.solve.time_domain import TimeHistories, extract, integrate, plan_r
 from workbook.solve.truncation import describe_truncation, truncation_error
 
 __all__ = ["PreparedScene", "prepare", "run_excitation", "run_in_time", "solve_frequencies", "run_case",
-           "four_pole", "report_four_pole", "RESONANCE_BAND"]
+           "four_pole", "report_four_pole"]
 
 log = logging.getLogger(__name__)
 
-#: Relative distance from an undamped mode at which the harmonic
-#: solution is refused (the dynamic matrix is singular on the mode).
-RESONANCE_BAND = 1e-6
 
 
 @dataclasses.dataclass
@@ -363,6 +360,10 @@ def run_case(case: Case, *, progress: ProgressFactory | None = None,
         else:
             item_runs = [run_excitation(case, excitation, reduce_for=points[-1], progress=progress, method=chosen)
                          for excitation in points]
+            if isinstance(item, Sweep):        # the modes as the frequency domain counts their damping
+                prepared = prepare(case, points[0], reduce_for=highest)
+                with prepared.scene:
+                    add_grid_warnings(item, item_runs, prepared.modes)
         runs += item_runs
     log.info("%s: %d runs", case.name, len(runs))
     return MountResult(case.name, runs)
@@ -394,7 +395,7 @@ def four_pole(case: Case, frequencies_hz, *, points=()) -> FourPole:
                           amplitude=1.0, frequency_hz=float(frequencies.max()))
     prepared = prepare(mount_case(case), probe)
     with prepared.scene:
-        return condense(prepared.model, case, frequencies, points=points)
+        return condense(prepared.model, case, frequencies, points=points, modes=prepared.modes)
 
 
 def report_four_pole(case: Case) -> FourPole:

@@ -49,7 +49,7 @@ from workbook.solve.modes import FREE_FREQUENCY_HZ, Mode, free_motions, lineariz
 
 __all__ = ["Preload", "applied_static_force", "check_mechanism", "check_preloaded_stability", "link_compression",
            "static_failure_message", "LOAD_STEPS",
-           "check_equilibrium", "solve_preload", "spring_roundoff_force", "ROUNDOFF_MARGIN",
+           "check_equilibrium", "solve_preload", "spring_roundoff_force", "stiffest_spring", "ROUNDOFF_MARGIN",
            "geometry_roundoff_force", "GEOMETRY_PRECISION"]
 
 log = logging.getLogger(__name__)
@@ -147,17 +147,9 @@ def applied_static_force(scene: Scene) -> np.ndarray:
     return total
 
 
-def spring_roundoff_force(scene: Scene) -> float:
-    """Force the static Newton iteration can resolve on the stiffest spring, N.
-
-    A spring force ``k (p1 - p0)`` is computed from positions of size
-    ``|p|``, known to the machine epsilon ``eps``: its round-off is
-    ``k eps |p|``, which a Newton tolerance must not undercut (a 1e12 N/m
-    transducer 1.7 m from the origin: 4e-4 N, ten times the default
-    tolerance on the reference mount). The springs are the hinges, the
-    rig's transducers and a flexible engine's bearings. Returned with a margin of
-    :data:`ROUNDOFF_MARGIN`.
-    """
+def stiffest_spring(scene: Scene) -> float:
+    """The largest stiffness of the scene's springs: the hinges, the rig's
+    transducers and a flexible engine's bearings, N/m."""
     case = scene.case
     stiffness = [h.largest_stiffness for h in case.hinges]
     if scene.transducers:
@@ -165,8 +157,21 @@ def spring_roundoff_force(scene: Scene) -> float:
         stiffness += list(case.test_rig.stiffness)
     if case.engine.casing is not None:
         stiffness += list(case.engine.casing.bearing_stiffness)
-    reach = max((float(np.abs(h.position).max()) for h in case.hinges), default=0.0)
-    return ROUNDOFF_MARGIN * max(stiffness, default=0.0) * np.finfo(float).eps * max(reach, 1.0)
+    return max(stiffness, default=0.0)
+
+
+def spring_roundoff_force(scene: Scene) -> float:
+    """Force the static Newton iteration can resolve on the stiffest spring (:func:`stiffest_spring`), N.
+
+    A spring force ``k (p1 - p0)`` is computed from positions of size
+    ``|p|``, known to the machine epsilon ``eps``: its round-off is
+    ``k eps |p|``, which a Newton tolerance must not undercut (a 1e12 N/m
+    transducer 1.7 m from the origin: 4e-4 N, ten times the default
+    tolerance on the reference mount). Returned with a margin of
+    :data:`ROUNDOFF_MARGIN`.
+    """
+    reach = max((float(np.abs(h.position).max()) for h in scene.case.hinges), default=0.0)
+    return ROUNDOFF_MARGIN * stiffest_spring(scene) * np.finfo(float).eps * max(reach, 1.0)
 
 
 def geometry_roundoff_force(scene: Scene) -> float:
