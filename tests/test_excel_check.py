@@ -9,6 +9,7 @@ import zipfile
 import pytest
 from excel_helpers import REFERENCE, TEMPLATE, column_of, compound_file, copy_reference, give_cached_value, set_cells, sha256
 from openpyxl import load_workbook
+from openpyxl.chart import BarChart, Reference
 
 from workbook.cli.main import main
 from workbook.errors import UnitProblem, WorkbookError
@@ -287,6 +288,30 @@ def _no_pylon(wb):
                 ws.cell(row, col).value = "engine"
 
 
+def _chart_sheet_named_runs(wb):
+    """A chart sheet named 'Runs' in place of the Runs sheet."""
+    chart = BarChart()
+    chart.add_data(Reference(wb["Hinges"], min_col=7, min_row=3, max_row=18))
+    index = wb.sheetnames.index("Runs")
+    wb.remove(wb["Runs"])
+    wb.create_chartsheet("Runs", index).add_chart(chart)
+
+
+def _cleared_header(wb):
+    """The header of the optional column 'stiffness axial' cleared, its value in row 4 kept."""
+    ws = wb["Hinges"]
+    col = column_of(ws, "stiffness axial")
+    ws.cell(1, col).value = None
+    ws.cell(4, col).value = 5e7
+
+
+def _values_beside_the_table(wb):
+    ws = wb["Links"]
+    col = ws.max_column + 2
+    for row in (3, 5, 6):
+        ws.cell(row, col, "spare part")
+
+
 BAD_INPUTS = {
     "missing sheet": (_edit_wb(lambda wb: wb.remove(wb["Hinges"])), ["sheet 'Hinges'"]),
     "missing column": (_edit_wb(lambda wb: wb["Hinges"].delete_cols(column_of(wb["Hinges"], "stiffness"))),
@@ -416,6 +441,14 @@ BAD_INPUTS = {
                                   ["sheet 'Case'", "column 'start'", "sometimes", "steady"]),
     "negative element size": (_edit({("Links", "element size", 4): -1}),
                               ["sheet 'Links'", "cell R4", "column 'element size'", "found -1", "a mesh size > 0"]),
+    "a chart sheet named Runs": (_edit_wb(_chart_sheet_named_runs),
+                                 ["sheet 'Runs'", "found 'a chart sheet'", "a sheet of cells named 'Runs'"]),
+    "a value under a cleared header": (_edit_wb(_cleared_header),
+                                       ["sheet 'Hinges'", "cell M4", "found 50000000", "a column header in cell M1",
+                                        "values would be ignored"]),
+    "values in a column without a header": (_edit_wb(_values_beside_the_table),
+                                            ["sheet 'Links'", "cell AW3", "'spare part'", "cell AW1",
+                                             "2 more cells below it", "starting with '#'"]),
     "zero element size": (_edit({("Links", "element size", 3): 0}),
                           ["sheet 'Links'", "cell R3", "column 'element size'", "found 0", "a mesh size > 0"]),
 }

@@ -20,6 +20,7 @@ from openpyxl.cell.read_only import EmptyCell
 from openpyxl.utils import get_column_letter
 from openpyxl.utils.cell import coordinate_to_tuple
 from openpyxl.utils.datetime import to_excel
+from openpyxl.worksheet.worksheet import Worksheet
 
 import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
@@ -109,6 +110,11 @@ class _Cells:
         """Columns of the stored cells of *row*."""
         return sorted(c for r, c in self._values if r == row)
 
+    def data_cells(self) -> list[tuple[int, int]]:
+        """``(row, column)`` of each data-row cell holding a value or a formula, by row then column."""
+        found = {key for key in (*self._values, *self._formulas) if key[0] >= L.FIRST_DATA_ROW and self.has(*key)}
+        return sorted(found)
+
     def rows(self, columns: set) -> list[int]:
         """Data rows with a value or a formula in one of *columns*, in order."""
         found = {r for r, c in (*self._values, *self._formulas) if c in columns and self.has(r, c)}
@@ -195,6 +201,10 @@ class SheetReader:
                          f"one sheet named '{name}' (these names read as the same one, letter case and spaces "
                          "aside: rename or delete all but one)")
             return None
+        if titles and not isinstance(self.formulas[titles[0]], Worksheet):
+            self.problem(titles[0], None, None, "a chart sheet",
+                         f"a sheet of cells named '{name}' (a chart sheet holds no table: rename the chart sheet)")
+            return None
         return titles[0] if titles else None
 
     def misspelt_sheets(self, read: tuple, known: tuple) -> None:
@@ -246,6 +256,7 @@ class SheetReader:
             return []
         sheet = _Cells(self.values.cells(title), self.formulas[title])
         positions = self._headers(table, sheet)
+        self._headless(table, sheet)
         if positions is None:
             return []
         merged = self._merged(table, sheet, positions)
@@ -310,6 +321,25 @@ class SheetReader:
                 self.problem(table.sheet, f"row {L.HEADER_ROW}", column.header, None,
                              f"a column headed '{column.header}'")
         return None if any(c.required for c in missing) else positions
+
+    def _headless(self, table: L.Table, sheet: "_Cells") -> None:
+        """Report each column holding data below an empty header cell: its values would be ignored.
+
+        A header cleared by mistake would drop the column's values silently (an
+        optional column is then read as empty); a column of notes is headed
+        with '#'.
+        """
+        cells: dict[int, list[int]] = {}
+        for row, col in sheet.data_cells():
+            header = sheet.value(L.HEADER_ROW, col)
+            if header is None or (isinstance(header, str) and not header.strip()):
+                cells.setdefault(col, []).append(row)
+        for col, rows in sorted(cells.items()):
+            more = f"; {len(rows) - 1} more cell{'s' if len(rows) > 2 else ''} below it" if len(rows) > 1 else ""
+            self.problem(table.sheet, f"{get_column_letter(col)}{rows[0]}", None, sheet.value(rows[0], col),
+                         f"a column header in cell {get_column_letter(col)}{L.HEADER_ROW} above data (it is empty, "
+                         f"so the column's values would be ignored{more}: give the column its header, or a header "
+                         "starting with '#' for notes)")
 
     def _units(self, table: L.Table, sheet: "_Cells", positions: dict) -> dict:
         """Factor to SI of each number column (None where the unit cell is bad)."""
