@@ -22,6 +22,7 @@ from openpyxl import Workbook, load_workbook
 from openpyxl.cell.rich_text import CellRichText, TextBlock
 from openpyxl.cell.text import InlineFont
 from openpyxl.comments import Comment
+from openpyxl.workbook.defined_name import DefinedName
 
 from workbook.cli.main import main
 from workbook.errors import WorkbookError
@@ -256,6 +257,28 @@ def test_rich_text_and_the_cached_values_of_date_formulas_are_kept(cheap_ran, tm
     rich = load_workbook(path, rich_text=True)["Hinges"]["AD4"].value
     assert isinstance(rich, CellRichText) and str(rich) == "bearing replaced in 2025"
     assert [block.font.b for block in rich if isinstance(block, TextBlock)] == [True]
+
+
+def test_formulas_on_the_results_do_not_keep_the_earlier_results(cheap_ran, tmp_path):
+    """A formula of the user's that takes a result is saved without a value, for Excel and LibreOffice to
+    calculate: the value it had is that of the earlier results. The others keep theirs."""
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    notes = wb.create_sheet("My notes")
+    formulas = {"A1": "='Result efficiency'!H3", "A2": "=A1*2", "A3": "=ETA_x", "A4": 'INDIRECT("\'Result model card\'!A1")',
+                "A5": "=SUM('MY NOTES'!A1:A2)", "B1": "=Engine!A3*2", "B2": "=B1+SUM(A6:A9)"}
+    for cell, formula in formulas.items():
+        notes[cell] = formula if formula.startswith("=") else f"={formula}"
+    wb.defined_names["eta_x"] = DefinedName("eta_x", attr_text="'Result efficiency'!$H$3")
+    wb.save(path)
+    sheet = f"xl/worksheets/sheet{wb.sheetnames.index('My notes') + 1}.xml"
+    for cell in formulas:
+        give_cached_value(path, sheet, cell, 7136 if cell.startswith("B") else -29.5)
+    assert load_workbook(path, data_only=True)["My notes"]["A2"].value == -29.5
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    notes = load_workbook(path, data_only=True)["My notes"]
+    assert {cell: notes[cell].value for cell in formulas} == {"A1": None, "A2": None, "A3": None, "A4": None,
+                                                              "A5": None, "B1": 7136, "B2": 7136}
 
 
 def _add_part(path, name, content_type, data=b"<x/>"):

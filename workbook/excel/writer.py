@@ -41,7 +41,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from openpyxl import Workbook
+from openpyxl.formula.tokenizer import Token, Tokenizer
 from openpyxl.styles import Font, PatternFill
+from openpyxl.utils.cell import range_boundaries
 
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
@@ -62,7 +64,7 @@ from workbook.excel.files import (
     write_atomic,
 )
 from workbook.excel.runs import RunSpec, TestPoint
-from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_values
+from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_cells, stored_values
 from workbook.excel.styling import print_setup, write_frame, write_table, write_text_lines
 from workbook.model.case import DIRECTIONS
 
@@ -404,11 +406,78 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=
     return None, workbook, values
 
 
-def _cached_formula_values(workbook, values: CachedValues) -> dict[int, dict[str, object]]:
+def _reference_boxes(names: dict, ws, text: str) -> list[tuple[str, tuple]]:
+    """The cells a formula *text* of sheet *ws* refers to: ``(sheet title in lower case, (min col, min row,
+    max col, max row))`` each, a whole column or row open-ended (None); the defined *names* (by lower-case
+    name) are followed. References that cannot be placed (other workbooks, tables, 3-D ranges) are left out."""
+    local = {name.lower(): defined for name, defined in ws.defined_names.items()}
+    boxes: list[tuple[str, tuple]] = []
+    try:
+        tokens = Tokenizer(text).items
+    except Exception:  # openpyxl's tokenizer refuses some formulas Excel takes; the text check still holds
+        return boxes
+    for token in tokens:
+        if token.type != Token.OPERAND or token.subtype != Token.RANGE:
+            continue
+        sheet, _, ref = token.value.rpartition("!")
+        sheet = sheet[1:-1].replace("''", "'") if sheet.startswith("'") else sheet or ws.title
+        places = [(sheet, ref)]
+        name = local.get(ref.lower()) or names.get(ref.lower())
+        if name is not None:
+            try:
+                places = list(name.destinations)
+            except Exception:  # a name openpyxl cannot parse
+                places = []
+        for target, place in places:
+            try:
+                boxes.append((target.lower(), range_boundaries(place.replace("$", ""))))
+            except ValueError:
+                continue
+    return boxes
+
+
+def _inside(box: tuple, col: int, row: int) -> bool:
+    low_col, low_row, high_col, high_row = box
+    return ((low_col is None or low_col <= col <= high_col) and (low_row is None or low_row <= row <= high_row))
+
+
+def _result_dependents(workbook, titles) -> set[tuple[str, str]]:
+    """The formula cells of *workbook* whose value may come from the sheets *titles*: ``(sheet, coordinate)`` each.
+
+    A formula depends on those sheets when it names one (in a reference or
+    in a text, as INDIRECT takes it), or refers to a cell of theirs or to a
+    formula cell that depends on them, directly or through a defined name.
+    """
+    lowered = [title.lower() for title in titles]
+    formulas = {(ws.title, cell.row, cell.column): (cell.coordinate, str(cell.value))
+                for ws in workbook.worksheets for cell in stored_cells(ws) if cell.data_type == "f"}
+    names = {name.lower(): defined for name, defined in workbook.defined_names.items()}
+    referring: dict[str, list[tuple[tuple, tuple]]] = {}    # sheet -> (formula cell, box on that sheet)
+    tainted = set()
+    for key, (_, text) in formulas.items():
+        boxes = _reference_boxes(names, workbook[key[0]], text)
+        if any(title in text.lower() for title in lowered) or any(sheet in lowered for sheet, _ in boxes):
+            tainted.add(key)
+        for sheet, box in boxes:
+            referring.setdefault(sheet, []).append((key, box))
+    waiting = list(tainted)
+    while waiting:
+        sheet, row, col = waiting.pop()
+        for key, box in referring.get(sheet.lower(), ()):
+            if key not in tainted and _inside(box, col, row):
+                tainted.add(key)
+                waiting.append(key)
+    return {(sheet, formulas[(sheet, row, col)][0]) for sheet, row, col in tainted}
+
+
+def _cached_formula_values(workbook, values: CachedValues, results: tuple) -> dict[int, dict[str, object]]:
     """The values Excel cached for the formula cells of *workbook* (as the reader found them in *values*), by
-    sheet number."""
-    cached = {number: values.formula_values(ws.title) for number, ws in enumerate(workbook.worksheets, start=1)
-              if ws.title in values.sheetnames}
+    sheet number; none for a formula that depends on the result sheets *results* (:func:`_result_dependents`):
+    its cached value is that of the earlier results, and Excel calculates it anew on opening the file."""
+    stale = _result_dependents(workbook, results)
+    cached = {number: {cell: value for cell, value in values.formula_values(ws.title).items()
+                       if (ws.title, cell) not in stale}
+              for number, ws in enumerate(workbook.worksheets, start=1) if ws.title in values.sheetnames}
     return {number: found for number, found in cached.items() if found}
 
 
@@ -447,7 +516,8 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         if reason is None:
             log.info("building the new %s with the results", path.name)
             add_result_sheets(workbook, runs, tests, stamp, tables, loads, fatigue)
-            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(workbook, values))
+            data = restore_formula_values(workbook_bytes(workbook, path),
+                                          _cached_formula_values(workbook, values, RESULT_SHEETS))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
         if reason is None:
