@@ -262,6 +262,15 @@ def _zip_of_text(path):
     return buffer.getvalue()
 
 
+def _opendocument(path):
+    """The bytes of an OpenDocument spreadsheet (the start of one LibreOffice saves as .ods)."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        archive.writestr("mimetype", "application/vnd.oasis.opendocument.spreadsheet")
+        archive.writestr("content.xml", "<office:document-content/>")
+    return buffer.getvalue()
+
+
 def _date_formatted_mass(wb):
     wb["Engine"]["A3"].number_format = "yyyy-mm-dd"
 
@@ -335,9 +344,14 @@ BAD_INPUTS = {
                                                               "5 mm away"]),
     "missing mesh file": (_edit({("Links", "mesh file", 3): "meshes/front-left.msh"}),
                           ["sheet 'Links'", "cell AB3", "'meshes/front-left.msh'", "mesh file"]),
-    "not an xlsx file": (_write_bytes(lambda p: b"name,mass\nengine,3568\n"), ["case.xlsx", "not a zip",
-                                                                              "Excel .xlsx workbook"]),
-    "corrupt zip": (_write_bytes(lambda p: p.read_bytes()[:3000]), ["case.xlsx", "Excel .xlsx"]),
+    "not an xlsx file": (_write_bytes(lambda p: b"name,mass\nengine,3568\n"),
+                         ["case.xlsx", "22 bytes of text that are not a zip archive (a CSV or text file",
+                          "save it as an .xlsx workbook"]),
+    "corrupt zip": (_write_bytes(lambda p: p.read_bytes()[:3000]),
+                    ["case.xlsx", "3000 bytes of an incomplete zip archive", "a complete Excel .xlsx"]),
+    "an empty file": (_write_bytes(lambda p: b""), ["case.xlsx", "found 'an empty file (0 bytes)'"]),
+    "an OpenDocument spreadsheet": (_write_bytes(_opendocument), ["case.xlsx", "an OpenDocument spreadsheet (.ods)",
+                                                                  "Excel 2007-365 .xlsx"]),
     "a zip that is not a workbook": (_write_bytes(_zip_of_text), ["case.xlsx", "readable Excel .xlsx"]),
     "formula without a cached value": (_edit({("Engine", "mass", 3): "=3000+568"}),
                                        ["sheet 'Engine'", "cell A3", "'=3000+568'", "calculated value"]),

@@ -637,7 +637,39 @@ def _not_a_workbook(path: Path) -> Problem:
                            "Protect Workbook > Encrypt with Password, clear the password)")
         return Problem(path.name, None, None, None, "an Excel 97-2003 workbook (.xls)",
                        "an Excel .xlsx workbook (save it as Excel Workbook .xlsx)")
+    if size == 0:
+        return Problem(path.name, None, None, None, "an empty file (0 bytes)", "an Excel .xlsx workbook")
+    if head.startswith(b"PK"):
+        return Problem(path.name, None, None, None, f"{size} bytes of an incomplete zip archive (the file was cut "
+                       "short: copied, downloaded or saved only in part)",
+                       "a complete Excel .xlsx workbook (copy or save it again)")
+    if b"\0" not in head[:65536]:
+        return Problem(path.name, None, None, None, f"{size} bytes of text that are not a zip archive (a CSV or "
+                       "text file named .xlsx?)", "an Excel .xlsx workbook (open the file in Excel or LibreOffice "
+                       "and save it as an .xlsx workbook)")
     return Problem(path.name, None, None, None, f"{size} bytes that are not a zip archive", "an Excel .xlsx workbook")
+
+
+#: The media type an OpenDocument spreadsheet (.ods) names in its 'mimetype' part.
+_ODS_MIMETYPE = b"application/vnd.oasis.opendocument.spreadsheet"
+
+
+def _not_excel(path: Path) -> Problem | None:
+    """A problem if the zip archive at *path* is not an Excel workbook (it has no content types), naming an
+    OpenDocument spreadsheet as such; None if it is."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = archive.namelist()
+            if "[Content_Types].xml" in names:
+                return None
+            mimetype = archive.read("mimetype").strip() if "mimetype" in names else b""
+    except Exception:  # a damaged archive: reported as unreadable when it is opened
+        return None
+    if mimetype.startswith(_ODS_MIMETYPE):
+        return Problem(path.name, None, None, None, "an OpenDocument spreadsheet (.ods)",
+                       "an Excel .xlsx workbook (in LibreOffice: File > Save As, file type Excel 2007-365 .xlsx)")
+    return Problem(path.name, None, None, None, "a zip archive without the parts of an Excel workbook",
+                   "a readable Excel .xlsx workbook")
 
 
 def _too_large(path: Path) -> Problem | None:
@@ -773,7 +805,7 @@ def read_workbook_bytes(path: Path) -> bytes:
         raise WorkbookError([Problem(path.name, None, None, None, str(path), "an existing workbook file")])
     if not zipfile.is_zipfile(path):
         raise WorkbookError([_not_a_workbook(path)])
-    problem = _too_large(path)
+    problem = _too_large(path) or _not_excel(path)
     if problem is not None:
         raise WorkbookError([problem])
     return path.read_bytes()
