@@ -566,3 +566,13 @@ def test_text_numbers_with_one_reading_are_read(tmp_path, text, mass):
     path = copy_reference(tmp_path)
     set_cells(path, {("Engine", "mass", 3): text})
     assert read_workbook(path).case.engine.mass == mass
+
+
+def test_invisible_characters_pasted_into_cells_are_read_as_the_cells_show(tmp_path):
+    """A zero-width space, a byte-order mark or a soft hyphen (pasted from a web page or a PDF) is not part of
+    the name, header, choice or number the cell shows: the hinges still find their link."""
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Links", "name", 3): "front-left\u200b", ("Links", "name", 4): "\ufefffront-right",
+                     ("Links", "name", 5): "rear-\u00adleft", ("Hinges", "stiffness", 1): "stiff\u200bness",
+                     ("Excitations", "type", 3): "rotating\u200e", ("Engine", "mass", 3): "3568\u200b"})
+    assert to_dict(read_workbook(path).case) == to_dict(read_workbook(REFERENCE).case)

@@ -10,6 +10,7 @@ import datetime
 import difflib
 import math
 import re
+import unicodedata
 import warnings
 import zipfile
 from dataclasses import dataclass
@@ -307,7 +308,7 @@ class SheetReader:
             if text is None or (isinstance(text, str) and (not text.strip() or text.strip().startswith("#"))):
                 continue
             cell = f"{get_column_letter(col)}{L.HEADER_ROW}"
-            column = by_header.get(str(text).strip().lower())
+            column = by_header.get(_visible(str(text)).lower())
             if column is None:
                 self.problem(table.sheet, cell, None, text,
                              "a known column header (notes: start the header with '#')")
@@ -517,7 +518,7 @@ def _text_number(text: str) -> float:
     separator) or 3.568 (a decimal separator) and is refused with both
     readings. A number entered as a number is never ambiguous.
     """
-    compact = text.strip().replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
+    compact = _visible(text).replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
     grouped = _GROUPED.match(compact)
     separator = grouped.group("sep") if grouped else ""
     if grouped and compact.count(separator) == 1:
@@ -550,7 +551,14 @@ def _as_text(value: Any, column: L.Column) -> str:
     _not_a_value(value)
     if isinstance(value, float) and value.is_integer():
         value = int(value)
-    return str(value).strip()
+    return _visible(str(value))
+
+
+def _visible(text: str) -> str:
+    """*text* as a cell shows it: without spaces at its ends and without invisible format characters (zero-width
+    space, byte-order mark, soft hyphen, direction marks: text pasted from web pages and PDFs brings them), which
+    would make two names that look the same differ."""
+    return "".join(char for char in text if unicodedata.category(char) != "Cf").strip()
 
 
 def _as_choice(value: Any, column: L.Column) -> str:
