@@ -281,6 +281,20 @@ def test_formulas_on_the_results_do_not_keep_the_earlier_results(cheap_ran, tmp_
                                                               "A5": None, "B1": 7136, "B2": 7136}
 
 
+def test_result_sheets_written_again_keep_their_place_among_the_sheets(cheap_ran, tmp_path):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    wb.move_sheet("Result efficiency", -wb.sheetnames.index("Result efficiency"))
+    wb.create_sheet("My notes")
+    wb.active = wb.sheetnames.index("My notes")
+    wb.save(path)
+    order = wb.sheetnames
+    assert order[0] == "Result efficiency" and order[-1] == "My notes"
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    wb = load_workbook(path)
+    assert (wb.sheetnames, wb.active.title) == (order, "My notes")
+
+
 def _add_part(path, name, content_type, data=b"<x/>"):
     """Add a zip part with its content type, as Excel writes a feature openpyxl does not know."""
     _rezip(path, lambda member, text: text.replace(

@@ -348,6 +348,7 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
     cards = _earlier_cards(earlier[title]) if title in earlier else []
     fresh = [(run.spec.name, card_lines([run])) for run in runs]
     lines = [line for block in _merged(cards, fresh, computed) for line in block]
+    order = {title: index for index, title in enumerate(workbook.sheetnames)}
     for ws in earlier.values():
         workbook.remove(ws)
     for title, (table, note) in merged.items():
@@ -365,6 +366,8 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
             write_frame(ws, frame, top=2, fill=_HEADER_FILL, quantities=module.QUANTITIES)
             _mark(ws)
             written.append(title)
+    # a rewritten sheet takes the place of the one it replaces; new ones go last
+    workbook._sheets.sort(key=lambda sheet: order.get(sheet.title, len(order)))
     return written
 
 
