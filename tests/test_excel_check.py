@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import io
 import re
 import zipfile
@@ -455,6 +456,9 @@ BAD_INPUTS = {
                                   ["sheet 'Case'", "column 'start'", "sometimes", "steady"]),
     "negative element size": (_edit({("Links", "element size", 4): -1}),
                               ["sheet 'Links'", "cell R4", "column 'element size'", "found -1", "a mesh size > 0"]),
+    "a run name typed as 1-2, made a date": (_edit({("Runs", "run", 4): datetime.datetime(2026, 1, 2)}),
+                                            ["sheet 'Runs'", "cell A4", "found 'the date 2026-01-02'",
+                                             "text, not a date", "format the cell as Text"]),
     "a chart sheet named Runs": (_edit_wb(_chart_sheet_named_runs),
                                  ["sheet 'Runs'", "found 'a chart sheet'", "a sheet of cells named 'Runs'"]),
     "a value under a cleared header": (_edit_wb(_cleared_header),

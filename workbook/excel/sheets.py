@@ -451,13 +451,20 @@ FORMULA_ERRORS = ("#NULL!", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#
                   "#GETTING_DATA")
 
 
-def _not_a_value(value: Any) -> None:
+#: Column kinds whose cells hold words (a name, a choice, yes or no, a unit), not numbers.
+_WORD_KINDS = ("text", "choice", "yesno", "unit")
+
+
+def _not_a_value(value: Any, column: L.Column) -> None:
     """Refuse a formula error or a date where a number or text is read."""
     if isinstance(value, str) and value.strip().upper() in FORMULA_ERRORS:
         raise _Bad(f"a value (the cell shows the formula error {value.strip()}: correct the formula or the cells "
                    "it uses)")
     if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
         number = float(to_excel(value))
+        if column.kind in _WORD_KINDS:
+            raise _Bad("text, not a date (Excel and LibreOffice turn text such as 1-2, 3/4 or 10:30 into a date as "
+                       "it is typed: format the cell as Text and type it again)", f"the date {_shown_date(value)}")
         raise _Bad(f"a number, not a date (the cell is formatted as a date: format it as a number; it holds "
                    f"{number:.10g})", f"{number:.10g} formatted as the date {_shown_date(value)}")
 
@@ -496,7 +503,7 @@ _UNIT_SPELLINGS = (
 
 
 def _as_number(value: Any, column: L.Column) -> float:
-    _not_a_value(value)
+    _not_a_value(value, column)
     if isinstance(value, bool):
         raise _Bad("a number")
     number = float(value) if isinstance(value, (int, float)) else _text_number(str(value))
@@ -548,7 +555,7 @@ def _as_integer(value: Any, column: L.Column) -> int:
 
 
 def _as_text(value: Any, column: L.Column) -> str:
-    _not_a_value(value)
+    _not_a_value(value, column)
     if isinstance(value, float) and value.is_integer():
         value = int(value)
     return _visible(str(value))
