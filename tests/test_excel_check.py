@@ -580,3 +580,13 @@ def test_invisible_characters_pasted_into_cells_are_read_as_the_cells_show(tmp_p
                      ("Links", "name", 5): "rear-\u00adleft", ("Hinges", "stiffness", 1): "stiff\u200bness",
                      ("Excitations", "type", 3): "rotating\u200e", ("Engine", "mass", 3): "3568\u200b"})
     assert to_dict(read_workbook(path).case) == to_dict(read_workbook(REFERENCE).case)
+
+
+@pytest.mark.parametrize("name, named", [("case.ods", "an OpenDocument spreadsheet"), ("case.csv", "a CSV table"),
+                                         ("case.xls", "an Excel 97-2003 workbook")])
+def test_a_spreadsheet_of_another_kind_is_named_by_run(tmp_path, capsys, name, named):
+    path = tmp_path / name
+    path.write_bytes(_opendocument(path) if name.endswith(".ods") else b"name,mass\nengine,3568\n")
+    assert main(["run", str(path), "--no-progress"]) == 2
+    assert f"{named} is not read as a case; save it as an Excel workbook (.xlsx)" in capsys.readouterr().err
+    assert sorted(tmp_path.iterdir()) == [path]
