@@ -320,6 +320,7 @@ def _values_beside_the_table(wb):
     col = ws.max_column + 2
     for row in (3, 5, 6):
         ws.cell(row, col, "spare part")
+    ws.cell(4, col + 1, " ")    # shows nothing: not a value
 
 
 BAD_INPUTS = {
@@ -465,7 +466,7 @@ BAD_INPUTS = {
                                        ["sheet 'Hinges'", "cell M4", "found 50000000", "a column header in cell M1",
                                         "values would be ignored"]),
     "values in a column without a header": (_edit_wb(_values_beside_the_table),
-                                            ["sheet 'Links'", "cell AW3", "'spare part'", "cell AW1",
+                                            ["1 problem found", "sheet 'Links'", "cell AW3", "'spare part'", "cell AW1",
                                              "2 more cells below it", "starting with '#'"]),
     "zero element size": (_edit({("Links", "element size", 3): 0}),
                           ["sheet 'Links'", "cell R3", "column 'element size'", "found 0", "a mesh size > 0"]),

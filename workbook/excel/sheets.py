@@ -112,9 +112,9 @@ class _Cells:
         return sorted(c for r, c in self._values if r == row)
 
     def data_cells(self) -> list[tuple[int, int]]:
-        """``(row, column)`` of each data-row cell holding a value or a formula, by row then column."""
-        found = {key for key in (*self._values, *self._formulas) if key[0] >= L.FIRST_DATA_ROW and self.has(*key)}
-        return sorted(found)
+        """``(row, column)`` of each data-row cell showing a value (not blank text), by row then column."""
+        return sorted(key for key, value in self._values.items() if key[0] >= L.FIRST_DATA_ROW and value is not None
+                      and not (isinstance(value, str) and not value.strip()))
 
     def rows(self, columns: set) -> list[int]:
         """Data rows with a value or a formula in one of *columns*, in order."""

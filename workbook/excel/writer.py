@@ -11,8 +11,11 @@ rows of the runs it computed: the rows of the workbook's other runs stay as
 they were, and the sheet's note names them. A copy of a
 result sheet (``Result efficiency (2)``) or a renamed one (``Result LP
 baseline``) is the user's and is kept, like any sheet of the user's that
-happens to share a name. The input sheets are left as openpyxl read them (values,
-styles, drop-downs, comments).
+happens to share a name. A result sheet written again keeps its place among
+the sheets. The input sheets are left as openpyxl read them (values, styles,
+drop-downs, comments); formulas keep the values Excel cached, except those
+that take a result (directly or through other formulas or defined names):
+they are saved without one, for Excel or LibreOffice to calculate anew.
 
 The case workbook is not overwritten (the results go to a separate, new
 workbook beside it, and the reason is given) when:
