@@ -62,6 +62,43 @@ def test_copied_and_renamed_result_sheets_are_the_users(cheap_ran, tmp_path):
     assert sum(n == "Result efficiency" for n in wb.sheetnames) == 1
 
 
+def _note_column(wb):
+    wb["Result efficiency"].cell(2, 11, "reviewed")
+    wb["Result efficiency"].cell(3, 11, "OK, see review 12")
+
+
+def _note_row(wb):
+    ws = wb["Result hinges"]
+    ws.cell(ws.max_row + 2, 1, "hinge forces below the supplier's limit")
+
+
+def _changed_note(wb):
+    wb["Result model card"]["A1"] = "the baseline of the design review"
+
+
+@pytest.mark.parametrize("edit, sheet", [(_note_column, "Result efficiency"), (_note_row, "Result hinges"),
+                                         (_changed_note, "Result model card")])
+def test_a_result_sheet_the_user_annotated_is_not_written_over(cheap_ran, tmp_path, capsys, edit, sheet):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    edit(wb)
+    wb.save(path)
+    before = sha256(path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert f"its result sheets '{sheet}' were changed after mountwb wrote them" in capsys.readouterr().out
+    assert sha256(path) == before and len(list(tmp_path.iterdir())) == 2
+
+
+def test_a_result_sheet_written_before_its_marker_held_a_digest_is_written_again(cheap_ran, tmp_path):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    wb["Result efficiency"]["Z1"] = "mountwb result sheet: Result efficiency"
+    wb["Result efficiency"].cell(3, 11, "a note")
+    wb.save(path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]
+
+
 # -- files changed only as asked ---------------------------------------------------------------------------------
 
 _XLSX_MAIN = "application/vnd.openxmlformats-officedocument.spreadsheetml.sheet.main+xml"

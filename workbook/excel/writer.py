@@ -28,6 +28,9 @@ workbook beside it, and the reason is given) when:
   and manager properties, ...), or the rewritten file would lack any kind
   of part the original has (:func:`~workbook.excel.files.lost_parts`);
 - a sheet named like a result sheet exists that is not ours;
+- a result sheet it would rewrite was changed since it was written (a note,
+  a column or a row added, a text changed: the digest in its marker no
+  longer matches; a number changed is not told);
 - the user cannot write it (read-only, e.g. mode 444);
 - it changed on disk while the runs were computed, or while the new file
   was built (checked again just before the rename; other ``mountwb``
@@ -46,7 +49,7 @@ from pathlib import Path
 from openpyxl import Workbook
 from openpyxl.formula.tokenizer import Token, Tokenizer
 from openpyxl.styles import Font, PatternFill
-from openpyxl.utils.cell import range_boundaries
+from openpyxl.utils.cell import coordinate_to_tuple, range_boundaries
 
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
@@ -219,8 +222,28 @@ def _marker(title: str) -> str:
     return f"{MARKER}: {title}"
 
 
+#: Separates the marker from the digest of the sheet's content that follows it.
+_DIGEST = " #"
+
+
+def _shown(value) -> str:
+    """A cell value of a result sheet as :func:`_content_digest` takes it: text as it is, any number or yes/no
+    as ``#`` (a save by LibreOffice rounds numbers to 15 digits and saves yes/no as the formulas =TRUE() and
+    =FALSE())."""
+    return "#" if isinstance(value, (int, float)) or value in ("=TRUE()", "=FALSE()") else str(value)
+
+
+def _content_digest(ws) -> str:
+    """A digest of where *ws* holds values (but its marker) and of its texts (:func:`_shown`): a note, a
+    column or a row the user adds, or a text changed, changes it."""
+    marker = coordinate_to_tuple(MARKER_CELL)
+    text = "\n".join(f"{key} {_shown(cell.value)}" for key, cell in sorted(ws._cells.items())
+                     if key != marker and cell.value is not None and cell.value != "")
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 def _mark(ws) -> None:
-    ws[MARKER_CELL] = _marker(ws.title)
+    ws[MARKER_CELL] = f"{_marker(ws.title)}{_DIGEST}{_content_digest(ws)}"
     ws.column_dimensions[MARKER_CELL.rstrip("0123456789")].hidden = True
 
 
@@ -234,7 +257,14 @@ def is_result_sheet(ws) -> bool:
     if ws.title not in RESULT_SHEETS:
         return False
     value = peek(ws, MARKER_CELL)
-    return value == _marker(ws.title) or value == MARKER
+    return isinstance(value, str) and value.split(_DIGEST)[0] in (_marker(ws.title), MARKER)
+
+
+def _edited(ws) -> bool:
+    """True if the result sheet *ws* was changed since this package wrote it (a note or a column of the
+    user's, say), as the digest in its marker tells; a sheet written before the marker held one is not."""
+    _, _, digest = str(peek(ws, MARKER_CELL)).partition(_DIGEST)
+    return bool(digest) and digest != _content_digest(ws)
 
 
 def _write_table(ws, table: ResultTable, note: str) -> None:
@@ -378,6 +408,13 @@ def _conflicts(workbook, titles: list[str]) -> list[str]:
     return [title for title in titles if title in workbook.sheetnames and not is_result_sheet(workbook[title])]
 
 
+def _edited_sheets(workbook, titles: list[str]) -> list[str]:
+    """The result sheets a write of the sheets *titles* replaces that were changed since they were written
+    (the loads and fatigue sheets are replaced only when written again)."""
+    return [ws.title for ws in workbook.worksheets if is_result_sheet(ws) and _edited(ws)
+            and (ws.title in titles or ws.title not in (LOADS_SHEET, FATIGUE_SHEET))]
+
+
 def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=None):
     """(reason or None, the loaded workbook or None, its cached values (a closed CachedValues) or None).
 
@@ -409,6 +446,11 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
                 "rename them to write the results into the workbook"), None, None
+    edited = _edited_sheets(workbook, titles)
+    if edited:
+        return (f"its result sheets {', '.join(repr(e) for e in edited)} were changed after mountwb wrote them, "
+                "and writing the results again would lose the changes; rename those sheets to keep them (or "
+                "delete them) to write the results into the workbook"), None, None
     return None, workbook, values
 
 
