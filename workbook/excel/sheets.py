@@ -506,7 +506,7 @@ def _as_number(value: Any, column: L.Column) -> float:
     _not_a_value(value, column)
     if isinstance(value, bool):
         raise _Bad("a number")
-    number = float(value) if isinstance(value, (int, float)) else _text_number(str(value))
+    number = float(value) if isinstance(value, (int, float)) else _text_number(str(value), column.si_unit)
     if not math.isfinite(number):
         raise _Bad("a finite number")
     return number
@@ -517,13 +517,15 @@ _GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$", re.ASCII)
 _PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$", re.ASCII)
 
 
-def _text_number(text: str) -> float:
+def _text_number(text: str, si_unit: str | None = None) -> float:
     """A number typed as text, read only when its separators leave one reading.
 
     ``3,5`` is 3.5, ``1.234,5`` and ``1,234.5`` are 1234.5, ``1,234,567`` is
     1234567; but ``3,568`` (or ``3.568``) may be 3568 (a thousands
     separator) or 3.568 (a decimal separator) and is refused with both
-    readings. A number entered as a number is never ambiguous.
+    readings. A number entered as a number is never ambiguous. A number
+    followed by a unit of the quantity of *si_unit* (``20 kN/mm``) is refused
+    saying that the unit goes in the unit row.
     """
     compact = _visible(text).replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
     grouped = _GROUPED.match(compact)
@@ -543,8 +545,26 @@ def _text_number(text: str) -> float:
             return float(whole.replace("," if decimal == "." else ".", "") + "." + fraction)
         raise _Bad("a number")
     if not _PLAIN.match(compact) and compact.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
+        with_unit = _WITH_UNIT.match(_visible(text))
+        if with_unit and si_unit and _is_unit(with_unit.group(2), si_unit):
+            raise _Bad(f"a number without its unit (a cell takes the number, {with_unit.group(1)}; the unit, "
+                       f"{with_unit.group(2)}, goes in the column's unit cell, row {L.UNIT_ROW}, for the whole "
+                       "column)")
         raise _Bad("a number")
     return float(compact.replace(",", "."))
+
+
+def _is_unit(text: str, si_unit: str) -> bool:
+    """True if *text* is a unit of the quantity of *si_unit*."""
+    try:
+        si_factor(text, si_unit)
+    except UnitProblem:
+        return False
+    return True
+
+
+#: A number followed by a unit, typed into one cell: '20 kN/mm'.
+_WITH_UNIT = re.compile(r"^([+-]?[\d.,]*\d(?:[eE][+-]?\d+)?)\s*([^\W\d_].*)$")
 
 
 def _as_integer(value: Any, column: L.Column) -> int:
