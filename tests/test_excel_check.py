@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import dataclasses
+import datetime
 import io
 import re
 import zipfile
@@ -9,6 +10,7 @@ import zipfile
 import pytest
 from excel_helpers import REFERENCE, TEMPLATE, column_of, compound_file, copy_reference, give_cached_value, set_cells, sha256
 from openpyxl import load_workbook
+from openpyxl.chart import BarChart, Reference
 
 from workbook.cli.main import main
 from workbook.errors import UnitProblem, WorkbookError
@@ -261,6 +263,15 @@ def _zip_of_text(path):
     return buffer.getvalue()
 
 
+def _opendocument(path):
+    """The bytes of an OpenDocument spreadsheet (the start of one LibreOffice saves as .ods)."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w") as archive:
+        archive.writestr("mimetype", "application/vnd.oasis.opendocument.spreadsheet")
+        archive.writestr("content.xml", "<office:document-content/>")
+    return buffer.getvalue()
+
+
 def _date_formatted_mass(wb):
     wb["Engine"]["A3"].number_format = "yyyy-mm-dd"
 
@@ -287,6 +298,31 @@ def _no_pylon(wb):
                 ws.cell(row, col).value = "engine"
 
 
+def _chart_sheet_named_runs(wb):
+    """A chart sheet named 'Runs' in place of the Runs sheet."""
+    chart = BarChart()
+    chart.add_data(Reference(wb["Hinges"], min_col=7, min_row=3, max_row=18))
+    index = wb.sheetnames.index("Runs")
+    wb.remove(wb["Runs"])
+    wb.create_chartsheet("Runs", index).add_chart(chart)
+
+
+def _cleared_header(wb):
+    """The header of the optional column 'stiffness axial' cleared, its value in row 4 kept."""
+    ws = wb["Hinges"]
+    col = column_of(ws, "stiffness axial")
+    ws.cell(1, col).value = None
+    ws.cell(4, col).value = 5e7
+
+
+def _values_beside_the_table(wb):
+    ws = wb["Links"]
+    col = ws.max_column + 2
+    for row in (3, 5, 6):
+        ws.cell(row, col, "spare part")
+    ws.cell(4, col + 1, " ")    # shows nothing: not a value
+
+
 BAD_INPUTS = {
     "missing sheet": (_edit_wb(lambda wb: wb.remove(wb["Hinges"])), ["sheet 'Hinges'"]),
     "missing column": (_edit_wb(lambda wb: wb["Hinges"].delete_cols(column_of(wb["Hinges"], "stiffness"))),
@@ -310,9 +346,14 @@ BAD_INPUTS = {
                                                               "5 mm away"]),
     "missing mesh file": (_edit({("Links", "mesh file", 3): "meshes/front-left.msh"}),
                           ["sheet 'Links'", "cell AB3", "'meshes/front-left.msh'", "mesh file"]),
-    "not an xlsx file": (_write_bytes(lambda p: b"name,mass\nengine,3568\n"), ["case.xlsx", "not a zip",
-                                                                              "Excel .xlsx workbook"]),
-    "corrupt zip": (_write_bytes(lambda p: p.read_bytes()[:3000]), ["case.xlsx", "Excel .xlsx"]),
+    "not an xlsx file": (_write_bytes(lambda p: b"name,mass\nengine,3568\n"),
+                         ["case.xlsx", "22 bytes of text that are not a zip archive (a CSV or text file",
+                          "save it as an .xlsx workbook"]),
+    "corrupt zip": (_write_bytes(lambda p: p.read_bytes()[:3000]),
+                    ["case.xlsx", "3000 bytes of an incomplete zip archive", "a complete Excel .xlsx"]),
+    "an empty file": (_write_bytes(lambda p: b""), ["case.xlsx", "found 'an empty file (0 bytes)'"]),
+    "an OpenDocument spreadsheet": (_write_bytes(_opendocument), ["case.xlsx", "an OpenDocument spreadsheet (.ods)",
+                                                                  "Excel 2007-365 .xlsx"]),
     "a zip that is not a workbook": (_write_bytes(_zip_of_text), ["case.xlsx", "readable Excel .xlsx"]),
     "formula without a cached value": (_edit({("Engine", "mass", 3): "=3000+568"}),
                                        ["sheet 'Engine'", "cell A3", "'=3000+568'", "calculated value"]),
@@ -416,6 +457,20 @@ BAD_INPUTS = {
                                   ["sheet 'Case'", "column 'start'", "sometimes", "steady"]),
     "negative element size": (_edit({("Links", "element size", 4): -1}),
                               ["sheet 'Links'", "cell R4", "column 'element size'", "found -1", "a mesh size > 0"]),
+    "a run name typed as 1-2, made a date": (_edit({("Runs", "run", 4): datetime.datetime(2026, 1, 2)}),
+                                            ["sheet 'Runs'", "cell A4", "found 'the date 2026-01-02'",
+                                             "text, not a date", "format the cell as Text"]),
+    "a number typed with its unit": (_edit({("Hinges", "stiffness", 4): "20 kN/mm"}),
+                                     ["sheet 'Hinges'", "cell G4", "found '20 kN/mm'", "a number without its unit",
+                                      "the unit, kN/mm, goes in the column's unit cell, row 2"]),
+    "a chart sheet named Runs": (_edit_wb(_chart_sheet_named_runs),
+                                 ["sheet 'Runs'", "found 'a chart sheet'", "a sheet of cells named 'Runs'"]),
+    "a value under a cleared header": (_edit_wb(_cleared_header),
+                                       ["sheet 'Hinges'", "cell M4", "found 50000000", "a column header in cell M1",
+                                        "values would be ignored"]),
+    "values in a column without a header": (_edit_wb(_values_beside_the_table),
+                                            ["1 problem found", "sheet 'Links'", "cell AW3", "'spare part'", "cell AW1",
+                                             "2 more cells below it", "starting with '#'"]),
     "zero element size": (_edit({("Links", "element size", 3): 0}),
                           ["sheet 'Links'", "cell R3", "column 'element size'", "found 0", "a mesh size > 0"]),
 }
@@ -519,3 +574,23 @@ def test_text_numbers_with_one_reading_are_read(tmp_path, text, mass):
     path = copy_reference(tmp_path)
     set_cells(path, {("Engine", "mass", 3): text})
     assert read_workbook(path).case.engine.mass == mass
+
+
+def test_invisible_characters_pasted_into_cells_are_read_as_the_cells_show(tmp_path):
+    """A zero-width space, a byte-order mark or a soft hyphen (pasted from a web page or a PDF) is not part of
+    the name, header, choice or number the cell shows: the hinges still find their link."""
+    path = copy_reference(tmp_path)
+    set_cells(path, {("Links", "name", 3): "front-left\u200b", ("Links", "name", 4): "\ufefffront-right",
+                     ("Links", "name", 5): "rear-\u00adleft", ("Hinges", "stiffness", 1): "stiff\u200bness",
+                     ("Excitations", "type", 3): "rotating\u200e", ("Engine", "mass", 3): "3568\u200b"})
+    assert to_dict(read_workbook(path).case) == to_dict(read_workbook(REFERENCE).case)
+
+
+@pytest.mark.parametrize("name, named", [("case.ods", "an OpenDocument spreadsheet"), ("case.csv", "a CSV table"),
+                                         ("case.xls", "an Excel 97-2003 workbook")])
+def test_a_spreadsheet_of_another_kind_is_named_by_run(tmp_path, capsys, name, named):
+    path = tmp_path / name
+    path.write_bytes(_opendocument(path) if name.endswith(".ods") else b"name,mass\nengine,3568\n")
+    assert main(["run", str(path), "--no-progress"]) == 2
+    assert f"{named} is not read as a case; save it as an Excel workbook (.xlsx)" in capsys.readouterr().err
+    assert sorted(tmp_path.iterdir()) == [path]

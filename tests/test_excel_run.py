@@ -107,7 +107,7 @@ def test_results_written_back_match_a_python_run(ran):
     wb = load_workbook(path)
     assert [n for n in wb.sheetnames if n.startswith(L.RESULT_PREFIX)] == [
         "Result efficiency", "Result hinges", "Result sweep", "Result model card"]
-    assert all(wb[n][MARKER_CELL].value == f"{MARKER}: {n}" and wb[n].column_dimensions["Z"].hidden
+    assert all(wb[n][MARKER_CELL].value.startswith(f"{MARKER}: {n} #") and wb[n].column_dimensions["Z"].hidden
                for n in wb.sheetnames if n.startswith(L.RESULT_PREFIX))
     rows = _sheet_rows(wb["Result efficiency"])
     assert len(rows) == 3 * (1 + 1 + 4)          # LP, HP, 4 sweep points x 3 directions

@@ -22,6 +22,7 @@ from openpyxl import Workbook, load_workbook
 from openpyxl.cell.rich_text import CellRichText, TextBlock
 from openpyxl.cell.text import InlineFont
 from openpyxl.comments import Comment
+from openpyxl.workbook.defined_name import DefinedName
 
 from workbook.cli.main import main
 from workbook.errors import WorkbookError
@@ -59,6 +60,43 @@ def test_copied_and_renamed_result_sheets_are_the_users(cheap_ran, tmp_path):
     assert wb["Result efficiency (2)"]["A1"].value == "kept for the design review"
     assert wb["Result LP baseline"].max_row == wb["Result hinges"].max_row
     assert sum(n == "Result efficiency" for n in wb.sheetnames) == 1
+
+
+def _note_column(wb):
+    wb["Result efficiency"].cell(2, 11, "reviewed")
+    wb["Result efficiency"].cell(3, 11, "OK, see review 12")
+
+
+def _note_row(wb):
+    ws = wb["Result hinges"]
+    ws.cell(ws.max_row + 2, 1, "hinge forces below the supplier's limit")
+
+
+def _changed_note(wb):
+    wb["Result model card"]["A1"] = "the baseline of the design review"
+
+
+@pytest.mark.parametrize("edit, sheet", [(_note_column, "Result efficiency"), (_note_row, "Result hinges"),
+                                         (_changed_note, "Result model card")])
+def test_a_result_sheet_the_user_annotated_is_not_written_over(cheap_ran, tmp_path, capsys, edit, sheet):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    edit(wb)
+    wb.save(path)
+    before = sha256(path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert f"its result sheets '{sheet}' were changed after mountwb wrote them" in capsys.readouterr().out
+    assert sha256(path) == before and len(list(tmp_path.iterdir())) == 2
+
+
+def test_a_result_sheet_written_before_its_marker_held_a_digest_is_written_again(cheap_ran, tmp_path):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    wb["Result efficiency"]["Z1"] = "mountwb result sheet: Result efficiency"
+    wb["Result efficiency"].cell(3, 11, "a note")
+    wb.save(path)
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["case.xlsx"]
 
 
 # -- files changed only as asked ---------------------------------------------------------------------------------
@@ -256,6 +294,42 @@ def test_rich_text_and_the_cached_values_of_date_formulas_are_kept(cheap_ran, tm
     rich = load_workbook(path, rich_text=True)["Hinges"]["AD4"].value
     assert isinstance(rich, CellRichText) and str(rich) == "bearing replaced in 2025"
     assert [block.font.b for block in rich if isinstance(block, TextBlock)] == [True]
+
+
+def test_formulas_on_the_results_do_not_keep_the_earlier_results(cheap_ran, tmp_path):
+    """A formula of the user's that takes a result is saved without a value, for Excel and LibreOffice to
+    calculate: the value it had is that of the earlier results. The others keep theirs."""
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    notes = wb.create_sheet("My notes")
+    formulas = {"A1": "='Result efficiency'!H3", "A2": "=A1*2", "A3": "=ETA_x", "A4": 'INDIRECT("\'Result model card\'!A1")',
+                "A5": "=SUM('MY NOTES'!A1:A2)", "B1": "=Engine!A3*2", "B2": "=B1+SUM(A6:A9)"}
+    for cell, formula in formulas.items():
+        notes[cell] = formula if formula.startswith("=") else f"={formula}"
+    wb.defined_names["eta_x"] = DefinedName("eta_x", attr_text="'Result efficiency'!$H$3")
+    wb.save(path)
+    sheet = f"xl/worksheets/sheet{wb.sheetnames.index('My notes') + 1}.xml"
+    for cell in formulas:
+        give_cached_value(path, sheet, cell, 7136 if cell.startswith("B") else -29.5)
+    assert load_workbook(path, data_only=True)["My notes"]["A2"].value == -29.5
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    notes = load_workbook(path, data_only=True)["My notes"]
+    assert {cell: notes[cell].value for cell in formulas} == {"A1": None, "A2": None, "A3": None, "A4": None,
+                                                              "A5": None, "B1": 7136, "B2": 7136}
+
+
+def test_result_sheets_written_again_keep_their_place_among_the_sheets(cheap_ran, tmp_path):
+    path = _copy(cheap_ran, tmp_path)
+    wb = load_workbook(path)
+    wb.move_sheet("Result efficiency", -wb.sheetnames.index("Result efficiency"))
+    wb.create_sheet("My notes")
+    wb.active = wb.sheetnames.index("My notes")
+    wb.save(path)
+    order = wb.sheetnames
+    assert order[0] == "Result efficiency" and order[-1] == "My notes"
+    assert main(["run", str(path), "--no-progress", "--run", "LP rotor"]) == 0
+    wb = load_workbook(path)
+    assert (wb.sheetnames, wb.active.title) == (order, "My notes")
 
 
 def _add_part(path, name, content_type, data=b"<x/>"):

@@ -32,7 +32,16 @@ def is_workbook(name: str | None) -> bool:
     return name is not None and Path(name).suffix.lower() in WORKBOOK_SUFFIXES
 
 
+#: Spreadsheet files not read, by ending, and what they are.
+_OTHER_SPREADSHEETS = {".ods": "an OpenDocument spreadsheet", ".xls": "an Excel 97-2003 workbook",
+                       ".xlsb": "an Excel binary workbook", ".csv": "a CSV table"}
+
+
 def _json_case(path: str) -> Case:
+    other = _OTHER_SPREADSHEETS.get(Path(path).suffix.lower())
+    if other is not None:
+        raise UsageError(f"{path}: {other} is not read as a case; save it as an Excel workbook (.xlsx) and give "
+                         "that, or give a JSON case")
     try:
         case = from_json(Path(path).read_text(encoding="utf-8"))
     except UnicodeDecodeError:

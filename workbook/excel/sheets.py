@@ -10,6 +10,7 @@ import datetime
 import difflib
 import math
 import re
+import unicodedata
 import warnings
 import zipfile
 from dataclasses import dataclass
@@ -20,6 +21,7 @@ from openpyxl.cell.read_only import EmptyCell
 from openpyxl.utils import get_column_letter
 from openpyxl.utils.cell import coordinate_to_tuple
 from openpyxl.utils.datetime import to_excel
+from openpyxl.worksheet.worksheet import Worksheet
 
 import workbook.excel.layout as L
 from workbook.errors import Problem, UnitProblem, WorkbookError
@@ -109,6 +111,11 @@ class _Cells:
         """Columns of the stored cells of *row*."""
         return sorted(c for r, c in self._values if r == row)
 
+    def data_cells(self) -> list[tuple[int, int]]:
+        """``(row, column)`` of each data-row cell showing a value (not blank text), by row then column."""
+        return sorted(key for key, value in self._values.items() if key[0] >= L.FIRST_DATA_ROW and value is not None
+                      and not (isinstance(value, str) and not value.strip()))
+
     def rows(self, columns: set) -> list[int]:
         """Data rows with a value or a formula in one of *columns*, in order."""
         found = {r for r, c in (*self._values, *self._formulas) if c in columns and self.has(r, c)}
@@ -195,6 +202,10 @@ class SheetReader:
                          f"one sheet named '{name}' (these names read as the same one, letter case and spaces "
                          "aside: rename or delete all but one)")
             return None
+        if titles and not isinstance(self.formulas[titles[0]], Worksheet):
+            self.problem(titles[0], None, None, "a chart sheet",
+                         f"a sheet of cells named '{name}' (a chart sheet holds no table: rename the chart sheet)")
+            return None
         return titles[0] if titles else None
 
     def misspelt_sheets(self, read: tuple, known: tuple) -> None:
@@ -246,6 +257,7 @@ class SheetReader:
             return []
         sheet = _Cells(self.values.cells(title), self.formulas[title])
         positions = self._headers(table, sheet)
+        self._headless(table, sheet)
         if positions is None:
             return []
         merged = self._merged(table, sheet, positions)
@@ -296,7 +308,7 @@ class SheetReader:
             if text is None or (isinstance(text, str) and (not text.strip() or text.strip().startswith("#"))):
                 continue
             cell = f"{get_column_letter(col)}{L.HEADER_ROW}"
-            column = by_header.get(str(text).strip().lower())
+            column = by_header.get(_visible(str(text)).lower())
             if column is None:
                 self.problem(table.sheet, cell, None, text,
                              "a known column header (notes: start the header with '#')")
@@ -310,6 +322,25 @@ class SheetReader:
                 self.problem(table.sheet, f"row {L.HEADER_ROW}", column.header, None,
                              f"a column headed '{column.header}'")
         return None if any(c.required for c in missing) else positions
+
+    def _headless(self, table: L.Table, sheet: "_Cells") -> None:
+        """Report each column holding data below an empty header cell: its values would be ignored.
+
+        A header cleared by mistake would drop the column's values silently (an
+        optional column is then read as empty); a column of notes is headed
+        with '#'.
+        """
+        cells: dict[int, list[int]] = {}
+        for row, col in sheet.data_cells():
+            header = sheet.value(L.HEADER_ROW, col)
+            if header is None or (isinstance(header, str) and not header.strip()):
+                cells.setdefault(col, []).append(row)
+        for col, rows in sorted(cells.items()):
+            more = f"; {len(rows) - 1} more cell{'s' if len(rows) > 2 else ''} below it" if len(rows) > 1 else ""
+            self.problem(table.sheet, f"{get_column_letter(col)}{rows[0]}", None, sheet.value(rows[0], col),
+                         f"a column header in cell {get_column_letter(col)}{L.HEADER_ROW} above data (it is empty, "
+                         f"so the column's values would be ignored{more}: give the column its header, or a header "
+                         "starting with '#' for notes)")
 
     def _units(self, table: L.Table, sheet: "_Cells", positions: dict) -> dict:
         """Factor to SI of each number column (None where the unit cell is bad)."""
@@ -420,13 +451,20 @@ FORMULA_ERRORS = ("#NULL!", "#DIV/0!", "#VALUE!", "#REF!", "#NAME?", "#NUM!", "#
                   "#GETTING_DATA")
 
 
-def _not_a_value(value: Any) -> None:
+#: Column kinds whose cells hold words (a name, a choice, yes or no, a unit), not numbers.
+_WORD_KINDS = ("text", "choice", "yesno", "unit")
+
+
+def _not_a_value(value: Any, column: L.Column) -> None:
     """Refuse a formula error or a date where a number or text is read."""
     if isinstance(value, str) and value.strip().upper() in FORMULA_ERRORS:
         raise _Bad(f"a value (the cell shows the formula error {value.strip()}: correct the formula or the cells "
                    "it uses)")
     if isinstance(value, (datetime.datetime, datetime.date, datetime.time)):
         number = float(to_excel(value))
+        if column.kind in _WORD_KINDS:
+            raise _Bad("text, not a date (Excel and LibreOffice turn text such as 1-2, 3/4 or 10:30 into a date as "
+                       "it is typed: format the cell as Text and type it again)", f"the date {_shown_date(value)}")
         raise _Bad(f"a number, not a date (the cell is formatted as a date: format it as a number; it holds "
                    f"{number:.10g})", f"{number:.10g} formatted as the date {_shown_date(value)}")
 
@@ -465,10 +503,10 @@ _UNIT_SPELLINGS = (
 
 
 def _as_number(value: Any, column: L.Column) -> float:
-    _not_a_value(value)
+    _not_a_value(value, column)
     if isinstance(value, bool):
         raise _Bad("a number")
-    number = float(value) if isinstance(value, (int, float)) else _text_number(str(value))
+    number = float(value) if isinstance(value, (int, float)) else _text_number(str(value), column.si_unit)
     if not math.isfinite(number):
         raise _Bad("a finite number")
     return number
@@ -479,15 +517,17 @@ _GROUPED = re.compile(r"^[+-]?[1-9]\d{0,2}(?:(?P<sep>[,.])\d{3})+$", re.ASCII)
 _PLAIN = re.compile(r"^[+-]?(\d+([.,]\d*)?|[.,]\d+)([eE][+-]?\d+)?$", re.ASCII)
 
 
-def _text_number(text: str) -> float:
+def _text_number(text: str, si_unit: str | None = None) -> float:
     """A number typed as text, read only when its separators leave one reading.
 
     ``3,5`` is 3.5, ``1.234,5`` and ``1,234.5`` are 1234.5, ``1,234,567`` is
     1234567; but ``3,568`` (or ``3.568``) may be 3568 (a thousands
     separator) or 3.568 (a decimal separator) and is refused with both
-    readings. A number entered as a number is never ambiguous.
+    readings. A number entered as a number is never ambiguous. A number
+    followed by a unit of the quantity of *si_unit* (``20 kN/mm``) is refused
+    saying that the unit goes in the unit row.
     """
-    compact = text.strip().replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
+    compact = _visible(text).replace("\u00a0", "").replace("\u202f", "").replace(" ", "")
     grouped = _GROUPED.match(compact)
     separator = grouped.group("sep") if grouped else ""
     if grouped and compact.count(separator) == 1:
@@ -505,8 +545,26 @@ def _text_number(text: str) -> float:
             return float(whole.replace("," if decimal == "." else ".", "") + "." + fraction)
         raise _Bad("a number")
     if not _PLAIN.match(compact) and compact.lower().lstrip("+-") not in ("inf", "infinity", "nan"):
+        with_unit = _WITH_UNIT.match(_visible(text))
+        if with_unit and si_unit and _is_unit(with_unit.group(2), si_unit):
+            raise _Bad(f"a number without its unit (a cell takes the number, {with_unit.group(1)}; the unit, "
+                       f"{with_unit.group(2)}, goes in the column's unit cell, row {L.UNIT_ROW}, for the whole "
+                       "column)")
         raise _Bad("a number")
     return float(compact.replace(",", "."))
+
+
+def _is_unit(text: str, si_unit: str) -> bool:
+    """True if *text* is a unit of the quantity of *si_unit*."""
+    try:
+        si_factor(text, si_unit)
+    except UnitProblem:
+        return False
+    return True
+
+
+#: A number followed by a unit, typed into one cell: '20 kN/mm'.
+_WITH_UNIT = re.compile(r"^([+-]?[\d.,]*\d(?:[eE][+-]?\d+)?)\s*([^\W\d_].*)$")
 
 
 def _as_integer(value: Any, column: L.Column) -> int:
@@ -517,10 +575,17 @@ def _as_integer(value: Any, column: L.Column) -> int:
 
 
 def _as_text(value: Any, column: L.Column) -> str:
-    _not_a_value(value)
+    _not_a_value(value, column)
     if isinstance(value, float) and value.is_integer():
         value = int(value)
-    return str(value).strip()
+    return _visible(str(value))
+
+
+def _visible(text: str) -> str:
+    """*text* as a cell shows it: without spaces at its ends and without invisible format characters (zero-width
+    space, byte-order mark, soft hyphen, direction marks: text pasted from web pages and PDFs brings them), which
+    would make two names that look the same differ."""
+    return "".join(char for char in text if unicodedata.category(char) != "Cf").strip()
 
 
 def _as_choice(value: Any, column: L.Column) -> str:
@@ -607,7 +672,39 @@ def _not_a_workbook(path: Path) -> Problem:
                            "Protect Workbook > Encrypt with Password, clear the password)")
         return Problem(path.name, None, None, None, "an Excel 97-2003 workbook (.xls)",
                        "an Excel .xlsx workbook (save it as Excel Workbook .xlsx)")
+    if size == 0:
+        return Problem(path.name, None, None, None, "an empty file (0 bytes)", "an Excel .xlsx workbook")
+    if head.startswith(b"PK"):
+        return Problem(path.name, None, None, None, f"{size} bytes of an incomplete zip archive (the file was cut "
+                       "short: copied, downloaded or saved only in part)",
+                       "a complete Excel .xlsx workbook (copy or save it again)")
+    if b"\0" not in head[:65536]:
+        return Problem(path.name, None, None, None, f"{size} bytes of text that are not a zip archive (a CSV or "
+                       "text file named .xlsx?)", "an Excel .xlsx workbook (open the file in Excel or LibreOffice "
+                       "and save it as an .xlsx workbook)")
     return Problem(path.name, None, None, None, f"{size} bytes that are not a zip archive", "an Excel .xlsx workbook")
+
+
+#: The media type an OpenDocument spreadsheet (.ods) names in its 'mimetype' part.
+_ODS_MIMETYPE = b"application/vnd.oasis.opendocument.spreadsheet"
+
+
+def _not_excel(path: Path) -> Problem | None:
+    """A problem if the zip archive at *path* is not an Excel workbook (it has no content types), naming an
+    OpenDocument spreadsheet as such; None if it is."""
+    try:
+        with zipfile.ZipFile(path) as archive:
+            names = archive.namelist()
+            if "[Content_Types].xml" in names:
+                return None
+            mimetype = archive.read("mimetype").strip() if "mimetype" in names else b""
+    except Exception:  # a damaged archive: reported as unreadable when it is opened
+        return None
+    if mimetype.startswith(_ODS_MIMETYPE):
+        return Problem(path.name, None, None, None, "an OpenDocument spreadsheet (.ods)",
+                       "an Excel .xlsx workbook (in LibreOffice: File > Save As, file type Excel 2007-365 .xlsx)")
+    return Problem(path.name, None, None, None, "a zip archive without the parts of an Excel workbook",
+                   "a readable Excel .xlsx workbook")
 
 
 def _too_large(path: Path) -> Problem | None:
@@ -743,7 +840,7 @@ def read_workbook_bytes(path: Path) -> bytes:
         raise WorkbookError([Problem(path.name, None, None, None, str(path), "an existing workbook file")])
     if not zipfile.is_zipfile(path):
         raise WorkbookError([_not_a_workbook(path)])
-    problem = _too_large(path)
+    problem = _too_large(path) or _not_excel(path)
     if problem is not None:
         raise WorkbookError([problem])
     return path.read_bytes()

@@ -11,8 +11,11 @@ rows of the runs it computed: the rows of the workbook's other runs stay as
 they were, and the sheet's note names them. A copy of a
 result sheet (``Result efficiency (2)``) or a renamed one (``Result LP
 baseline``) is the user's and is kept, like any sheet of the user's that
-happens to share a name. The input sheets are left as openpyxl read them (values,
-styles, drop-downs, comments).
+happens to share a name. A result sheet written again keeps its place among
+the sheets. The input sheets are left as openpyxl read them (values, styles,
+drop-downs, comments); formulas keep the values Excel cached, except those
+that take a result (directly or through other formulas or defined names):
+they are saved without one, for Excel or LibreOffice to calculate anew.
 
 The case workbook is not overwritten (the results go to a separate, new
 workbook beside it, and the reason is given) when:
@@ -25,6 +28,9 @@ workbook beside it, and the reason is given) when:
   and manager properties, ...), or the rewritten file would lack any kind
   of part the original has (:func:`~workbook.excel.files.lost_parts`);
 - a sheet named like a result sheet exists that is not ours;
+- a result sheet it would rewrite was changed since it was written (a note,
+  a column or a row added, a text changed: the digest in its marker no
+  longer matches; a number changed is not told);
 - the user cannot write it (read-only, e.g. mode 444);
 - it changed on disk while the runs were computed, or while the new file
   was built (checked again just before the rename; other ``mountwb``
@@ -41,7 +47,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from openpyxl import Workbook
+from openpyxl.formula.tokenizer import Token, Tokenizer
 from openpyxl.styles import Font, PatternFill
+from openpyxl.utils.cell import coordinate_to_tuple, range_boundaries
 
 import workbook.excel.layout as L
 from workbook.answers.isolation import efficiency, relative_error
@@ -62,7 +70,7 @@ from workbook.excel.files import (
     write_atomic,
 )
 from workbook.excel.runs import RunSpec, TestPoint
-from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_values
+from workbook.excel.sheets import CachedValues, open_workbook, peek, stored_cells, stored_values
 from workbook.excel.styling import print_setup, write_frame, write_table, write_text_lines
 from workbook.model.case import DIRECTIONS
 
@@ -214,8 +222,28 @@ def _marker(title: str) -> str:
     return f"{MARKER}: {title}"
 
 
+#: Separates the marker from the digest of the sheet's content that follows it.
+_DIGEST = " #"
+
+
+def _shown(value) -> str:
+    """A cell value of a result sheet as :func:`_content_digest` takes it: text as it is, any number or yes/no
+    as ``#`` (a save by LibreOffice rounds numbers to 15 digits and saves yes/no as the formulas =TRUE() and
+    =FALSE())."""
+    return "#" if isinstance(value, (int, float)) or value in ("=TRUE()", "=FALSE()") else str(value)
+
+
+def _content_digest(ws) -> str:
+    """A digest of where *ws* holds values (but its marker) and of its texts (:func:`_shown`): a note, a
+    column or a row the user adds, or a text changed, changes it."""
+    marker = coordinate_to_tuple(MARKER_CELL)
+    text = "\n".join(f"{key} {_shown(cell.value)}" for key, cell in sorted(ws._cells.items())
+                     if key != marker and cell.value is not None and cell.value != "")
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 def _mark(ws) -> None:
-    ws[MARKER_CELL] = _marker(ws.title)
+    ws[MARKER_CELL] = f"{_marker(ws.title)}{_DIGEST}{_content_digest(ws)}"
     ws.column_dimensions[MARKER_CELL.rstrip("0123456789")].hidden = True
 
 
@@ -229,7 +257,14 @@ def is_result_sheet(ws) -> bool:
     if ws.title not in RESULT_SHEETS:
         return False
     value = peek(ws, MARKER_CELL)
-    return value == _marker(ws.title) or value == MARKER
+    return isinstance(value, str) and value.split(_DIGEST)[0] in (_marker(ws.title), MARKER)
+
+
+def _edited(ws) -> bool:
+    """True if the result sheet *ws* was changed since this package wrote it (a note or a column of the
+    user's, say), as the digest in its marker tells; a sheet written before the marker held one is not."""
+    _, _, digest = str(peek(ws, MARKER_CELL)).partition(_DIGEST)
+    return bool(digest) and digest != _content_digest(ws)
 
 
 def _write_table(ws, table: ResultTable, note: str) -> None:
@@ -346,6 +381,7 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
     cards = _earlier_cards(earlier[title]) if title in earlier else []
     fresh = [(run.spec.name, card_lines([run])) for run in runs]
     lines = [line for block in _merged(cards, fresh, computed) for line in block]
+    order = {title: index for index, title in enumerate(workbook.sheetnames)}
     for ws in earlier.values():
         workbook.remove(ws)
     for title, (table, note) in merged.items():
@@ -363,11 +399,20 @@ def add_result_sheets(workbook, runs: list[RunResult], tests: tuple, stamp: str,
             write_frame(ws, frame, top=2, fill=_HEADER_FILL, quantities=module.QUANTITIES)
             _mark(ws)
             written.append(title)
+    # a rewritten sheet takes the place of the one it replaces; new ones go last
+    workbook._sheets.sort(key=lambda sheet: order.get(sheet.title, len(order)))
     return written
 
 
 def _conflicts(workbook, titles: list[str]) -> list[str]:
     return [title for title in titles if title in workbook.sheetnames and not is_result_sheet(workbook[title])]
+
+
+def _edited_sheets(workbook, titles: list[str]) -> list[str]:
+    """The result sheets a write of the sheets *titles* replaces that were changed since they were written
+    (the loads and fatigue sheets are replaced only when written again)."""
+    return [ws.title for ws in workbook.worksheets if is_result_sheet(ws) and _edited(ws)
+            and (ws.title in titles or ws.title not in (LOADS_SHEET, FATIGUE_SHEET))]
 
 
 def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=None):
@@ -401,14 +446,86 @@ def _reason_not_to_overwrite(path: Path, sha256: str, titles: list[str], opened=
     if conflicts:
         return (f"it has sheets named {', '.join(repr(c) for c in conflicts)} that were not written by mountwb; "
                 "rename them to write the results into the workbook"), None, None
+    edited = _edited_sheets(workbook, titles)
+    if edited:
+        return (f"its result sheets {', '.join(repr(e) for e in edited)} were changed after mountwb wrote them, "
+                "and writing the results again would lose the changes; rename those sheets to keep them (or "
+                "delete them) to write the results into the workbook"), None, None
     return None, workbook, values
 
 
-def _cached_formula_values(workbook, values: CachedValues) -> dict[int, dict[str, object]]:
+def _reference_boxes(names: dict, ws, text: str) -> list[tuple[str, tuple]]:
+    """The cells a formula *text* of sheet *ws* refers to: ``(sheet title in lower case, (min col, min row,
+    max col, max row))`` each, a whole column or row open-ended (None); the defined *names* (by lower-case
+    name) are followed. References that cannot be placed (other workbooks, tables, 3-D ranges) are left out."""
+    local = {name.lower(): defined for name, defined in ws.defined_names.items()}
+    boxes: list[tuple[str, tuple]] = []
+    try:
+        tokens = Tokenizer(text).items
+    except Exception:  # openpyxl's tokenizer refuses some formulas Excel takes; the text check still holds
+        return boxes
+    for token in tokens:
+        if token.type != Token.OPERAND or token.subtype != Token.RANGE:
+            continue
+        sheet, _, ref = token.value.rpartition("!")
+        sheet = sheet[1:-1].replace("''", "'") if sheet.startswith("'") else sheet or ws.title
+        places = [(sheet, ref)]
+        name = local.get(ref.lower()) or names.get(ref.lower())
+        if name is not None:
+            try:
+                places = list(name.destinations)
+            except Exception:  # a name openpyxl cannot parse
+                places = []
+        for target, place in places:
+            try:
+                boxes.append((target.lower(), range_boundaries(place.replace("$", ""))))
+            except ValueError:
+                continue
+    return boxes
+
+
+def _inside(box: tuple, col: int, row: int) -> bool:
+    low_col, low_row, high_col, high_row = box
+    return ((low_col is None or low_col <= col <= high_col) and (low_row is None or low_row <= row <= high_row))
+
+
+def _result_dependents(workbook, titles) -> set[tuple[str, str]]:
+    """The formula cells of *workbook* whose value may come from the sheets *titles*: ``(sheet, coordinate)`` each.
+
+    A formula depends on those sheets when it names one (in a reference or
+    in a text, as INDIRECT takes it), or refers to a cell of theirs or to a
+    formula cell that depends on them, directly or through a defined name.
+    """
+    lowered = [title.lower() for title in titles]
+    formulas = {(ws.title, cell.row, cell.column): (cell.coordinate, str(cell.value))
+                for ws in workbook.worksheets for cell in stored_cells(ws) if cell.data_type == "f"}
+    names = {name.lower(): defined for name, defined in workbook.defined_names.items()}
+    referring: dict[str, list[tuple[tuple, tuple]]] = {}    # sheet -> (formula cell, box on that sheet)
+    tainted = set()
+    for key, (_, text) in formulas.items():
+        boxes = _reference_boxes(names, workbook[key[0]], text)
+        if any(title in text.lower() for title in lowered) or any(sheet in lowered for sheet, _ in boxes):
+            tainted.add(key)
+        for sheet, box in boxes:
+            referring.setdefault(sheet, []).append((key, box))
+    waiting = list(tainted)
+    while waiting:
+        sheet, row, col = waiting.pop()
+        for key, box in referring.get(sheet.lower(), ()):
+            if key not in tainted and _inside(box, col, row):
+                tainted.add(key)
+                waiting.append(key)
+    return {(sheet, formulas[(sheet, row, col)][0]) for sheet, row, col in tainted}
+
+
+def _cached_formula_values(workbook, values: CachedValues, results: tuple) -> dict[int, dict[str, object]]:
     """The values Excel cached for the formula cells of *workbook* (as the reader found them in *values*), by
-    sheet number."""
-    cached = {number: values.formula_values(ws.title) for number, ws in enumerate(workbook.worksheets, start=1)
-              if ws.title in values.sheetnames}
+    sheet number; none for a formula that depends on the result sheets *results* (:func:`_result_dependents`):
+    its cached value is that of the earlier results, and Excel calculates it anew on opening the file."""
+    stale = _result_dependents(workbook, results)
+    cached = {number: {cell: value for cell, value in values.formula_values(ws.title).items()
+                       if (ws.title, cell) not in stale}
+              for number, ws in enumerate(workbook.worksheets, start=1) if ws.title in values.sheetnames}
     return {number: found for number, found in cached.items() if found}
 
 
@@ -447,7 +564,8 @@ def write_results(path: str | Path, sha256: str, runs: list[RunResult], tests: t
         if reason is None:
             log.info("building the new %s with the results", path.name)
             add_result_sheets(workbook, runs, tests, stamp, tables, loads, fatigue)
-            data = restore_formula_values(workbook_bytes(workbook, path), _cached_formula_values(workbook, values))
+            data = restore_formula_values(workbook_bytes(workbook, path),
+                                          _cached_formula_values(workbook, values, RESULT_SHEETS))
             lost = lost_parts(path.read_bytes(), data)
             reason = f"it holds content this program cannot keep ({', '.join(lost)})" if lost else None
         if reason is None:
