@@ -50,7 +50,7 @@ _HOMES = {
     "studies.parametric": ("PARAMETERS", "grid", "latin_hypercube", "study_cases"),
     "studies.parallel": ("run_rows", "RowOutcome"),
     "errors": ("MountwbError", "InputError", "CaseError", "WorkbookError", "RecordError", "UsageError", "SimulationError", "MechanismError",
-               "EquilibriumError", "ResonanceError", "FourPoleError", "UnstablePreloadError", "BucklingError",
+               "EquilibriumError", "ResonanceError", "RoundOffError", "FourPoleError", "UnstablePreloadError", "BucklingError",
                "OutsideDesignModel", "InfeasibleProblem", "Terminated"),
 }
 __getattr__, __dir__, _NAMES = lazy_names(__name__, _HOMES)

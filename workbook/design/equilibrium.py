@@ -221,9 +221,7 @@ def static_state(expansion: SceneExpansion, springs: ChannelSprings, base_force:
             active = np.array([k for k in active if k not in failures], dtype=int)
         if not len(active):
             break
-    for k in active:
-        failures[int(k)] = f"the preload did not converge in {PRELOAD_STEPS} steps"
-    return StaticSolution(dq, steps, failures)
+    return StaticSolution(dq, steps, failures, tuple(int(k) for k in active))
 
 
 def _renew(chord: ChordStiffness, rows: np.ndarray, expansion: SceneExpansion, springs: ChannelSprings,
@@ -248,13 +246,17 @@ class StaticSolution:
     steps : ndarray of int, shape (B,)
         Steps each design took.
     failures : dict of int to str
-        The designs whose tangent stiffness was singular or that did not
-        converge, with the reason (their rows of *dq* mean nothing).
+        The designs whose tangent stiffness was singular, with the reason
+        (their rows of *dq* mean nothing).
+    unconverged : tuple of int
+        The designs not brought to rest in :data:`PRELOAD_STEPS` steps
+        (their rows of *dq* mean nothing).
     """
 
     dq: np.ndarray
     steps: np.ndarray
     failures: dict
+    unconverged: tuple = ()
 
 
 def _tangent_inverse(expansion: SceneExpansion, springs: ChannelSprings, loads: StateLoads, dq: np.ndarray,

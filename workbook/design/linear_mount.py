@@ -47,7 +47,7 @@ from workbook.design.assembly import (
     without_normal,
 )
 from workbook.design.channel_set import spring_matrix, spring_rows
-from workbook.design.equilibrium import ChordStiffness, PreparedTangent, prepared_tangent, static_state
+from workbook.design.equilibrium import PRELOAD_STEPS, ChordStiffness, PreparedTangent, prepared_tangent, static_state
 from workbook.design.expansion import SceneExpansion, expand_scene
 from workbook.design.harmonic_model import BodyHarmonic, Harmonic
 from workbook.design.memory import keep_freed_memory
@@ -252,6 +252,12 @@ def _field_names(kind: type) -> tuple[str, ...]:
 
 
 #: What a design may change, by field (module text); the excitations are checked on their own.
+#: Largest change of the engine's static translation (m) and rotation (rad) from the prepared design's preload
+#: that a design's answer may have: the expansion about the prepared state is of second order, and T drifts
+#: from the pipeline's as the preload moves (the far-design table of docs/design-evaluation.md); a
+#: mechanism's "equilibrium" lies kilometres away.
+REACH_M = 0.01
+REACH_RAD = 0.01
 _DESIGN_CHANGES = {"name": None, "excitations": None, "hinges": None,
                    "engine": {"mass": None, "inertia": None, "casing": {"material": {"youngs_modulus": None}}},
                    "test_rig": {"stiffness": None, "damping": None}}
@@ -455,13 +461,13 @@ class LinearMount:
             np.array([case.engine.inertia_matrix - base.inertia_matrix for case in cases], dtype=float),
             np.array([1.0 if casing is None else casing.scale(case) for case in cases]))
 
-    def _item_runs(self, cases: list[Case], position: int, prepared: _Item, model: "Harmonic | BodyHarmonic", solved: np.ndarray,
-                   failures: dict) -> list:
+    def _item_runs(self, cases: list[Case], position: int, prepared: _Item, model: "Harmonic | BodyHarmonic | None",
+                   solved: np.ndarray, failures: dict) -> list:
         """Per design *cases*, its excitation results of the item at *position* (its own excitations), or the
         error that stopped it.
 
-        *model* holds the linear models of the designs *solved* (sorted positions among *designs*); *failures*
-        the errors of the others."""
+        *model* holds the linear models of the designs *solved* (sorted positions among *designs*; None: none
+        solved); *failures* the errors of the others."""
         results: list = [[] for _ in cases]
         excitations = [points_of(case.excitations[position]) for case in cases]
         pylon = [self.channels.index(name) for name in self.pylon]
@@ -470,6 +476,7 @@ class LinearMount:
                             dtype=int)
             if not len(rows):
                 continue
+            assert model is not None, "designs left that solved"
             chosen = [excitations[k][point] for k in rows]
             omega = 2 * np.pi * np.array([e.frequency for e in chosen])
             positions = np.searchsorted(solved, rows)
@@ -722,7 +729,7 @@ class _SolvedItem:
     prepared: _Item
     designs: _Designs
     state: _State              # of every design (the rows of failed ones mean nothing)
-    model: BodyHarmonic | Harmonic     # of the designs *rows*
+    model: BodyHarmonic | Harmonic | None     # of the designs *rows* (None: none solved)
     rows: np.ndarray           # the designs solved, sorted
     failures: dict             # design -> SimulationError of the others
     passes: list               # (rows, dq, tensions, stiffened) of each preload solve, when kept
@@ -737,8 +744,21 @@ class _SolvedItem:
                 loads = _state_loads(self.designs.take(np.array([k])), self.prepared, tensions[p][None]).take(0)
                 passes.append((dq[p], stiffened[p], loads))
         state = dataclasses.replace(self.state.take(k), passes=tuple(passes))
+        assert self.model is not None, "design(k) of a design that solved"
         return ItemSolution(self.prepared, self.designs.springs.take(k), state,
                             self.model.take(int(np.searchsorted(self.rows, k))).dense())
+
+
+def _beyond_reach(name: str, engine_change: np.ndarray) -> OutsideDesignModel | None:
+    """The refusal of a design whose preload moves the engine (*engine_change*: its translation, m, and
+    Rxyz rotation, rad, from the prepared design's preload) beyond :data:`REACH_M` or :data:`REACH_RAD`, or
+    None."""
+    move, turn = float(np.abs(engine_change[:3]).max()), float(np.abs(engine_change[3:]).max())
+    if move <= REACH_M and turn <= REACH_RAD:
+        return None
+    return OutsideDesignModel(name, f"a preload that moves the engine {move * 1e3:.3g} mm and turns it "
+                                    f"{turn * 1e3:.3g} mrad from the prepared design's (it follows up to "
+                                    f"{REACH_M * 1e3:g} mm and {REACH_RAD * 1e3:g} mrad)")
 
 
 def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False) -> _SolvedItem:
@@ -765,13 +785,16 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
         for k, reason in solution.failures.items():
             failures[int(rows[k])] = UnstablePreloadError(
                 f"{designs.cases[rows[k]].name}: the design's preload has no stable equilibrium ({reason})", [])
+        for k in solution.unconverged:  # far from the prepared state, or a mechanism: the pipeline tells
+            failures[int(rows[k])] = OutsideDesignModel(
+                designs.cases[rows[k]].name, f"a preload its expansion does not bring to rest in {PRELOAD_STEPS} steps")
         dq[rows] = solution.dq
         forces[rows] = _channel_forces(prepared, designs.springs.take(rows), solution.dq)
         if keep_passes:
             passes.append((rows, solution.dq, tensions[rows].copy(), stiffened[rows].copy()))
         if chord is not None and part is not None:
             chord.put(rows, part)
-        return np.delete(rows, list(solution.failures))
+        return np.delete(rows, [*solution.failures, *solution.unconverged])
 
     def link_tensions(rows: np.ndarray) -> np.ndarray:
         return -np.einsum("lcx,bcx->bl", prepared.compression, forces[rows])[:, prepared.flexible_positions]
@@ -798,10 +821,14 @@ def _solve_item(designs: _Designs, prepared: _Item, *, keep_passes: bool = False
             going = ~((change <= TENSION_TOLERANCE) | (solves > MAX_PASSES))
             tensions[active[going]] = np.where(chosen, new, 0.0)[going]
             active = active[going]
+    for k in sorted(set(range(count)) - set(failures)):
+        far = _beyond_reach(designs.cases[k].name, dq[k, prepared.engine])
+        if far is not None:
+            failures[k] = far
     solved = np.array(sorted(set(range(count)) - set(failures)), dtype=int)
     state = _State(dq, tensions, stiffened, forces, _state_loads(designs, prepared, tensions))
     part = designs.take(solved)
-    model = linear_model(prepared, part.springs, state.take(solved), part.casing_scale)
+    model = linear_model(prepared, part.springs, state.take(solved), part.casing_scale) if len(solved) else None
     return _SolvedItem(prepared, designs, state, model, solved, failures, passes)
 
 
