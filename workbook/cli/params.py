@@ -221,10 +221,12 @@ def run_table(args, case, table, resume: str) -> list:
     KeyboardInterrupt
         Ctrl-C or SIGTERM, with the number of finished rows kept in the table and *resume* as its message.
     """
-    from workbook.studies.parallel import run_rows
+    from workbook.studies.parallel import check_scheduler, run_rows
     from workbook.studies.parametric import study_cases
     from workbook.studies.progress import StudyProgress
 
+    if args.dask:
+        check_scheduler(args.dask)
     rows = table.rows
     cases = study_cases(case, rows)
     design_model = None if args.exudyn else linear_mount_for(case, cases)

@@ -60,7 +60,7 @@ from multiprocessing import reduction
 from typing import TYPE_CHECKING, Callable, cast
 
 from workbook.answers.isolation import efficiency
-from workbook.errors import OutsideDesignModel, Terminated, interruption
+from workbook.errors import OutsideDesignModel, Terminated, UsageError, interruption
 from workbook.model.case import DIRECTIONS, Case
 from workbook.processes import end_with_parent, loosen_allocator, stop_workers
 
@@ -68,7 +68,8 @@ if TYPE_CHECKING:
     from workbook.design.linear_mount import LinearMount
 
 __all__ = ["RowOutcome", "prepare", "prepare_design_model", "run_row", "run_batch", "batches", "run_rows", "SERIAL",
-           "ROWS_PER_WORKER", "BATCH_ROWS", "START_TRIES", "NUMPY_PATH", "EXUDYN_PATH"]
+           "ROWS_PER_WORKER", "BATCH_ROWS", "START_TRIES", "NUMPY_PATH", "EXUDYN_PATH",
+           "SCHEDULER_TIMEOUT", "check_scheduler"]
 
 log = logging.getLogger(__name__)
 
@@ -84,6 +85,8 @@ DESIGN_ROWS_PER_WORKER = 5000
 #: Process pools in a row that may break before any row starts (a worker process died as it started) before
 #: the study's remaining rows are reported failed.
 START_TRIES = 3
+#: Seconds a Dask scheduler gets to accept a study's connection.
+SCHEDULER_TIMEOUT = 10.0
 #: Rows the prepared linear mount answers together, in one NumPy batch (one task of a worker).
 BATCH_ROWS = 128
 #: The row was answered by the prepared linear mount in NumPy.
@@ -623,12 +626,46 @@ def _row_ranges(rows) -> str:
     return ", ".join(str(low) if low == high else f"{low} to {high}" for low, high in ranges)
 
 
+def check_scheduler(address: str, timeout: float | None = None) -> None:
+    """Refuse a Dask scheduler address that is malformed or where nothing answers, at once.
+
+    Parameters
+    ----------
+    address : str
+        ``tcp://host:port`` (or ``host:port``; ``tls://`` too). Other
+        transports are only read.
+    timeout : float, optional
+        s to wait for the connection (default :data:`SCHEDULER_TIMEOUT`).
+
+    Raises
+    ------
+    UsageError
+        Naming the address and why (Dask's own client retries a refused
+        connection for 30 s before it says so).
+    """
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme not in ("tcp", "tls"):
+            return
+        host, port = parse_host_port(location)
+    except ValueError as error:
+        raise UsageError(f"--dask {address!r}: {error}; expected tcp://HOST:PORT") from None
+    try:
+        socket.create_connection((host, port), timeout=SCHEDULER_TIMEOUT if timeout is None else timeout).close()
+    except OSError as error:
+        raise UsageError(f"--dask {address!r}: no Dask scheduler answers there ({error})") from None
+
+
 def _run_dask(pending: dict, address: str, done: Callable, design_model: LinearMount | None) -> None:
     from distributed import Client
     from distributed import as_completed as dask_completed
 
     cache = os.environ.get("MOUNTWB_CACHE")
-    with Client(address) as client:
+    with Client(address, timeout=SCHEDULER_TIMEOUT) as client:
         if cache:  # the workers load the reductions made here (a shared folder on a real cluster)
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
         client.run(loosen_allocator)    # Dask's own setting slows NumPy's large temporaries (workbook.processes)
