@@ -352,3 +352,4 @@ def test_workers_end_when_the_study_is_killed_outright(case_file, tmp_path):
     _wait(lambda: not alive(workers), timeout=60, what="the orphaned workers to end")
     table = _table(output)
     assert len(table) >= 1 and set(table["status"]) == {"ok"}
+
