@@ -353,3 +353,35 @@ def test_workers_end_when_the_study_is_killed_outright(case_file, tmp_path):
     table = _table(output)
     assert len(table) >= 1 and set(table["status"]) == {"ok"}
 
+
+
+@pytest.fixture()
+def small_disk(tmp_path):
+    """A folder on a file system of 64 kB of its own (tmpfs; skipped where this process may not mount one)."""
+    folder = tmp_path / "small"
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)], capture_output=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a small file system: {mounted.stderr.decode().strip()}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", "-l", str(folder)], check=True)
+
+
+@pytest.mark.slow
+def test_a_study_whose_disk_fills_says_which_rows_it_kept(small_disk, capsys):
+    """The table's disk filled mid-study: the message was the system's alone; now it says how many rows the
+    table holds and how to go on, as after Ctrl-C."""
+    from workbook.cli.main import main
+
+    output = small_disk / "out"
+    argv = ["study", "params", "--rigid", "--output", str(output), "--vary=hinge_stiffness=1e7:3e7:3000",
+            "--workers", "1"]
+    assert main(argv) == 2
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    kept = len(set(_table(output)["row"]))
+    assert 1 <= kept < 3000
+    assert last == (f"mountwb study: [Errno 28] No space left on device; {kept} of 3000 rows finished and kept in "
+                    f"{table_path(output)}; --resume runs the rest")
+    assert not [name for name in files_in(output) if name.endswith(".tmp")]

@@ -220,6 +220,8 @@ def run_table(args, case, table, resume: str) -> list:
     ------
     KeyboardInterrupt
         Ctrl-C or SIGTERM, with the number of finished rows kept in the table and *resume* as its message.
+    OSError
+        A file that could not be written (the table's disk full), with the same words after its own.
     """
     from workbook.studies.parallel import check_scheduler, run_rows
     from workbook.studies.parametric import study_cases
@@ -238,6 +240,9 @@ def run_table(args, case, table, resume: str) -> list:
     except KeyboardInterrupt as interrupt:
         table.flush()
         raise type(interrupt)(f"{table.kept} of {len(rows)} rows finished and kept in {table.path}; {resume}") from None
+    except OSError as error:           # the table's disk full, its folder gone...: the rows of its last write are kept
+        raise OSError(error.errno, f"{error.strerror or error}; {table.kept} of {len(rows)} rows finished and kept "
+                                   f"in {table.path}; {resume}") from None
     return outcomes
 
 
