@@ -215,40 +215,45 @@ _DYING_WORKERS = textwrap.dedent("""
                 open(marker, "w").close()
             os.kill(os.getpid(), signal.SIGKILL)
 
-    import dataclasses, json
+    import dataclasses, json, sys
     from workbook.model.reference import LP_ROTOR, reference_case
-    from workbook.studies.parallel import prepare_design_model, run_rows
+    from workbook.studies.parallel import _run_processes, prepare_design_model, run_rows
     from workbook.studies.parametric import grid, linear_range, study_cases
 
     if __name__ == "__main__":
         case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
-        cases = study_cases(case, grid({"hinge_stiffness": linear_range(1e7, 3e7, 300)}))
-        outcomes = run_rows(cases, workers=2, design_model=prepare_design_model(case))
-        print(json.dumps([[o.status, o.error] for o in outcomes]))
+        if sys.argv[1] == "mount":
+            cases = study_cases(case, grid({"hinge_stiffness": linear_range(1e7, 3e7, 300)}))
+            outcomes = run_rows(cases, workers=2, design_model=prepare_design_model(case))
+        else:                                     # rows handed to the pool one by one, 100,000 of them
+            outcomes = []
+            _run_processes(dict.fromkeys(range(100_000), case), 2, outcomes.append, 100_000, None)
+        print(json.dumps([len(outcomes), sorted({(o.status, o.error) for o in outcomes})]))
 """)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("die", ["always", "first"])
-def test_workers_killed_as_they_start_never_hang_the_study(tmp_path, die):
+@pytest.mark.parametrize(("die", "rows"), [("always", "mount"), ("first", "mount"), ("always", "many")])
+def test_workers_killed_as_they_start_never_hang_the_study(tmp_path, die, rows):
     """The prepared linear mount (megabytes) goes to each worker as it starts: a worker killed before it read
     it all blocked the study for ever. Now a pool whose workers die as they start is started again, at most
-    START_TRIES times, then its rows are reported failed; one death costs nothing but a new pool."""
+    START_TRIES times, then its rows are reported failed; one death costs nothing but a new pool. A death while
+    the rows were still handed to the pool ("many") ended the study with an internal error (BrokenProcessPool)."""
     script = tmp_path / "dying.py"
     script.write_text(_DYING_WORKERS)
     marker = "always" if die == "always" else str(tmp_path / "died")
     environment = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1", "WORKERS_DIE": marker}
-    done = subprocess.run([sys.executable, str(script)], env=environment, capture_output=True, text=True,
+    done = subprocess.run([sys.executable, str(script), rows], env=environment, capture_output=True, text=True,
                           timeout=60)
     assert done.returncode == 0, done.stderr
-    rows = json.loads(done.stdout.strip().splitlines()[-1])
-    assert len(rows) == 300
+    count, answers = json.loads(done.stdout.strip().splitlines()[-1])
+    assert count == (300 if rows == "mount" else 100_000)
     if die == "always":
-        assert {tuple(row) for row in rows} == {("failed", f"WorkerDied: no worker process could start a row "
+        assert {tuple(answer) for answer in answers} == {("failed", f"WorkerDied: no worker process could start a row "
                                                            f"({START_TRIES} process pools in a row broke before "
                                                            f"any row ran)")}
     else:
-        assert os.path.exists(marker) and {tuple(row) for row in rows} == {("ok", "")}
+        assert os.path.exists(marker) and {tuple(answer) for answer in answers} == {("ok", "")}
 
 
 def _busy(pid: int, exclude=()) -> list[psutil.Process]:

@@ -532,7 +532,12 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
 
     try:
         size = max(1, min(BATCH_ROWS, -(-len(pending) // (2 * workers))))       # at least two batches per worker
-        futures = {pool.submit(_reported_batch, batch): batch for batch in batches(pending, design_model, size)}
+        futures = {}
+        for batch in batches(pending, design_model, size):
+            try:
+                futures[pool.submit(_reported_batch, batch)] = batch
+            except BrokenProcessPool:        # a worker died while the rows were handed out: not started
+                broken.update(batch)
         processes.update(set(multiprocessing.active_children()) - before)  # to read their exit codes later
         for future in as_completed(futures):
             processes.update(set(multiprocessing.active_children()) - before)
@@ -582,6 +587,7 @@ def _pool_rounds(pending: dict, workers: int, done: Callable, rows_per_worker: i
         if unstarting == START_TRIES:
             _unstartable({**unstarted, **later, **suspects}, done)
             return
+        _said_unstarted(unstarting)
         pending = {**unstarted, **later}
         suspects.update(lost)
     if suspects:
@@ -596,6 +602,7 @@ def _pool_rounds(pending: dict, workers: int, done: Callable, rows_per_worker: i
         if unstarting == START_TRIES:
             _unstartable({index: case for rows in (unstarted, *groups) for index, case in rows.items()}, done)
             return
+        _said_unstarted(unstarting)
         if unstarted:
             groups.append(unstarted)
         if len(lost) == 1:
@@ -605,6 +612,13 @@ def _pool_rounds(pending: dict, workers: int, done: Callable, rows_per_worker: i
         elif lost:                           # its halves apart, until a row that ends its worker is alone
             rows = sorted(lost.items())
             groups += [dict(rows[:len(rows) // 2]), dict(rows[len(rows) // 2:])]
+
+
+def _said_unstarted(unstarting: int) -> None:
+    """Warn of the *unstarting*-th pool in a row that broke before any row started (none: nothing)."""
+    if unstarting:
+        log.warning("a worker process died as it started, before any row ran; a new pool is started (%d of %d)",
+                    unstarting + 1, START_TRIES)
 
 
 def _unstartable(rows: dict, done: Callable) -> None:
