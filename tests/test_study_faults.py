@@ -316,12 +316,13 @@ def test_a_worker_killed_in_a_batch_of_rows_costs_one_more_pool(tmp_path):
     _wait(lambda: table_path(output).exists(), what="a first batch of rows")   # the others running theirs
     workers = {worker.pid for worker in _workers(process.pid)}
     psutil.Process(min(workers)).kill()
+    end = time.monotonic() + 120
     try:
-        while process.poll() is None and len(workers) <= _WORKERS_AFTER_A_KILL:
+        while process.poll() is None and len(workers) <= _WORKERS_AFTER_A_KILL and time.monotonic() < end:
             workers.update(worker.pid for worker in _workers(process.pid))
             time.sleep(0.05)
         assert len(workers) <= _WORKERS_AFTER_A_KILL, f"{len(workers)} worker processes started"
-        stdout, stderr = process.communicate(timeout=120)
+        stdout, stderr = process.communicate(timeout=max(1.0, end - time.monotonic()))
     finally:
         if process.poll() is None:             # Ctrl-C: the study stops its workers
             process.send_signal(signal.SIGINT)
