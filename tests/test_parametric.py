@@ -170,6 +170,32 @@ def test_dask_cluster_equals_local(base, rows, serial, tmp_path):
     assert pd.read_excel(tmp_path / "out" / "parameter-study.xlsx").shape[0] == len(serial)
 
 
+@pytest.mark.parametrize(("address", "message"), [
+    ("tcp://127.0.0.1:{port}", "no Dask scheduler answers there ("),
+    ("nonsense", "--dask 'nonsense': missing port number in address 'nonsense'; expected tcp://HOST:PORT"),
+])
+@pytest.mark.parametrize("kind", ["params", "uq"])
+def test_a_dask_address_where_no_scheduler_answers_is_refused_at_once(base, tmp_path, capsys, address, message, kind):
+    """Dask's client tried a refused address for 30 s (a malformed one was an internal error) after the linear
+    mount was prepared; now either is bad input before anything runs."""
+    import socket
+    import time
+
+    with socket.socket() as free:                 # a port nothing listens on
+        free.bind(("127.0.0.1", 0))
+        port = free.getsockname()[1]
+    case_file = tmp_path / "case.json"
+    case_file.write_text(to_json(base))
+    option = "--vary=hinge_stiffness=1e7,2e7" if kind == "params" else "--param=hinge_stiffness=uniform:1e7:2e7"
+    argv = ["study", kind, str(case_file), "--output", str(tmp_path / "out"), option, "--dask",
+            address.format(port=port)]
+    start = time.monotonic()
+    assert main(argv) == 2
+    assert time.monotonic() - start < 15         # importing distributed takes seconds; its client took 30 s
+    assert message.format(port=port) in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_section_too_wide_for_the_eyes_is_a_case_error_of_its_row(base):
     cases = study_cases(base, ({"section_scale": 1.0}, {"section_scale": 2.0}))
     assert cases[0].links[0].model == base.links[0].model

@@ -20,7 +20,7 @@ from cli_signals import ROOT, SIGNAL_EXIT, alive, descendants, files_in, start
 from workbook.errors import EXIT_FAILED_ROWS, UsageError
 from workbook.model.codec import to_json
 from workbook.model.reference import LP_ROTOR, reference_case
-from workbook.studies.parallel import RowOutcome
+from workbook.studies.parallel import START_TRIES, RowOutcome
 from workbook.studies.sensitivity import StudyTable, read_finished, table_path
 
 #: Six rows of a few seconds each (rigid links, LP rotor, time domain from rest).
@@ -204,6 +204,58 @@ def test_a_study_from_standard_input_runs_its_rows_here_and_a_pool_that_cannot_s
                for _, status, error, _ in rows)
 
 
+#: A study of rows the prepared linear mount answers, whose worker processes are killed (SIGKILL) as they start,
+#: before they read the mount sent to them: always ("always"), or the first one only (the file it creates).
+_DYING_WORKERS = textwrap.dedent("""
+    import os, signal
+    if __name__ == "__mp_main__":                 # a worker process imports the main script as it starts
+        marker = os.environ["WORKERS_DIE"]
+        if marker == "always" or not os.path.exists(marker):
+            if marker != "always":
+                open(marker, "w").close()
+            os.kill(os.getpid(), signal.SIGKILL)
+
+    import dataclasses, json, sys
+    from workbook.model.reference import LP_ROTOR, reference_case
+    from workbook.studies.parallel import _run_processes, prepare_design_model, run_rows
+    from workbook.studies.parametric import grid, linear_range, study_cases
+
+    if __name__ == "__main__":
+        case = dataclasses.replace(reference_case().with_rigid_links(), excitations=(LP_ROTOR,))
+        if sys.argv[1] == "mount":
+            cases = study_cases(case, grid({"hinge_stiffness": linear_range(1e7, 3e7, 300)}))
+            outcomes = run_rows(cases, workers=2, design_model=prepare_design_model(case))
+        else:                                     # rows handed to the pool one by one, 100,000 of them
+            outcomes = []
+            _run_processes(dict.fromkeys(range(100_000), case), 2, outcomes.append, 100_000, None)
+        print(json.dumps([len(outcomes), sorted({(o.status, o.error) for o in outcomes})]))
+""")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("die", "rows"), [("always", "mount"), ("first", "mount"), ("always", "many")])
+def test_workers_killed_as_they_start_never_hang_the_study(tmp_path, die, rows):
+    """The prepared linear mount (megabytes) goes to each worker as it starts: a worker killed before it read
+    it all blocked the study for ever. Now a pool whose workers die as they start is started again, at most
+    START_TRIES times, then its rows are reported failed; one death costs nothing but a new pool. A death while
+    the rows were still handed to the pool ("many") ended the study with an internal error (BrokenProcessPool)."""
+    script = tmp_path / "dying.py"
+    script.write_text(_DYING_WORKERS)
+    marker = "always" if die == "always" else str(tmp_path / "died")
+    environment = {**os.environ, "PYTHONPATH": str(ROOT), "OPENBLAS_NUM_THREADS": "1", "WORKERS_DIE": marker}
+    done = subprocess.run([sys.executable, str(script), rows], env=environment, capture_output=True, text=True,
+                          timeout=60)
+    assert done.returncode == 0, done.stderr
+    count, answers = json.loads(done.stdout.strip().splitlines()[-1])
+    assert count == (300 if rows == "mount" else 100_000)
+    if die == "always":
+        assert {tuple(answer) for answer in answers} == {("failed", f"WorkerDied: no worker process could start a row "
+                                                           f"({START_TRIES} process pools in a row broke before "
+                                                           f"any row ran)")}
+    else:
+        assert os.path.exists(marker) and {tuple(answer) for answer in answers} == {("ok", "")}
+
+
 def _busy(pid: int, exclude=()) -> list[psutil.Process]:
     """Workers of *pid* not in *exclude* that have used more CPU time than their start-up takes."""
     busy = []
@@ -229,9 +281,9 @@ def test_a_killed_worker_is_retried_and_a_twice_killed_row_is_marked_failed(tmp_
     first = _wait(lambda: _busy(process.pid), what="a worker running a row")
     first[0].kill()                                   # SIGKILL: both rows in flight are lost
     lines = []
-    for line in process.stderr:                       # the lost rows are retried one at a time
+    for line in process.stderr:                       # the lost rows are retried in a pool of their own
         lines.append(line)
-        if "retried one at a time" in line:
+        if "retried in a process of their own" in line:
             break
     assert "a worker process died; rows" in lines[-1]
     seen = {p.pid for p in _workers(process.pid)} | {first[0].pid}
@@ -242,10 +294,44 @@ def test_a_killed_worker_is_retried_and_a_twice_killed_row_is_marked_failed(tmp_
     assert "Traceback" not in stderr + "".join(lines) and "BrokenProcessPool" not in stdout + stderr
     table = _table(output)
     failed = table[table["status"] == "failed"]
-    assert len(table) == 2 and len(failed) == 1      # the other row succeeded when retried alone
+    assert len(table) == 2 and len(failed) == 1      # the other row succeeded when retried
     assert failed["error"].iloc[0].startswith("WorkerDied: the worker process running this row was killed by SIGKILL")
     summary = stdout.strip().splitlines()[-1]
     assert summary == f"1 of 2 rows ok, 1 failed (rows {failed['row'].iloc[0]}; exit code {EXIT_FAILED_ROWS})"
+
+
+#: Worker processes a study of two may start in all when one of them is killed: two pools of two and the pool
+#: of one that retries the rows in flight (each row retried in a pool of its own started hundreds).
+_WORKERS_AFTER_A_KILL = 6
+
+
+@pytest.mark.slow
+def test_a_worker_killed_in_a_batch_of_rows_costs_one_more_pool(tmp_path):
+    """Rows answered in NumPy run 128 to a batch: the rows in flight when a worker was killed (two batches)
+    were retried each in a fresh pool of its own, a start-up of a second or more per row (minutes); now they
+    are retried together in one pool, and the study ends with every row."""
+    output = tmp_path / "out"
+    process = start("study", "params", "--rigid", "--output", str(output), "--vary=hinge_stiffness=1e7:3e7:600",
+                    "--workers", "2", cwd=tmp_path)
+    _wait(lambda: table_path(output).exists(), what="a first batch of rows")   # the others running theirs
+    workers = {worker.pid for worker in _workers(process.pid)}
+    psutil.Process(min(workers)).kill()
+    end = time.monotonic() + 120
+    try:
+        while process.poll() is None and len(workers) <= _WORKERS_AFTER_A_KILL and time.monotonic() < end:
+            workers.update(worker.pid for worker in _workers(process.pid))
+            time.sleep(0.05)
+        assert len(workers) <= _WORKERS_AFTER_A_KILL, f"{len(workers)} worker processes started"
+        stdout, stderr = process.communicate(timeout=max(1.0, end - time.monotonic()))
+    finally:
+        if process.poll() is None:             # Ctrl-C: the study stops its workers
+            process.send_signal(signal.SIGINT)
+            process.communicate(timeout=60)
+    assert process.returncode == 0, stderr
+    assert "a worker process died; rows " in stderr and "retried in a process of their own" in stderr
+    table = _table(output)
+    assert sorted(set(table["row"])) == list(range(600)) and set(table["status"]) == {"ok"}
+    assert set(table["path"]) == {"NumPy"} and stdout.strip().splitlines()[-1] == "600 of 600 rows ok, 0 failed"
 
 
 def test_resuming_from_the_table_of_another_study_is_refused(tmp_path):
@@ -272,3 +358,36 @@ def test_workers_end_when_the_study_is_killed_outright(case_file, tmp_path):
     _wait(lambda: not alive(workers), timeout=60, what="the orphaned workers to end")
     table = _table(output)
     assert len(table) >= 1 and set(table["status"]) == {"ok"}
+
+
+
+@pytest.fixture()
+def small_disk(tmp_path):
+    """A folder on a file system of 64 kB of its own (tmpfs; skipped where this process may not mount one)."""
+    folder = tmp_path / "small"
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)], capture_output=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a small file system: {mounted.stderr.decode().strip()}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", "-l", str(folder)], check=True)
+
+
+@pytest.mark.slow
+def test_a_study_whose_disk_fills_says_which_rows_it_kept(small_disk, capsys):
+    """The table's disk filled mid-study: the message was the system's alone; now it says how many rows the
+    table holds and how to go on, as after Ctrl-C."""
+    from workbook.cli.main import main
+
+    output = small_disk / "out"
+    argv = ["study", "params", "--rigid", "--output", str(output), "--vary=hinge_stiffness=1e7:3e7:3000",
+            "--workers", "1"]
+    assert main(argv) == 2
+    last = capsys.readouterr().err.strip().splitlines()[-1]
+    kept = len(set(_table(output)["row"]))
+    assert 1 <= kept < 3000
+    assert last == (f"mountwb study: [Errno 28] No space left on device; {kept} of 3000 rows finished and kept in "
+                    f"{table_path(output)}; --resume runs the rest")
+    assert not [name for name in files_in(output) if name.endswith(".tmp")]

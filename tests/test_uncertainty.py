@@ -13,7 +13,7 @@ from scipy.stats import norm
 
 from workbook.cli.main import main
 from workbook.cli.uq import parse_params
-from workbook.errors import InputError, UsageError
+from workbook.errors import EXIT_FAILED_ROWS, InputError, UsageError
 from workbook.model.codec import to_json
 from workbook.model.reference import LP_ROTOR, reference_case
 from workbook.studies.parallel import NUMPY_PATH, prepare_design_model, run_rows
@@ -131,3 +131,14 @@ def test_dask_workers_use_the_linear_mount_and_equal_local_processes(base, model
         on_dask = study_frame(rows, run_rows(cases, dask=cluster.scheduler_address, design_model=model))
     assert set(on_dask["path"]) == {NUMPY_PATH}
     pd.testing.assert_frame_equal(local.drop(columns="wall time s"), on_dask.drop(columns="wall time s"))
+
+
+def test_a_study_whose_every_row_fails_says_why(tmp_path, capsys):
+    """It printed pandas' "Empty DataFrame" and its columns; now the first row's error."""
+    argv = ["study", "uq", "--rigid", "--param", "hinge_stiffness=uniform:-2e7:-1e7", "--samples", "4", "--workers",
+            "1", "--output", str(tmp_path)]
+    assert main(argv) == EXIT_FAILED_ROWS
+    out = capsys.readouterr().out
+    assert "Empty DataFrame" not in out
+    assert out.splitlines()[0].startswith("no statistics: every row failed (row 0: CaseError: hinge ")
+    assert out.splitlines()[-1] == f"4 of 4 rows failed (their errors in {tmp_path / 'uncertainty.csv'})"

@@ -12,6 +12,7 @@ guarantees, kept here:
 """
 from __future__ import annotations
 
+import multiprocessing
 import os
 import threading
 import time
@@ -30,8 +31,15 @@ ALLOCATOR_KEEPS = 64 * 2 ** 20
 
 def end_with_parent() -> None:
     """In a worker process: end it (exit code 1) once its parent is gone, checked every
-    :data:`PARENT_CHECK_INTERVAL` s from a daemon thread."""
-    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True).start()
+    :data:`PARENT_CHECK_INTERVAL` s from a daemon thread.
+
+    The parent is the process that started this one (:func:`multiprocessing.parent_process`), also when it
+    was killed before this worker got here: the parent this worker has now would be another process (init),
+    and the worker would outlive the study for ever.
+    """
+    parent = multiprocessing.parent_process()
+    threading.Thread(target=_watch_parent, args=(os.getppid() if parent is None else parent.pid,),
+                     daemon=True).start()
 
 
 def _watch_parent(parent: int) -> None:

@@ -220,11 +220,15 @@ def run_table(args, case, table, resume: str) -> list:
     ------
     KeyboardInterrupt
         Ctrl-C or SIGTERM, with the number of finished rows kept in the table and *resume* as its message.
+    OSError
+        A file that could not be written (the table's disk full), with the same words after its own.
     """
-    from workbook.studies.parallel import run_rows
+    from workbook.studies.parallel import check_scheduler, run_rows
     from workbook.studies.parametric import study_cases
     from workbook.studies.progress import StudyProgress
 
+    if args.dask:
+        check_scheduler(args.dask)
     rows = table.rows
     cases = study_cases(case, rows)
     design_model = None if args.exudyn else linear_mount_for(case, cases)
@@ -236,6 +240,9 @@ def run_table(args, case, table, resume: str) -> list:
     except KeyboardInterrupt as interrupt:
         table.flush()
         raise type(interrupt)(f"{table.kept} of {len(rows)} rows finished and kept in {table.path}; {resume}") from None
+    except OSError as error:           # the table's disk full, its folder gone...: the rows of its last write are kept
+        raise OSError(error.errno, f"{error.strerror or error}; {table.kept} of {len(rows)} rows finished and kept "
+                                   f"in {table.path}; {resume}") from None
     return outcomes
 
 

@@ -105,7 +105,11 @@ def run_uq_study(args) -> int:
                           "sobol": None if result.sobol is None else result.sobol.to_dict("records"),
                           "files": [str(path) for path in files]}, indent=1))
     else:
-        print(statistics.to_string(index=False, float_format=lambda v: f"{v:.5g}"))
+        if statistics.empty:           # every row failed: the first one's error says why
+            first = next(outcome for outcome in outcomes if outcome.status != "ok")
+            print(f"no statistics: every row failed (row {first.index}: {first.error})")
+        else:
+            print(statistics.to_string(index=False, float_format=lambda v: f"{v:.5g}"))
         if result.sobol is not None:
             print(result.sobol.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
         for path in files:

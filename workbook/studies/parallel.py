@@ -21,9 +21,14 @@ versions supported once the first worker retires, so it is not used.)
 Faults (local processes):
 
 - A worker process that dies (killed, out of memory) takes its pool down.
-  The rows it and the other workers were running are retried once, each
-  alone in a fresh one-worker pool; a row whose worker dies again is marked
-  failed with the reason. Rows not started yet simply run in a new pool.
+  Rows not started yet simply run in a new pool. The rows it and the other
+  workers were running are retried at the end in a fresh one-worker pool;
+  when that worker dies too, the batch it was running is split in halves,
+  each retried in a pool of its own, until a row whose worker dies alone is
+  marked failed with the reason (one death costs one pool's start-up, not
+  one per row). After :data:`START_TRIES` pools in a row that broke before
+  any row started (its workers died as they started), the remaining rows
+  are marked failed.
 - An interrupt (Ctrl-C, or SIGTERM raised as :class:`workbook.errors.Terminated`)
   stops every worker process of the study before it propagates; workers
   ignore Ctrl-C themselves, so only the parent decides. A worker whose
@@ -38,20 +43,24 @@ import contextlib
 import dataclasses
 import itertools
 import logging
+import mmap
 import multiprocessing
 import os
+import pickle
 import signal
 import sys
+import tempfile
 import threading
 import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Callable
+from multiprocessing import reduction
+from typing import TYPE_CHECKING, Callable, cast
 
 from workbook.answers.isolation import efficiency
-from workbook.errors import OutsideDesignModel, Terminated, interruption
+from workbook.errors import OutsideDesignModel, Terminated, UsageError, interruption
 from workbook.model.case import DIRECTIONS, Case
 from workbook.processes import end_with_parent, loosen_allocator, stop_workers
 
@@ -59,7 +68,8 @@ if TYPE_CHECKING:
     from workbook.design.linear_mount import LinearMount
 
 __all__ = ["RowOutcome", "prepare", "prepare_design_model", "run_row", "run_batch", "batches", "run_rows", "SERIAL",
-           "ROWS_PER_WORKER", "BATCH_ROWS", "NUMPY_PATH", "EXUDYN_PATH"]
+           "ROWS_PER_WORKER", "BATCH_ROWS", "START_TRIES", "NUMPY_PATH", "EXUDYN_PATH",
+           "SCHEDULER_TIMEOUT", "check_scheduler"]
 
 log = logging.getLogger(__name__)
 
@@ -72,6 +82,11 @@ ROWS_PER_WORKER = 200
 #: Rows per worker in one chunk when the study has a prepared linear mount: its NumPy rows gather no
 #: memory (the bound is for Exudyn's runs), and each fresh pool costs seconds of start-up.
 DESIGN_ROWS_PER_WORKER = 5000
+#: Process pools in a row that may break before any row starts (a worker process died as it started) before
+#: the study's remaining rows are reported failed.
+START_TRIES = 3
+#: Seconds a Dask scheduler gets to accept a study's connection.
+SCHEDULER_TIMEOUT = 10.0
 #: Rows the prepared linear mount answers together, in one NumPy batch (one task of a worker).
 BATCH_ROWS = 128
 #: The row was answered by the prepared linear mount in NumPy.
@@ -418,11 +433,47 @@ def _signals_seen():
 _started = None
 
 
+class _SharedFile:
+    """An open file whose descriptor a spawned worker process gets a copy of as it starts.
+
+    A payload of megabytes (the prepared linear mount) goes to the workers in
+    such a file, read by each in its initialiser, and not in the start-up data
+    of a process: :mod:`multiprocessing` writes that into a pipe the parent
+    itself keeps open until the write ends, so a worker that died before
+    reading it all (killed, out of memory) left the parent blocked there for
+    ever. The file has no name (:func:`tempfile.TemporaryFile`): nothing is
+    left on disk, also when the study is killed outright.
+    """
+
+    def __init__(self, payload):
+        self.file = tempfile.TemporaryFile()
+        pickle.dump(payload, self.file, protocol=pickle.HIGHEST_PROTOCOL)
+        self.file.flush()
+
+    def __reduce__(self):
+        # a descriptor for the process being started (multiprocessing passes it on as it spawns the process)
+        return _load_shared, (reduction.DupFd(self.file.fileno()),)
+
+    def close(self) -> None:
+        self.file.close()
+
+
+def _load_shared(descriptor):
+    """In a worker: the payload of a :class:`_SharedFile` (read without moving the file position it shares)."""
+    fd = descriptor.detach()
+    try:
+        with mmap.mmap(fd, 0, access=mmap.ACCESS_READ) as view:
+            return pickle.loads(view)
+    finally:
+        os.close(fd)
+
+
 def _worker_init(started, design_model: LinearMount | None) -> None:
     """Set up a worker: Ctrl-C is the parent's to handle (it stops the workers),
     the worker ends when its parent is gone (killed with no chance to stop it),
-    and it answers the rows *design_model* follows with it (its allocator keeping
-    freed memory for NumPy's temporaries, :func:`~workbook.processes.loosen_allocator`)."""
+    and it answers the rows *design_model* (a :class:`_SharedFile`'s, read as the
+    process starts) follows with it (its allocator keeping freed memory for NumPy's
+    temporaries, :func:`~workbook.processes.loosen_allocator`)."""
     global _started, _design_model
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     _started, _design_model = started, design_model
@@ -450,9 +501,10 @@ def _death(exitcode: int | None) -> str:
     return f"exited with code {exitcode}"
 
 
-def _pool_round(pending: dict, workers: int, done: Callable, context, design_model: LinearMount | None
-                ) -> tuple[dict, dict, dict]:
-    """Run *pending* in a fresh pool until every row is done or the pool breaks.
+def _pool_round(pending: dict, workers: int, done: Callable, context, design_model: LinearMount | None,
+                shared: _SharedFile | None) -> tuple[dict, dict, dict]:
+    """Run *pending* in a fresh pool until every row is done or the pool breaks (*shared*: *design_model*
+    for the workers).
 
     Returns
     -------
@@ -466,7 +518,8 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
     started = context.SimpleQueue()
     before = set(multiprocessing.active_children())
     pool = ProcessPoolExecutor(max_workers=min(workers, len(pending)), mp_context=context,
-                               initializer=_worker_init, initargs=(started, design_model))
+                               initializer=_worker_init,
+                               initargs=(started, cast("LinearMount | None", shared)))  # the mount once unpickled
     processes = set()
     broken: dict = {}
     pids: dict = {}
@@ -479,7 +532,12 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
 
     try:
         size = max(1, min(BATCH_ROWS, -(-len(pending) // (2 * workers))))       # at least two batches per worker
-        futures = {pool.submit(_reported_batch, batch): batch for batch in batches(pending, design_model, size)}
+        futures = {}
+        for batch in batches(pending, design_model, size):
+            try:
+                futures[pool.submit(_reported_batch, batch)] = batch
+            except BrokenProcessPool:        # a worker died while the rows were handed out: not started
+                broken.update(batch)
         processes.update(set(multiprocessing.active_children()) - before)  # to read their exit codes later
         for future in as_completed(futures):
             processes.update(set(multiprocessing.active_children()) - before)
@@ -506,28 +564,114 @@ def _run_processes(pending: dict, workers: int, done: Callable, rows_per_worker:
                    design_model: LinearMount | None) -> None:
     if rows_per_worker < 1:
         raise ValueError(f"rows_per_worker must be at least 1, got {rows_per_worker}")
+    shared = None if design_model is None else _SharedFile(design_model)
+    try:
+        _pool_rounds(pending, workers, done, rows_per_worker, design_model, shared)
+    finally:
+        if shared is not None:
+            shared.close()
+
+
+def _pool_rounds(pending: dict, workers: int, done: Callable, rows_per_worker: int,
+                 design_model: LinearMount | None, shared: _SharedFile | None) -> None:
+    """The pools of :func:`_run_processes`: a chunk of rows each, then the rows lost in a worker's death
+    (module text)."""
     context = multiprocessing.get_context("spawn")
-    suspects = {}
+    suspects: dict = {}
+    unstarting = 0                           # pools in a row that broke before any row started
     while pending:
         chunk = dict(itertools.islice(pending.items(), workers * rows_per_worker))
         later = {i: case for i, case in pending.items() if i not in chunk}
-        lost, unstarted, _ = _pool_round(chunk, workers, done, context, design_model)
-        if len(unstarted) == len(chunk):     # the pool broke before any row started: its workers cannot start
-            for index in sorted({**unstarted, **later}):
-                done(RowOutcome(index, [], "failed", "WorkerDied: no worker process could start a row (the "
-                                                     "process pool broke before any row ran)"))
+        lost, unstarted, _ = _pool_round(chunk, workers, done, context, design_model, shared)
+        unstarting = unstarting + 1 if len(unstarted) == len(chunk) else 0
+        if unstarting == START_TRIES:
+            _unstartable({**unstarted, **later, **suspects}, done)
             return
+        _said_unstarted(unstarting)
         pending = {**unstarted, **later}
-        if lost:
-            log.warning("a worker process died; rows %s, which were running, are retried one at a time",
-                        ", ".join(map(str, sorted(lost))))
         suspects.update(lost)
-    for index, case in suspects.items():  # alone, so that a death now is the row's own
-        lost, unstarted, deaths = _pool_round({index: case}, 1, done, context, design_model)
-        if index in lost or index in unstarted:
-            how = deaths.get(index, "ended before it started the row")
-            done(RowOutcome(index, [], "failed", f"WorkerDied: the worker process running this row {how}, "
-                                                 f"also when the row was retried alone"))
+    if suspects:
+        log.warning("a worker process died; rows %s, which were running, are retried in a process of their own",
+                    _row_ranges(suspects))
+    groups = [suspects] if suspects else []
+    unstarting = 0
+    while groups:                            # one worker: a death is that of the batch it was running
+        group = groups.pop()
+        lost, unstarted, deaths = _pool_round(group, 1, done, context, design_model, shared)
+        unstarting = unstarting + 1 if len(unstarted) == len(group) else 0
+        if unstarting == START_TRIES:
+            _unstartable({index: case for rows in (unstarted, *groups) for index, case in rows.items()}, done)
+            return
+        _said_unstarted(unstarting)
+        if unstarted:
+            groups.append(unstarted)
+        if len(lost) == 1:
+            index = next(iter(lost))
+            done(RowOutcome(index, [], "failed", f"WorkerDied: the worker process running this row {deaths[index]}, "
+                                                 f"also when the row was retried"))
+        elif lost:                           # its halves apart, until a row that ends its worker is alone
+            rows = sorted(lost.items())
+            groups += [dict(rows[:len(rows) // 2]), dict(rows[len(rows) // 2:])]
+
+
+def _said_unstarted(unstarting: int) -> None:
+    """Warn of the *unstarting*-th pool in a row that broke before any row started (none: nothing)."""
+    if unstarting:
+        log.warning("a worker process died as it started, before any row ran; a new pool is started (%d of %d)",
+                    unstarting + 1, START_TRIES)
+
+
+def _unstartable(rows: dict, done: Callable) -> None:
+    """Report *rows* failed: :data:`START_TRIES` process pools in a row broke before any row started."""
+    for index in sorted(rows):
+        done(RowOutcome(index, [], "failed", f"WorkerDied: no worker process could start a row ({START_TRIES} "
+                                             f"process pools in a row broke before any row ran)"))
+
+
+def _row_ranges(rows) -> str:
+    """Row numbers in ranges: ``0 to 127, 256, 300 to 301``."""
+    numbers = sorted(rows)
+    ranges = [[numbers[0], numbers[0]]] if numbers else []
+    for number in numbers[1:]:
+        if number == ranges[-1][1] + 1:
+            ranges[-1][1] = number
+        else:
+            ranges.append([number, number])
+    return ", ".join(str(low) if low == high else f"{low} to {high}" for low, high in ranges)
+
+
+def check_scheduler(address: str, timeout: float | None = None) -> None:
+    """Refuse a Dask scheduler address that is malformed or where nothing answers, at once.
+
+    Parameters
+    ----------
+    address : str
+        ``tcp://host:port`` (or ``host:port``; ``tls://`` too). Other
+        transports are only read.
+    timeout : float, optional
+        s to wait for the connection (default :data:`SCHEDULER_TIMEOUT`).
+
+    Raises
+    ------
+    UsageError
+        Naming the address and why (Dask's own client retries a refused
+        connection for 30 s before it says so).
+    """
+    import socket
+
+    from distributed.comm.addressing import parse_address, parse_host_port
+
+    try:
+        scheme, location = parse_address(address)
+        if scheme not in ("tcp", "tls"):
+            return
+        host, port = parse_host_port(location)
+    except ValueError as error:
+        raise UsageError(f"--dask {address!r}: {error}; expected tcp://HOST:PORT") from None
+    try:
+        socket.create_connection((host, port), timeout=SCHEDULER_TIMEOUT if timeout is None else timeout).close()
+    except OSError as error:
+        raise UsageError(f"--dask {address!r}: no Dask scheduler answers there ({error})") from None
 
 
 def _run_dask(pending: dict, address: str, done: Callable, design_model: LinearMount | None) -> None:
@@ -535,7 +679,7 @@ def _run_dask(pending: dict, address: str, done: Callable, design_model: LinearM
     from distributed import as_completed as dask_completed
 
     cache = os.environ.get("MOUNTWB_CACHE")
-    with Client(address) as client:
+    with Client(address, timeout=SCHEDULER_TIMEOUT) as client:
         if cache:  # the workers load the reductions made here (a shared folder on a real cluster)
             client.run(os.environ.__setitem__, "MOUNTWB_CACHE", cache)
         client.run(loosen_allocator)    # Dask's own setting slows NumPy's large temporaries (workbook.processes)

@@ -11,10 +11,12 @@ import threading
 import time
 from typing import Callable, TextIO
 
-__all__ = ["PROGRESS_INTERVAL", "StudyProgress", "duration"]
+__all__ = ["PROGRESS_INTERVAL", "RATE_SPAN", "StudyProgress", "duration"]
 
 #: Seconds between two progress lines.
 PROGRESS_INTERVAL = 10.0
+#: Most seconds of finished rows the rate waits for (:meth:`StudyProgress.rate`).
+RATE_SPAN = 60.0
 
 
 def duration(seconds: float) -> str:
@@ -66,12 +68,14 @@ class StudyProgress:
 
     def rate(self) -> float | None:
         """Rows per second, counted from the first row this run finished (the start-up, link
-        reductions included, does not slow it); None before two rows finished at different times."""
+        reductions included, does not slow it); None until rows finished over at least half the time
+        the first took (:data:`RATE_SPAN` s at most): rows that workers finish together at first gave
+        rates of rows per millisecond, "about 0 s left" of a study of minutes."""
         if self.first_row is None:
             return None
         when, done = self.first_row
         last, now_done = self.last_row, self.done
-        if last > when and now_done > done:
+        if now_done > done and last - when >= max(min((when - self.started) / 2, RATE_SPAN), 1e-9):
             return (now_done - done) / (last - when)
         return None
 
