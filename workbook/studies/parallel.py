@@ -62,7 +62,7 @@ from typing import TYPE_CHECKING, Callable, cast
 from workbook.answers.isolation import efficiency
 from workbook.errors import OutsideDesignModel, Terminated, UsageError, interruption
 from workbook.model.case import DIRECTIONS, Case
-from workbook.processes import end_with_parent, loosen_allocator, stop_workers
+from workbook.processes import WORKER_STOP_TIMEOUT, end_with_parent, loosen_allocator, stop_workers
 
 if TYPE_CHECKING:
     from workbook.design.linear_mount import LinearMount
@@ -552,6 +552,14 @@ def _pool_round(pending: dict, workers: int, done: Callable, context, design_mod
         pool.shutdown(wait=False, cancel_futures=True)
         stop_workers(processes)
         raise
+    # the workers end as the pool tells them; one left waiting on the call queue's lock that a killed worker
+    # held would keep the pool's shutdown waiting for ever: each gets WORKER_STOP_TIMEOUT s, then is stopped
+    processes.update(set(multiprocessing.active_children()) - before)
+    pool.shutdown(wait=False)
+    deadline = time.monotonic() + WORKER_STOP_TIMEOUT
+    for process in processes:
+        process.join(max(0.0, deadline - time.monotonic()))
+    stop_workers(processes)
     pool.shutdown(wait=True)
     read_started()
     exitcodes = {process.pid: process.exitcode for process in processes}
