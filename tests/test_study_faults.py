@@ -303,6 +303,8 @@ def test_a_killed_worker_is_retried_and_a_twice_killed_row_is_marked_failed(tmp_
 #: Worker processes a study of two may start in all when one of them is killed: two pools of two and the pool
 #: of one that retries the rows in flight (each row retried in a pool of its own started hundreds).
 _WORKERS_AFTER_A_KILL = 6
+#: Rows of the study whose worker is killed.
+_ROWS = 6000
 
 
 @pytest.mark.slow
@@ -311,7 +313,8 @@ def test_a_worker_killed_in_a_batch_of_rows_costs_one_more_pool(tmp_path):
     were retried each in a fresh pool of its own, a start-up of a second or more per row (minutes); now they
     are retried together in one pool, and the study ends with every row."""
     output = tmp_path / "out"
-    process = start("study", "params", "--rigid", "--output", str(output), "--vary=hinge_stiffness=1e7:3e7:600",
+    # enough rows that the workers are still at them when the first batches are in the table
+    process = start("study", "params", "--rigid", "--output", str(output), f"--vary=hinge_stiffness=1e7:3e7:{_ROWS}",
                     "--workers", "2", cwd=tmp_path)
     _wait(lambda: table_path(output).exists(), what="a first batch of rows")   # the others running theirs
     workers = {worker.pid for worker in _workers(process.pid)}
@@ -331,8 +334,8 @@ def test_a_worker_killed_in_a_batch_of_rows_costs_one_more_pool(tmp_path):
     # a worker killed between its batches loses no row (then nothing is retried); the study ends all the same
     assert ("a worker process died; rows " in stderr) == ("retried in a process of their own" in stderr)
     table = _table(output)
-    assert sorted(set(table["row"])) == list(range(600)) and set(table["status"]) == {"ok"}
-    assert set(table["path"]) == {"NumPy"} and stdout.strip().splitlines()[-1] == "600 of 600 rows ok, 0 failed"
+    assert sorted(set(table["row"])) == list(range(_ROWS)) and set(table["status"]) == {"ok"}
+    assert set(table["path"]) == {"NumPy"} and stdout.strip().splitlines()[-1] == f"{_ROWS} of {_ROWS} rows ok, 0 failed"
 
 
 def test_resuming_from_the_table_of_another_study_is_refused(tmp_path):
