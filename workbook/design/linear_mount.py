@@ -62,7 +62,7 @@ if TYPE_CHECKING:
     from flexbodies.reduced import ReducedBody
 
 __all__ = ["LinearMount", "DesignAnswer", "ItemSolution", "StressedLink", "channel_springs",
-           "keeps_casing_modes"]
+           "keeps_casing_modes", "REACH_M", "REACH_RAD"]
 
 
 def hinge_frames(case: Case) -> dict:
@@ -251,13 +251,13 @@ def _field_names(kind: type) -> tuple[str, ...]:
     return _FIELD_NAMES[kind]
 
 
-#: What a design may change, by field (module text); the excitations are checked on their own.
 #: Largest change of the engine's static translation (m) and rotation (rad) from the prepared design's preload
 #: that a design's answer may have: the expansion about the prepared state is of second order, and T drifts
 #: from the pipeline's as the preload moves (the far-design table of docs/design-evaluation.md); a
 #: mechanism's "equilibrium" lies kilometres away.
 REACH_M = 0.01
 REACH_RAD = 0.01
+#: What a design may change, by field (module text); the excitations are checked on their own.
 _DESIGN_CHANGES = {"name": None, "excitations": None, "hinges": None,
                    "engine": {"mass": None, "inertia": None, "casing": {"material": {"youngs_modulus": None}}},
                    "test_rig": {"stiffness": None, "damping": None}}
