@@ -326,7 +326,7 @@ class FourPole:
         response = PylonResponse(float(frequency_hz), engine, pins.reshape(-1, 3), loads.reshape(-1, 3))
         if self.roundoff is not None:
             amplitude = max(float(np.abs(engine).max()), float(np.abs(pins).max(initial=0.0)))
-            self.roundoff.check(frequency_hz, amplitude, response.pylon_force)
+            self.roundoff.check(frequency_hz, amplitude, response.pylon_force, loads)
         return response
 
     def _compliance_matrix(self, compliance) -> np.ndarray:

@@ -51,7 +51,7 @@ from workbook.solve.preload import ROUNDOFF_MARGIN, spring_roundoff_force, stiff
 from workbook.solve.truncation import residual_stiffness
 
 __all__ = ["HarmonicModel", "harmonic_model", "excitation_phasor", "point_phasors", "FrequencyResponse",
-           "RoundOff", "ROUNDOFF_SHARE"]
+           "RoundOff", "ROUNDOFF_SHARE", "ROUNDOFF_FLOOR"]
 
 log = logging.getLogger(__name__)
 
@@ -63,6 +63,9 @@ VELOCITY_STEP = 1e-3
 #: central differences may reach (:meth:`RoundOff.check`, a bound 10 to 100
 #: times above the error measured on the reference mount).
 ROUNDOFF_SHARE = 0.25
+#: ... unless it stays below this share of the largest force-channel amplitude: a pylon force that cancels
+#: (zero by symmetry, as a couple's on a mount that passes none) is then known to it.
+ROUNDOFF_FLOOR = 1e-6
 
 
 def point_phasors(excitation: SingleFrequencyExcitation) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -104,17 +107,18 @@ class RoundOff:
         over the outputs' coordinate step (twice it) and over K's."""
         return self.force * (1 / (2 * COORDINATE_STEP) + 1 / STIFFNESS_STEP)
 
-    def check(self, frequency_hz: float, amplitude: float, pylon_force: np.ndarray) -> None:
+    def check(self, frequency_hz: float, amplitude: float, pylon_force: np.ndarray, forces: np.ndarray) -> None:
         """Refuse an answer whose round-off bound, :attr:`stiffness` times the largest coordinate
         amplitude *amplitude* (m, rad, ...), reaches :data:`ROUNDOFF_SHARE` of the largest amplitude of
-        *pylon_force* (N, complex, shape (3,)).
+        *pylon_force* (N, complex, shape (3,)) and :data:`ROUNDOFF_FLOOR` of that of the force channels'
+        *forces* (N, complex): a pylon force that cancels (a couple's) is known to that floor.
 
         Raises
         ------
         RoundOffError
         """
         noise, largest = self.stiffness * amplitude, float(np.abs(pylon_force).max())
-        if not noise < ROUNDOFF_SHARE * largest:
+        if not (noise < ROUNDOFF_SHARE * largest or noise < ROUNDOFF_FLOOR * float(np.abs(forces).max())):
             raise RoundOffError(
                 f"case {self.case_name!r}: the frequency-domain answer at {frequency_hz:.6g} Hz cannot be "
                 f"trusted: the stiffest spring has {self.stiffest_spring:.3g} N/m, so its force is known only to "
@@ -251,7 +255,7 @@ class HarmonicModel:
         hinges = dict(zip(self.hinge_names, forces, strict=True))
         pylon = pylon_sum(hinges, self.pylon_hinges)
         if self.roundoff is not None:
-            self.roundoff.check(frequency_hz, float(np.abs(self.linearization.basis @ motion).max()), pylon)
+            self.roundoff.check(frequency_hz, float(np.abs(self.linearization.basis @ motion).max()), pylon, forces)
         return FrequencyResponse(frequency_hz, hinges, pylon)
 
     def result(self, excitation: SingleFrequencyExcitation, steady_tolerance: float) -> ExcitationResult:
